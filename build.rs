@@ -1,0 +1,197 @@
+//! Build script: finds Embree, generates its FFI bindings from the installed header, and
+//! compiles the C++ shim over OpenImageIO.
+//!
+//! Embree is looked up the way openssl-sys and libsqlite3-sys look up their libraries:
+//! environment overrides first, then the usual system prefixes. The Embree version comes
+//! from the installed `rtcore_config.h`, so the bindings and the `embree3`/`embree4` cfg
+//! always describe the library that is actually linked, never a bundled copy.
+
+use std::env;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+/// Where Embree's headers and library were found.
+struct Embree {
+    /// The directory that holds `rtcore.h`.
+    include_dir: PathBuf,
+    /// `None` when the library is on the linker's default search path.
+    lib_dir: Option<PathBuf>,
+    major: u32,
+    version: String,
+}
+
+fn main() {
+    let embree = find_embree();
+    generate_embree_bindings(&embree);
+    link_embree(&embree);
+    build_oiio_shim();
+}
+
+fn env_path(name: &str) -> Option<PathBuf> {
+    println!("cargo:rerun-if-env-changed={name}");
+    env::var_os(name)
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+}
+
+/// The header directory below an include root: Embree 4 wins when both are installed.
+fn header_dir_under(include_root: &Path) -> Option<PathBuf> {
+    ["embree4", "embree3"]
+        .iter()
+        .map(|sub| include_root.join(sub))
+        .find(|dir| dir.join("rtcore.h").is_file())
+}
+
+fn find_embree() -> Embree {
+    let embree_dir = env_path("EMBREE_DIR");
+    let include_override = env_path("EMBREE_INCLUDE_DIR");
+    let lib_override = env_path("EMBREE_LIB_DIR");
+
+    let mut searched = Vec::new();
+    // EMBREE_INCLUDE_DIR may name the header directory itself or its parent.
+    let include_dir = if let Some(dir) = include_override {
+        searched.push(dir.display().to_string());
+        if dir.join("rtcore.h").is_file() {
+            Some(dir)
+        } else {
+            header_dir_under(&dir)
+        }
+    } else if let Some(prefix) = &embree_dir {
+        let root = prefix.join("include");
+        searched.push(root.display().to_string());
+        header_dir_under(&root)
+    } else {
+        ["/usr/include", "/usr/local/include"]
+            .iter()
+            .find_map(|root| {
+                searched.push(root.to_string());
+                header_dir_under(Path::new(root))
+            })
+    };
+
+    let Some(include_dir) = include_dir else {
+        panic!(
+            "\n\nhairtrace: Embree (rtcore.h) not found; searched {}.\n\
+             Install it with `scripts/setup` (on Debian/Ubuntu: `sudo apt-get install libembree-dev`),\n\
+             or point EMBREE_DIR at an Embree 3 or 4 install prefix (or set EMBREE_INCLUDE_DIR and\n\
+             EMBREE_LIB_DIR).\n\n",
+            searched.join(", ")
+        );
+    };
+
+    let lib_dir = lib_override.or_else(|| embree_dir.map(|prefix| prefix.join("lib")));
+    let (major, version) = read_version(&include_dir.join("rtcore_config.h"));
+    Embree {
+        include_dir,
+        lib_dir,
+        major,
+        version,
+    }
+}
+
+/// Parses `#define RTC_VERSION_{MAJOR,MINOR,PATCH} n` from Embree's config header.
+fn read_version(config: &Path) -> (u32, String) {
+    println!("cargo:rerun-if-changed={}", config.display());
+    let text = fs::read_to_string(config).unwrap_or_else(|e| {
+        panic!(
+            "hairtrace: cannot read {} ({e}); the Embree install looks incomplete: reinstall \
+             it with `scripts/setup` or fix EMBREE_DIR",
+            config.display()
+        )
+    });
+    let field = |name: &str| -> u32 {
+        text.lines()
+            .filter_map(|line| {
+                let mut words = line.split_whitespace();
+                match (words.next(), words.next(), words.next()) {
+                    (Some("#define"), Some(n), Some(value)) if n == name => value.parse().ok(),
+                    _ => None,
+                }
+            })
+            .next()
+            .unwrap_or_else(|| panic!("hairtrace: no `#define {name}` in {}", config.display()))
+    };
+    let (major, minor, patch) = (
+        field("RTC_VERSION_MAJOR"),
+        field("RTC_VERSION_MINOR"),
+        field("RTC_VERSION_PATCH"),
+    );
+    if !(3..=4).contains(&major) {
+        panic!(
+            "hairtrace: found Embree {major}.{minor}.{patch} in {}, but only Embree 3 and 4 are \
+             supported",
+            config.display()
+        );
+    }
+    (major, format!("{major}.{minor}.{patch}"))
+}
+
+fn generate_embree_bindings(embree: &Embree) {
+    let header = embree.include_dir.join("rtcore.h");
+    println!("cargo:rerun-if-changed={}", header.display());
+
+    // Newtype enums: Embree may hand back values a Rust enum would not know (a newer
+    // library than the header), which must not be undefined behaviour. The flag enums
+    // are bitfields so that they can be or-ed together.
+    let bindings = bindgen::Builder::default()
+        .header(header.to_string_lossy())
+        .clang_arg(format!("-I{}", embree.include_dir.display()))
+        .allowlist_function("rtc.*")
+        .allowlist_type("RTC.*")
+        .allowlist_var("RTC.*")
+        .default_enum_style(bindgen::EnumVariation::NewType {
+            is_bitfield: false,
+            is_global: false,
+        })
+        .bitfield_enum("RTC.*Flags")
+        .derive_default(true)
+        .derive_debug(true)
+        .derive_copy(true)
+        .parse_callbacks(Box::new(bindgen::CargoCallbacks::new()))
+        .generate()
+        .unwrap_or_else(|e| {
+            panic!(
+                "hairtrace: bindgen failed on {} ({e}); libclang is needed: run `scripts/setup`",
+                header.display()
+            )
+        });
+
+    let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    bindings
+        .write_to_file(out.join("embree_sys.rs"))
+        .expect("hairtrace: cannot write embree_sys.rs into OUT_DIR");
+}
+
+fn link_embree(embree: &Embree) {
+    println!("cargo:rustc-check-cfg=cfg(embree3)");
+    println!("cargo:rustc-check-cfg=cfg(embree4)");
+    println!("cargo:rustc-cfg=embree{}", embree.major);
+    println!("cargo:rustc-env=HT_EMBREE_VERSION={}", embree.version);
+    if let Some(dir) = &embree.lib_dir {
+        println!("cargo:rustc-link-search=native={}", dir.display());
+    }
+    println!("cargo:rustc-link-lib=dylib=embree{}", embree.major);
+}
+
+fn build_oiio_shim() {
+    let shim = "src/image/oiio_shim.cpp";
+    println!("cargo:rerun-if-changed={shim}");
+    // Also emits the link lines for OpenImageIO and OpenImageIO_Util.
+    let oiio = pkg_config::Config::new()
+        .atleast_version("2.2")
+        .probe("OpenImageIO")
+        .unwrap_or_else(|e| {
+            panic!(
+                "hairtrace: OpenImageIO not found through pkg-config ({e}).\n\
+                 Install it with `scripts/setup` (on Debian/Ubuntu: `sudo apt-get install \
+                 libopenimageio-dev pkg-config`)"
+            )
+        });
+    // cc links the platform's C++ standard library itself for a C++ build.
+    cc::Build::new()
+        .cpp(true)
+        .std("c++17")
+        .file(shim)
+        .includes(&oiio.include_paths)
+        .compile("ht_oiio_shim");
+}

@@ -1,0 +1,320 @@
+//! The Chiang et al. 2016 near-field hair BSDF: lobes R, TT and TRT with their own
+//! longitudinal (Mp), attenuation (Ap) and azimuthal (Np) terms, plus a residual lobe
+//! that carries all higher orders of internal reflection.
+//!
+//! Frame and conventions are DESIGN.md section 3: x is the fiber tangent, h the signed
+//! offset across the fiber, `f` includes the 1/|wi.z| of pbrt's convention.
+//!
+//! Work is split by what it depends on: [`HairBsdf::new`] computes everything that
+//! depends on the parameters alone; [`Outgoing`] what depends on (h, wo) (Fresnel,
+//! absorption, deflection angles), shared by sampling and evaluation; the per-wi part is
+//! the four lobes. Both stages are generic over [`Lanes`], so `eval_batch` runs the same
+//! code eight inputs at a time.
+
+use super::azimuthal::{TrimmedLogistic, azimuthal_scale, wrap_angle};
+use super::longitudinal::{LongitudinalLobe, longitudinal_variance};
+use super::params::HairParams;
+use crate::error::{Result, invalid_arg};
+use crate::math::{Lanes, safe_asin, safe_sqrt};
+use glam::Vec3;
+use std::f32::consts::{FRAC_1_PI, PI, TAU};
+use wide::f32x8;
+
+/// Number of explicit lobes (R, TT, TRT); the residual lobe comes after them.
+const EXPLICIT_LOBES: usize = 3;
+/// Below this |wi.z| the 1/|wi.z| factor is skipped, as pbrt does at exactly zero; the
+/// threshold keeps f finite for every unit wi (the largest lobe value is ~1e7).
+const MIN_COS_WI: f32 = 1e-20;
+
+/// The value of the BSDF for a pair of directions.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairEval {
+    /// RGB; `f * |wi.z|` is the scattered fraction per unit solid angle.
+    pub f: Vec3,
+    /// Density of [`HairBsdf::sample`] at wi, per unit solid angle.
+    pub pdf: f32,
+}
+
+/// A sampled incident direction with the BSDF value and density there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairSample {
+    pub wi: Vec3,
+    pub f: Vec3,
+    pub pdf: f32,
+}
+
+/// The hair BSDF for one parameter set, with every parameter-only constant precomputed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HairBsdf {
+    params: HairParams,
+    /// Mp of R, TT, TRT and the residual lobe.
+    mp: [LongitudinalLobe; 4],
+    np: TrimmedLogistic,
+    /// (sin, cos) of the cuticle shift of theta_o for R, TT, TRT: -2 alpha, alpha, 4 alpha.
+    tilt: [(f32, f32); EXPLICIT_LOBES],
+}
+
+/// Everything that depends on (h, wo) but not on wi.
+struct Outgoing<T> {
+    sin_to: T,
+    cos_to: T,
+    /// (sin, |cos|) of theta_o shifted by each explicit lobe's cuticle tilt.
+    tilted: [(T, T); EXPLICIT_LOBES],
+    /// Azimuthal deflection Phi(p) = 2 p gamma_t - 2 gamma_o + p pi of each explicit lobe.
+    deflection: [T; EXPLICIT_LOBES],
+    /// Attenuation Ap per lobe and channel.
+    ap: [[T; 3]; 4],
+    /// Probability of sampling each lobe: its mean attenuation over the total.
+    lobe_pdf: [T; 4],
+}
+
+impl HairBsdf {
+    /// Validates the parameters and precomputes the per-parameter constants.
+    pub fn new(params: &HairParams) -> Result<Self> {
+        params.validate()?;
+        let v = longitudinal_variance(params.beta_m);
+        let alpha = f64::from(params.alpha).to_radians();
+        Ok(Self {
+            params: *params,
+            mp: [v, 0.25 * v, 4.0 * v, 4.0 * v].map(LongitudinalLobe::new),
+            np: TrimmedLogistic::new(azimuthal_scale(params.beta_n)),
+            tilt: [-2.0 * alpha, alpha, 4.0 * alpha].map(|a| (a.sin() as f32, a.cos() as f32)),
+        })
+    }
+
+    pub fn params(&self) -> &HairParams {
+        &self.params
+    }
+
+    /// f and pdf for outgoing wo and incident wi (unit vectors, local frame), h in [-1, 1].
+    pub fn eval(&self, h: f32, wo: Vec3, wi: Vec3) -> HairEval {
+        let o = self.outgoing(h, wo.to_array());
+        let (f, pdf) = self.eval_lobes(&o, wo.to_array(), wi.to_array());
+        HairEval {
+            f: Vec3::from_array(f),
+            pdf,
+        }
+    }
+
+    /// Density of [`Self::sample`] at wi (per unit solid angle).
+    pub fn pdf(&self, h: f32, wo: Vec3, wi: Vec3) -> f32 {
+        self.eval(h, wo, wi).pdf
+    }
+
+    /// Energy of each lobe (R, TT, TRT, residual) leaving wo at h: the lobes' Mp and Np
+    /// integrate to one, so this is Ap.
+    pub fn lobe_energies(&self, h: f32, wo: Vec3) -> [Vec3; 4] {
+        self.outgoing(h, wo.to_array()).ap.map(Vec3::from_array)
+    }
+
+    /// Samples wi: u[0] picks the lobe (proportionally to its mean attenuation) and is
+    /// then reused, rescaled, for the azimuth; u[1] and u[2] sample the longitudinal lobe.
+    /// Returns None only when the density at the sampled direction is zero.
+    pub fn sample(&self, h: f32, wo: Vec3, u: [f32; 3]) -> Option<HairSample> {
+        let wo_a = wo.to_array();
+        let o = self.outgoing(h, wo_a);
+        let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
+
+        let (sin_to, cos_to) = if p < EXPLICIT_LOBES {
+            o.tilted[p]
+        } else {
+            (o.sin_to, o.cos_to)
+        };
+        let (sin_ti, cos_ti) = self.mp[p].sample(sin_to, cos_to, [u[1], u[2]]);
+        let dphi = if p < EXPLICIT_LOBES {
+            o.deflection[p] + self.np.sample(u_phi)
+        } else {
+            TAU * u_phi
+        };
+
+        // Rotate wo's azimuth by dphi; wo along the tangent has none, any will do.
+        let len_o = (wo.y * wo.y + wo.z * wo.z).sqrt();
+        let (cos_po, sin_po) = if len_o > 0.0 {
+            (wo.y / len_o, wo.z / len_o)
+        } else {
+            (1.0, 0.0)
+        };
+        let (sin_d, cos_d) = dphi.sin_cos();
+        let wi = [
+            sin_ti,
+            cos_ti * (cos_po * cos_d - sin_po * sin_d),
+            cos_ti * (sin_po * cos_d + cos_po * sin_d),
+        ];
+
+        let (f, pdf) = self.eval_lobes(&o, wo_a, wi);
+        (pdf > 0.0).then(|| HairSample {
+            wi: Vec3::from_array(wi),
+            f: Vec3::from_array(f),
+            pdf,
+        })
+    }
+
+    /// Evaluates n inputs at once (eight per SIMD step); each result equals [`Self::eval`]
+    /// up to the last bits of the vectorised exp/asin/atan2. All slices must have the
+    /// same length.
+    pub fn eval_batch(
+        &self,
+        h: &[f32],
+        wo: &[[f32; 3]],
+        wi: &[[f32; 3]],
+        f: &mut [[f32; 3]],
+        pdf: &mut [f32],
+    ) -> Result<()> {
+        let n = h.len();
+        if [wo.len(), wi.len(), f.len(), pdf.len()]
+            .iter()
+            .any(|&m| m != n)
+        {
+            return Err(invalid_arg!(
+                "eval_batch: slice lengths differ (h {n}, wo {}, wi {}, f {}, pdf {})",
+                wo.len(),
+                wi.len(),
+                f.len(),
+                pdf.len()
+            ));
+        }
+        const W: usize = 8;
+        for start in (0..n).step_by(W) {
+            let len = W.min(n - start);
+            // A short final chunk repeats its last input in the unused lanes.
+            let lane = |k: usize| start + k.min(len - 1);
+            let gather =
+                |v: &[[f32; 3]], c: usize| f32x8::new(std::array::from_fn(|k| v[lane(k)][c]));
+            let hv = f32x8::new(std::array::from_fn(|k| h[lane(k)]));
+            let wov = [0, 1, 2].map(|c| gather(wo, c));
+            let wiv = [0, 1, 2].map(|c| gather(wi, c));
+            let o = self.outgoing(hv, wov);
+            let (fv, pv) = self.eval_lobes(&o, wov, wiv);
+            let fa = fv.map(f32x8::to_array);
+            let pa = pv.to_array();
+            for k in 0..len {
+                f[start + k] = [fa[0][k], fa[1][k], fa[2][k]];
+                pdf[start + k] = pa[k];
+            }
+        }
+        Ok(())
+    }
+
+    /// The (h, wo) stage: tilted outgoing angles, refraction inside the fiber, Fresnel
+    /// and absorption, lobe attenuations and sampling weights.
+    #[inline(always)]
+    fn outgoing<T: Lanes>(&self, h: T, wo: [T; 3]) -> Outgoing<T> {
+        let one = T::splat(1.0);
+        let zero = T::splat(0.0);
+        let h = h.max(-one).min(one);
+        let sin_to = wo[0].max(-one).min(one);
+        let cos_to = safe_sqrt(one - sin_to * sin_to);
+        let tilt = |p: usize| {
+            let (s, c) = (T::splat(self.tilt[p].0), T::splat(self.tilt[p].1));
+            (sin_to * c + cos_to * s, (cos_to * c - sin_to * s).abs())
+        };
+        let tilted = [tilt(0), tilt(1), tilt(2)];
+
+        // Modified index eta' = sqrt(eta^2 - sin^2 to) / cos to enters only as h / eta';
+        // written this way it never divides by cos to, which is 0 along the tangent.
+        let eta = T::splat(self.params.eta);
+        let sin_gt = h * cos_to / (eta * eta - sin_to * sin_to).sqrt();
+        let cos_gt = safe_sqrt(one - sin_gt * sin_gt);
+        let gamma_t = safe_asin(sin_gt);
+        let gamma_o = safe_asin(h);
+        let sin_tt = sin_to / eta;
+        let cos_tt = safe_sqrt(one - sin_tt * sin_tt);
+        let path = T::splat(2.0) * cos_gt / cos_tt;
+        let transmit = |c: usize| (-(T::splat(self.params.sigma_a[c]) * path)).exp();
+
+        let fr = fresnel_dielectric(cos_to * safe_sqrt(one - h * h), eta);
+        let lobes = |t: T| {
+            let tt = (one - fr) * (one - fr) * t;
+            let trt = tt * t * fr;
+            // Residual sum of p >= 3: trt * t f / (1 - t f). When t f reaches 1 (no
+            // absorption at grazing Fresnel = 1) the numerator is 0 too and the limit is 0.
+            let denom = one - t * fr;
+            let residual = T::branch(denom.gt(zero), || trt * t * fr / denom, || zero);
+            [fr, tt, trt, residual]
+        };
+        let (r, g, b) = (lobes(transmit(0)), lobes(transmit(1)), lobes(transmit(2)));
+        let ap = [0, 1, 2, 3].map(|p| [r[p], g[p], b[p]]);
+        let third = T::splat(1.0 / 3.0);
+        let mean = |p: usize| (r[p] + g[p] + b[p]) * third;
+        // The R lobe's Fresnel term is > 0 for eta > 1, so the total is never 0.
+        let inv_total = one / (mean(0) + mean(1) + mean(2) + mean(3));
+        let two_gt = T::splat(2.0) * gamma_t;
+        let two_go = T::splat(2.0) * gamma_o;
+        Outgoing {
+            sin_to,
+            cos_to,
+            tilted,
+            deflection: [
+                -two_go,
+                two_gt - two_go + T::splat(PI),
+                two_gt + two_gt - two_go + T::splat(TAU),
+            ],
+            ap,
+            lobe_pdf: [0, 1, 2, 3].map(|p| mean(p) * inv_total),
+        }
+    }
+
+    /// The per-wi stage: sums the lobes into (f, pdf).
+    #[inline(always)]
+    fn eval_lobes<T: Lanes>(&self, o: &Outgoing<T>, wo: [T; 3], wi: [T; 3]) -> ([T; 3], T) {
+        let one = T::splat(1.0);
+        let sin_ti = wi[0].max(-one).min(one);
+        let cos_ti = safe_sqrt(one - sin_ti * sin_ti);
+        // phi_i - phi_o from the yz components directly: one atan2, defined along the tangent.
+        let phi = (wo[1] * wi[2] - wo[2] * wi[1]).atan2(wo[1] * wi[1] + wo[2] * wi[2]);
+
+        let mut f = [T::splat(0.0); 3];
+        let mut pdf = T::splat(0.0);
+        for p in 0..=EXPLICIT_LOBES {
+            let weight = if p < EXPLICIT_LOBES {
+                let (sin_to, cos_to) = o.tilted[p];
+                self.mp[p].eval(sin_ti, cos_ti, sin_to, cos_to)
+                    * self.np.eval(wrap_angle(phi - o.deflection[p]))
+            } else {
+                self.mp[p].eval(sin_ti, cos_ti, o.sin_to, o.cos_to) * T::splat(0.5 * FRAC_1_PI)
+            };
+            for c in 0..3 {
+                f[c] = f[c] + weight * o.ap[p][c];
+            }
+            pdf = pdf + weight * o.lobe_pdf[p];
+        }
+        let cos_wi = wi[2].abs();
+        let inv_cos = T::select(cos_wi.gt(T::splat(MIN_COS_WI)), one / cos_wi, one);
+        ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
+    }
+}
+
+/// Picks a lobe with probability `lobe_pdf[p]` and rescales u into [0, 1) for reuse.
+fn pick_lobe(lobe_pdf: &[f32; 4], u: f32) -> (usize, f32) {
+    let mut u = u;
+    for (p, &w) in lobe_pdf.iter().enumerate().take(3) {
+        if u < w {
+            return (p, (u / w).min(ONE_MINUS_EPSILON));
+        }
+        u -= w;
+    }
+    let w = lobe_pdf[3];
+    (
+        3,
+        if w > 0.0 {
+            (u / w).clamp(0.0, ONE_MINUS_EPSILON)
+        } else {
+            0.0
+        },
+    )
+}
+
+/// The largest f32 below one.
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Unpolarised Fresnel reflectance from outside into a dielectric of index eta > 1 at
+/// incidence cosine cos_i in [0, 1]; 1 at grazing incidence, never divides by zero.
+#[inline(always)]
+fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> T {
+    let one = T::splat(1.0);
+    let sin2_t = (one - cos_i * cos_i) / (eta * eta);
+    let cos_t = safe_sqrt(one - sin2_t);
+    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    T::splat(0.5) * (r_par * r_par + r_perp * r_perp)
+}

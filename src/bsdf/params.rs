@@ -1,0 +1,80 @@
+//! The user-facing parameters of the hair BSDF and their validation.
+
+use super::absorption::sigma_a_from_melanin;
+use crate::error::{Result, invalid_arg};
+
+/// Parameters of the Chiang 2016 hair model (DESIGN.md section 3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairParams {
+    /// Absorption per unit fiber radius, linear RGB; finite, >= 0.
+    pub sigma_a: [f32; 3],
+    /// Index of refraction of the fiber, in (1, 3].
+    pub eta: f32,
+    /// Longitudinal roughness, in [0.01, 1].
+    pub beta_m: f32,
+    /// Azimuthal roughness, in [0.01, 1].
+    pub beta_n: f32,
+    /// Cuticle scale tilt in degrees, |alpha| <= 20; pbrt's sign.
+    pub alpha: f32,
+}
+
+/// Eumelanin concentration of the default (brown) hair.
+pub(crate) const DEFAULT_EUMELANIN: f32 = 1.3;
+
+impl Default for HairParams {
+    /// Brown hair (eumelanin 1.3), eta 1.55, beta_m = beta_n = 0.3, alpha = 2 degrees.
+    fn default() -> Self {
+        Self {
+            sigma_a: sigma_a_from_melanin(DEFAULT_EUMELANIN, 0.0)
+                .expect("the default melanin concentration is valid"),
+            eta: 1.55,
+            beta_m: 0.3,
+            beta_n: 0.3,
+            alpha: 2.0,
+        }
+    }
+}
+
+/// Valid range of both roughnesses.
+pub(crate) const BETA_RANGE: (f32, f32) = (0.01, 1.0);
+/// Largest accepted index of refraction (the lower bound 1 is excluded).
+pub(crate) const ETA_MAX: f32 = 3.0;
+/// Largest accepted |alpha| in degrees.
+pub(crate) const ALPHA_MAX_DEG: f32 = 20.0;
+
+impl HairParams {
+    /// Checks every parameter against its range; the error names the first bad one.
+    /// Out-of-range values are refused rather than clamped, so a mistake is seen.
+    pub fn validate(&self) -> Result<()> {
+        for (c, &s) in self.sigma_a.iter().enumerate() {
+            if !(s.is_finite() && s >= 0.0) {
+                return Err(invalid_arg!("sigma_a[{c}] = {s}: must be finite and >= 0"));
+            }
+        }
+        if !(self.eta > 1.0 && self.eta <= ETA_MAX) {
+            return Err(invalid_arg!(
+                "eta = {}: must be in (1, {ETA_MAX}]",
+                self.eta
+            ));
+        }
+        check_beta("beta_m", self.beta_m)?;
+        check_beta("beta_n", self.beta_n)?;
+        if !(self.alpha.abs() <= ALPHA_MAX_DEG) {
+            return Err(invalid_arg!(
+                "alpha = {} degrees: must be in [-{ALPHA_MAX_DEG}, {ALPHA_MAX_DEG}]",
+                self.alpha
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Checks a roughness against [`BETA_RANGE`]; `name` goes into the message.
+pub(crate) fn check_beta(name: &str, beta: f32) -> Result<()> {
+    let (lo, hi) = BETA_RANGE;
+    if beta >= lo && beta <= hi {
+        Ok(())
+    } else {
+        Err(invalid_arg!("{name} = {beta}: must be in [{lo}, {hi}]"))
+    }
+}

@@ -1,0 +1,20 @@
+//! Numerical building blocks of the hair model: the lane abstraction that lets one
+//! implementation run on scalars and on SIMD vectors, and the special functions.
+
+pub mod bessel;
+pub mod fast;
+pub mod lanes;
+
+pub use lanes::Lanes;
+
+/// sqrt that treats tiny negative round-off as zero instead of returning NaN.
+#[inline(always)]
+pub fn safe_sqrt<T: Lanes>(x: T) -> T {
+    x.max(T::splat(0.0)).sqrt()
+}
+
+/// asin of a value that round-off may have pushed just outside [-1, 1].
+#[inline(always)]
+pub fn safe_asin<T: Lanes>(x: T) -> T {
+    x.max(T::splat(-1.0)).min(T::splat(1.0)).asin()
+}

@@ -1,0 +1,122 @@
+//! The C examples use only `include/hairtrace.h`. Each is compiled as C99 and as C++
+//! with warnings as errors, linked against the static library that this test run built,
+//! run, and its output checked against the Rust API.
+
+use glam::Vec3;
+use hairtrace::{HairBsdf, HairParams};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The profile directory of this build (target/<profile>), where libhairtrace.a lives.
+fn profile_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    exe.parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>/deps/<test>")
+        .to_path_buf()
+}
+
+/// Libraries the static library needs, as `--print native-static-libs` lists them.
+const NATIVE_LIBS: &[&str] = &[
+    "-lembree3",
+    "-lOpenImageIO",
+    "-lOpenImageIO_Util",
+    "-lstdc++",
+    "-lgcc_s",
+    "-lutil",
+    "-lrt",
+    "-lpthread",
+    "-lm",
+    "-ldl",
+];
+
+/// Compiles `c_examples/<name>` with `compiler` and `flags`, links and runs it; returns stdout.
+fn build_and_run(name: &str, compiler: &str, flags: &[&str]) -> String {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let lib = profile_dir().join("libhairtrace.a");
+    assert!(lib.exists(), "{} not built", lib.display());
+    let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{compiler}"));
+    let out = Command::new(compiler)
+        .args(flags)
+        .args(["-Wall", "-Wextra", "-Werror", "-O1", "-I"])
+        .arg(root.join("include"))
+        .arg(root.join("c_examples").join(name))
+        // Ends a `-x c++` so that the archive is not read as source.
+        .args(["-x", "none"])
+        .arg(&lib)
+        .args(NATIVE_LIBS)
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {compiler}: {e}"));
+    assert!(
+        out.status.success(),
+        "{compiler} {name} failed:\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let run = Command::new(&exe).output().expect("run the example");
+    assert!(
+        run.status.success(),
+        "{name} ({compiler}) exited with {}:\n{}",
+        run.status,
+        String::from_utf8_lossy(&run.stderr)
+    );
+    String::from_utf8(run.stdout).expect("utf-8 output")
+}
+
+/// The numbers after `key` on the line that starts with it.
+fn numbers(out: &str, key: &str) -> Vec<f32> {
+    let line = out
+        .lines()
+        .find(|l| l.starts_with(key))
+        .unwrap_or_else(|| panic!("no `{key}` line in:\n{out}"));
+    line.split_whitespace()
+        .filter_map(|w| w.parse().ok())
+        .collect()
+}
+
+fn check_bsdf_output(out: &str) {
+    assert!(
+        out.starts_with(&format!("version {} abi 1", hairtrace::VERSION)),
+        "{out}"
+    );
+    let bsdf = HairBsdf::new(&HairParams::default()).unwrap();
+    let e = bsdf.eval(0.5, Vec3::Z, Vec3::new(0.0, 0.866_025_4, 0.5));
+    let want = [e.f.x, e.f.y, e.f.z, e.pdf];
+    for key in ["eval", "batch"] {
+        let got = numbers(out, key);
+        assert_eq!(got.len(), 4, "{key}: {got:?}");
+        for (g, w) in got.iter().zip(want) {
+            assert!(
+                (g - w).abs() <= 1e-5 * w.abs(),
+                "{key}: C printed {got:?}, Rust gives {want:?}"
+            );
+        }
+    }
+    let furnace = numbers(out, "furnace")[0];
+    assert!(
+        (furnace - 1.0).abs() < 1e-3,
+        "white furnace through the C ABI: {furnace}"
+    );
+    assert!(out.contains("null a required pointer is NULL"), "{out}");
+    assert!(
+        out.contains("invalid invalid argument: invalid argument: beta_m = 2"),
+        "{out}"
+    );
+    let sigma = numbers(out, "from_melanin");
+    assert!((sigma[0] - 8.0 * 0.419).abs() < 1e-4, "{sigma:?}");
+}
+
+#[test]
+fn bsdf_example_as_c99() {
+    check_bsdf_output(&build_and_run("bsdf.c", "gcc", &["-std=c99", "-pedantic"]));
+}
+
+#[test]
+fn bsdf_example_as_cpp() {
+    check_bsdf_output(&build_and_run(
+        "bsdf.c",
+        "g++",
+        &["-x", "c++", "-std=c++17"],
+    ));
+}

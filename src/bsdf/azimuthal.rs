@@ -2,6 +2,7 @@
 //! deflection angle, trimmed to [-pi, pi] and renormalised there.
 
 use crate::math::Lanes;
+use crate::math::fast::{exp_neg, round};
 use std::f32::consts::PI;
 
 /// Azimuthal logistic scale for roughness beta_n (Chiang et al. 2016, eq. 8).
@@ -41,7 +42,7 @@ impl TrimmedLogistic {
     /// Density at x in [-pi, pi].
     #[inline(always)]
     pub fn eval<T: Lanes>(&self, x: T) -> T {
-        let e = (-(x.abs() * T::splat(self.inv_s))).exp();
+        let e = exp_neg(-(x.abs() * T::splat(self.inv_s)));
         let d = T::splat(1.0) + e;
         T::splat(self.scale) * e / (d * d)
     }
@@ -60,5 +61,5 @@ impl TrimmedLogistic {
 #[inline(always)]
 pub(crate) fn wrap_angle<T: Lanes>(x: T) -> T {
     let tau = T::splat(std::f32::consts::TAU);
-    x - tau * (x * T::splat(1.0 / std::f32::consts::TAU)).round()
+    x - tau * round(x * T::splat(1.0 / std::f32::consts::TAU))
 }

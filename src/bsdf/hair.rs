@@ -12,13 +12,14 @@
 //! code eight inputs at a time.
 
 use super::azimuthal::{TrimmedLogistic, azimuthal_scale, wrap_angle};
-use super::longitudinal::{LongitudinalLobe, longitudinal_variance};
+use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
 use super::params::HairParams;
 use crate::error::{Result, invalid_arg};
+use crate::math::fast::{atan2, exp_neg};
 use crate::math::{Lanes, safe_asin, safe_sqrt};
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
-use wide::f32x8;
+use wide::{f32x4, f32x8};
 
 /// Number of explicit lobes (R, TT, TRT); the residual lobe comes after them.
 const EXPLICIT_LOBES: usize = 3;
@@ -49,6 +50,8 @@ pub struct HairBsdf {
     params: HairParams,
     /// Mp of R, TT, TRT and the residual lobe.
     mp: [LongitudinalLobe; 4],
+    /// The same four lobes side by side, for the scalar evaluation.
+    mp_packed: MpConstants<f32x4>,
     np: TrimmedLogistic,
     /// (sin, cos) of the cuticle shift of theta_o for R, TT, TRT: -2 alpha, alpha, 4 alpha.
     tilt: [(f32, f32); EXPLICIT_LOBES],
@@ -74,9 +77,11 @@ impl HairBsdf {
         params.validate()?;
         let v = longitudinal_variance(params.beta_m);
         let alpha = f64::from(params.alpha).to_radians();
+        let mp = [v, 0.25 * v, 4.0 * v, 4.0 * v].map(LongitudinalLobe::new);
         Ok(Self {
             params: *params,
-            mp: [v, 0.25 * v, 4.0 * v, 4.0 * v].map(LongitudinalLobe::new),
+            mp,
+            mp_packed: LongitudinalLobe::pack(&mp),
             np: TrimmedLogistic::new(azimuthal_scale(params.beta_n)),
             tilt: [-2.0 * alpha, alpha, 4.0 * alpha].map(|a| (a.sin() as f32, a.cos() as f32)),
         })
@@ -114,13 +119,16 @@ impl HairBsdf {
         let wo_a = wo.to_array();
         let o = self.outgoing(h, wo_a);
         let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
+        // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
+        // density underflows, from being sampled with a whole 2^-24 of probability.
+        let (u_phi, u_theta) = (u_phi.max(U_MIN), u[1].max(U_MIN));
 
         let (sin_to, cos_to) = if p < EXPLICIT_LOBES {
             o.tilted[p]
         } else {
             (o.sin_to, o.cos_to)
         };
-        let (sin_ti, cos_ti) = self.mp[p].sample(sin_to, cos_to, [u[1], u[2]]);
+        let (sin_ti, cos_ti) = self.mp[p].sample(sin_to, cos_to, [u_theta, u[2]]);
         let dphi = if p < EXPLICIT_LOBES {
             o.deflection[p] + self.np.sample(u_phi)
         } else {
@@ -141,7 +149,7 @@ impl HairBsdf {
             cos_ti * (sin_po * cos_d + cos_po * sin_d),
         ];
 
-        let (f, pdf) = self.eval_lobes(&o, wo_a, wi);
+        let (f, pdf) = self.eval_lobes_packed(&o, wo_a, wi);
         (pdf > 0.0).then(|| HairSample {
             wi: Vec3::from_array(wi),
             f: Vec3::from_array(f),
@@ -149,9 +157,8 @@ impl HairBsdf {
         })
     }
 
-    /// Evaluates n inputs at once (eight per SIMD step); each result equals [`Self::eval`]
-    /// up to the last bits of the vectorised exp/asin/atan2. All slices must have the
-    /// same length.
+    /// Evaluates n inputs at once (eight per SIMD step); each result equals
+    /// [`Self::eval`]'s bit for bit. All slices must have the same length.
     pub fn eval_batch(
         &self,
         h: &[f32],
@@ -220,7 +227,7 @@ impl HairBsdf {
         let sin_tt = sin_to / eta;
         let cos_tt = safe_sqrt(one - sin_tt * sin_tt);
         let path = T::splat(2.0) * cos_gt / cos_tt;
-        let transmit = |c: usize| (-(T::splat(self.params.sigma_a[c]) * path)).exp();
+        let transmit = |c: usize| exp_neg(-(T::splat(self.params.sigma_a[c]) * path));
 
         let fr = fresnel_dielectric(cos_to * safe_sqrt(one - h * h), eta);
         let lobes = |t: T| {
@@ -261,7 +268,7 @@ impl HairBsdf {
         let sin_ti = wi[0].max(-one).min(one);
         let cos_ti = safe_sqrt(one - sin_ti * sin_ti);
         // phi_i - phi_o from the yz components directly: one atan2, defined along the tangent.
-        let phi = (wo[1] * wi[2] - wo[2] * wi[1]).atan2(wo[1] * wi[1] + wo[2] * wi[2]);
+        let phi = atan2(wo[1] * wi[2] - wo[2] * wi[1], wo[1] * wi[1] + wo[2] * wi[2]);
 
         let mut f = [T::splat(0.0); 3];
         let mut pdf = T::splat(0.0);
@@ -280,6 +287,46 @@ impl HairBsdf {
         }
         let cos_wi = wi[2].abs();
         let inv_cos = T::select(cos_wi.gt(T::splat(MIN_COS_WI)), one / cos_wi, one);
+        ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
+    }
+
+    /// The per-wi stage of one evaluation with the four lobes in the lanes of an f32x4.
+    /// Every lane runs the operations [`Self::eval_lobes`] runs for that lobe, and the
+    /// lobes are summed in the same order, so the two agree bit for bit.
+    #[inline(always)]
+    fn eval_lobes_packed(&self, o: &Outgoing<f32>, wo: [f32; 3], wi: [f32; 3]) -> ([f32; 3], f32) {
+        let sin_ti = wi[0].clamp(-1.0, 1.0);
+        let cos_ti = safe_sqrt(1.0 - sin_ti * sin_ti);
+        let phi = atan2(wo[1] * wi[2] - wo[2] * wi[1], wo[1] * wi[1] + wo[2] * wi[2]);
+
+        let [(s0, c0), (s1, c1), (s2, c2)] = o.tilted;
+        let sin_to = f32x4::new([s0, s1, s2, o.sin_to]);
+        let cos_to = f32x4::new([c0, c1, c2, o.cos_to]);
+        let mp = self
+            .mp_packed
+            .eval(f32x4::splat(sin_ti), f32x4::splat(cos_ti), sin_to, cos_to);
+        let [d0, d1, d2] = o.deflection;
+        let np = self.np.eval(wrap_angle(
+            f32x4::splat(phi) - f32x4::new([d0, d1, d2, 0.0]),
+        ));
+        let mut np = np.to_array();
+        np[EXPLICIT_LOBES] = 0.5 * FRAC_1_PI;
+        let weight = (mp * f32x4::new(np)).to_array();
+
+        let mut f = [0.0f32; 3];
+        let mut pdf = 0.0f32;
+        for p in 0..=EXPLICIT_LOBES {
+            for c in 0..3 {
+                f[c] += weight[p] * o.ap[p][c];
+            }
+            pdf += weight[p] * o.lobe_pdf[p];
+        }
+        let cos_wi = wi[2].abs();
+        let inv_cos = if cos_wi > MIN_COS_WI {
+            1.0 / cos_wi
+        } else {
+            1.0
+        };
         ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
     }
 }
@@ -304,17 +351,28 @@ fn pick_lobe(lobe_pdf: &[f32; 4], u: f32) -> (usize, f32) {
     )
 }
 
+/// Half the spacing of uniform f32 numbers in [0, 1).
+const U_MIN: f32 = 1.0 / 33_554_432.0;
 /// The largest f32 below one.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Unpolarised Fresnel reflectance from outside into a dielectric of index eta > 1 at
 /// incidence cosine cos_i in [0, 1]; 1 at grazing incidence, never divides by zero.
+/// Written with e = eta^2 - 1 = (eta - 1)(eta + 1) factored out of both amplitudes, so that
+/// an index just above 1 keeps its precision instead of cancelling in (eta c - cos t).
 #[inline(always)]
 fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> T {
     let one = T::splat(1.0);
-    let sin2_t = (one - cos_i * cos_i) / (eta * eta);
-    let cos_t = safe_sqrt(one - sin2_t);
-    let r_par = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    T::splat(0.5) * (r_par * r_par + r_perp * r_perp)
+    let e = (eta - one) * (eta + one);
+    let q = e.sqrt();
+    let c2 = cos_i * cos_i;
+    // eta cos_t = sqrt(eta^2 - sin_i^2) by Snell's law. At grazing incidence it is q
+    // exactly, so both ratios below are exactly 1 and F is exactly 1 (no leak into 1 - F).
+    let eta_cos_t = (e + c2).sqrt();
+    let perp = q / (cos_i + eta_cos_t);
+    let r_perp = perp * perp;
+    let par = q / (eta * eta * cos_i + eta_cos_t);
+    let r_par = par * par * ((e + T::splat(2.0)) * c2 - one);
+    // Rounding can lift the grazing value just above 1, which would leak into 1 - F.
+    (T::splat(0.5) * (r_par * r_par + r_perp * r_perp)).min(one)
 }

@@ -7,6 +7,7 @@
 //! the exponent is computed without cancellation, and one exp suffices.
 
 use crate::math::bessel::{SPLIT, i0_large_scaled, i0_small};
+use crate::math::fast::exp_neg;
 use crate::math::{Lanes, safe_sqrt};
 
 /// Variance v of the R lobe for longitudinal roughness beta_m (Chiang et al. 2016, eq. 7).
@@ -44,25 +45,23 @@ impl LongitudinalLobe {
         self.v
     }
 
+    /// The constants of four lobes side by side, for [`MpConstants`] over f32x4.
+    pub(crate) fn pack(lobes: &[LongitudinalLobe; 4]) -> MpConstants<wide::f32x4> {
+        MpConstants {
+            inv_v: wide::f32x4::new(lobes.map(|l| l.inv_v)),
+            norm: wide::f32x4::new(lobes.map(|l| l.norm)),
+        }
+    }
+
     /// Density over theta_i with respect to cos(theta_i) d theta_i, for the outgoing
     /// direction (sin_to, cos_to >= 0) already tilted by the cuticle angle.
     #[inline(always)]
     pub fn eval<T: Lanes>(&self, sin_ti: T, cos_ti: T, sin_to: T, cos_to: T) -> T {
-        let one = T::splat(1.0);
-        let inv_v = T::splat(self.inv_v);
-        let a = cos_ti * cos_to * inv_v;
-        // 1 - cos(ti + to), through sin^2 / (1 + cos) where cos > 0 to avoid cancellation.
-        let c = cos_ti * cos_to - sin_ti * sin_to;
-        let s = sin_ti * cos_to + cos_ti * sin_to;
-        let one_minus_c = T::branch(c.gt(T::splat(0.0)), || s * s / (one + c), || one - c);
-        let small = a.lt(T::splat(SPLIT));
-        // Small a: I0(a) itself, and e^-a moves into the exponent (both terms <= 0).
-        let exponent = -(one_minus_c * inv_v);
-        T::branch(
-            small,
-            || T::splat(self.norm) * (exponent - a).exp() * i0_small(a),
-            || T::splat(self.norm) * exponent.exp() * i0_large_scaled(a),
-        )
+        let constants = MpConstants {
+            inv_v: T::splat(self.inv_v),
+            norm: T::splat(self.norm),
+        };
+        constants.eval(sin_ti, cos_ti, sin_to, cos_to)
     }
 
     /// Samples theta_i exactly from this lobe: a direction at angle psi from the lobe
@@ -77,5 +76,31 @@ impl LongitudinalLobe {
         let cos_phi = (std::f32::consts::TAU * u[1]).cos();
         let sin_ti = (-cos_psi * sin_to + sin_psi * cos_phi * cos_to).clamp(-1.0, 1.0);
         (sin_ti, safe_sqrt(1.0 - sin_ti * sin_ti))
+    }
+}
+
+/// Per-lane lobe constants: one lobe splatted, or the four lobes of a hair side by side.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct MpConstants<T> {
+    pub inv_v: T,
+    pub norm: T,
+}
+
+impl<T: Lanes> MpConstants<T> {
+    #[inline(always)]
+    pub fn eval(&self, sin_ti: T, cos_ti: T, sin_to: T, cos_to: T) -> T {
+        let one = T::splat(1.0);
+        let a = cos_ti * cos_to * self.inv_v;
+        // 1 - cos(ti + to), through sin^2 / (1 + cos) where cos > 0 to avoid cancellation.
+        let c = cos_ti * cos_to - sin_ti * sin_to;
+        let s = sin_ti * cos_to + cos_ti * sin_to;
+        let one_minus_c = T::branch(c.gt(T::splat(0.0)), || s * s / (one + c), || one - c);
+        let exponent = -(one_minus_c * self.inv_v);
+        // Small a: I0(a) itself, and e^-a moves into the exponent (both terms <= 0).
+        T::branch(
+            a.lt(T::splat(SPLIT)),
+            || self.norm * exp_neg(exponent - a) * i0_small(a),
+            || self.norm * exp_neg(exponent) * i0_large_scaled(a),
+        )
     }
 }

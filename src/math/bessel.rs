@@ -9,6 +9,7 @@
 //! several percent off between x = 5 and 12; these fits are not, at the same cost.
 
 use super::Lanes;
+use super::fast::exp_neg;
 
 /// Above this argument the asymptotic form is used.
 pub(crate) const SPLIT: f32 = 3.75;
@@ -45,7 +46,7 @@ pub(crate) fn i0_large_scaled<T: Lanes>(x: T) -> T {
 /// e^-x I0(x) for x >= 0; finite for every finite x, about 1/sqrt(2 pi x) for large x.
 pub fn i0_scaled(x: f32) -> f32 {
     if x < SPLIT {
-        (-x).exp() * i0_small(x)
+        exp_neg(-x) * i0_small(x)
     } else {
         i0_large_scaled(x)
     }

@@ -1,13 +1,14 @@
-//! One hair model, two widths. [`Lanes`] is the small set of operations the BSDF needs;
-//! it is implemented for `f32` (the scalar hot path, branches stay branches) and for
-//! `wide::f32x8` (eight evaluations at once for `eval_batch`, branches become selects).
-//! Writing the model once against this trait keeps the scalar and the batched results
-//! identical up to the last bits of the transcendental functions.
+//! One hair model, two widths. [`Lanes`] is the small set of primitive operations the
+//! BSDF needs; it is implemented for `f32` (the scalar hot path, where branches stay
+//! branches) and for `wide::f32x8` (eight evaluations at once for `eval_batch`, where
+//! branches become selects). The transcendental functions are written once on top of
+//! these primitives (see [`super::fast`]), and every primitive is exact IEEE arithmetic,
+//! so a batched result equals the scalar one bit for bit.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
-use wide::f32x8;
+use wide::{f32x4, f32x8, i32x4, i32x8};
 
-/// Arithmetic, comparisons and the transcendental functions the hair model uses.
+/// Exact arithmetic, comparisons and selection, per lane.
 pub trait Lanes:
     Copy
     + Add<Output = Self>
@@ -21,15 +22,13 @@ pub trait Lanes:
 
     fn splat(x: f32) -> Self;
     fn sqrt(self) -> Self;
-    fn exp(self) -> Self;
-    fn asin(self) -> Self;
-    /// `atan2(self, x)`, like `f32::atan2`.
-    fn atan2(self, x: Self) -> Self;
     fn abs(self) -> Self;
-    /// Nearest integer for |x| < 2^22; ties may go either way (used for angle wrapping).
-    fn round(self) -> Self;
     fn min(self, other: Self) -> Self;
     fn max(self, other: Self) -> Self;
+    /// |self| with the sign bit of `sign`.
+    fn copysign(self, sign: Self) -> Self;
+    /// 2^n for integral n in [-126, 127].
+    fn pow2i(self) -> Self;
     fn lt(self, other: Self) -> Self::Mask;
     fn gt(self, other: Self) -> Self::Mask;
     /// Per lane: `if mask { a } else { b }`.
@@ -38,6 +37,10 @@ pub trait Lanes:
     /// a vector runs both and selects.
     fn branch(mask: Self::Mask, a: impl FnOnce() -> Self, b: impl FnOnce() -> Self) -> Self;
 }
+
+/// Adding 2^23 + 127 to an integral n leaves n + 127 in the low mantissa bits; shifted by
+/// 23 they become the exponent field of 2^n.
+const POW2_BIAS: f32 = 8_388_608.0 + 127.0;
 
 impl Lanes for f32 {
     type Mask = bool;
@@ -51,32 +54,25 @@ impl Lanes for f32 {
         f32::sqrt(self)
     }
     #[inline(always)]
-    fn exp(self) -> Self {
-        super::fast::exp(self)
-    }
-    #[inline(always)]
-    fn asin(self) -> Self {
-        super::fast::asin(self)
-    }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        super::fast::atan2(self, x)
-    }
-    #[inline(always)]
     fn abs(self) -> Self {
         f32::abs(self)
     }
-    #[inline(always)]
-    fn round(self) -> Self {
-        super::fast::round(self)
-    }
+    // Plain comparisons (one minss/maxss) with the SSE rule for NaN: the second operand.
     #[inline(always)]
     fn min(self, other: Self) -> Self {
-        f32::min(self, other)
+        if self < other { self } else { other }
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
-        f32::max(self, other)
+        if self > other { self } else { other }
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        f32::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn pow2i(self) -> Self {
+        f32::from_bits((self + POW2_BIAS).to_bits() << 23)
     }
     #[inline(always)]
     fn lt(self, other: Self) -> bool {
@@ -96,59 +92,61 @@ impl Lanes for f32 {
     }
 }
 
-impl Lanes for f32x8 {
-    type Mask = f32x8;
+/// The SIMD widths: f32x4 holds the four lobes of one scalar evaluation, f32x8 eight
+/// inputs of a batch. Both use raw minps/maxps, which agree with the scalar min/max.
+macro_rules! impl_lanes_for_simd {
+    ($t:ty, $int:ty) => {
+        impl Lanes for $t {
+            type Mask = $t;
 
-    #[inline(always)]
-    fn splat(x: f32) -> Self {
-        f32x8::splat(x)
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f32x8::sqrt(self)
-    }
-    #[inline(always)]
-    fn exp(self) -> Self {
-        f32x8::exp(self)
-    }
-    #[inline(always)]
-    fn asin(self) -> Self {
-        f32x8::asin(self)
-    }
-    #[inline(always)]
-    fn atan2(self, x: Self) -> Self {
-        f32x8::atan2(self, x)
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        f32x8::abs(self)
-    }
-    #[inline(always)]
-    fn round(self) -> Self {
-        f32x8::round(self)
-    }
-    #[inline(always)]
-    fn min(self, other: Self) -> Self {
-        f32x8::min(self, other)
-    }
-    #[inline(always)]
-    fn max(self, other: Self) -> Self {
-        f32x8::max(self, other)
-    }
-    #[inline(always)]
-    fn lt(self, other: Self) -> Self {
-        self.simd_lt(other)
-    }
-    #[inline(always)]
-    fn gt(self, other: Self) -> Self {
-        self.simd_gt(other)
-    }
-    #[inline(always)]
-    fn select(mask: Self, a: Self, b: Self) -> Self {
-        mask.select(a, b)
-    }
-    #[inline(always)]
-    fn branch(mask: Self, a: impl FnOnce() -> Self, b: impl FnOnce() -> Self) -> Self {
-        mask.select(a(), b())
-    }
+            #[inline(always)]
+            fn splat(x: f32) -> Self {
+                <$t>::splat(x)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                <$t>::sqrt(self)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                <$t>::abs(self)
+            }
+            #[inline(always)]
+            fn min(self, other: Self) -> Self {
+                <$t>::fast_min(self, other)
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                <$t>::fast_max(self, other)
+            }
+            #[inline(always)]
+            fn copysign(self, sign: Self) -> Self {
+                self.abs() | (sign & <$t>::splat(-0.0))
+            }
+            #[inline(always)]
+            fn pow2i(self) -> Self {
+                let bits: $int = bytemuck::cast(self + <$t>::splat(POW2_BIAS));
+                bytemuck::cast(bits << 23)
+            }
+            #[inline(always)]
+            fn lt(self, other: Self) -> Self {
+                self.simd_lt(other)
+            }
+            #[inline(always)]
+            fn gt(self, other: Self) -> Self {
+                self.simd_gt(other)
+            }
+            #[inline(always)]
+            fn select(mask: Self, a: Self, b: Self) -> Self {
+                mask.select(a, b)
+            }
+            #[inline(always)]
+            fn branch(mask: Self, a: impl FnOnce() -> Self, b: impl FnOnce() -> Self) -> Self {
+                mask.select(a(), b())
+            }
+        }
+    };
 }
+
+impl_lanes_for_simd!(f32x4, i32x4);
+impl_lanes_for_simd!(f32x8, i32x8);

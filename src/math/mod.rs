@@ -16,5 +16,5 @@ pub fn safe_sqrt<T: Lanes>(x: T) -> T {
 /// asin of a value that round-off may have pushed just outside [-1, 1].
 #[inline(always)]
 pub fn safe_asin<T: Lanes>(x: T) -> T {
-    x.max(T::splat(-1.0)).min(T::splat(1.0)).asin()
+    fast::asin(x.max(T::splat(-1.0)).min(T::splat(1.0)))
 }

@@ -64,6 +64,23 @@ fn bench(c: &mut Criterion) {
             }
         })
     });
+    // The per-wi part alone: (h, wo) prepared once per shading point, as a path tracer
+    // does for next-event estimation plus BSDF sampling at the same vertex.
+    let points: Vec<_> = (0..N).map(|i| bsdf.at(inp.h[i], v(inp.wo[i]))).collect();
+    g.bench_function("point_eval", |b| {
+        b.iter(|| {
+            for (i, p) in points.iter().enumerate() {
+                black_box(p.eval(v(inp.wi[i])));
+            }
+        })
+    });
+    g.bench_function("point_sample", |b| {
+        b.iter(|| {
+            for (i, p) in points.iter().enumerate() {
+                black_box(p.sample(inp.u[i]));
+            }
+        })
+    });
     let mut f = vec![[0.0; 3]; N];
     let mut pdf = vec![0.0; N];
     g.bench_function("eval_batch", |b| {

@@ -91,70 +91,39 @@ impl HairBsdf {
         &self.params
     }
 
+    /// The BSDF at one shading point: the work that depends on (h, wo) is done once here
+    /// and shared by every `eval`, `pdf` and `sample` at that point (next-event
+    /// estimation and BSDF sampling of a path vertex use the same point).
+    pub fn at(&self, h: f32, wo: Vec3) -> HairPoint<'_> {
+        let wo = wo.to_array();
+        HairPoint {
+            bsdf: self,
+            wo,
+            o: self.outgoing(h, wo),
+        }
+    }
+
     /// f and pdf for outgoing wo and incident wi (unit vectors, local frame), h in [-1, 1].
     pub fn eval(&self, h: f32, wo: Vec3, wi: Vec3) -> HairEval {
-        let o = self.outgoing(h, wo.to_array());
-        let (f, pdf) = self.eval_lobes(&o, wo.to_array(), wi.to_array());
-        HairEval {
-            f: Vec3::from_array(f),
-            pdf,
-        }
+        self.at(h, wo).eval(wi)
     }
 
     /// Density of [`Self::sample`] at wi (per unit solid angle).
     pub fn pdf(&self, h: f32, wo: Vec3, wi: Vec3) -> f32 {
-        self.eval(h, wo, wi).pdf
+        self.at(h, wo).eval(wi).pdf
     }
 
     /// Energy of each lobe (R, TT, TRT, residual) leaving wo at h: the lobes' Mp and Np
     /// integrate to one, so this is Ap.
     pub fn lobe_energies(&self, h: f32, wo: Vec3) -> [Vec3; 4] {
-        self.outgoing(h, wo.to_array()).ap.map(Vec3::from_array)
+        self.at(h, wo).o.ap.map(Vec3::from_array)
     }
 
     /// Samples wi: u[0] picks the lobe (proportionally to its mean attenuation) and is
     /// then reused, rescaled, for the azimuth; u[1] and u[2] sample the longitudinal lobe.
     /// Returns None only when the density at the sampled direction is zero.
     pub fn sample(&self, h: f32, wo: Vec3, u: [f32; 3]) -> Option<HairSample> {
-        let wo_a = wo.to_array();
-        let o = self.outgoing(h, wo_a);
-        let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
-        // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
-        // density underflows, from being sampled with a whole 2^-24 of probability.
-        let (u_phi, u_theta) = (u_phi.max(U_MIN), u[1].max(U_MIN));
-
-        let (sin_to, cos_to) = if p < EXPLICIT_LOBES {
-            o.tilted[p]
-        } else {
-            (o.sin_to, o.cos_to)
-        };
-        let (sin_ti, cos_ti) = self.mp[p].sample(sin_to, cos_to, [u_theta, u[2]]);
-        let dphi = if p < EXPLICIT_LOBES {
-            o.deflection[p] + self.np.sample(u_phi)
-        } else {
-            TAU * u_phi
-        };
-
-        // Rotate wo's azimuth by dphi; wo along the tangent has none, any will do.
-        let len_o = (wo.y * wo.y + wo.z * wo.z).sqrt();
-        let (cos_po, sin_po) = if len_o > 0.0 {
-            (wo.y / len_o, wo.z / len_o)
-        } else {
-            (1.0, 0.0)
-        };
-        let (sin_d, cos_d) = dphi.sin_cos();
-        let wi = [
-            sin_ti,
-            cos_ti * (cos_po * cos_d - sin_po * sin_d),
-            cos_ti * (sin_po * cos_d + cos_po * sin_d),
-        ];
-
-        let (f, pdf) = self.eval_lobes_packed(&o, wo_a, wi);
-        (pdf > 0.0).then(|| HairSample {
-            wi: Vec3::from_array(wi),
-            f: Vec3::from_array(f),
-            pdf,
-        })
+        self.at(h, wo).sample(u)
     }
 
     /// Evaluates n inputs at once (eight per SIMD step); each result equals
@@ -227,7 +196,8 @@ impl HairBsdf {
         let sin_tt = sin_to / eta;
         let cos_tt = safe_sqrt(one - sin_tt * sin_tt);
         let path = T::splat(2.0) * cos_gt / cos_tt;
-        let transmit = |c: usize| exp_neg(-(T::splat(self.params.sigma_a[c]) * path));
+        let sigma = self.params.sigma_a.map(T::splat);
+        let transmit = T::exp_neg3([0, 1, 2].map(|c| -(sigma[c] * path)));
 
         let fr = fresnel_dielectric(cos_to * safe_sqrt(one - h * h), eta);
         let lobes = |t: T| {
@@ -239,7 +209,7 @@ impl HairBsdf {
             let residual = T::branch(denom.gt(zero), || trt * t * fr / denom, || zero);
             [fr, tt, trt, residual]
         };
-        let (r, g, b) = (lobes(transmit(0)), lobes(transmit(1)), lobes(transmit(2)));
+        let [r, g, b] = transmit.map(lobes);
         let ap = [0, 1, 2, 3].map(|p| [r[p], g[p], b[p]]);
         let third = T::splat(1.0 / 3.0);
         let mean = |p: usize| (r[p] + g[p] + b[p]) * third;
@@ -261,7 +231,7 @@ impl HairBsdf {
         }
     }
 
-    /// The per-wi stage: sums the lobes into (f, pdf).
+    /// The per-wi stage over inputs in lanes (the batch): sums the lobes into (f, pdf).
     #[inline(always)]
     fn eval_lobes<T: Lanes>(&self, o: &Outgoing<T>, wo: [T; 3], wi: [T; 3]) -> ([T; 3], T) {
         let one = T::splat(1.0);
@@ -280,8 +250,8 @@ impl HairBsdf {
             } else {
                 self.mp[p].eval(sin_ti, cos_ti, o.sin_to, o.cos_to) * T::splat(0.5 * FRAC_1_PI)
             };
-            for c in 0..3 {
-                f[c] = f[c] + weight * o.ap[p][c];
+            for (f, &a) in f.iter_mut().zip(&o.ap[p]) {
+                *f = *f + weight * a;
             }
             pdf = pdf + weight * o.lobe_pdf[p];
         }
@@ -290,7 +260,7 @@ impl HairBsdf {
         ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
     }
 
-    /// The per-wi stage of one evaluation with the four lobes in the lanes of an f32x4.
+    /// The per-wi stage of one evaluation, with the four lobes in the lanes of an f32x4.
     /// Every lane runs the operations [`Self::eval_lobes`] runs for that lobe, and the
     /// lobes are summed in the same order, so the two agree bit for bit.
     #[inline(always)]
@@ -315,11 +285,11 @@ impl HairBsdf {
 
         let mut f = [0.0f32; 3];
         let mut pdf = 0.0f32;
-        for p in 0..=EXPLICIT_LOBES {
-            for c in 0..3 {
-                f[c] += weight[p] * o.ap[p][c];
+        for ((w, ap), lobe_pdf) in weight.iter().zip(&o.ap).zip(&o.lobe_pdf) {
+            for (f, a) in f.iter_mut().zip(ap) {
+                *f += w * a;
             }
-            pdf += weight[p] * o.lobe_pdf[p];
+            pdf += w * lobe_pdf;
         }
         let cos_wi = wi[2].abs();
         let inv_cos = if cos_wi > MIN_COS_WI {
@@ -328,6 +298,65 @@ impl HairBsdf {
             1.0
         };
         ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
+    }
+}
+
+/// [`HairBsdf`] at a fixed (h, wo); see [`HairBsdf::at`].
+pub struct HairPoint<'a> {
+    bsdf: &'a HairBsdf,
+    wo: [f32; 3],
+    o: Outgoing<f32>,
+}
+
+impl HairPoint<'_> {
+    /// f and pdf for the incident direction wi.
+    pub fn eval(&self, wi: Vec3) -> HairEval {
+        let (f, pdf) = self.bsdf.eval_lobes_packed(&self.o, self.wo, wi.to_array());
+        HairEval {
+            f: Vec3::from_array(f),
+            pdf,
+        }
+    }
+
+    /// Samples wi; see [`HairBsdf::sample`].
+    pub fn sample(&self, u: [f32; 3]) -> Option<HairSample> {
+        let (bsdf, o, wo) = (self.bsdf, &self.o, self.wo);
+        let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
+        // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
+        // density underflows, from being sampled with a whole 2^-24 of probability.
+        let (u_phi, u_theta) = (u_phi.max(U_MIN), u[1].max(U_MIN));
+
+        let (sin_to, cos_to) = if p < EXPLICIT_LOBES {
+            o.tilted[p]
+        } else {
+            (o.sin_to, o.cos_to)
+        };
+        let (sin_ti, cos_ti) = bsdf.mp[p].sample(sin_to, cos_to, [u_theta, u[2]]);
+        let dphi = if p < EXPLICIT_LOBES {
+            o.deflection[p] + bsdf.np.sample(u_phi)
+        } else {
+            TAU * u_phi
+        };
+
+        // Rotate wo's azimuth by dphi; wo along the tangent has none, any will do.
+        let len_o = (wo[1] * wo[1] + wo[2] * wo[2]).sqrt();
+        let (cos_po, sin_po) = if len_o > 0.0 {
+            (wo[1] / len_o, wo[2] / len_o)
+        } else {
+            (1.0, 0.0)
+        };
+        let (sin_d, cos_d) = dphi.sin_cos();
+        let wi = Vec3::new(
+            sin_ti,
+            cos_ti * (cos_po * cos_d - sin_po * sin_d),
+            cos_ti * (sin_po * cos_d + cos_po * sin_d),
+        );
+        let e = self.eval(wi);
+        (e.pdf > 0.0).then_some(HairSample {
+            wi,
+            f: e.f,
+            pdf: e.pdf,
+        })
     }
 }
 

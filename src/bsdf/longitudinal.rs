@@ -96,11 +96,10 @@ impl<T: Lanes> MpConstants<T> {
         let s = sin_ti * cos_to + cos_ti * sin_to;
         let one_minus_c = T::branch(c.gt(T::splat(0.0)), || s * s / (one + c), || one - c);
         let exponent = -(one_minus_c * self.inv_v);
-        // Small a: I0(a) itself, and e^-a moves into the exponent (both terms <= 0).
-        T::branch(
-            a.lt(T::splat(SPLIT)),
-            || self.norm * exp_neg(exponent - a) * i0_small(a),
-            || self.norm * exp_neg(exponent) * i0_large_scaled(a),
-        )
+        // Small a: I0(a) itself, and e^-a moves into the exponent (both terms <= 0); one
+        // exp serves both forms.
+        let small = a.lt(T::splat(SPLIT));
+        let scaled_i0 = T::branch(small, || i0_small(a), || i0_large_scaled(a));
+        self.norm * exp_neg(T::select(small, exponent - a, exponent)) * scaled_i0
     }
 }

@@ -4,11 +4,13 @@
 
 pub mod absorption;
 pub mod azimuthal;
+pub mod diffuse;
 pub mod hair;
 pub mod longitudinal;
 pub mod params;
 
 pub use absorption::{sigma_a_from_color, sigma_a_from_melanin};
-pub use hair::{HairBsdf, HairEval, HairSample};
+pub use diffuse::Diffuse;
+pub use hair::{HairBsdf, HairEval, HairPoint, HairSample};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
 pub use params::HairParams;

@@ -59,7 +59,7 @@ impl HairParams {
         }
         check_beta("beta_m", self.beta_m)?;
         check_beta("beta_n", self.beta_n)?;
-        if !(self.alpha.abs() <= ALPHA_MAX_DEG) {
+        if self.alpha.is_nan() || self.alpha.abs() > ALPHA_MAX_DEG {
             return Err(invalid_arg!(
                 "alpha = {} degrees: must be in [-{ALPHA_MAX_DEG}, {ALPHA_MAX_DEG}]",
                 self.alpha

@@ -8,6 +8,9 @@
 //! the tests. A truncated Taylor series with a one-term asymptotic tail (as in pbrt) is
 //! several percent off between x = 5 and 12; these fits are not, at the same cost.
 
+// Coefficients are quoted as published, digits beyond f32 included.
+#![allow(clippy::excessive_precision)]
+
 use super::Lanes;
 use super::fast::exp_neg;
 

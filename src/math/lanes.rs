@@ -36,6 +36,12 @@ pub trait Lanes:
     /// Per lane: `if mask { a() } else { b() }`. A scalar runs only the branch taken,
     /// a vector runs both and selects.
     fn branch(mask: Self::Mask, a: impl FnOnce() -> Self, b: impl FnOnce() -> Self) -> Self;
+    /// [`super::fast::exp_neg`] of three values (an RGB absorption); a scalar packs them
+    /// into one SIMD evaluation, with the same bits as three separate ones.
+    #[inline(always)]
+    fn exp_neg3(x: [Self; 3]) -> [Self; 3] {
+        x.map(super::fast::exp_neg)
+    }
 }
 
 /// Adding 2^23 + 127 to an integral n leaves n + 127 in the low mantissa bits; shifted by
@@ -89,6 +95,11 @@ impl Lanes for f32 {
     #[inline(always)]
     fn branch(mask: bool, a: impl FnOnce() -> Self, b: impl FnOnce() -> Self) -> Self {
         if mask { a() } else { b() }
+    }
+    #[inline(always)]
+    fn exp_neg3(x: [Self; 3]) -> [Self; 3] {
+        let e = super::fast::exp_neg(f32x4::new([x[0], x[1], x[2], 0.0])).to_array();
+        [e[0], e[1], e[2]]
     }
 }
 

@@ -1,9 +1,11 @@
 //! The hairtrace command line. Until the renderer lands, `lobes` is the main job: it
-//! prints how the default (or a given) hair splits energy between its lobes.
+//! prints how the default (or a given) hair splits energy between its lobes. `info`
+//! describes a .hair groom.
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use hairtrace::scene::{Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use std::process::ExitCode;
 
@@ -23,6 +25,17 @@ enum Command {
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),
+    /// Print a .hair groom's strand, point and segment counts, bounds and radius range.
+    Info(InfoArgs),
+}
+
+#[derive(Args)]
+struct InfoArgs {
+    /// The .hair file.
+    file: std::path::PathBuf,
+    /// Read the file's thickness as a radius instead of a diameter (the default).
+    #[arg(long)]
+    thickness_is_radius: bool,
 }
 
 #[derive(Args)]
@@ -111,10 +124,22 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
+fn info(args: &InfoArgs) -> hairtrace::Result<()> {
+    let thickness = if args.thickness_is_radius {
+        Thickness::Radius
+    } else {
+        Thickness::Diameter
+    };
+    let strands = read_hair_file(&args.file, thickness)?;
+    print!("{}", info_report(&strands));
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Lobes(a) => lobes(a),
+        Command::Info(a) => info(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

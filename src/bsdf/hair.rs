@@ -15,7 +15,7 @@ use super::azimuthal::{TrimmedLogistic, azimuthal_scale, wrap_angle};
 use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
 use super::params::HairParams;
 use crate::error::{Result, invalid_arg};
-use crate::math::fast::{atan2, exp_neg};
+use crate::math::fast::atan2;
 use crate::math::{Lanes, safe_asin, safe_sqrt};
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};

@@ -14,8 +14,12 @@ mod error;
 pub mod image;
 /// cbindgen:ignore
 pub mod math;
+/// cbindgen:ignore
+pub mod render;
+/// cbindgen:ignore
+pub mod scene;
 
-pub use bsdf::{HairBsdf, HairEval, HairParams, HairSample};
+pub use bsdf::{HairBsdf, HairEval, HairParams, HairPoint, HairSample};
 pub use error::{Error, Result};
 
 /// The crate version, as the C ABI reports it.

@@ -34,14 +34,26 @@ pub fn sigma_a_from_color(color: [f32; 3], beta_n: f32) -> Result<[f32; 3]> {
             ));
         }
     }
-    let b = f64::from(beta_n);
-    let d = 5.969 - 0.215 * b + 2.532 * b.powi(2) - 10.73 * b.powi(3)
-        + 5.574 * b.powi(4)
-        + 0.245 * b.powi(5);
+    let d = color_fit(beta_n);
     Ok(color.map(|c| {
         let r = f64::from(c).ln() / d;
         (r * r) as f32
     }))
+}
+
+/// The reflectance colour a fiber of absorption sigma_a looks like at roughness beta_n:
+/// the inverse of [`sigma_a_from_color`] (for AOVs and previews; not range-checked).
+pub fn color_from_sigma_a(sigma_a: [f32; 3], beta_n: f32) -> [f32; 3] {
+    let d = color_fit(beta_n);
+    sigma_a.map(|s| (-f64::from(s.max(0.0)).sqrt() * d).exp() as f32)
+}
+
+/// The denominator of Chiang's colour fit, a polynomial in beta_n.
+fn color_fit(beta_n: f32) -> f64 {
+    let b = f64::from(beta_n);
+    5.969 - 0.215 * b + 2.532 * b.powi(2) - 10.73 * b.powi(3)
+        + 5.574 * b.powi(4)
+        + 0.245 * b.powi(5)
 }
 
 #[cfg(test)]
@@ -68,6 +80,10 @@ mod tests {
         assert!(s[0] < s[1] && s[1] < s[2]);
         assert!(sigma_a_from_color([0.0, 0.5, 0.5], 0.3).is_err());
         assert!(sigma_a_from_color([0.5, 1.5, 0.5], 0.3).is_err());
+        let back = color_from_sigma_a(s, 0.3);
+        for (b, c) in back.iter().zip([0.8, 0.5, 0.2]) {
+            assert!((b - c).abs() < 1e-5, "{back:?}");
+        }
         let e = sigma_a_from_color([0.5; 3], 0.0).unwrap_err().to_string();
         assert!(e.contains("beta_n"), "{e}");
     }

@@ -4,6 +4,7 @@
 pub mod bessel;
 pub mod fast;
 pub mod lanes;
+pub mod sampling;
 
 pub use lanes::Lanes;
 

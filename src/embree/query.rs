@@ -1,0 +1,254 @@
+//! Ray queries: closest hit and occlusion for single rays, with an optional per-query
+//! exclusion filter.
+//!
+//! This is the only file that knows Embree 3 from Embree 4. The differences it hides:
+//! - Embree 3 passes an `RTCIntersectContext` (flags, filter) as the second argument of
+//!   `rtcIntersect1`/`rtcOccluded1`; Embree 4 takes the ray first and an optional
+//!   `RTCIntersectArguments`/`RTCOccludedArguments` (flags, feature mask, context, filter).
+//! - A per-query filter needs `RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION` on the scene in
+//!   Embree 3, `RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS` plus the query flag
+//!   `RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER` in Embree 4.
+//! - Geometry masks default to all bits in Embree 3 and to 1 in Embree 4; the geometry layer
+//!   always sets them and rays always carry one, so both behave the same.
+//!
+//! The exclusion data reaches the filter callback through the context pointer Embree passes
+//! to it: the context is the first field of a `#[repr(C)]` struct that also holds the
+//! [`Exclude`], so the callback can cast back (Embree's documented way to extend a ray).
+
+use glam::Vec3;
+
+use super::scene::Scene;
+use super::sys;
+
+/// A ray. Embree does not require a unit direction; `t` is in units of `dir`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    pub org: Vec3,
+    pub dir: Vec3,
+    pub tnear: f32,
+    pub tfar: f32,
+    /// Only geometries whose mask shares a bit with this one are hit.
+    pub mask: u32,
+}
+
+impl Ray {
+    /// A ray from `org` along `dir` over [0, infinity), hitting every geometry.
+    pub fn new(org: Vec3, dir: Vec3) -> Self {
+        Ray {
+            org,
+            dir,
+            tnear: 0.0,
+            tfar: f32::INFINITY,
+            mask: u32::MAX,
+        }
+    }
+
+    pub fn point_at(&self, t: f32) -> Vec3 {
+        self.org + t * self.dir
+    }
+
+    fn to_sys(self) -> sys::RTCRay {
+        sys::RTCRay {
+            org_x: self.org.x,
+            org_y: self.org.y,
+            org_z: self.org.z,
+            tnear: self.tnear,
+            dir_x: self.dir.x,
+            dir_y: self.dir.y,
+            dir_z: self.dir.z,
+            time: 0.0,
+            tfar: self.tfar,
+            mask: self.mask,
+            id: 0,
+            flags: 0,
+        }
+    }
+}
+
+/// What Embree reports about the closest hit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RayHit {
+    pub t: f32,
+    pub geom_id: u32,
+    pub prim_id: u32,
+    /// Embree's hit coordinates: for curves u along the segment and v across a flat curve
+    /// (-1..1); for triangles the barycentrics of vertices 1 and 2.
+    pub u: f32,
+    pub v: f32,
+    /// Embree's unnormalised geometric normal (for flat curves: the curve tangent).
+    pub ng: Vec3,
+}
+
+/// Hits a query must ignore: primitives `first_prim..=last_prim` of geometry `geom_id`
+/// closer than `max_t`. It is how a ray leaving a fiber avoids hitting the same tube
+/// again while still seeing the same strand further away.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exclude {
+    pub geom_id: u32,
+    pub first_prim: u32,
+    pub last_prim: u32,
+    pub max_t: f32,
+}
+
+/// Embree's "no geometry" id.
+const INVALID_ID: u32 = u32::MAX;
+
+/// The scene flag that lets a query bring its own filter.
+#[cfg(embree3)]
+pub(super) const FILTER_SCENE_FLAG: sys::RTCSceneFlags =
+    sys::RTCSceneFlags::RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION;
+#[cfg(embree4)]
+pub(super) const FILTER_SCENE_FLAG: sys::RTCSceneFlags =
+    sys::RTCSceneFlags::RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS;
+
+#[cfg(embree3)]
+type RawContext = sys::RTCIntersectContext;
+#[cfg(embree4)]
+type RawContext = sys::RTCRayQueryContext;
+
+/// Embree's context extended with the exclusion the filter reads.
+#[repr(C)]
+struct QueryContext {
+    /// Must stay first: the filter receives a pointer to it and casts back to the whole.
+    raw: RawContext,
+    exclude: Exclude,
+}
+
+impl QueryContext {
+    /// The equivalent of Embree's inline `rtcInitIntersectContext`/`rtcInitRayQueryContext`,
+    /// which bindgen cannot translate.
+    fn new(exclude: Option<&Exclude>) -> Self {
+        #[cfg(embree3)]
+        let raw = sys::RTCIntersectContext {
+            flags: sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT,
+            filter: exclude.map(|_| exclude_filter as _),
+            instID: [INVALID_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT as usize],
+        };
+        #[cfg(embree4)]
+        let raw = {
+            let mut raw = sys::RTCRayQueryContext::default();
+            raw.instID = [INVALID_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT as usize];
+            raw
+        };
+        QueryContext {
+            raw,
+            exclude: exclude.copied().unwrap_or(Exclude {
+                geom_id: INVALID_ID,
+                first_prim: 1,
+                last_prim: 0,
+                max_t: 0.0,
+            }),
+        }
+    }
+}
+
+/// Rejects the candidate hits an [`Exclude`] names. Embree calls it for every hit found on
+/// the way (closest-hit and occlusion queries alike) and drops the lanes set to 0.
+///
+/// # Safety
+/// Only installed by this module, on a context that is the first field of a `QueryContext`.
+unsafe extern "C" fn exclude_filter(args: *const sys::RTCFilterFunctionNArguments) {
+    // SAFETY: Embree passes valid arguments for the duration of the call.
+    let args = unsafe { &*args };
+    // SAFETY: the context is the first field of a live `QueryContext` (see `query`).
+    let exclude = unsafe { &(*(args.context as *const QueryContext)).exclude };
+    let n = args.N as usize;
+    // SAFETY: `valid` holds N ints; ray and hit are SOA packets of N lanes: tfar is the 9th
+    // float array of RTCRayN, primID and geomID the 6th and 7th u32 arrays of RTCHitN.
+    unsafe {
+        let ray = args.ray as *const f32;
+        let hit = args.hit as *const u32;
+        for i in 0..n {
+            let valid = args.valid.add(i);
+            if *valid == 0 {
+                continue;
+            }
+            let t = *ray.add(8 * n + i);
+            let prim = *hit.add(5 * n + i);
+            let geom = *hit.add(6 * n + i);
+            if geom == exclude.geom_id
+                && (exclude.first_prim..=exclude.last_prim).contains(&prim)
+                && t < exclude.max_t
+            {
+                *valid = 0;
+            }
+        }
+    }
+}
+
+impl Scene {
+    /// The closest hit along `ray`, ignoring what `exclude` names.
+    pub fn intersect(&self, ray: &Ray, exclude: Option<&Exclude>) -> Option<RayHit> {
+        let mut ctx = QueryContext::new(exclude);
+        let mut rayhit = sys::RTCRayHit {
+            ray: ray.to_sys(),
+            hit: sys::RTCHit {
+                geomID: INVALID_ID,
+                primID: INVALID_ID,
+                instID: [INVALID_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT as usize],
+                ..Default::default()
+            },
+        };
+        #[cfg(embree3)]
+        // SAFETY: committed scene (a `Scene` is only made by commit); context and ray live
+        // across the call; the filter reads the context as a `QueryContext`, which it is.
+        unsafe {
+            sys::rtcIntersect1(self.raw(), &mut ctx.raw, &mut rayhit)
+        };
+        #[cfg(embree4)]
+        // SAFETY: as above; the arguments point at the context, alive across the call.
+        unsafe {
+            let mut args = sys::RTCIntersectArguments {
+                flags: query_flags(exclude),
+                feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
+                context: &mut ctx.raw,
+                filter: exclude.map(|_| exclude_filter as _),
+                ..Default::default()
+            };
+            sys::rtcIntersect1(self.raw(), &mut rayhit, &mut args)
+        };
+        let h = rayhit.hit;
+        (h.geomID != INVALID_ID).then(|| RayHit {
+            t: rayhit.ray.tfar,
+            geom_id: h.geomID,
+            prim_id: h.primID,
+            u: h.u,
+            v: h.v,
+            ng: Vec3::new(h.Ng_x, h.Ng_y, h.Ng_z),
+        })
+    }
+
+    /// Whether anything (not named by `exclude`) lies along `ray` within [tnear, tfar].
+    pub fn occluded(&self, ray: &Ray, exclude: Option<&Exclude>) -> bool {
+        let mut ctx = QueryContext::new(exclude);
+        let mut r = ray.to_sys();
+        #[cfg(embree3)]
+        // SAFETY: as in `intersect`.
+        unsafe {
+            sys::rtcOccluded1(self.raw(), &mut ctx.raw, &mut r)
+        };
+        #[cfg(embree4)]
+        // SAFETY: as in `intersect`.
+        unsafe {
+            let mut args = sys::RTCOccludedArguments {
+                flags: query_flags(exclude),
+                feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
+                context: &mut ctx.raw,
+                filter: exclude.map(|_| exclude_filter as _),
+                ..Default::default()
+            };
+            sys::rtcOccluded1(self.raw(), &mut r, &mut args)
+        };
+        // Embree marks an occluded ray by setting tfar to -infinity.
+        r.tfar < 0.0 && ray.tfar >= 0.0
+    }
+}
+
+#[cfg(embree4)]
+fn query_flags(exclude: Option<&Exclude>) -> sys::RTCRayQueryFlags {
+    if exclude.is_some() {
+        sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER
+    } else {
+        sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT
+    }
+}

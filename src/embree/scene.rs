@@ -1,0 +1,178 @@
+//! Embree scenes: a builder that attaches geometries, and the committed, immutable scene
+//! that render threads query concurrently.
+//!
+//! The split is the type-level form of Embree's rule that a scene may only be queried after
+//! `rtcCommitScene` and must not change while queries run: [`SceneBuilder::commit`] consumes
+//! the builder and returns a [`Scene`] that is `Sync` and has no mutating methods.
+
+use std::ptr::NonNull;
+use std::sync::Arc;
+
+use super::geometry::Geometry;
+use super::query::FILTER_SCENE_FLAG;
+use super::{Device, sys};
+use crate::error::invalid_arg;
+use crate::{Error, Result};
+
+/// Embree's BVH build quality: a trade between build time and trace speed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum BuildQuality {
+    /// Fastest build (Morton); for interactive previews.
+    Low,
+    /// Embree's default (binned SAH).
+    #[default]
+    Medium,
+    /// Spatial splits: slower build, faster traversal.
+    High,
+}
+
+/// How a scene is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SceneOptions {
+    pub quality: BuildQuality,
+    /// `RTC_SCENE_FLAG_COMPACT`: a smaller BVH that indexes into the vertex buffers, for
+    /// very large grooms, at some trace speed.
+    pub compact: bool,
+    /// `RTC_SCENE_FLAG_ROBUST`: avoids optimisations that can miss hits at edges.
+    pub robust: bool,
+}
+
+/// One reference to an Embree scene, released when dropped.
+#[derive(Debug)]
+struct RawScene(NonNull<sys::RTCSceneTy>);
+
+// SAFETY: Embree scenes may be used from any thread; mutation happens only through
+// `SceneBuilder` (owned, not shared), queries only on a committed `Scene`, which Embree
+// allows from many threads at once.
+unsafe impl Send for RawScene {}
+// SAFETY: as above.
+unsafe impl Sync for RawScene {}
+
+impl Drop for RawScene {
+    fn drop(&mut self) {
+        // SAFETY: we own one reference.
+        unsafe { sys::rtcReleaseScene(self.0.as_ptr()) };
+    }
+}
+
+/// A scene being assembled. Geometries get consecutive ids from 0 in attach order.
+#[derive(Debug)]
+pub struct SceneBuilder {
+    // Released before the geometries (field order), which are released before their buffers.
+    raw: RawScene,
+    geometries: Vec<Geometry>,
+    device: Arc<Device>,
+}
+
+impl SceneBuilder {
+    pub fn new(device: Arc<Device>, options: SceneOptions) -> Result<Self> {
+        // SAFETY: live device.
+        let raw = unsafe { sys::rtcNewScene(device.raw()) };
+        let Some(raw) = NonNull::new(raw) else {
+            return Err(device.check().err().unwrap_or_else(|| Error::Embree {
+                code: sys::RTCError::RTC_ERROR_UNKNOWN.0,
+                message: "rtcNewScene returned null".into(),
+            }));
+        };
+        let raw = RawScene(raw);
+        let mut flags = FILTER_SCENE_FLAG;
+        if options.compact {
+            flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_COMPACT;
+        }
+        if options.robust {
+            flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_ROBUST;
+        }
+        let quality = match options.quality {
+            BuildQuality::Low => sys::RTCBuildQuality::RTC_BUILD_QUALITY_LOW,
+            BuildQuality::Medium => sys::RTCBuildQuality::RTC_BUILD_QUALITY_MEDIUM,
+            BuildQuality::High => sys::RTCBuildQuality::RTC_BUILD_QUALITY_HIGH,
+        };
+        // SAFETY: live scene, valid enum values.
+        unsafe {
+            sys::rtcSetSceneFlags(raw.0.as_ptr(), flags);
+            sys::rtcSetSceneBuildQuality(raw.0.as_ptr(), quality);
+        }
+        device.check()?;
+        Ok(SceneBuilder {
+            raw,
+            geometries: Vec::new(),
+            device,
+        })
+    }
+
+    pub fn device(&self) -> &Arc<Device> {
+        &self.device
+    }
+
+    /// Attaches a committed geometry and returns its id (the `geom_id` of its hits).
+    pub fn attach(&mut self, geometry: impl Into<Geometry>) -> Result<u32> {
+        let geometry = geometry.into();
+        let id = u32::try_from(self.geometries.len())
+            .ok()
+            .filter(|&id| id != u32::MAX)
+            .ok_or_else(|| invalid_arg!("too many geometries in one scene"))?;
+        // SAFETY: live scene and geometry; the id is unused (ids are consecutive). The scene
+        // retains the geometry, and we keep ours (and its buffers) until the scene is gone.
+        unsafe { sys::rtcAttachGeometryByID(self.raw.0.as_ptr(), geometry.raw(), id) };
+        self.device.check()?;
+        self.geometries.push(geometry);
+        Ok(id)
+    }
+
+    /// Builds the BVH. Embree's build uses the device's worker threads.
+    pub fn commit(self) -> Result<Scene> {
+        // SAFETY: live scene with committed geometries.
+        unsafe { sys::rtcCommitScene(self.raw.0.as_ptr()) };
+        self.device.check()?;
+        Ok(Scene {
+            raw: self.raw,
+            geometries: self.geometries,
+            device: self.device,
+        })
+    }
+}
+
+/// A committed scene: immutable, queried from any number of threads (see `query.rs`).
+#[derive(Debug)]
+pub struct Scene {
+    raw: RawScene,
+    geometries: Vec<Geometry>,
+    device: Arc<Device>,
+}
+
+impl Scene {
+    /// The geometry with the id [`SceneBuilder::attach`] returned.
+    pub fn geometry(&self, id: u32) -> Option<&Geometry> {
+        self.geometries.get(id as usize)
+    }
+
+    pub fn geometries(&self) -> &[Geometry] {
+        &self.geometries
+    }
+
+    pub fn device(&self) -> &Arc<Device> {
+        &self.device
+    }
+
+    /// Bytes of the buffers hairtrace holds for the geometries (not Embree's BVH).
+    pub fn heap_bytes(&self) -> usize {
+        self.geometries.iter().map(Geometry::heap_bytes).sum()
+    }
+
+    /// Axis-aligned bounds (lower, upper) of everything in the scene, radii included.
+    pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
+        let mut b = sys::RTCBounds::default();
+        // SAFETY: committed scene, valid output (RTCBounds is 16-byte aligned by bindgen).
+        unsafe { sys::rtcGetSceneBounds(self.raw.0.as_ptr(), &mut b) };
+        (
+            [b.lower_x, b.lower_y, b.lower_z],
+            [b.upper_x, b.upper_y, b.upper_z],
+        )
+    }
+
+    /// The raw handle, for benchmarks that call Embree directly and for FFI. Valid while
+    /// `self` lives; do not release or modify it.
+    pub fn raw(&self) -> sys::RTCScene {
+        self.raw.0.as_ptr()
+    }
+}

@@ -1,0 +1,325 @@
+//! The film: per-pixel averages of camera samples in a crop window of the full frame,
+//! with optional AOVs (albedo, depth, strand id) for compositing and denoising.
+//!
+//! Pixels are addressed by full-frame coordinates everywhere, so a crop renders exactly
+//! the values the same pixels have in a full render: a render farm can split a frame and
+//! assemble the pieces bit for bit.
+
+use glam::Vec3;
+
+use crate::Result;
+use crate::error::invalid_arg;
+
+/// A rectangle of pixels `[x0, x1) x [y0, y1)` in full-frame coordinates: a crop window
+/// or a tile.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct Window {
+    pub x0: u32,
+    pub y0: u32,
+    pub x1: u32,
+    pub y1: u32,
+}
+
+impl Window {
+    pub fn width(&self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+
+    pub fn pixel_count(&self) -> u64 {
+        u64::from(self.width()) * u64::from(self.height())
+    }
+
+    /// Full-frame coordinates of the window's pixels, row by row from the top.
+    pub fn pixels(&self) -> impl Iterator<Item = (u32, u32)> + use<> {
+        let Window { x0, y0, x1, y1 } = *self;
+        (y0..y1).flat_map(move |y| (x0..x1).map(move |x| (x, y)))
+    }
+}
+
+/// Which AOVs a film keeps besides colour.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Aovs {
+    pub albedo: bool,
+    pub depth: bool,
+    pub strand_id: bool,
+}
+
+/// What the first camera-ray hit of a sample reports for the AOVs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FirstHit {
+    /// Reflectance colour of the surface (hair colour, diffuse albedo), in [0, 1].
+    pub albedo: Vec3,
+    /// Distance from the camera along the ray.
+    pub depth: f32,
+    /// Strand index for hair, `None` for meshes.
+    pub strand: Option<u32>,
+}
+
+/// How a pixel's samples map to positions: each sample's offset from the pixel centre
+/// is drawn from the filter (filter importance sampling), so every sample has weight 1
+/// and belongs to exactly one pixel, which keeps pixels independent of each other (and of
+/// tiles and crops). A wider filter trades sharpness for less aliasing of thin strands.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PixelFilter {
+    /// Half-width of a tent in pixels; 0 is the one-pixel box.
+    tent_radius: f32,
+}
+
+impl PixelFilter {
+    /// The one-pixel box filter (the default).
+    pub const BOX: PixelFilter = PixelFilter { tent_radius: 0.0 };
+
+    /// A separable tent (triangle) of half-width `radius` pixels, in (0, 8].
+    pub fn tent(radius: f32) -> Result<Self> {
+        if !(radius > 0.0 && radius <= 8.0) {
+            return Err(invalid_arg!(
+                "tent filter radius {radius} must be in (0, 8] pixels"
+            ));
+        }
+        Ok(Self {
+            tent_radius: radius,
+        })
+    }
+
+    /// Offset from the pixel centre, in pixels, for `u` in [0, 1)^2.
+    pub fn sample(&self, u: [f32; 2]) -> [f32; 2] {
+        let r = self.tent_radius;
+        if r == 0.0 {
+            return [u[0] - 0.5, u[1] - 0.5];
+        }
+        // Inverse CDF of the triangle on [-r, r], one half at a time.
+        let tent = |u: f32| {
+            if u < 0.5 {
+                r * ((2.0 * u).sqrt() - 1.0)
+            } else {
+                r * (1.0 - (2.0 - 2.0 * u).sqrt())
+            }
+        };
+        [tent(u[0]), tent(u[1])]
+    }
+}
+
+/// Depth AOV of a pixel no sample hit. Zero, because a file must stay finite (and half
+/// floats overflow past 65504); no real hit is at distance 0.
+pub const NO_HIT_DEPTH: f32 = 0.0;
+/// Strand-id AOV of a pixel whose nearest hit is not hair (or nothing).
+pub const NO_STRAND: f32 = -1.0;
+
+/// Sums one pixel's samples. The tiles hand a fresh one to the per-pixel function and
+/// store its averages.
+#[derive(Debug, Clone)]
+pub struct PixelAccumulator {
+    rgb: [f64; 3],
+    albedo: [f64; 3],
+    samples: u32,
+    rejected: u32,
+    nearest: f32,
+    strand: f32,
+}
+
+impl Default for PixelAccumulator {
+    fn default() -> Self {
+        Self {
+            rgb: [0.0; 3],
+            albedo: [0.0; 3],
+            samples: 0,
+            rejected: 0,
+            nearest: f32::INFINITY,
+            strand: NO_STRAND,
+        }
+    }
+}
+
+impl PixelAccumulator {
+    /// Adds a camera sample's radiance and what its first hit reports (`None` for a ray
+    /// that escaped).
+    ///
+    /// A sample with any NaN or infinite value (a numerical accident somewhere along the
+    /// path) counts as a black sample that hit nothing, and is counted in
+    /// [`Film::rejected_samples`]: one bad path darkens its pixel by 1/spp instead of
+    /// poisoning it, and the count tells the accident happened.
+    pub fn add(&mut self, radiance: Vec3, hit: Option<&FirstHit>) {
+        self.samples += 1;
+        let hit_ok = hit.is_none_or(|h| h.albedo.is_finite() && h.depth.is_finite());
+        if !(radiance.is_finite() && hit_ok) {
+            self.rejected += 1;
+            return;
+        }
+        for (sum, v) in self.rgb.iter_mut().zip(radiance.to_array()) {
+            *sum += f64::from(v);
+        }
+        if let Some(h) = hit {
+            for (sum, v) in self.albedo.iter_mut().zip(h.albedo.to_array()) {
+                *sum += f64::from(v);
+            }
+            // Depth and strand come from the nearest hit: an average of ids is no id,
+            // and an average depth across a silhouette is a depth of nothing.
+            if h.depth < self.nearest {
+                self.nearest = h.depth;
+                self.strand = h.strand.map_or(NO_STRAND, |s| s as f32);
+            }
+        }
+    }
+
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    pub fn rejected(&self) -> u32 {
+        self.rejected
+    }
+
+    fn mean(&self, sum: [f64; 3]) -> [f32; 3] {
+        let n = f64::from(self.samples.max(1));
+        sum.map(|s| (s / n) as f32)
+    }
+}
+
+/// Float RGB (and AOV) pixels of a crop window of a `width` x `height` frame.
+#[derive(Debug, Clone)]
+pub struct Film {
+    width: u32,
+    height: u32,
+    crop: Window,
+    rgb: Vec<f32>,
+    albedo: Option<Vec<f32>>,
+    depth: Option<Vec<f32>>,
+    strand_id: Option<Vec<f32>>,
+    rejected: u64,
+}
+
+impl Film {
+    /// A black film of the full frame, or of `crop` (non-empty, inside the frame).
+    pub fn new(width: u32, height: u32, crop: Option<Window>, aovs: Aovs) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(invalid_arg!(
+                "film size {width} x {height} must be at least 1 x 1"
+            ));
+        }
+        let crop = crop.unwrap_or(Window {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        });
+        if !(crop.x0 < crop.x1 && crop.y0 < crop.y1 && crop.x1 <= width && crop.y1 <= height) {
+            return Err(invalid_arg!(
+                "crop window x [{}, {}) y [{}, {}) must be non-empty and inside the \
+                 {width} x {height} frame",
+                crop.x0,
+                crop.x1,
+                crop.y0,
+                crop.y1
+            ));
+        }
+        let pixels = usize::try_from(crop.pixel_count())
+            .map_err(|_| invalid_arg!("film of {width} x {height} is too large"))?;
+        let rgb = zeroed(pixels, 3)?;
+        let aov = |on: bool, channels, fill| -> Result<Option<Vec<f32>>> {
+            on.then(|| {
+                let mut v = zeroed(pixels, channels)?;
+                v.fill(fill);
+                Ok(v)
+            })
+            .transpose()
+        };
+        Ok(Self {
+            width,
+            height,
+            crop,
+            rgb,
+            albedo: aov(aovs.albedo, 3, 0.0)?,
+            depth: aov(aovs.depth, 1, NO_HIT_DEPTH)?,
+            strand_id: aov(aovs.strand_id, 1, NO_STRAND)?,
+            rejected: 0,
+        })
+    }
+
+    /// Full frame width.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Full frame height.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    pub fn crop(&self) -> Window {
+        self.crop
+    }
+
+    /// The camera's [0, 1]^2 image point of a sample at `offset` pixels (from a
+    /// [`PixelFilter`]) from the centre of the full-frame `pixel`.
+    pub fn ndc(&self, pixel: (u32, u32), offset: [f32; 2]) -> [f32; 2] {
+        [
+            (pixel.0 as f32 + 0.5 + offset[0]) / self.width as f32,
+            (pixel.1 as f32 + 0.5 + offset[1]) / self.height as f32,
+        ]
+    }
+
+    /// Interleaved RGB of the crop window, rows from the top: what `write_image` takes,
+    /// with the crop's width and height.
+    pub fn rgb(&self) -> &[f32] {
+        &self.rgb
+    }
+
+    /// Interleaved mean albedo RGB of the first hits (0 where rays escaped).
+    pub fn albedo(&self) -> Option<&[f32]> {
+        self.albedo.as_deref()
+    }
+
+    /// Distance to the nearest first hit of each pixel ([`NO_HIT_DEPTH`] for none).
+    pub fn depth(&self) -> Option<&[f32]> {
+        self.depth.as_deref()
+    }
+
+    /// Strand index of each pixel's nearest first hit as f32 ([`NO_STRAND`] for none);
+    /// exact up to 2^24 strands.
+    pub fn strand_id(&self) -> Option<&[f32]> {
+        self.strand_id.as_deref()
+    }
+
+    /// Samples whose values were NaN or infinite, counted as black (see
+    /// [`PixelAccumulator::add`]).
+    pub fn rejected_samples(&self) -> u64 {
+        self.rejected
+    }
+
+    /// Stores a finished pixel, given in full-frame coordinates inside the crop.
+    pub(super) fn store(&mut self, pixel: (u32, u32), acc: &PixelAccumulator) {
+        let i = ((pixel.1 - self.crop.y0) as usize) * self.crop.width() as usize
+            + (pixel.0 - self.crop.x0) as usize;
+        self.rgb[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.rgb));
+        if let Some(albedo) = &mut self.albedo {
+            albedo[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.albedo));
+        }
+        if let Some(depth) = &mut self.depth {
+            depth[i] = if acc.nearest.is_finite() {
+                acc.nearest
+            } else {
+                NO_HIT_DEPTH
+            };
+        }
+        if let Some(strand) = &mut self.strand_id {
+            strand[i] = acc.strand;
+        }
+        self.rejected += u64::from(acc.rejected);
+    }
+}
+
+/// A zero-filled buffer, or an error rather than an abort when memory runs out.
+fn zeroed(pixels: usize, channels: usize) -> Result<Vec<f32>> {
+    let n = pixels
+        .checked_mul(channels)
+        .ok_or_else(|| invalid_arg!("film of {pixels} pixels is too large"))?;
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| invalid_arg!("cannot allocate a film of {pixels} pixels"))?;
+    v.resize(n, 0.0);
+    Ok(v)
+}

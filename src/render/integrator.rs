@@ -1,0 +1,385 @@
+//! Unidirectional path tracing with next-event estimation and multiple importance
+//! sampling (power heuristic) between light sampling and BSDF sampling.
+//!
+//! Hair keeps energy through very many bounces (DESIGN.md section 4b), so the depth cap is
+//! high and paths end mostly by Russian roulette on their throughput, which is unbiased.
+
+use glam::Vec3;
+
+use super::film::FirstHit;
+use super::sampler::PixelSampler;
+use crate::bsdf::absorption::color_from_sigma_a;
+use crate::bsdf::diffuse::Diffuse;
+use crate::embree::Ray;
+use crate::error::{Result, invalid_arg};
+use crate::math::sampling::{Distribution1D, power_heuristic};
+use crate::scene::hit::{HairHit, Hit, SurfaceHit};
+use crate::scene::light::{Light, luminance};
+use crate::scene::material::PreparedHair;
+use crate::scene::tracer::{SpawnedRay, Tracer};
+
+/// How a path's light is gathered. `Mis` is the renderer; the two others exist so that
+/// tests can show MIS is unbiased (all three converge to the same image).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Strategy {
+    #[default]
+    Mis,
+    /// Next-event estimation only: emission found by BSDF sampling is ignored (except
+    /// what the camera sees directly).
+    LightOnly,
+    /// BSDF sampling only: no shadow rays.
+    BsdfOnly,
+}
+
+/// Path settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathSettings {
+    /// Longest path, in scattering events. 256 keeps a white fur ball's furnace above
+    /// 0.9999 (DESIGN.md 4b); Russian roulette ends most paths far earlier.
+    pub max_depth: u32,
+    /// Russian roulette starts after this many events.
+    pub rr_depth: u32,
+    /// Upper bound on the luminance of any one contribution after the first bounce
+    /// (biased, reduces fireflies); None = off, the default.
+    pub clamp_indirect: Option<f32>,
+    pub strategy: Strategy,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            max_depth: 256,
+            rr_depth: 8,
+            clamp_indirect: None,
+            strategy: Strategy::Mis,
+        }
+    }
+}
+
+impl PathSettings {
+    pub fn validate(&self) -> Result<()> {
+        if self.max_depth == 0 {
+            return Err(invalid_arg!("max_depth = 0: must be at least 1"));
+        }
+        if let Some(c) = self.clamp_indirect {
+            if !(c.is_finite() && c > 0.0) {
+                return Err(invalid_arg!("clamp_indirect = {c}: must be finite and > 0"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What a geometry is made of.
+#[derive(Debug, Clone)]
+pub enum Material {
+    Hair(PreparedHair),
+    Diffuse(Diffuse),
+}
+
+/// Everything a path needs: geometry, one material per geometry id, lights.
+pub struct World {
+    pub tracer: Tracer,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    /// Light selection proportional to power, and each light's probability under it.
+    light_choice: Option<Distribution1D>,
+    light_prob: Vec<f32>,
+}
+
+impl World {
+    /// `materials[g]` shades geometry id g of the tracer.
+    pub fn new(tracer: Tracer, materials: Vec<Material>, lights: Vec<Light>) -> Result<Self> {
+        let geometries = tracer.scene().geometries().len();
+        if materials.len() != geometries {
+            return Err(invalid_arg!(
+                "{} materials for {geometries} geometries",
+                materials.len()
+            ));
+        }
+        let (lo, hi) = tracer.scene().bounds();
+        let radius = 0.5 * (Vec3::from_array(hi) - Vec3::from_array(lo)).length();
+        let radius = if radius.is_finite() && radius > 0.0 {
+            radius
+        } else {
+            1.0
+        };
+        let power: Vec<f32> = lights.iter().map(|l| l.power(radius)).collect();
+        let total: f32 = power.iter().sum();
+        let (light_choice, light_prob) = if total > 0.0 && total.is_finite() {
+            (
+                Some(Distribution1D::new(&power)?),
+                power.iter().map(|p| p / total).collect(),
+            )
+        } else {
+            (None, vec![0.0; lights.len()])
+        };
+        Ok(World {
+            tracer,
+            materials,
+            lights,
+            light_choice,
+            light_prob,
+        })
+    }
+
+    /// Radiance arriving along the camera ray (org, dir), what its first hit reports for
+    /// the AOVs (None when it escapes), and the number of rays traced.
+    pub fn radiance(
+        &self,
+        org: Vec3,
+        dir: Vec3,
+        settings: &PathSettings,
+        sampler: &mut PixelSampler,
+    ) -> (Vec3, Option<FirstHit>, u32) {
+        let mut first = None;
+        let mut rays = 0;
+        let mut l = Vec3::ZERO;
+        let mut beta = Vec3::ONE;
+        let mut ray = SpawnedRay {
+            ray: Ray::new(org, dir),
+            exclude: None,
+        };
+        // The BSDF pdf of the direction that produced `ray`, for MIS on the emission it
+        // finds; None for camera rays, which see emission with full weight.
+        let mut bsdf_pdf: Option<f32> = None;
+        for depth in 0..settings.max_depth {
+            let hit = self.tracer.intersect_spawned(&ray);
+            rays += 1;
+            let t_hit = hit.as_ref().map_or(f32::INFINITY, Hit::t);
+            let contribution =
+                self.emission(ray.ray.org, ray.ray.dir, t_hit, bsdf_pdf, settings.strategy);
+            l += clamp(beta * contribution, depth, settings);
+            let Some(hit) = hit else { break };
+            if depth == 0 {
+                first = Some(self.first_hit(&hit));
+            }
+            let wo_world = -ray.ray.dir.normalize();
+            // A fixed number of dimensions per bounce keeps the sample sequence aligned.
+            let choice = sampler.next_1d();
+            let u_light = sampler.next_2d();
+            let u_lobe = sampler.next_1d();
+            let u_dir = sampler.next_2d();
+            let u_rr = sampler.next_1d();
+            let shading = match self.shading(&hit, wo_world) {
+                Some(s) => s,
+                None => break,
+            };
+            if settings.strategy != Strategy::BsdfOnly {
+                let (direct, shadow_rays) =
+                    self.direct(&hit, &shading, choice, u_light, settings.strategy);
+                rays += shadow_rays;
+                l += clamp(beta * direct, depth + 1, settings);
+            }
+            let Some((wi, weight, pdf)) = shading.sample([u_lobe, u_dir[0], u_dir[1]]) else {
+                break;
+            };
+            beta *= weight;
+            bsdf_pdf = Some(pdf);
+            if depth + 1 >= settings.rr_depth {
+                let survive = beta.max_element().min(0.95);
+                if !(u_rr < survive) {
+                    break;
+                }
+                beta /= survive;
+            }
+            ray = self.tracer.spawn(&hit, wi, f32::INFINITY);
+        }
+        (l, first, rays)
+    }
+
+    fn first_hit(&self, hit: &Hit) -> FirstHit {
+        let (albedo, strand) = match (hit, self.materials.get(hit.geom_id() as usize)) {
+            (Hit::Hair(h), Some(Material::Hair(m))) => {
+                let p = m.params_at(h.strand.strand, h.s, h.color);
+                (
+                    Vec3::from_array(color_from_sigma_a(p.sigma_a, p.beta_n)),
+                    Some(h.strand.strand),
+                )
+            }
+            (Hit::Surface(_), Some(Material::Diffuse(d))) => (d.albedo(), None),
+            _ => (Vec3::ZERO, None),
+        };
+        FirstHit {
+            albedo,
+            depth: hit.t(),
+            strand,
+        }
+    }
+
+    /// Emission met by a ray: lights at infinity when it escapes, rect lights nearer than
+    /// its hit. `bsdf_pdf` is None for camera rays (full weight).
+    fn emission(
+        &self,
+        org: Vec3,
+        dir: Vec3,
+        t_hit: f32,
+        bsdf_pdf: Option<f32>,
+        strategy: Strategy,
+    ) -> Vec3 {
+        let dir_n = dir.normalize();
+        let mut sum = Vec3::ZERO;
+        for (i, light) in self.lights.iter().enumerate() {
+            let le = if light.is_infinite() {
+                if t_hit.is_finite() {
+                    continue;
+                }
+                light.le(dir_n)
+            } else {
+                match light.intersect(org, dir) {
+                    Some(t) if t < t_hit => {
+                        light.eval_li(org, dir_n).map_or(Vec3::ZERO, |e| e.radiance)
+                    }
+                    _ => continue,
+                }
+            };
+            let weight = match (bsdf_pdf, strategy) {
+                (None, _) | (Some(_), Strategy::BsdfOnly) => 1.0,
+                (Some(_), Strategy::LightOnly) => 0.0,
+                (Some(pdf), Strategy::Mis) => {
+                    let light_pdf = self.choice_pdf(i) * light.pdf_li(org, dir_n);
+                    power_heuristic(1.0, pdf, 1.0, light_pdf)
+                }
+            };
+            sum += le * weight;
+        }
+        sum
+    }
+
+    fn choice_pdf(&self, light: usize) -> f32 {
+        self.light_prob[light]
+    }
+
+    /// Next-event estimation: one light, chosen by power, one direction toward it.
+    /// Returns the contribution and the number of shadow rays traced (0 or 1).
+    fn direct(
+        &self,
+        hit: &Hit,
+        shading: &Shading,
+        u_choice: f32,
+        u: [f32; 2],
+        strategy: Strategy,
+    ) -> (Vec3, u32) {
+        let none = (Vec3::ZERO, 0);
+        let Some(choice) = &self.light_choice else {
+            return none;
+        };
+        let (_, _, index) = choice.sample(u_choice);
+        let (Some(light), choice_pdf) = (self.lights.get(index), self.choice_pdf(index)) else {
+            return none;
+        };
+        let Some(ls) = light.sample_li(hit.p(), u) else {
+            return none;
+        };
+        if !(ls.pdf > 0.0) || ls.radiance == Vec3::ZERO {
+            return none;
+        }
+        let (f_cos, bsdf_pdf) = shading.eval(ls.wi);
+        if f_cos == Vec3::ZERO {
+            return none;
+        }
+        let tfar = if ls.distance.is_finite() {
+            ls.distance * (1.0 - 1e-4)
+        } else {
+            f32::INFINITY
+        };
+        if self
+            .tracer
+            .occluded_spawned(&self.tracer.spawn(hit, ls.wi, tfar))
+        {
+            return (Vec3::ZERO, 1);
+        }
+        let light_pdf = ls.pdf * choice_pdf;
+        let weight = if ls.is_delta || strategy == Strategy::LightOnly {
+            1.0
+        } else {
+            power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
+        };
+        (f_cos * ls.radiance * (weight / light_pdf), 1)
+    }
+
+    /// The BSDF at a hit, in its local frame.
+    fn shading<'a>(&'a self, hit: &Hit, wo_world: Vec3) -> Option<Shading<'a>> {
+        match (hit, self.materials.get(hit.geom_id() as usize)?) {
+            (Hit::Hair(h), Material::Hair(m)) => Some(Shading::hair(h, m, wo_world)),
+            (Hit::Surface(s), Material::Diffuse(d)) => Some(Shading::diffuse(s, *d, wo_world)),
+            _ => None,
+        }
+    }
+}
+
+/// A BSDF at a path vertex with its local frame.
+enum Shading<'a> {
+    Hair {
+        frame: crate::scene::hit::HairFrame,
+        bsdf: std::borrow::Cow<'a, crate::bsdf::HairBsdf>,
+        h: f32,
+        wo: Vec3,
+    },
+    Diffuse {
+        frame: [Vec3; 3],
+        bsdf: Diffuse,
+        wo: Vec3,
+    },
+}
+
+impl<'a> Shading<'a> {
+    fn hair(h: &HairHit, m: &'a PreparedHair, wo_world: Vec3) -> Self {
+        let wo = h.frame.to_local(wo_world);
+        Shading::Hair {
+            frame: h.frame,
+            bsdf: m.bsdf_at(h.strand.strand, h.s, h.color),
+            h: h.h,
+            wo,
+        }
+    }
+
+    fn diffuse(s: &SurfaceHit, bsdf: Diffuse, wo_world: Vec3) -> Self {
+        let (t, b) = s.ns.any_orthonormal_pair();
+        let frame = [t, b, s.ns];
+        let wo = Vec3::new(wo_world.dot(t), wo_world.dot(b), wo_world.dot(s.ns));
+        Shading::Diffuse { frame, bsdf, wo }
+    }
+
+    /// f * |cos| and the BSDF pdf toward the world direction wi.
+    fn eval(&self, wi: Vec3) -> (Vec3, f32) {
+        match self {
+            Shading::Hair { frame, bsdf, h, wo } => {
+                let local = frame.to_local(wi);
+                let e = bsdf.eval(*h, *wo, local);
+                (e.f * local.z.abs(), e.pdf)
+            }
+            Shading::Diffuse { frame, bsdf, wo } => {
+                let local = Vec3::new(wi.dot(frame[0]), wi.dot(frame[1]), wi.dot(frame[2]));
+                let (f, pdf) = bsdf.eval(*wo, local);
+                (f * local.z.abs(), pdf)
+            }
+        }
+    }
+
+    /// A world direction, its path weight f |cos| / pdf and its pdf.
+    fn sample(&self, u: [f32; 3]) -> Option<(Vec3, Vec3, f32)> {
+        match self {
+            Shading::Hair { frame, bsdf, h, wo } => {
+                let s = bsdf.sample(*h, *wo, u)?;
+                Some((frame.to_world(s.wi), s.f * s.wi.z.abs() / s.pdf, s.pdf))
+            }
+            Shading::Diffuse { frame, bsdf, wo } => {
+                let (wi, f, pdf) = bsdf.sample(*wo, [u[1], u[2]])?;
+                let world = frame[0] * wi.x + frame[1] * wi.y + frame[2] * wi.z;
+                Some((world, f * wi.z.abs() / pdf, pdf))
+            }
+        }
+    }
+}
+
+/// Applies the indirect clamp to a contribution found at `depth` (0 = seen directly).
+fn clamp(c: Vec3, depth: u32, settings: &PathSettings) -> Vec3 {
+    match settings.clamp_indirect {
+        Some(max) if depth > 0 => {
+            let y = luminance(c);
+            if y > max { c * (max / y) } else { c }
+        }
+        _ => c,
+    }
+}

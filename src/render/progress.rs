@@ -1,0 +1,27 @@
+//! Progress reports and cancellation, for the CLI's progress bar and a host's callback.
+
+/// Told how far a render has got. The renderer calls [`update`](Progress::update) once
+/// per finished tile, from worker threads but never two calls at once, with `done`
+/// increasing from call to call up to `total` (both in pixels).
+pub trait Progress: Sync {
+    /// Returns `false` to cancel the render: no new pixel starts after that, and the
+    /// render returns [`RenderStatus::Cancelled`](super::RenderStatus::Cancelled).
+    fn update(&self, done: u64, total: u64) -> bool;
+}
+
+/// Reports nowhere and never cancels.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn update(&self, _done: u64, _total: u64) -> bool {
+        true
+    }
+}
+
+/// Any `Fn(done, total) -> keep_going` closure is a progress sink.
+impl<F: Fn(u64, u64) -> bool + Sync> Progress for F {
+    fn update(&self, done: u64, total: u64) -> bool {
+        self(done, total)
+    }
+}

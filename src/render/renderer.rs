@@ -1,0 +1,83 @@
+//! One render: camera samples per pixel through the integrator, over tiles in parallel.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use super::film::{Aovs, Film, PixelFilter, Window};
+use super::integrator::World;
+use super::progress::Progress;
+use super::sampler::PixelSampler;
+use super::settings::RenderSettings;
+use super::tiles::{RenderStatus, TileOptions, render_tiles};
+use crate::error::Result;
+use crate::scene::camera::Camera;
+
+/// A finished (or cancelled) render and what it cost.
+#[derive(Debug)]
+pub struct RenderOutput {
+    pub film: Film,
+    pub status: RenderStatus,
+    pub stats: RenderStats,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderStats {
+    pub seconds: f64,
+    /// Camera samples taken.
+    pub samples: u64,
+    /// Rays traced: closest-hit and shadow.
+    pub rays: u64,
+}
+
+/// Renders `world` through `camera`. Each sample's numbers depend only on the seed, the
+/// full-frame pixel and the sample index, so the image is the same for any thread count,
+/// tile order or crop.
+pub fn render(
+    world: &World,
+    camera: &Camera,
+    settings: &RenderSettings,
+    aovs: Aovs,
+    progress: &dyn Progress,
+) -> Result<RenderOutput> {
+    settings.validate()?;
+    let crop = settings
+        .crop
+        .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
+    let mut film = Film::new(settings.width, settings.height, crop, aovs)?;
+    // A tent of one pixel: thin strands alias badly under a box.
+    let filter = PixelFilter::tent(1.0)?;
+    let options = TileOptions {
+        tile_size: 16,
+        threads: settings.threads.unwrap_or(0),
+    };
+    let rays = AtomicU64::new(0);
+    let (width, height) = (settings.width as f32, settings.height as f32);
+    let start = Instant::now();
+    let status = render_tiles(&mut film, &options, progress, |pixel, acc| {
+        let mut pixel_rays = 0u64;
+        for index in 0..settings.spp {
+            let mut sampler = PixelSampler::new(settings.seed, pixel, index);
+            let offset = filter.sample(sampler.next_2d());
+            let ndc = [
+                (pixel.0 as f32 + 0.5 + offset[0]) / width,
+                (pixel.1 as f32 + 0.5 + offset[1]) / height,
+            ];
+            let (org, dir) = camera.ray(ndc, sampler.next_2d());
+            let (radiance, first, traced) = world.radiance(org, dir, &settings.path, &mut sampler);
+            pixel_rays += u64::from(traced);
+            acc.add(radiance, first.as_ref());
+        }
+        rays.fetch_add(pixel_rays, Ordering::Relaxed);
+    })?;
+    let window = film.crop();
+    let stats = RenderStats {
+        seconds: start.elapsed().as_secs_f64(),
+        samples: window.pixel_count() * u64::from(settings.spp),
+        rays: rays.into_inner(),
+    };
+    Ok(RenderOutput {
+        film,
+        status,
+        stats,
+    })
+}

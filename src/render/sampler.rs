@@ -1,0 +1,169 @@
+//! The numbers that drive every random decision of a camera path, from a padded,
+//! Owen-scrambled Sobol sequence (Burley 2020, through `sobol_burley`).
+//!
+//! A sample's numbers depend only on (seed, full-frame pixel, sample index, the order in
+//! which the path asks for them): never on the thread, the tile order or the crop, so
+//! renders are reproducible bit for bit and crops assemble into the full frame.
+//!
+//! Each request (`next_1d`, `next_2d`, `next_3d`) takes the first dimensions of its own
+//! independently scrambled sequence, seeded from the pixel and the request's position
+//! ("padding", as pbrt-v4's PaddedSobolSampler does): every 2D request (a lens point, a
+//! light sample) is stratified across the pixel's samples, requests never correlate with
+//! each other, and a path may ask for any number of them, as deep hair paths do.
+
+/// `sobol_burley` holds 2^16 samples per sequence; past that, blocks of 2^16 get their own
+/// scramble, which keeps values valid and independent (only the stratification across
+/// blocks is lost).
+const BLOCK_BITS: u32 = 16;
+
+/// A cursor over one pixel sample's dimensions. Cheap to create (a few hashes): make one
+/// per camera sample.
+#[derive(Debug, Clone)]
+pub struct PixelSampler {
+    /// Scramble seed of this pixel and sample block.
+    seed: u64,
+    /// Index inside the 2^16 block.
+    index: u32,
+    /// Number of requests made so far.
+    request: u32,
+}
+
+impl PixelSampler {
+    /// Sample `sample_index` of the full-frame `pixel` in a render seeded with `seed`.
+    pub fn new(seed: u64, pixel: (u32, u32), sample_index: u32) -> Self {
+        let pixel_key = (u64::from(pixel.0) << 32) | u64::from(pixel.1);
+        let block = u64::from(sample_index >> BLOCK_BITS);
+        Self {
+            seed: mix(mix(mix(seed) ^ pixel_key) ^ block),
+            index: sample_index & ((1 << BLOCK_BITS) - 1),
+            request: 0,
+        }
+    }
+
+    /// The scramble of the next request's sequence.
+    fn next_sequence(&mut self) -> u32 {
+        let s = mix(self.seed ^ u64::from(self.request));
+        self.request = self.request.wrapping_add(1);
+        (s >> 32) as u32
+    }
+
+    /// One number in [0, 1).
+    pub fn next_1d(&mut self) -> f32 {
+        let s = self.next_sequence();
+        sobol_burley::sample(self.index, 0, s)
+    }
+
+    /// Two numbers in [0, 1), jointly stratified.
+    pub fn next_2d(&mut self) -> [f32; 2] {
+        let s = self.next_sequence();
+        [
+            sobol_burley::sample(self.index, 0, s),
+            sobol_burley::sample(self.index, 1, s),
+        ]
+    }
+
+    /// Three numbers in [0, 1), jointly stratified (what the hair BSDF's sample takes).
+    pub fn next_3d(&mut self) -> [f32; 3] {
+        let s = self.next_sequence();
+        let v = sobol_burley::sample_4d(self.index, 0, s);
+        [v[0], v[1], v[2]]
+    }
+}
+
+/// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,
+/// such as neighbouring pixels, get unrelated seeds.
+fn mix(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn correlation(a: &[f32], b: &[f32]) -> f64 {
+        let n = a.len() as f64;
+        let mean = |x: &[f32]| x.iter().map(|&v| f64::from(v)).sum::<f64>() / n;
+        let (ma, mb) = (mean(a), mean(b));
+        let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
+        for (&x, &y) in a.iter().zip(b) {
+            let (dx, dy) = (f64::from(x) - ma, f64::from(y) - mb);
+            sab += dx * dy;
+            saa += dx * dx;
+            sbb += dy * dy;
+        }
+        sab / (saa * sbb).sqrt()
+    }
+
+    #[test]
+    fn deterministic_and_in_range() {
+        let draw = |seed, pixel, i| {
+            let mut s = PixelSampler::new(seed, pixel, i);
+            let a = s.next_1d();
+            let [b, c] = s.next_2d();
+            let [d, e, f] = s.next_3d();
+            [a, b, c, d, e, f]
+        };
+        for i in [0, 1, 17, 65_535, 65_536, 1 << 20, u32::MAX] {
+            let v = draw(42, (3, 9), i);
+            assert_eq!(v, draw(42, (3, 9), i));
+            assert!(v.iter().all(|x| (0.0..1.0).contains(x)), "{v:?}");
+            assert_ne!(v, draw(43, (3, 9), i));
+            assert_ne!(v, draw(42, (9, 3), i));
+        }
+    }
+
+    #[test]
+    fn first_64_samples_are_stratified_in_every_request() {
+        for pixel in [(0, 0), (1, 0), (640, 480)] {
+            // Requests at several depths of a path: each is its own stratified sequence.
+            for request in 0..5 {
+                let mut grid = [0u8; 64];
+                let mut strata_x = [0u8; 64];
+                let mut strata_y = [0u8; 64];
+                for i in 0..64 {
+                    let mut s = PixelSampler::new(7, pixel, i);
+                    for _ in 0..request {
+                        s.next_2d();
+                    }
+                    let [x, y] = s.next_2d();
+                    grid[(y * 8.0) as usize * 8 + (x * 8.0) as usize] += 1;
+                    strata_x[(x * 64.0) as usize] += 1;
+                    strata_y[(y * 64.0) as usize] += 1;
+                }
+                assert!(grid.iter().all(|&c| c == 1), "8x8 strata: {grid:?}");
+                assert!(strata_x.iter().all(|&c| c == 1) && strata_y.iter().all(|&c| c == 1));
+            }
+        }
+    }
+
+    #[test]
+    fn pixels_and_requests_are_decorrelated() {
+        let n = 4096;
+        let series = |seed, pixel: (u32, u32), skip: usize| -> Vec<f32> {
+            (0..n)
+                .map(|i| {
+                    let mut s = PixelSampler::new(seed, pixel, i);
+                    for _ in 0..skip {
+                        s.next_1d();
+                    }
+                    s.next_1d()
+                })
+                .collect()
+        };
+        let base = series(1, (10, 10), 0);
+        // 4 / sqrt(n) is four standard deviations of the correlation of independent series.
+        let bound = 4.0 / (n as f64).sqrt();
+        for other in [
+            series(1, (11, 10), 0),
+            series(1, (10, 11), 0),
+            series(2, (10, 10), 0),
+            series(1, (10, 10), 1),
+            series(1, (10, 10), 40),
+        ] {
+            let r = correlation(&base, &other);
+            assert!(r.abs() < bound, "correlation {r}");
+        }
+    }
+}

@@ -1,0 +1,464 @@
+//! Curves from host data: the control points, index buffer and per-strand tables that turn
+//! strands into one Embree curve geometry.
+//!
+//! Two ways in:
+//! - [`Curves::from_strands`] treats each strand as a polyline through its points and
+//!   converts it for the chosen basis, so that every basis draws a curve from the root
+//!   point to the tip point, with one curve segment per polyline segment:
+//!   - linear: the points themselves;
+//!   - Catmull-Rom and B-spline: the points plus one phantom point at each end, the end
+//!     point reflected through its neighbour (`2 p0 - p1`). Reflection rather than a tripled
+//!     end point, because a tripled B-spline end has a zero derivative (a cusp) at the root
+//!     and tip, and this way both bases share one layout. The Catmull-Rom curve passes
+//!     through every point; the B-spline curve passes through the root and the tip and
+//!     smooths the points between (it is the polyline read as B-spline control points);
+//!   - Bezier: the Catmull-Rom curve above, each segment converted to its exact Bezier
+//!     form (inner control points `p_i + (p_{i+1} - p_{i-1}) / 6` and
+//!     `p_{i+1} - (p_{i+2} - p_i) / 6`), consecutive segments sharing end points.
+//! - [`Curves::from_control_points`] takes float4 (x, y, z, radius) control points already
+//!   laid out for the basis and shares the host's buffer with Embree without copying it.
+//!
+//! Either way, attributes survive to the hit through [`StrandIndex`]: the strand of a
+//! primitive (a prefix table of segment counts, 4 bytes per strand rather than 4 per
+//! segment), the position s along the strand (root 0, tip 1, uniform in the segment
+//! parameter) and an optional colour per polyline point, interpolated linearly.
+
+use std::ops::Range;
+
+use crate::embree::{CurveBasis, CurveShape, SharedBuffer, padding_for};
+use crate::error::{Result, invalid_arg};
+use crate::scene::Strands;
+
+/// Curves ready for Embree: control points, index buffer and strand table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curves {
+    basis: CurveBasis,
+    shape: CurveShape,
+    vertices: SharedBuffer<[f32; 4]>,
+    indices: SharedBuffer<u32>,
+    strands: StrandIndex,
+}
+
+/// Where a primitive sits in its strand.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StrandSegment {
+    pub strand: u32,
+    /// Index of the segment within its strand, from the root.
+    pub segment: u32,
+    /// Segments in the strand.
+    pub segments: u32,
+    /// Primitive id of the strand's first segment.
+    pub first_prim: u32,
+}
+
+impl StrandSegment {
+    /// Position along the strand at parameter u of this segment: root 0, tip 1.
+    pub fn s(&self, u: f32) -> f32 {
+        ((self.segment as f32 + u.clamp(0.0, 1.0)) / self.segments as f32).clamp(0.0, 1.0)
+    }
+
+    /// Primitive ids of the strand's segments.
+    pub fn prims(&self) -> Range<u32> {
+        self.first_prim..self.first_prim + self.segments
+    }
+}
+
+/// Per-strand data kept next to the Embree geometry: which strand a primitive belongs to,
+/// and the optional colours.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StrandIndex {
+    /// First segment of each strand, plus the total at the end.
+    segment_starts: Vec<u32>,
+    /// Linear RGB at each polyline point (segments + 1 per strand), strand after strand.
+    colors: Option<Vec<[f32; 3]>>,
+}
+
+impl StrandIndex {
+    /// From segment counts per strand; `colors` must hold `segments + 1` entries per strand.
+    fn new(segments: impl Iterator<Item = usize>, colors: Option<Vec<[f32; 3]>>) -> Result<Self> {
+        let mut segment_starts = vec![0u32];
+        let mut total = 0u64;
+        for n in segments {
+            total += n as u64;
+            let end = u32::try_from(total)
+                .map_err(|_| invalid_arg!("more than {} curve segments", u32::MAX))?;
+            segment_starts.push(end);
+        }
+        let index = StrandIndex {
+            segment_starts,
+            colors,
+        };
+        if let Some(c) = &index.colors {
+            let knots = total as usize + index.strand_count();
+            if c.len() != knots {
+                return Err(invalid_arg!(
+                    "{} colours for {knots} strand points (segments + 1 per strand)",
+                    c.len()
+                ));
+            }
+            if let Some(i) = c
+                .iter()
+                .position(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0))
+            {
+                return Err(invalid_arg!(
+                    "colour {i} = {:?}: must be finite and >= 0",
+                    c[i]
+                ));
+            }
+        }
+        Ok(index)
+    }
+
+    pub fn strand_count(&self) -> usize {
+        self.segment_starts.len() - 1
+    }
+
+    pub fn segment_count(&self) -> usize {
+        *self.segment_starts.last().unwrap_or(&0) as usize
+    }
+
+    /// The strand and segment of primitive `prim` (binary search over the strand table).
+    pub fn locate(&self, prim: u32) -> Option<StrandSegment> {
+        if prim as usize >= self.segment_count() {
+            return None;
+        }
+        let strand = self.segment_starts.partition_point(|&start| start <= prim) - 1;
+        let first_prim = self.segment_starts[strand];
+        Some(StrandSegment {
+            strand: strand as u32,
+            segment: prim - first_prim,
+            segments: self.segment_starts[strand + 1] - first_prim,
+            first_prim,
+        })
+    }
+
+    /// The segments of `strand`, as primitive ids.
+    pub fn strand_prims(&self, strand: u32) -> Option<Range<u32>> {
+        let s = strand as usize;
+        (s < self.strand_count()).then(|| self.segment_starts[s]..self.segment_starts[s + 1])
+    }
+
+    /// The colour at parameter u of segment `at`, if the curves have colours.
+    pub fn color(&self, at: &StrandSegment, u: f32) -> Option<[f32; 3]> {
+        let colors = self.colors.as_ref()?;
+        // Each strand has one more point than segments: skip one per strand before it.
+        let k = (at.first_prim + at.strand + at.segment) as usize;
+        let (a, b) = (colors.get(k)?, colors.get(k + 1)?);
+        let u = u.clamp(0.0, 1.0);
+        Some(std::array::from_fn(|c| a[c] + (b[c] - a[c]) * u))
+    }
+
+    /// Heap bytes of the table.
+    pub fn heap_bytes(&self) -> usize {
+        self.segment_starts.capacity() * 4 + self.colors.as_ref().map_or(0, |c| c.capacity() * 12)
+    }
+}
+
+impl Curves {
+    /// Converts strands (radii, not diameters) for `basis`; see the module notes for what
+    /// each basis makes of the points. Copies the points once, into the buffer Embree reads.
+    pub fn from_strands(strands: &Strands, basis: CurveBasis, shape: CurveShape) -> Result<Self> {
+        strands.validate()?;
+        let phantom = usize::from(basis != CurveBasis::Linear);
+        let per_strand = |n: usize| match basis {
+            CurveBasis::Linear => n,
+            CurveBasis::BSpline | CurveBasis::CatmullRom => n + 2,
+            CurveBasis::Bezier => 3 * (n - 1) + 1,
+        };
+        let total: usize = strands.counts.iter().map(|&n| per_strand(n as usize)).sum();
+        check_vertex_count(total)?;
+        let mut vertices = Vec::with_capacity(total + padding_for::<[f32; 4]>());
+        let segments = strands.segment_count();
+        let mut indices = Vec::with_capacity(segments + padding_for::<u32>());
+
+        for (start, &n) in strands.offsets().zip(&strands.counts) {
+            let n = n as usize;
+            let point = |i: usize| {
+                let [x, y, z] = strands.points[start + i];
+                [x, y, z, strands.radii[start + i]]
+            };
+            let reflect = |end: usize, next: usize| {
+                let (a, b) = (point(end), point(next));
+                std::array::from_fn::<f32, 4, _>(|c| 2.0 * a[c] - b[c])
+            };
+            // Extended points: index 0 is the root's phantom, n + 1 the tip's.
+            let ext = |k: usize| match k {
+                0 => reflect(0, 1),
+                k if k == n + 1 => reflect(n - 1, n - 2),
+                k => point(k - 1),
+            };
+            let base = vertices.len() as u32;
+            match basis {
+                CurveBasis::Linear | CurveBasis::BSpline | CurveBasis::CatmullRom => {
+                    vertices.extend((1 - phantom..n + 1 + phantom).map(ext));
+                    indices.extend((0..n as u32 - 1).map(|i| base + i));
+                }
+                CurveBasis::Bezier => {
+                    vertices.push(ext(1));
+                    for i in 1..n {
+                        let (pm, p0, p1, p2) = (ext(i - 1), ext(i), ext(i + 1), ext(i + 2));
+                        let mut b1: [f32; 4] =
+                            std::array::from_fn(|c| p0[c] + (p1[c] - pm[c]) / 6.0);
+                        let mut b2: [f32; 4] =
+                            std::array::from_fn(|c| p1[c] - (p2[c] - p0[c]) / 6.0);
+                        // Bernstein weights are positive: radii >= 0 at the control points
+                        // keep the interpolated radius >= 0, as Embree requires.
+                        b1[3] = b1[3].max(0.0);
+                        b2[3] = b2[3].max(0.0);
+                        vertices.extend([b1, b2, p1]);
+                    }
+                    indices.extend((0..n as u32 - 1).map(|i| base + 3 * i));
+                }
+            }
+        }
+        let strand_index = StrandIndex::new(
+            strands.counts.iter().map(|&n| n as usize - 1),
+            strands.colors.clone(),
+        )?;
+        Ok(Curves {
+            basis,
+            shape,
+            vertices: SharedBuffer::new(vertices),
+            indices: SharedBuffer::new(indices),
+            strands: strand_index,
+        })
+    }
+
+    /// Control points already laid out for `basis`, `counts[i]` of them for strand i, shared
+    /// with Embree as they are (no copy when `vertices` has
+    /// `padding_for::<[f32; 4]>()` spare capacity; one reallocation otherwise).
+    /// `colors`, if any, holds one linear RGB value per segment end: segments + 1 per strand.
+    pub fn from_control_points(
+        vertices: Vec<[f32; 4]>,
+        counts: &[u32],
+        colors: Option<Vec<[f32; 3]>>,
+        basis: CurveBasis,
+        shape: CurveShape,
+    ) -> Result<Self> {
+        let total: u64 = counts.iter().map(|&c| u64::from(c)).sum();
+        if total != vertices.len() as u64 {
+            return Err(invalid_arg!(
+                "strand counts add up to {total} control points but {} are given",
+                vertices.len()
+            ));
+        }
+        check_vertex_count(vertices.len())?;
+        if let Some(i) = vertices
+            .iter()
+            .position(|v| !(v.iter().all(|c| c.is_finite()) && v[3] >= 0.0))
+        {
+            return Err(invalid_arg!(
+                "control point {i} = {:?}: must be finite with a radius >= 0",
+                vertices[i]
+            ));
+        }
+        let mut segments = Vec::with_capacity(counts.len());
+        for (s, &n) in counts.iter().enumerate() {
+            segments.push(basis.segments_for(n as usize).ok_or_else(|| {
+                invalid_arg!(
+                    "strand {s} has {n} control points, which is not a whole number of \
+                     {basis:?} segments"
+                )
+            })?);
+        }
+        let mut indices = Vec::with_capacity(segments.iter().sum::<usize>() + padding_for::<u32>());
+        let stride = basis.segment_stride() as u32;
+        let mut base = 0u32;
+        for (&n, &count) in segments.iter().zip(counts) {
+            indices.extend((0..n as u32).map(|i| base + stride * i));
+            base += count;
+        }
+        Ok(Curves {
+            basis,
+            shape,
+            vertices: SharedBuffer::new(vertices),
+            indices: SharedBuffer::new(indices),
+            strands: StrandIndex::new(segments.into_iter(), colors)?,
+        })
+    }
+
+    pub fn basis(&self) -> CurveBasis {
+        self.basis
+    }
+
+    pub fn shape(&self) -> CurveShape {
+        self.shape
+    }
+
+    /// Control points (x, y, z, radius) as Embree will read them.
+    pub fn vertices(&self) -> &[[f32; 4]] {
+        self.vertices.as_slice()
+    }
+
+    /// First control point of each segment.
+    pub fn indices(&self) -> &[u32] {
+        self.indices.as_slice()
+    }
+
+    pub fn strands(&self) -> &StrandIndex {
+        &self.strands
+    }
+
+    /// Heap bytes of everything hairtrace keeps for these curves.
+    pub fn heap_bytes(&self) -> usize {
+        self.vertices.heap_bytes() + self.indices.heap_bytes() + self.strands.heap_bytes()
+    }
+
+    /// Splits into the Embree buffers and the table that stays with the scene.
+    pub fn into_parts(
+        self,
+    ) -> (
+        CurveBasis,
+        CurveShape,
+        SharedBuffer<[f32; 4]>,
+        SharedBuffer<u32>,
+        StrandIndex,
+    ) {
+        (
+            self.basis,
+            self.shape,
+            self.vertices,
+            self.indices,
+            self.strands,
+        )
+    }
+}
+
+/// Embree indexes control points with u32.
+fn check_vertex_count(n: usize) -> Result<()> {
+    if n > u32::MAX as usize {
+        return Err(invalid_arg!(
+            "{n} curve control points: at most {} fit Embree's 32-bit indices",
+            u32::MAX
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn strands() -> Strands {
+        Strands {
+            points: vec![
+                [0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 2.0, 1.0],
+                [5.0, 0.0, 0.0],
+                [5.0, 1.0, 0.0],
+            ],
+            radii: vec![0.1, 0.1, 0.05, 0.2, 0.1],
+            counts: vec![3, 2],
+            colors: Some(vec![
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [0.0, 0.0, 1.0],
+                [1.0, 1.0, 1.0],
+                [0.0, 0.0, 0.0],
+            ]),
+        }
+    }
+
+    #[test]
+    fn layouts_per_basis() {
+        let s = strands();
+        for basis in CurveBasis::ALL {
+            let c = Curves::from_strands(&s, basis, CurveShape::Round).unwrap();
+            assert_eq!(c.indices().len(), 3, "{basis:?}");
+            let expected_vertices = match basis {
+                CurveBasis::Linear => 5,
+                CurveBasis::BSpline | CurveBasis::CatmullRom => 9,
+                CurveBasis::Bezier => 7 + 4,
+            };
+            assert_eq!(c.vertices().len(), expected_vertices, "{basis:?}");
+            let span = basis.points_per_segment();
+            assert!(
+                c.indices()
+                    .iter()
+                    .all(|&i| i as usize + span <= c.vertices().len())
+            );
+        }
+        let c = Curves::from_strands(&s, CurveBasis::BSpline, CurveShape::Flat).unwrap();
+        // Root phantom of strand 0 is the root reflected through the second point.
+        assert_eq!(c.vertices()[0], [0.0, -1.0, 0.0, 0.1]);
+        assert_eq!(c.indices(), &[0, 1, 5]);
+        let c = Curves::from_strands(&s, CurveBasis::Bezier, CurveShape::Flat).unwrap();
+        assert_eq!(c.indices(), &[0, 3, 7]);
+        assert_eq!(c.vertices()[3], [0.0, 1.0, 0.0, 0.1]);
+    }
+
+    #[test]
+    fn strands_and_colours_survive() {
+        let c = Curves::from_strands(&strands(), CurveBasis::Linear, CurveShape::Round).unwrap();
+        let idx = c.strands();
+        assert_eq!((idx.strand_count(), idx.segment_count()), (2, 3));
+        let at = idx.locate(1).unwrap();
+        assert_eq!(
+            at,
+            StrandSegment {
+                strand: 0,
+                segment: 1,
+                segments: 2,
+                first_prim: 0
+            }
+        );
+        assert_eq!(at.s(0.5), 0.75);
+        assert_eq!(idx.color(&at, 0.5), Some([0.0, 0.5, 0.5]));
+        let at = idx.locate(2).unwrap();
+        assert_eq!(
+            (at.strand, at.segment, at.s(0.0), at.s(1.0)),
+            (1, 0, 0.0, 1.0)
+        );
+        assert_eq!(idx.color(&at, 0.25), Some([0.75; 3]));
+        assert_eq!(idx.locate(3), None);
+        assert_eq!(idx.strand_prims(1), Some(2..3));
+    }
+
+    #[test]
+    fn host_xyzr_is_shared_not_copied() {
+        let mut v = Vec::with_capacity(6 + padding_for::<[f32; 4]>());
+        v.extend((0..6).map(|i| [i as f32, 0.0, 0.0, 0.1]));
+        let ptr = v.as_ptr();
+        let c =
+            Curves::from_control_points(v, &[4, 2], None, CurveBasis::Linear, CurveShape::Round)
+                .unwrap();
+        assert_eq!(c.vertices().as_ptr(), ptr);
+        assert_eq!(c.indices(), &[0, 1, 2, 4]);
+        let bez = vec![[0.0, 0.0, 0.0, 0.1]; 7];
+        let c = Curves::from_control_points(bez, &[7], None, CurveBasis::Bezier, CurveShape::Flat)
+            .unwrap();
+        assert_eq!(c.indices(), &[0, 3]);
+    }
+
+    #[test]
+    fn bad_control_points_are_named() {
+        let err = Curves::from_control_points(
+            vec![[0.0; 4]; 5],
+            &[5],
+            None,
+            CurveBasis::Bezier,
+            CurveShape::Round,
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("strand 0 has 5"), "{err}");
+        let mut v = vec![[0.0, 0.0, 0.0, 0.1]; 4];
+        v[2][1] = f32::NAN;
+        let err =
+            Curves::from_control_points(v, &[4], None, CurveBasis::BSpline, CurveShape::Round)
+                .unwrap_err();
+        assert!(err.to_string().contains("control point 2"), "{err}");
+        let err = Curves::from_control_points(
+            vec![[0.0, 0.0, 0.0, 0.1]; 4],
+            &[4],
+            Some(vec![[1.0; 3]; 3]),
+            CurveBasis::Linear,
+            CurveShape::Round,
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("3 colours for 4"), "{err}");
+        let mut s = strands();
+        s.radii[0] = -1.0;
+        assert!(Curves::from_strands(&s, CurveBasis::Linear, CurveShape::Round).is_err());
+    }
+}

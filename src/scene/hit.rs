@@ -1,0 +1,203 @@
+//! Hit records and the hair shading frame of DESIGN.md section 3.
+//!
+//! The frame and h are computed in f64 from the f32 inputs: h is a small offset (a fraction
+//! of a fiber radius) taken from the difference of two points that may be far from the
+//! origin and from the camera, and y must be exactly perpendicular to the ray, or the ray's
+//! length leaks into h. In f64 both errors vanish and what remains is the f32 error of the
+//! inputs themselves.
+
+use glam::{DVec3, Vec3};
+
+use super::curves::StrandSegment;
+use crate::embree::CurveShape;
+
+/// The local frame of a hair hit: x the tangent (root to tip), y = normalize(cross(x, d))
+/// for the ray direction d, z = cross(x, y), facing back toward the viewer (z . d <= 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairFrame {
+    pub x: Vec3,
+    pub y: Vec3,
+    pub z: Vec3,
+}
+
+impl HairFrame {
+    /// The frame for `tangent` (any length) and ray direction `dir`, with the offset h of
+    /// the ray from the axis point `axis` in units of `radius`, clamped to [-1, 1].
+    ///
+    /// Degenerate input never gives NaN: a zero tangent becomes a direction perpendicular
+    /// to the ray, and a ray along the tangent gets an arbitrary y perpendicular to x
+    /// (every y is then equally valid: the ray sees the fiber end-on).
+    pub fn with_offset(
+        tangent: Vec3,
+        dir: Vec3,
+        org: Vec3,
+        axis: Vec3,
+        radius: f32,
+    ) -> (HairFrame, f32) {
+        let d = dir.as_dvec3();
+        let x = tangent.as_dvec3().try_normalize().unwrap_or_else(|| {
+            d.try_normalize()
+                .unwrap_or(DVec3::Z)
+                .any_orthonormal_vector()
+        });
+        let y = x
+            .cross(d)
+            .try_normalize()
+            .unwrap_or_else(|| x.any_orthonormal_vector());
+        let z = x.cross(y);
+        let h = if radius > 0.0 {
+            let offset = (org.as_dvec3() - axis.as_dvec3()).dot(y) / f64::from(radius);
+            if offset.is_finite() {
+                offset.clamp(-1.0, 1.0) as f32
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        let frame = HairFrame {
+            x: x.as_vec3(),
+            y: y.as_vec3(),
+            z: z.as_vec3(),
+        };
+        (frame, h)
+    }
+
+    /// A world direction in the BSDF's local frame.
+    pub fn to_local(&self, w: Vec3) -> Vec3 {
+        Vec3::new(w.dot(self.x), w.dot(self.y), w.dot(self.z))
+    }
+
+    /// A local direction back in world space.
+    pub fn to_world(&self, l: Vec3) -> Vec3 {
+        self.x * l.x + self.y * l.y + self.z * l.z
+    }
+}
+
+/// A hit on a hair curve, with everything shading needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairHit {
+    /// Distance along the ray, in units of its direction.
+    pub t: f32,
+    /// The hit point, `org + t dir`.
+    pub p: Vec3,
+    /// Unit geometric normal: the tube's outward normal for round curves, the ribbon's
+    /// ray-facing normal (the frame's z) for flat ones.
+    pub ng: Vec3,
+    pub frame: HairFrame,
+    /// Offset across the fiber in [-1, 1] (DESIGN.md section 3).
+    pub h: f32,
+    /// Axis point and fiber radius at the hit's curve parameter.
+    pub axis: Vec3,
+    pub radius: f32,
+    pub shape: CurveShape,
+    pub geom_id: u32,
+    pub prim_id: u32,
+    /// Parameter along the segment, in [0, 1], of the axis point the hit belongs to.
+    pub u: f32,
+    /// Embree's v: 0 on round curves, the offset across a flat ribbon in [-1, 1] (along -y;
+    /// `h` is the more accurate measure, see `tests/curves_geometry.rs`).
+    pub v: f32,
+    /// The strand and segment hit.
+    pub strand: StrandSegment,
+    /// Position along the strand: root 0, tip 1.
+    pub s: f32,
+    /// Interpolated per-point colour, when the curves have one.
+    pub color: Option<[f32; 3]>,
+}
+
+/// A hit on a triangle mesh.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SurfaceHit {
+    pub t: f32,
+    pub p: Vec3,
+    /// Unit geometric normal, in the winding's orientation (counter-clockwise front).
+    pub ng: Vec3,
+    /// Unit shading normal: interpolated vertex normals when the mesh has them, else `ng`;
+    /// always in the same hemisphere as `ng`.
+    pub ns: Vec3,
+    pub geom_id: u32,
+    pub prim_id: u32,
+    /// Barycentric coordinates of vertices 1 and 2.
+    pub u: f32,
+    pub v: f32,
+}
+
+/// The closest hit of a ray.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Hit {
+    Hair(HairHit),
+    Surface(SurfaceHit),
+}
+
+impl Hit {
+    pub fn t(&self) -> f32 {
+        match self {
+            Hit::Hair(h) => h.t,
+            Hit::Surface(s) => s.t,
+        }
+    }
+
+    pub fn p(&self) -> Vec3 {
+        match self {
+            Hit::Hair(h) => h.p,
+            Hit::Surface(s) => s.p,
+        }
+    }
+
+    pub fn geom_id(&self) -> u32 {
+        match self {
+            Hit::Hair(h) => h.geom_id,
+            Hit::Surface(s) => s.geom_id,
+        }
+    }
+
+    pub fn as_hair(&self) -> Option<&HairHit> {
+        match self {
+            Hit::Hair(h) => Some(h),
+            Hit::Surface(_) => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn design_worked_example() {
+        // Fiber along +x, ray along -z passing at y = +0.5 radius.
+        let (f, h) = HairFrame::with_offset(
+            Vec3::X,
+            -Vec3::Z,
+            Vec3::new(0.3, 0.5, 10.0),
+            Vec3::new(0.3, 0.0, 0.0),
+            1.0,
+        );
+        assert_eq!((f.x, f.y, f.z), (Vec3::X, Vec3::Y, Vec3::Z));
+        assert_eq!(h, 0.5);
+        let w = Vec3::new(0.2, -0.4, 0.7).normalize();
+        assert!((f.to_world(f.to_local(w)) - w).length() < 1e-6);
+    }
+
+    #[test]
+    fn degenerate_inputs_give_a_finite_orthonormal_frame() {
+        for (t, d) in [
+            (Vec3::ZERO, Vec3::Z),
+            (Vec3::X, Vec3::X),
+            (Vec3::X, -Vec3::X),
+            (Vec3::ZERO, Vec3::ZERO),
+            (Vec3::new(1e-30, 0.0, 0.0), Vec3::Y),
+        ] {
+            let (f, h) = HairFrame::with_offset(t, d, Vec3::ONE, Vec3::ZERO, 0.0);
+            for v in [f.x, f.y, f.z] {
+                assert!((v.length() - 1.0).abs() < 1e-6, "{t} {d} {f:?}");
+            }
+            assert!(f.x.dot(f.y).abs() < 1e-6 && f.x.dot(f.z).abs() < 1e-6);
+            assert!(f.z.dot(d) <= 1e-6);
+            assert_eq!(h, 0.0);
+        }
+        let (_, h) = HairFrame::with_offset(Vec3::X, -Vec3::Z, Vec3::Y * 5.0, Vec3::ZERO, 1.0);
+        assert_eq!(h, 1.0);
+    }
+}

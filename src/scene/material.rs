@@ -1,0 +1,257 @@
+//! Materials a hair scene needs: the hair BSDF with its colour source and per-strand
+//! variation, and a diffuse surface for scalps, heads and floors.
+
+use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
+use crate::error::{Result, invalid_arg};
+
+/// Where a hair material's absorption comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum HairColor {
+    /// Absorption per unit fiber radius, linear RGB.
+    SigmaA([f32; 3]),
+    /// Eumelanin and pheomelanin concentrations.
+    Melanin { eumelanin: f32, pheomelanin: f32 },
+    /// A reflectance colour, inverted through beta_n (Chiang et al. 2016).
+    Color([f32; 3]),
+}
+
+/// A hair material: the BSDF parameters plus how they vary over the groom. Variation is
+/// deterministic: it depends only on the seed, the strand id and the position along it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HairMaterial {
+    pub color: HairColor,
+    pub eta: f32,
+    pub beta_m: f32,
+    pub beta_n: f32,
+    /// Cuticle tilt, degrees.
+    pub alpha: f32,
+    /// Relative per-strand spread of the absorption (melanin), in [0, 1]: each strand's
+    /// sigma_a is scaled by a factor drawn uniformly from [1 - x, 1 + x].
+    pub absorption_variation: f32,
+    /// Relative per-strand spread of both roughnesses, in [0, 1] (results are kept in
+    /// the valid range [0.01, 1]).
+    pub roughness_variation: f32,
+    /// Absorption at the tip relative to the root, > 0 (below 1: lighter tips), varied
+    /// linearly along the strand.
+    pub tip_absorption: f32,
+    /// Take the absorption from the groom's per-vertex colours where it has them.
+    pub use_vertex_colors: bool,
+    pub seed: u64,
+}
+
+impl Default for HairMaterial {
+    /// The default brown hair, with no variation.
+    fn default() -> Self {
+        let p = HairParams::default();
+        HairMaterial {
+            color: HairColor::SigmaA(p.sigma_a),
+            eta: p.eta,
+            beta_m: p.beta_m,
+            beta_n: p.beta_n,
+            alpha: p.alpha,
+            absorption_variation: 0.0,
+            roughness_variation: 0.0,
+            tip_absorption: 1.0,
+            use_vertex_colors: false,
+            seed: 0,
+        }
+    }
+}
+
+/// The hair BSDFs of a material: one shared when nothing varies, else built per hit.
+#[derive(Debug, Clone)]
+pub struct PreparedHair {
+    material: HairMaterial,
+    base: HairParams,
+    uniform: Option<HairBsdf>,
+}
+
+impl HairMaterial {
+    fn base_params(&self) -> Result<HairParams> {
+        let sigma_a = match self.color {
+            HairColor::SigmaA(s) => s,
+            HairColor::Melanin {
+                eumelanin,
+                pheomelanin,
+            } => sigma_a_from_melanin(eumelanin, pheomelanin)?,
+            HairColor::Color(c) => sigma_a_from_color(c, self.beta_n)?,
+        };
+        let params = HairParams {
+            sigma_a,
+            eta: self.eta,
+            beta_m: self.beta_m,
+            beta_n: self.beta_n,
+            alpha: self.alpha,
+        };
+        params.validate()?;
+        Ok(params)
+    }
+
+    /// Validates everything and precomputes what does not vary.
+    pub fn prepare(&self) -> Result<PreparedHair> {
+        let base = self.base_params()?;
+        for (name, v) in [
+            ("absorption_variation", self.absorption_variation),
+            ("roughness_variation", self.roughness_variation),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(invalid_arg!("{name} = {v}: must be in [0, 1]"));
+            }
+        }
+        if !(self.tip_absorption.is_finite() && self.tip_absorption > 0.0) {
+            return Err(invalid_arg!(
+                "tip_absorption = {}: must be finite and > 0",
+                self.tip_absorption
+            ));
+        }
+        let varies = self.absorption_variation > 0.0
+            || self.roughness_variation > 0.0
+            || self.tip_absorption != 1.0
+            || self.use_vertex_colors;
+        let uniform = if varies {
+            None
+        } else {
+            Some(HairBsdf::new(&base)?)
+        };
+        Ok(PreparedHair {
+            material: self.clone(),
+            base,
+            uniform,
+        })
+    }
+}
+
+impl PreparedHair {
+    /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's colour
+    /// at the hit when it has one.
+    pub fn params_at(&self, strand: u32, s: f32, vertex_color: Option<[f32; 3]>) -> HairParams {
+        let m = &self.material;
+        let mut p = self.base;
+        if let (true, Some(c)) = (
+            m.use_vertex_colors,
+            vertex_color.filter(|c| c.iter().all(|v| v.is_finite())),
+        ) {
+            // Colours come from files: clamp them into the inversion's domain.
+            let c = c.map(|v| v.clamp(1e-4, 1.0));
+            p.sigma_a = sigma_a_from_color(c, p.beta_n).unwrap_or(p.sigma_a);
+        }
+        let [ua, ur] = strand_uniforms(m.seed, strand);
+        let absorption = (1.0 + m.absorption_variation * (2.0 * ua - 1.0))
+            * (1.0 + (m.tip_absorption - 1.0) * s.clamp(0.0, 1.0));
+        p.sigma_a = p.sigma_a.map(|v| (v * absorption).min(f32::MAX));
+        let roughness = 1.0 + m.roughness_variation * (2.0 * ur - 1.0);
+        p.beta_m = (p.beta_m * roughness).clamp(0.01, 1.0);
+        p.beta_n = (p.beta_n * roughness).clamp(0.01, 1.0);
+        p
+    }
+
+    /// The BSDF at a hit: shared when the material is uniform.
+    pub fn bsdf_at(
+        &self,
+        strand: u32,
+        s: f32,
+        vertex_color: Option<[f32; 3]>,
+    ) -> std::borrow::Cow<'_, HairBsdf> {
+        match &self.uniform {
+            Some(b) => std::borrow::Cow::Borrowed(b),
+            // The parameters are valid by construction (clamped into range).
+            None => std::borrow::Cow::Owned(
+                HairBsdf::new(&self.params_at(strand, s, vertex_color))
+                    .expect("varied parameters stay in range"),
+            ),
+        }
+    }
+}
+
+/// Two uniform numbers in [0, 1) for a strand, from a 64-bit mix of (seed, strand).
+fn strand_uniforms(seed: u64, strand: u32) -> [f32; 2] {
+    let mut x = seed ^ (u64::from(strand).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    // SplitMix64 finaliser: every input bit affects every output bit.
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^= x >> 31;
+    [
+        (x >> 40) as f32 / (1u64 << 24) as f32,
+        ((x >> 16) & 0xFF_FFFF) as f32 / (1u64 << 24) as f32,
+    ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uniform_material_shares_one_bsdf() {
+        let p = HairMaterial::default().prepare().unwrap();
+        assert!(matches!(
+            p.bsdf_at(3, 0.5, None),
+            std::borrow::Cow::Borrowed(_)
+        ));
+        assert_eq!(p.params_at(7, 0.9, None), HairParams::default());
+    }
+
+    #[test]
+    fn variation_is_deterministic_bounded_and_per_strand() {
+        let m = HairMaterial {
+            absorption_variation: 0.5,
+            roughness_variation: 0.5,
+            tip_absorption: 0.25,
+            seed: 9,
+            ..HairMaterial::default()
+        };
+        let p = m.prepare().unwrap();
+        let base = HairParams::default();
+        let a = p.params_at(1, 0.0, None);
+        assert_eq!(a, p.params_at(1, 0.0, None));
+        assert_ne!(a, p.params_at(2, 0.0, None));
+        for strand in 0..1000 {
+            let q = p.params_at(strand, 0.0, None);
+            q.validate().unwrap();
+            let k = q.sigma_a[0] / base.sigma_a[0];
+            assert!((0.5 - 1e-6..=1.5 + 1e-6).contains(&k), "{k}");
+            // Tips absorb a quarter of the root's.
+            let tip = p.params_at(strand, 1.0, None);
+            assert!((tip.sigma_a[2] / q.sigma_a[2] - 0.25).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn vertex_colours_and_bad_values() {
+        let m = HairMaterial {
+            use_vertex_colors: true,
+            ..HairMaterial::default()
+        };
+        let p = m.prepare().unwrap();
+        let white = p.params_at(0, 0.3, Some([1.0, 1.0, 1.0]));
+        assert_eq!(white.sigma_a, [0.0; 3]);
+        assert_eq!(
+            p.params_at(0, 0.3, None).sigma_a,
+            HairParams::default().sigma_a
+        );
+        let bad = HairMaterial {
+            roughness_variation: 1.5,
+            ..HairMaterial::default()
+        };
+        assert!(
+            bad.prepare()
+                .unwrap_err()
+                .to_string()
+                .contains("roughness_variation")
+        );
+        let bad = HairMaterial {
+            tip_absorption: 0.0,
+            ..HairMaterial::default()
+        };
+        assert!(
+            bad.prepare()
+                .unwrap_err()
+                .to_string()
+                .contains("tip_absorption")
+        );
+        let bad = HairMaterial {
+            beta_m: 0.0,
+            ..HairMaterial::default()
+        };
+        assert!(bad.prepare().unwrap_err().to_string().contains("beta_m"));
+    }
+}

@@ -1,0 +1,559 @@
+//! A traceable scene: curves and meshes in one Embree scene, queries that return full hit
+//! records (hair frame, h, strand attributes), and rays that leave a fiber without hitting
+//! it again.
+
+use std::sync::Arc;
+
+use glam::Vec3;
+
+use super::curves::{Curves, StrandIndex, StrandSegment};
+use super::hit::{HairFrame, HairHit, Hit, SurfaceHit};
+use super::mesh::Mesh;
+use crate::Result;
+use crate::embree::{
+    CurveBasis, CurveGeometry, CurvePoint, CurveShape, Device, Exclude, Geometry, Ray, RayHit,
+    Scene, SceneBuilder, SceneOptions, SharedBuffer, TriangleGeometry,
+};
+
+/// Geometry mask bit of hair curves: a ray with `mask = SURFACE_MASK` ignores hair.
+pub const HAIR_MASK: u32 = 1;
+/// Geometry mask bit of triangle meshes.
+pub const SURFACE_MASK: u32 = 2;
+
+/// How a continued ray (reflection, transmission, shadow) leaves a fiber. The re-hit rates
+/// of each are measured in `tests/rehit.rs`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Escape {
+    /// Move the origin off the surface, to the side the ray goes: transmitted rays start
+    /// inside the tube and hit its far wall. Kept as the baseline the others are measured
+    /// against.
+    Offset,
+    /// The offset plus the exclusion filter.
+    OffsetAndFilter,
+    /// Start where the ray leaves the tube (past the far wall for a transmitted ray, just
+    /// off the surface for a reflected one, from the local cylinder at the hit), plus the
+    /// exclusion filter for what that cylinder misses (bends, taper). Embree then rarely
+    /// meets the tube it left, which keeps the filter cheap.
+    #[default]
+    ExitAndFilter,
+    /// Start exactly at the hit point and let the exclusion filter reject every hit on the
+    /// same tube (same strand, neighbouring segments) before the ray can have left it.
+    Filter,
+}
+
+/// Distance, in fiber radii over the sine of the angle to the tangent, within which a hit
+/// on the same tube counts as the same tube: a ray crosses a cylinder of radius r in at most
+/// 2 r / sin(angle); the rest is margin for bends and taper.
+const EXIT_RADII: f32 = 3.0;
+/// Floor of that sine, so a ray along the fiber still gets a finite exclusion distance.
+const MIN_EXIT_SINE: f32 = 1e-3;
+/// Offset of a continued ray's origin, in fiber radii, plus a few ulps of the position.
+const OFFSET_RADII: f32 = 1e-3;
+const OFFSET_ULPS: f32 = 64.0 * f32::EPSILON;
+
+/// A ray leaving a hit, with the exclusion that keeps it off the surface it left.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpawnedRay {
+    pub ray: Ray,
+    pub exclude: Option<Exclude>,
+}
+
+/// What a geometry id refers to, besides the Embree geometry.
+#[derive(Debug)]
+enum Table {
+    Curves(StrandIndex),
+    Mesh { normals: Option<Vec<[f32; 3]>> },
+}
+
+/// Collects curves and meshes, then builds the scene.
+#[derive(Debug)]
+pub struct TracerBuilder {
+    scene: SceneBuilder,
+    tables: Vec<Table>,
+}
+
+impl TracerBuilder {
+    pub fn new(device: Arc<Device>, options: SceneOptions) -> Result<Self> {
+        Ok(TracerBuilder {
+            scene: SceneBuilder::new(device, options)?,
+            tables: Vec::new(),
+        })
+    }
+
+    /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
+    pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
+        let (basis, shape, vertices, indices, strands) = curves.into_parts();
+        let geometry = CurveGeometry::new(
+            self.scene.device(),
+            basis,
+            shape,
+            vertices,
+            indices,
+            HAIR_MASK,
+        )?;
+        let id = self.scene.attach(geometry)?;
+        self.tables.push(Table::Curves(strands));
+        Ok(id)
+    }
+
+    /// Adds a mesh (mask [`SURFACE_MASK`]) and returns its geometry id.
+    pub fn add_mesh(&mut self, mesh: Mesh) -> Result<u32> {
+        mesh.validate()?;
+        let geometry = TriangleGeometry::new(
+            self.scene.device(),
+            SharedBuffer::new(mesh.positions),
+            SharedBuffer::new(mesh.triangles),
+            SURFACE_MASK,
+        )?;
+        let id = self.scene.attach(geometry)?;
+        self.tables.push(Table::Mesh {
+            normals: mesh.normals,
+        });
+        Ok(id)
+    }
+
+    /// Builds the BVH.
+    pub fn build(self) -> Result<Tracer> {
+        Ok(Tracer {
+            scene: self.scene.commit()?,
+            tables: self.tables,
+        })
+    }
+}
+
+/// A committed scene with the tables that turn Embree hits into hit records. `Sync`: share
+/// it between render threads.
+#[derive(Debug)]
+pub struct Tracer {
+    scene: Scene,
+    tables: Vec<Table>,
+}
+
+impl Tracer {
+    pub fn scene(&self) -> &Scene {
+        &self.scene
+    }
+
+    /// The strand table of curves `geom_id`.
+    pub fn strands(&self, geom_id: u32) -> Option<&StrandIndex> {
+        match self.tables.get(geom_id as usize)? {
+            Table::Curves(s) => Some(s),
+            Table::Mesh { .. } => None,
+        }
+    }
+
+    /// Heap bytes hairtrace holds for the scene (buffers and tables; not Embree's BVH).
+    pub fn heap_bytes(&self) -> usize {
+        let tables: usize = self
+            .tables
+            .iter()
+            .map(|t| match t {
+                Table::Curves(s) => s.heap_bytes(),
+                Table::Mesh { normals } => normals.as_ref().map_or(0, |n| n.capacity() * 12),
+            })
+            .sum();
+        self.scene.heap_bytes() + tables
+    }
+
+    /// The closest hit along `ray`, as a full hit record.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let hit = self.scene.intersect(ray, None)?;
+        self.record(ray, &hit)
+    }
+
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        self.scene.occluded(ray, None)
+    }
+
+    /// The ray that continues a path from `from` along `dir` up to `tfar`, leaving the fiber
+    /// the default way ([`Escape::Filter`]).
+    pub fn spawn(&self, from: &Hit, dir: Vec3, tfar: f32) -> SpawnedRay {
+        self.spawn_with(from, dir, tfar, Escape::default())
+    }
+
+    /// As [`Self::spawn`], with the given escape strategy for hair hits. Surface hits always
+    /// offset the origin along the normal.
+    pub fn spawn_with(&self, from: &Hit, dir: Vec3, tfar: f32, escape: Escape) -> SpawnedRay {
+        let (p, ng) = match from {
+            Hit::Hair(h) => (h.p, h.ng),
+            Hit::Surface(s) => (s.p, s.ng),
+        };
+        let side = if dir.dot(ng) >= 0.0 { ng } else { -ng };
+        let ulps = OFFSET_ULPS * p.abs().max_element();
+        let (org, exclude) = match (from, escape) {
+            (Hit::Surface(_), _) => (p + side * ulps, None),
+            (Hit::Hair(h), Escape::Offset) => (p + side * (OFFSET_RADII * h.radius + ulps), None),
+            (Hit::Hair(h), Escape::OffsetAndFilter) => (
+                p + side * (OFFSET_RADII * h.radius + ulps),
+                self.exclusion(h, dir),
+            ),
+            (Hit::Hair(h), Escape::ExitAndFilter) => {
+                let exclude = self.exclusion(h, dir);
+                match (exit_distance(h, dir), exclude) {
+                    (Some(t), Some(ex)) => (
+                        p + dir * t,
+                        Some(Exclude {
+                            max_t: ex.max_t - t,
+                            ..ex
+                        }),
+                    ),
+                    _ => (p + side * (OFFSET_RADII * h.radius + ulps), exclude),
+                }
+            }
+            (Hit::Hair(h), Escape::Filter) => (p, self.exclusion(h, dir)),
+        };
+        SpawnedRay {
+            ray: Ray {
+                org,
+                dir,
+                tnear: 0.0,
+                tfar,
+                mask: u32::MAX,
+            },
+            exclude,
+        }
+    }
+
+    pub fn intersect_spawned(&self, s: &SpawnedRay) -> Option<Hit> {
+        let hit = self.scene.intersect(&s.ray, s.exclude.as_ref())?;
+        self.record(&s.ray, &hit)
+    }
+
+    pub fn occluded_spawned(&self, s: &SpawnedRay) -> bool {
+        self.scene.occluded(&s.ray, s.exclude.as_ref())
+    }
+
+    /// The segments of the hit's strand a ray along `dir` may cross before it is out of the
+    /// tube, and how far along the ray that can take.
+    fn exclusion(&self, h: &HairHit, dir: Vec3) -> Option<Exclude> {
+        let Some(Geometry::Curves(geom)) = self.scene.geometry(h.geom_id) else {
+            return None;
+        };
+        let len = dir.length();
+        let sine = (dir.cross(h.frame.x).length() / len).max(MIN_EXIT_SINE);
+        let reach = EXIT_RADII * h.radius / sine;
+        // Segments that distance can span, from the length of this one (at least its
+        // neighbours on each side, for the joints).
+        let chord = segment_chord(geom, h.prim_id);
+        let k = if chord > 0.0 {
+            ((reach / chord).ceil() as u32).saturating_add(1)
+        } else {
+            h.strand.segments
+        };
+        let prims = h.strand.prims();
+        Some(Exclude {
+            geom_id: h.geom_id,
+            first_prim: h.prim_id.saturating_sub(k).max(prims.start),
+            last_prim: h.prim_id.saturating_add(k).min(prims.end - 1),
+            max_t: reach / len,
+        })
+    }
+
+    fn record(&self, ray: &Ray, hit: &RayHit) -> Option<Hit> {
+        let p = ray.point_at(hit.t);
+        match (
+            self.scene.geometry(hit.geom_id)?,
+            self.tables.get(hit.geom_id as usize)?,
+        ) {
+            (Geometry::Curves(geom), Table::Curves(strands)) => {
+                let at = strands.locate(hit.prim_id)?;
+                Some(Hit::Hair(hair_hit(ray, hit, p, geom, strands, at)?))
+            }
+            (Geometry::Triangles(geom), Table::Mesh { normals }) => {
+                Some(Hit::Surface(surface_hit(hit, p, geom, normals.as_deref())?))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// How far along `dir` (in its units) a ray from a hair hit travels inside the fiber,
+/// plus the offset margin, from the cylinder tangent to the tube at the hit. `None` when
+/// the ray leaves at once (reflected) or runs along the axis (no finite exit).
+fn exit_distance(h: &HairHit, dir: Vec3) -> Option<f32> {
+    let x = h.frame.x;
+    let across = |v: Vec3| v - v.dot(x) * x;
+    let (w, e) = (across(h.p - h.axis), across(dir));
+    let (a, b) = (e.dot(e), 2.0 * w.dot(e));
+    if b >= 0.0 || a <= 0.0 {
+        return None;
+    }
+    let c = w.dot(w) - h.radius * h.radius;
+    let far = (-b + (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a);
+    let t = far + OFFSET_RADII * h.radius / a.sqrt();
+    t.is_finite().then_some(t)
+}
+
+fn hair_hit(
+    ray: &Ray,
+    hit: &RayHit,
+    p: Vec3,
+    geom: &CurveGeometry,
+    strands: &StrandIndex,
+    at: StrandSegment,
+) -> Option<HairHit> {
+    let flat_cubic = geom.shape() == CurveShape::Flat && geom.basis() != CurveBasis::Linear;
+    let (u, c) = if flat_cubic {
+        project_onto_axis(geom, hit.prim_id, hit.u, p)?
+    } else {
+        (hit.u, geom.interpolate(hit.prim_id, hit.u)?)
+    };
+    let axis = Vec3::from_array(c.p);
+    let tangent = tangent(geom, hit.prim_id, Vec3::from_array(c.dp_du), c.radius, &at);
+    // One formula for every shape: on flat cubic curves it beats Embree's v (the offset
+    // across the tessellated ribbon) by two orders of magnitude on bent fibers
+    // (tests/curves_geometry.rs prints both).
+    let (frame, h) = HairFrame::with_offset(tangent, ray.dir, ray.org, axis, c.radius);
+    let ng = match geom.shape() {
+        CurveShape::Round => hit.ng.try_normalize().unwrap_or(frame.z),
+        // Embree reports the tangent as Ng of flat curves; the ribbon faces the ray.
+        CurveShape::Flat => frame.z,
+    };
+    Some(HairHit {
+        t: hit.t,
+        p,
+        ng,
+        frame,
+        h,
+        axis,
+        radius: c.radius,
+        shape: geom.shape(),
+        geom_id: hit.geom_id,
+        prim_id: hit.prim_id,
+        u,
+        v: hit.v,
+        strand: at,
+        s: at.s(u),
+        color: strands.color(&at, u),
+    })
+}
+
+/// Newton steps on the closest point of the segment's axis to `p`, from Embree's u.
+///
+/// A flat cubic curve is intersected as a few ray-facing quads per segment, so Embree's u
+/// is the parameter along a quad, up to ~1e-3 rad of tangent away from the point of the
+/// curve the hit belongs to; two steps bring it to f32 precision.
+fn project_onto_axis(
+    geom: &CurveGeometry,
+    prim: u32,
+    u: f32,
+    p: Vec3,
+) -> Option<(f32, CurvePoint)> {
+    let mut u = u;
+    let mut c = geom.interpolate(prim, u)?;
+    for _ in 0..2 {
+        let (q, d1, d2) = (
+            Vec3::from_array(c.p) - p,
+            Vec3::from_array(c.dp_du),
+            Vec3::from_array(c.d2p_du2),
+        );
+        let slope = d1.dot(d1) + q.dot(d2);
+        if slope.is_nan() || slope <= 0.0 {
+            break;
+        }
+        u = (u - q.dot(d1) / slope).clamp(0.0, 1.0);
+        c = geom.interpolate(prim, u)?;
+    }
+    Some((u, c))
+}
+
+/// A derivative shorter than this fraction of the radius is a cusp or a repeated point.
+const DEGENERATE_DERIVATIVE: f32 = 1e-6;
+
+/// The curve tangent at the hit: the segment direction for linear curves, the derivative
+/// for cubic ones; where that vanishes, the chord of the segment, then of its neighbours
+/// (nearest first) in the same strand. Zero only when the whole strand is one point.
+fn tangent(
+    geom: &CurveGeometry,
+    prim: u32,
+    derivative: Vec3,
+    radius: f32,
+    at: &StrandSegment,
+) -> Vec3 {
+    let usable = |t: Vec3| t.is_finite() && t.length() > DEGENERATE_DERIVATIVE * radius.max(0.0);
+    let first = if geom.basis() == CurveBasis::Linear {
+        chord(geom, prim)
+    } else {
+        derivative
+    };
+    if usable(first) {
+        return first;
+    }
+    let prims = at.prims();
+    (0..at.segments)
+        .flat_map(|k| [prim.checked_sub(k), prim.checked_add(k)])
+        .flatten()
+        .filter(|q| prims.contains(q))
+        .map(|q| chord(geom, q))
+        .find(|&t| t.is_finite() && t != Vec3::ZERO)
+        .unwrap_or(Vec3::ZERO)
+}
+
+/// Start-to-end vector of segment `prim`: v1 - v0 for linear curves, from the curve itself
+/// for cubic ones.
+fn chord(geom: &CurveGeometry, prim: u32) -> Vec3 {
+    if geom.basis() == CurveBasis::Linear {
+        let Some(&first) = geom.indices().get(prim as usize) else {
+            return Vec3::ZERO;
+        };
+        let v = geom.vertices();
+        let p = |i: u32| Vec3::from_slice(&v[i as usize][..3]);
+        return p(first + 1) - p(first);
+    }
+    let end = |u| {
+        geom.interpolate(prim, u)
+            .map_or(Vec3::ZERO, |c| Vec3::from_array(c.p))
+    };
+    end(1.0) - end(0.0)
+}
+
+/// Approximate segment length from its control points, for neighbour counts only.
+fn segment_chord(geom: &CurveGeometry, prim: u32) -> f32 {
+    let Some(&first) = geom.indices().get(prim as usize) else {
+        return 0.0;
+    };
+    let (a, b) = match geom.basis() {
+        CurveBasis::Linear => (first, first + 1),
+        CurveBasis::BSpline | CurveBasis::CatmullRom => (first + 1, first + 2),
+        CurveBasis::Bezier => (first, first + 3),
+    };
+    let v = geom.vertices();
+    let p = |i: u32| Vec3::from_slice(&v[i as usize][..3]);
+    p(a).distance(p(b))
+}
+
+fn surface_hit(
+    hit: &RayHit,
+    p: Vec3,
+    geom: &TriangleGeometry,
+    normals: Option<&[[f32; 3]]>,
+) -> Option<SurfaceHit> {
+    let tri = geom.triangles().get(hit.prim_id as usize)?;
+    let pos = |i: usize| Vec3::from_array(geom.vertices()[tri[i] as usize]);
+    let ng = (pos(1) - pos(0))
+        .cross(pos(2) - pos(0))
+        .try_normalize()
+        .or_else(|| hit.ng.try_normalize())
+        .unwrap_or(Vec3::Z);
+    let ns = normals
+        .and_then(|n| {
+            let at = |i: usize| Vec3::from_array(n[tri[i] as usize]);
+            (at(0) * (1.0 - hit.u - hit.v) + at(1) * hit.u + at(2) * hit.v).try_normalize()
+        })
+        .map_or(ng, |ns| if ns.dot(ng) < 0.0 { -ns } else { ns });
+    Some(SurfaceHit {
+        t: hit.t,
+        p,
+        ng,
+        ns,
+        geom_id: hit.geom_id,
+        prim_id: hit.prim_id,
+        u: hit.u,
+        v: hit.v,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tracer(curves: Curves) -> Tracer {
+        let device = Arc::new(Device::new(Some(1)).unwrap());
+        let mut b = TracerBuilder::new(device, SceneOptions::default()).unwrap();
+        b.add_curves(curves).unwrap();
+        b.build().unwrap()
+    }
+
+    fn geometry(t: &Tracer) -> &CurveGeometry {
+        match t.scene().geometry(0) {
+            Some(Geometry::Curves(g)) => g,
+            _ => panic!("no curves"),
+        }
+    }
+
+    #[test]
+    fn zero_derivatives_fall_back_to_the_chord_then_the_neighbours() {
+        // Tripled B-spline ends: the derivative at the root is exactly zero.
+        let pts = [0.0f32, 0.0, 0.0, 1.0, 2.0, 2.0, 2.0].map(|x| [x, 0.0, 0.0, 0.1]);
+        let t = tracer(
+            Curves::from_control_points(
+                pts.to_vec(),
+                &[7],
+                None,
+                CurveBasis::BSpline,
+                CurveShape::Round,
+            )
+            .unwrap(),
+        );
+        let g = geometry(&t);
+        let at = t.strands(0).unwrap().locate(0).unwrap();
+        let root = g.interpolate(0, 0.0).unwrap();
+        assert_eq!(root.dp_du, [0.0; 3]);
+        let x = tangent(g, 0, Vec3::from_array(root.dp_du), root.radius, &at);
+        assert!(x.normalize().dot(Vec3::X) > 1.0 - 1e-6, "{x}");
+
+        // A zero-length first segment of a linear strand takes its neighbour's direction.
+        let pts = [0.0f32, 0.0, 1.0, 2.0].map(|x| [x, 0.0, 0.0, 0.1]);
+        let t = tracer(
+            Curves::from_control_points(
+                pts.to_vec(),
+                &[4],
+                None,
+                CurveBasis::Linear,
+                CurveShape::Round,
+            )
+            .unwrap(),
+        );
+        let at = t.strands(0).unwrap().locate(0).unwrap();
+        let x = tangent(geometry(&t), 0, Vec3::ZERO, 0.1, &at);
+        assert_eq!(x.normalize(), Vec3::X);
+
+        // A strand that is a single point has no tangent; the frame copes (see hit.rs).
+        let t = tracer(
+            Curves::from_control_points(
+                vec![[1.0, 2.0, 3.0, 0.1]; 3],
+                &[3],
+                None,
+                CurveBasis::Linear,
+                CurveShape::Flat,
+            )
+            .unwrap(),
+        );
+        let at = t.strands(0).unwrap().locate(1).unwrap();
+        assert_eq!(tangent(geometry(&t), 1, Vec3::ZERO, 0.1, &at), Vec3::ZERO);
+    }
+
+    #[test]
+    fn meshes_trace_with_shading_normals() {
+        let device = Arc::new(Device::new(Some(1)).unwrap());
+        let mut b = TracerBuilder::new(device, SceneOptions::default()).unwrap();
+        let mesh = Mesh::new(
+            vec![[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]],
+            vec![[0, 1, 2]],
+            Some(vec![[0.0, 0.0, -1.0]; 3]),
+        )
+        .unwrap();
+        let id = b.add_mesh(mesh).unwrap();
+        let t = b.build().unwrap();
+        let hit = t
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z))
+            .unwrap();
+        let Hit::Surface(s) = hit else {
+            panic!("expected a surface hit")
+        };
+        assert_eq!((s.geom_id, s.prim_id), (id, 0));
+        assert!((s.t - 5.0).abs() < 1e-5);
+        assert_eq!(s.ng, Vec3::Z);
+        // The vertex normals point the other way: flipped into the geometric hemisphere.
+        assert_eq!(s.ns, Vec3::Z);
+        // Hair-only rays pass through.
+        let hair_only = Ray {
+            mask: HAIR_MASK,
+            ..Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z)
+        };
+        assert!(t.intersect(&hair_only).is_none());
+        assert!(t.occluded(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z)));
+        let spawned = t.spawn(&hit, Vec3::Z, f32::INFINITY);
+        assert!(t.intersect_spawned(&spawned).is_none());
+    }
+}

@@ -18,6 +18,15 @@ fn close(a: Vec3, b: Vec3) -> bool {
 }
 
 #[test]
+fn render_pieces_are_shareable_across_threads() {
+    fn send_sync<T: Send + Sync>() {}
+    send_sync::<Camera>();
+    send_sync::<Film>();
+    send_sync::<PixelSampler>();
+    send_sync::<PixelAccumulator>();
+}
+
+#[test]
 fn pinhole_rays_follow_the_fov_and_image_axes() {
     let eye = Vec3::new(1.0, 2.0, 3.0);
     let cam = Camera::new(eye, eye + Vec3::new(0.0, 0.0, -5.0), Vec3::Y, 90.0, 2.0).unwrap();
@@ -52,6 +61,13 @@ fn pinhole_rays_follow_the_fov_and_image_axes() {
     ));
     assert_eq!(cam.eye(), eye);
     assert!(close(cam.forward(), -Vec3::Z));
+    // A new aspect keeps the vertical fov and the view.
+    let square = cam.with_aspect(1.0).unwrap();
+    assert!(close(
+        square.ray([1.0, 0.0], [0.5; 2]).1,
+        Vec3::new(1.0, 1.0, -1.0).normalize()
+    ));
+    assert!(cam.with_aspect(0.0).is_err() && cam.with_aspect(f32::NAN).is_err());
 }
 
 #[test]

@@ -1,13 +1,20 @@
-//! The hairtrace command line. Until the renderer lands, `lobes` is the main job: it
-//! prints how the default (or a given) hair splits energy between its lobes. `info`
-//! describes a .hair groom.
+//! The hairtrace command line: `render` a scene file, a .hair groom or a built-in demo;
+//! `info` describes a .hair groom; `lobes` prints how a hair splits energy between its
+//! lobes.
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use hairtrace::embree::Device;
+use hairtrace::image::{self, WriteOptions};
+use hairtrace::render::{Aovs, Progress, renderer};
+use hairtrace::scene::description::{self, BuiltScene, SceneDescription};
 use hairtrace::scene::{Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
 
 #[derive(Parser)]
 #[command(
@@ -22,6 +29,10 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Render a scene file (.toml), a bare groom (.hair: automatic camera, default light
+    /// and brown hair) or a built-in demo, and write the image (the extension picks the
+    /// format: .exr linear float, .png/.jpg/.tif sRGB).
+    Render(RenderArgs),
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),
@@ -30,9 +41,36 @@ enum Command {
 }
 
 #[derive(Args)]
+struct RenderArgs {
+    /// A scene description (.toml) or a groom (.hair).
+    scene: Option<PathBuf>,
+    /// A built-in scene instead of a file: furball (the default), furnace, scalp.
+    #[arg(long, conflicts_with = "scene")]
+    demo: Option<String>,
+    /// Samples per pixel.
+    #[arg(long)]
+    spp: Option<u32>,
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Longest path, in scattering events.
+    #[arg(long)]
+    max_depth: Option<u32>,
+    /// Output image.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+#[derive(Args)]
 struct InfoArgs {
     /// The .hair file.
-    file: std::path::PathBuf,
+    file: PathBuf,
     /// Read the file's thickness as a radius instead of a diameter (the default).
     #[arg(long)]
     thickness_is_radius: bool,
@@ -124,6 +162,100 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
+/// A progress bar with an ETA on stderr.
+struct Bar(ProgressBar);
+
+impl Progress for Bar {
+    fn update(&self, done: u64, total: u64) -> bool {
+        self.0.set_length(total);
+        self.0.set_position(done);
+        true
+    }
+}
+
+fn render(args: &RenderArgs) -> hairtrace::Result<()> {
+    // Refuse an output the writer will not take before spending minutes on the render.
+    image::check_output_path(&args.output)?;
+    let mut description = match (&args.scene, &args.demo) {
+        (Some(path), _)
+            if path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("hair")) =>
+        {
+            description::quick_look(path)?
+        }
+        (Some(path), _) => SceneDescription::from_file(path)?,
+        (None, name) => description::demo(name.as_deref().unwrap_or("furball"))?,
+    };
+    // Overrides go into the description, so that the camera's aspect follows the size.
+    let r = &mut description.render;
+    r.spp = args.spp.unwrap_or(r.spp);
+    r.width = args.width.unwrap_or(r.width);
+    r.height = args.height.unwrap_or(r.height);
+    r.seed = args.seed.unwrap_or(r.seed);
+    r.threads = args.threads.or(r.threads);
+    r.max_depth = args.max_depth.unwrap_or(r.max_depth);
+    let device = Arc::new(Device::new(r.threads)?);
+    let BuiltScene {
+        world,
+        camera,
+        settings,
+    } = description.build(device)?;
+
+    let bar = ProgressBar::new(0).with_style(
+        ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}")
+            .expect("a valid progress template"),
+    );
+    let out = renderer::render(
+        &world,
+        &camera,
+        &settings,
+        Aovs::default(),
+        &Bar(bar.clone()),
+    )?;
+    bar.finish_and_clear();
+    let window = out.film.crop();
+    image::write_image(
+        &args.output,
+        window.width() as usize,
+        window.height() as usize,
+        3,
+        out.film.rgb(),
+        &WriteOptions::default(),
+    )?;
+    let s = out.stats;
+    eprintln!(
+        "{}: {}x{} at {} spp in {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s, peak memory {}",
+        args.output.display(),
+        window.width(),
+        window.height(),
+        settings.spp,
+        s.seconds,
+        s.samples as f64 / s.seconds / 1e6,
+        s.rays as f64 / s.seconds / 1e6,
+        peak_memory()
+    );
+    if out.film.rejected_samples() > 0 {
+        eprintln!(
+            "warning: {} samples were not finite and were dropped",
+            out.film.rejected_samples()
+        );
+    }
+    Ok(())
+}
+
+/// The process's peak resident memory, from Linux's /proc ("unknown" elsewhere).
+fn peak_memory() -> String {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("VmHWM:"))
+                .map(|l| l[6..].trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     let thickness = if args.thickness_is_radius {
         Thickness::Radius
@@ -138,6 +270,7 @@ fn info(args: &InfoArgs) -> hairtrace::Result<()> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
+        Command::Render(a) => render(a),
         Command::Lobes(a) => lobes(a),
         Command::Info(a) => info(a),
     };

@@ -341,7 +341,13 @@ impl CurveGeometry {
             bufferSlot: 0,
             P: p.0.as_mut_ptr(),
             dPdu: dp.0.as_mut_ptr(),
-            ddPdudu: ddp.0.as_mut_ptr(),
+            // A linear curve has no second derivative, and Embree 3.13 returns a zero first
+            // derivative for linear curves when the second is requested too.
+            ddPdudu: if self.basis == CurveBasis::Linear {
+                std::ptr::null_mut()
+            } else {
+                ddp.0.as_mut_ptr()
+            },
             valueCount: 4,
             ..Default::default()
         };
@@ -521,6 +527,7 @@ mod tests {
         assert_eq!(mid.p, [1.0, 0.0, 0.0]);
         assert!((mid.radius - 0.2).abs() < 1e-6);
         assert_eq!(mid.dp_du, [2.0, 0.0, 0.0]);
+        assert_eq!(mid.d2p_du2, [0.0; 3]);
         assert!(c.interpolate(1, 0.5).is_none());
     }
 }

@@ -43,14 +43,9 @@ impl MemoryMonitor {
         self.counters.current.load(Ordering::Relaxed)
     }
 
-    /// The most bytes Embree held at once since attaching (or since [`Self::reset_peak`]).
+    /// The most bytes Embree held at once since attaching.
     pub fn peak(&self) -> i64 {
         self.counters.peak.load(Ordering::Relaxed)
-    }
-
-    /// Starts a new peak measurement from the current value.
-    pub fn reset_peak(&self) {
-        self.counters.peak.store(self.current(), Ordering::Relaxed);
     }
 }
 

@@ -103,6 +103,24 @@ impl Format {
     }
 }
 
+/// Checks, before any work, that `write_image` can take `path`: a supported extension and
+/// an existing folder to write into (permissions are only known when writing).
+pub fn check_output_path(path: &Path) -> Result<()> {
+    Format::from_path(path)?;
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !folder.is_dir() {
+        return Err(Error::Io(format!(
+            "cannot write {}: folder {} does not exist",
+            path.display(),
+            folder.display()
+        )));
+    }
+    Ok(())
+}
+
 /// Writes interleaved linear pixels (`channels` values per pixel, rows from the top) to
 /// `path`, in the format its extension names.
 ///

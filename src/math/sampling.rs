@@ -151,16 +151,6 @@ impl Distribution1D {
         })
     }
 
-    /// Number of cells.
-    pub fn len(&self) -> usize {
-        self.func.len()
-    }
-
-    /// Always false: a distribution has at least one cell.
-    pub fn is_empty(&self) -> bool {
-        self.func.is_empty()
-    }
-
     /// Mean of the table, i.e. the integral of the step function over [0, 1).
     pub fn integral(&self) -> f32 {
         self.integral

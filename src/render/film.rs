@@ -165,14 +165,6 @@ impl PixelAccumulator {
         }
     }
 
-    pub fn samples(&self) -> u32 {
-        self.samples
-    }
-
-    pub fn rejected(&self) -> u32 {
-        self.rejected
-    }
-
     fn mean(&self, sum: [f64; 3]) -> [f32; 3] {
         let n = f64::from(self.samples.max(1));
         sum.map(|s| (s / n) as f32)

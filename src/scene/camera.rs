@@ -100,6 +100,21 @@ impl Camera {
         })
     }
 
+    /// The same camera for an image of another `aspect` (width over height), keeping the
+    /// vertical field of view: a scene's camera follows the size a command line asks for.
+    pub fn with_aspect(self, aspect: f32) -> Result<Self> {
+        let half_width = self.half_extent.y * aspect;
+        if !(aspect.is_finite() && aspect > 0.0 && half_width.is_finite() && half_width > 0.0) {
+            return Err(invalid_arg!(
+                "camera aspect {aspect} must be finite and > 0"
+            ));
+        }
+        Ok(Self {
+            half_extent: Vec2::new(half_width, self.half_extent.y),
+            ..self
+        })
+    }
+
     /// A camera that frames the box `[lo, hi]` for a quick look at a groom: it looks at
     /// the box centre from the front (+z), a little to the right and above (+y is up), at
     /// the distance where the bounding sphere fits both fields of view with a small margin.

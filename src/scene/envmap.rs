@@ -213,14 +213,16 @@ impl Environment {
         })
     }
 
-    /// Solid-angle pdf of [`sample`](Self::sample) returning the unit direction `dir`.
-    pub fn pdf(&self, dir: Vec3) -> f32 {
+    /// Radiance from the unit direction `dir` and the solid-angle pdf with which
+    /// [`sample`](Self::sample) returns it: what MIS needs for a BSDF-sampled direction.
+    pub fn eval(&self, dir: Vec3) -> (Vec3, f32) {
         match &self.source {
-            Source::Uniform(_) => UNIFORM_SPHERE_PDF,
+            Source::Uniform(l) => (*l * self.scale, UNIFORM_SPHERE_PDF),
             Source::Map(map) => {
                 let uv = dir_to_uv(self.to_map * dir);
                 let (_, sin_theta) = uv_to_dir(uv);
-                uv_to_solid_angle(map.distribution.pdf(uv), sin_theta).unwrap_or(0.0)
+                let pdf = uv_to_solid_angle(map.distribution.pdf(uv), sin_theta).unwrap_or(0.0);
+                (map.texel(uv) * self.scale, pdf)
             }
         }
     }

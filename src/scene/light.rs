@@ -219,11 +219,14 @@ impl Light {
     /// past the rect, toward a one-sided rect's back, and always for a delta light.
     pub fn eval_li(&self, p: Vec3, wi: Vec3) -> Option<LightEval> {
         match self {
-            Light::Environment(env) => Some(LightEval {
-                radiance: env.le(wi),
-                pdf: env.pdf(wi),
-                distance: f32::INFINITY,
-            }),
+            Light::Environment(env) => {
+                let (radiance, pdf) = env.eval(wi);
+                Some(LightEval {
+                    radiance,
+                    pdf,
+                    distance: f32::INFINITY,
+                })
+            }
             Light::Distant(d) => d.in_disc(wi).then(|| LightEval {
                 radiance: d.radiance,
                 pdf: uniform_cone_pdf(d.one_minus_cos),

@@ -3,6 +3,7 @@
 
 pub mod camera;
 pub mod curves;
+pub mod description;
 pub mod envmap;
 pub mod groom;
 pub mod hair_file;
@@ -10,6 +11,7 @@ pub mod hit;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod shapes;
 pub mod strands;
 pub mod tracer;
 

@@ -143,7 +143,10 @@ mod tests {
             let normals = mesh.normals.as_ref().unwrap();
             for (p, nrm) in mesh.positions.iter().zip(normals) {
                 let d = Vec3::from_array(*p) - centre;
-                assert!((d.length() - 2.0).abs() < 1e-5, "vertex off the sphere: {d}");
+                assert!(
+                    (d.length() - 2.0).abs() < 1e-5,
+                    "vertex off the sphere: {d}"
+                );
                 let nrm = Vec3::from_array(*nrm);
                 assert!((nrm.length() - 1.0).abs() < 1e-5);
                 assert!(nrm.dot(d.normalize()) > 0.9999, "normal not outward");
@@ -174,7 +177,11 @@ mod tests {
             assert!(g.normalize().abs_diff_eq(Vec3::Y, 1e-6));
             assert_eq!(mid.y, -0.5);
         }
-        assert!(mesh.positions.iter().all(|p| p[0].abs() == 3.0 && p[2].abs() == 3.0));
+        assert!(
+            mesh.positions
+                .iter()
+                .all(|p| p[0].abs() == 3.0 && p[2].abs() == 3.0)
+        );
     }
 
     #[test]

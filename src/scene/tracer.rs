@@ -20,8 +20,13 @@ pub const HAIR_MASK: u32 = 1;
 /// Geometry mask bit of triangle meshes.
 pub const SURFACE_MASK: u32 = 2;
 
-/// How a continued ray (reflection, transmission, shadow) leaves a fiber. The re-hit rates
-/// of each are measured in `tests/rehit.rs`.
+/// How a continued ray (reflection, transmission, shadow) leaves a fiber.
+///
+/// Measured re-hit rates (`tests/rehit.rs`: ~2500 round-curve hits x 64 random directions,
+/// every basis, straight and bent strands): `Offset` re-hits ~100% of transmitted and ~50%
+/// of shadow rays; the three filtered strategies at most 0.005%. `ExitAndFilter` is the
+/// default because it is the fastest of those on round cubic curves (`benches/groom.rs`:
+/// Embree seldom meets the tube it left, so the filter seldom runs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Escape {
     /// Move the origin off the surface, to the side the ray goes: transmitted rays start

@@ -1,0 +1,426 @@
+//! Scene descriptions: the example files and the demos parse and build, and every kind of
+//! bad input is an error that names the file, the key and (while parsing) the line.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::Vec3;
+use hairtrace::Error;
+use hairtrace::embree::{CurveBasis, CurveShape, Device};
+use hairtrace::scene::description::{
+    DEMOS, EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource, SceneDescription,
+    demo, quick_look,
+};
+use hairtrace::scene::material::HairColor;
+use hairtrace::scene::{FurBall, HairStyle, Thickness, write_hair_file};
+
+fn device() -> Arc<Device> {
+    Arc::new(Device::new(Some(1)).unwrap())
+}
+
+fn examples() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes")
+}
+
+/// A fresh folder for one test's files.
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "hairtrace-description-{}-{name}",
+        std::process::id()
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Fewer strands, so that building stays quick.
+fn shrink(desc: &mut SceneDescription) {
+    for g in &mut desc.grooms {
+        match &mut g.source {
+            GroomSource::FurBall(f) => f.strands = 300,
+            GroomSource::Scalp(s) => s.strands = 300,
+            GroomSource::File { .. } => {}
+        }
+    }
+}
+
+fn parse(text: &str) -> hairtrace::Result<SceneDescription> {
+    SceneDescription::from_toml(text, Path::new("/scenes"), "test.toml")
+}
+
+/// The message of a parse error, checked to be an invalid-argument error.
+fn parse_error(text: &str) -> String {
+    match parse(text) {
+        Err(Error::InvalidArg(m)) => m,
+        other => panic!("expected an invalid-argument error, got {other:?}"),
+    }
+}
+
+fn build_error(text: &str) -> Error {
+    match parse(text).unwrap().build(device()) {
+        Err(e) => e,
+        Ok(_) => panic!("expected {text} to fail to build"),
+    }
+}
+
+fn assert_contains(message: &str, parts: &[&str]) {
+    for p in parts {
+        assert!(message.contains(p), "{message:?} should contain {p:?}");
+    }
+}
+
+/// A valid scene to break one piece at a time.
+const BASE: &str = r#"
+[materials.brown]
+type = "hair"
+melanin = [1.3, 0.2]
+
+[materials.skin]
+type = "diffuse"
+albedo = [0.6, 0.5, 0.4]
+
+[[groom]]
+procedural = "fur_ball"
+material = "brown"
+[groom.params]
+strands = 50
+
+[[mesh]]
+shape = "sphere"
+radius = 1.0
+material = "skin"
+
+[[light]]
+type = "environment"
+radiance = [1, 1, 1]
+"#;
+
+#[test]
+fn example_scenes_parse_and_build() {
+    let mut found = 0;
+    for entry in std::fs::read_dir(examples()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let desc = SceneDescription::from_file(&path).unwrap();
+            let built = desc
+                .build(device())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert_eq!(built.settings.width, desc.render.width);
+            assert!(built.camera.forward().is_normalized());
+            found += 1;
+        }
+    }
+    assert!(found >= 2, "only {found} example scenes");
+}
+
+#[test]
+fn example_keys_reach_the_description() {
+    let desc = SceneDescription::from_file(&examples().join("scalp.toml")).unwrap();
+    let g = &desc.grooms[0];
+    assert_eq!(g.basis, CurveBasis::CatmullRom);
+    assert_eq!(g.shape, CurveShape::Round);
+    assert_eq!(g.transform.rotate_y_deg, 20.0);
+    let GroomSource::Scalp(s) = &g.source else {
+        panic!("not a scalp: {:?}", g.source)
+    };
+    assert_eq!(
+        (s.style, s.strands, s.segments),
+        (HairStyle::Curly, 2000, 40)
+    );
+    let MaterialDesc::Hair(h) = &desc.materials["dark"] else {
+        panic!("not hair")
+    };
+    assert_eq!(
+        h.color,
+        HairColor::Melanin {
+            eumelanin: 4.0,
+            pheomelanin: 0.3
+        }
+    );
+    assert_eq!((h.beta_m, h.tip_absorption), (0.25, 0.7));
+    assert_eq!(desc.camera.eye, None);
+    assert!(matches!(desc.lights[0], LightDesc::Rect { .. }));
+}
+
+#[test]
+fn every_demo_builds() {
+    for name in DEMOS {
+        let mut desc = demo(name).unwrap();
+        shrink(&mut desc);
+        let built = desc
+            .build(device())
+            .unwrap_or_else(|e| panic!("demo {name}: {e}"));
+        assert_eq!((built.settings.width, built.settings.height), (640, 480));
+    }
+    let e = demo("furry").unwrap_err().to_string();
+    assert_contains(&e, &["furry", "furball, furnace, scalp"]);
+}
+
+#[test]
+fn furnace_demo_is_a_furnace() {
+    let desc = demo("furnace").unwrap();
+    assert_eq!(desc.render.max_depth, 256);
+    assert_eq!(
+        desc.lights,
+        vec![LightDesc::Environment {
+            source: EnvironmentSource::Uniform([1.0; 3]),
+            rotation_deg: 0.0,
+            scale: 1.0
+        }]
+    );
+    let hair = desc.materials.values().find_map(|m| match m {
+        MaterialDesc::Hair(h) => Some(h),
+        MaterialDesc::Diffuse { .. } => None,
+    });
+    let hair = hair.unwrap();
+    assert_eq!(hair.color, HairColor::SigmaA([0.0; 3]));
+    assert_eq!((hair.beta_m, hair.beta_n), (0.3, 0.3));
+    assert!(
+        desc.materials
+            .values()
+            .any(|m| *m == MaterialDesc::Diffuse { albedo: [1.0; 3] })
+    );
+    let GroomSource::FurBall(fur) = &desc.grooms[0].source else {
+        panic!("not a fur ball")
+    };
+    assert_eq!(
+        desc.meshes[0].source,
+        MeshSource::Sphere {
+            centre: [0.0; 3],
+            radius: fur.radius
+        }
+    );
+    assert_eq!(desc.camera.eye, None, "the furnace is framed automatically");
+}
+
+#[test]
+fn cli_style_overrides_reach_the_settings() {
+    let mut desc = parse(BASE).unwrap();
+    desc.render.spp = 3;
+    desc.render.width = 64;
+    desc.render.height = 32;
+    desc.render.max_depth = 12;
+    let built = desc.build(device()).unwrap();
+    assert_eq!(built.settings.spp, 3);
+    assert_eq!((built.settings.width, built.settings.height), (64, 32));
+    assert_eq!(built.settings.path.max_depth, 12);
+}
+
+#[test]
+fn misspelt_keys_name_the_key_and_line() {
+    let e = parse_error("[render]\nwidth = 64\nspp_count = 4\n");
+    assert_contains(&e, &["test.toml:3:1", "spp_count", "spp"]);
+
+    // The second groom's table: the line is the key's, not the first groom's.
+    let text = format!("{BASE}\n[[groom]]\nfile = \"a.hair\"\nmaterail = \"brown\"\n");
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("materail"))
+        .unwrap()
+        + 1;
+    let e = parse_error(&text);
+    assert_contains(&e, &[&format!("test.toml:{line}:"), "materail"]);
+
+    let e = parse_error("[camera]\nfov = 30\n");
+    assert_contains(&e, &["test.toml:2:1", "`fov`", "fov_deg"]);
+}
+
+#[test]
+fn bad_choices_list_the_valid_ones() {
+    let e = parse_error(&BASE.replace(
+        "material = \"brown\"",
+        "material = \"brown\"\nbasis = \"bspine\"",
+    ));
+    assert_contains(
+        &e,
+        &["bspine", "linear", "bezier", "bspline", "catmull_rom"],
+    );
+
+    let e = parse_error(&BASE.replace("procedural = \"fur_ball\"", "procedural = \"hedgehog\""));
+    assert_contains(&e, &["hedgehog", "fur_ball", "scalp"]);
+
+    let e = parse_error(&BASE.replace("strands = 50", "strands = 50\nstrandz = 3"));
+    let line = BASE.lines().position(|l| l == "strands = 50").unwrap() + 2;
+    assert_contains(
+        &e,
+        &[
+            &format!("test.toml:{line}:"),
+            "groom[0].params.strandz",
+            "clumping",
+        ],
+    );
+
+    let e = parse_error(&BASE.replace("strands = 50", "strands = -50"));
+    assert_contains(&e, &["groom[0].params.strands", "-50"]);
+
+    let e = parse_error(&BASE.replace("type = \"environment\"", "type = \"sun\""));
+    assert_contains(&e, &["sun", "environment", "distant", "rect"]);
+}
+
+#[test]
+fn entries_must_make_each_choice_once() {
+    let both = BASE.replace(
+        "procedural = \"fur_ball\"",
+        "procedural = \"fur_ball\"\nfile = \"x.hair\"",
+    );
+    let e = parse_error(&both);
+    assert_contains(&e, &["test.toml:", "groom[0]", "`file`", "`procedural`"]);
+
+    let e = parse_error(&BASE.replace(
+        "melanin = [1.3, 0.2]",
+        "melanin = [1.3, 0.2]\ncolor = [0.5, 0.4, 0.3]",
+    ));
+    assert_contains(&e, &["materials.brown", "sigma_a", "melanin", "color"]);
+
+    let e = parse_error(&BASE.replace(
+        "albedo = [0.6, 0.5, 0.4]",
+        "albedo = [0.6, 0.5, 0.4]\nbeta_m = 0.3",
+    ));
+    assert_contains(
+        &e,
+        &[
+            "materials.skin.beta_m",
+            "does not apply to a diffuse material",
+        ],
+    );
+
+    let e = parse_error(&BASE.replace("radius = 1.0", "radius = 1.0\nhalf_size = 3"));
+    assert_contains(&e, &["mesh[0].half_size", "sphere"]);
+
+    let e = parse_error(&BASE.replace(
+        "radiance = [1, 1, 1]",
+        "radiance = [1, 1, 1]\ndirection = [0, 1, 0]",
+    ));
+    assert_contains(&e, &["light[0].direction", "environment light"]);
+
+    let e = parse_error("[[light]]\ntype = \"distant\"\nirradiance = [1, 1, 1]\n");
+    assert_contains(&e, &["test.toml:1:", "light[0]", "needs `direction`"]);
+}
+
+#[test]
+fn unknown_material_lists_the_defined_ones() {
+    let text = format!("{BASE}\n[[groom]]\nprocedural = \"fur_ball\"\nmaterial = \"blond\"\n");
+    let e = build_error(&text).to_string();
+    assert_contains(
+        &e,
+        &[
+            "test.toml: groom[1].material",
+            "no material named \"blond\" (defined: brown, skin)",
+        ],
+    );
+}
+
+#[test]
+fn materials_must_suit_the_geometry() {
+    let e = build_error(&BASE.replace("material = \"skin\"", "material = \"brown\"")).to_string();
+    assert_contains(&e, &["mesh[0].material", "\"brown\" is a hair material"]);
+
+    let e = build_error(&BASE.replace(
+        "material = \"brown\"\n[groom",
+        "material = \"skin\"\n[groom",
+    ))
+    .to_string();
+    assert_contains(&e, &["groom[0].material", "\"skin\" is a diffuse material"]);
+}
+
+#[test]
+fn missing_files_are_io_errors_that_name_them() {
+    let e = build_error(
+        &BASE
+            .replace("procedural = \"fur_ball\"", "file = \"nowhere/lost.hair\"")
+            .replace("[groom.params]\nstrands = 50\n", ""),
+    );
+    let Error::Io(m) = &e else {
+        panic!("expected an i/o error, got {e:?}")
+    };
+    assert_contains(m, &["test.toml: groom[0]", "/scenes/nowhere/lost.hair"]);
+
+    let e = SceneDescription::from_file(Path::new("/no/such/scene.toml")).unwrap_err();
+    assert!(
+        matches!(&e, Error::Io(m) if m.contains("/no/such/scene.toml")),
+        "{e:?}"
+    );
+
+    let e = quick_look(Path::new("/no/such/groom.hair")).unwrap_err();
+    assert!(
+        matches!(&e, Error::Io(m) if m.contains("/no/such/groom.hair")),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn bad_values_name_their_entry() {
+    let e = build_error(&BASE.replace("radiance = [1, 1, 1]", "radiance = [-1, 1, 1]")).to_string();
+    assert_contains(&e, &["test.toml: light[0]", "radiance", "-1"]);
+
+    let e = build_error(&format!("[render]\nwidth = 0\n{BASE}")).to_string();
+    assert_contains(&e, &["test.toml: render", "width = 0"]);
+
+    let e = build_error(&BASE.replace("strands = 50", "strands = 0")).to_string();
+    assert_contains(&e, &["groom[0]", "strands"]);
+
+    let e = build_error(&BASE.replace("radius = 1.0", "radius = 1.0\nscale = -2")).to_string();
+    assert_contains(&e, &["mesh[0]", "scale = -2"]);
+
+    let e = build_error(&BASE.replace(
+        "[[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n",
+        "",
+    ))
+    .to_string();
+    assert_contains(&e, &["test.toml", "no lights"]);
+
+    let e = build_error(&format!("[camera]\neye = [0, 0, 5]\n{BASE}")).to_string();
+    assert_contains(&e, &["camera", "`eye` and `target`"]);
+}
+
+#[test]
+fn quick_look_frames_a_hair_file_and_paths_follow_the_scene_file() {
+    let dir = scratch("quick_look");
+    let strands = FurBall {
+        strands: 100,
+        segments: 4,
+        ..FurBall::default()
+    }
+    .build()
+    .unwrap();
+    let hair = dir.join("ball.hair");
+    write_hair_file(&hair, &strands, Thickness::Diameter).unwrap();
+
+    let look = quick_look(&hair).unwrap();
+    assert_eq!(look.grooms[0].basis, CurveBasis::BSpline);
+    assert_eq!(look.grooms[0].shape, CurveShape::Round);
+    let built = look.build(device()).unwrap();
+    // The automatic camera looks at the groom's centre, the origin.
+    let to_centre = (-built.camera.eye()).normalize();
+    assert!(built.camera.forward().dot(to_centre) > 0.999);
+
+    // A scene file next to the groom names it by a relative path; a transform moves it and
+    // the automatic camera follows.
+    let scene = dir.join("scene.toml");
+    std::fs::write(
+        &scene,
+        "[materials.h]\ntype = \"hair\"\ncolor = [0.6, 0.4, 0.2]\n\n[[groom]]\nfile = \"ball.hair\"\n\
+         thickness = \"radius\"\ntranslate = [10, 0, 0]\nscale = 2\nmaterial = \"h\"\n\n\
+         [[light]]\ntype = \"distant\"\ndirection = [0, 1, 0]\nirradiance = [1, 1, 1]\n",
+    )
+    .unwrap();
+    let desc = SceneDescription::from_file(&scene).unwrap();
+    assert_eq!(
+        desc.grooms[0].source,
+        GroomSource::File {
+            path: dir.join("ball.hair"),
+            thickness: Thickness::Radius
+        }
+    );
+    let built = desc.build(device()).unwrap();
+    let to_centre = (Vec3::new(10.0, 0.0, 0.0) - built.camera.eye()).normalize();
+    assert!(built.camera.forward().dot(to_centre) > 0.999);
+    // Twice the size: the camera stands about twice as far away.
+    let near = look_distance(&quick_look(&hair).unwrap());
+    let far = built.camera.eye().distance(Vec3::new(10.0, 0.0, 0.0));
+    assert!((far / near - 2.0).abs() < 0.05, "{near} -> {far}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+fn look_distance(desc: &SceneDescription) -> f32 {
+    desc.build(device()).unwrap().camera.eye().length()
+}

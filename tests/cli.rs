@@ -87,3 +87,76 @@ fn info_errors_are_one_line() {
     let o = hairtrace(&["info", bad.to_str().unwrap()]);
     assert!(!o.status.success());
 }
+
+fn tmp(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// The default demo renders to EXR and PNG, and the summary line reports the run.
+#[test]
+fn render_default_demo_to_exr_and_png() {
+    for ext in ["exr", "png"] {
+        let out = tmp(&format!("cli_demo.{ext}"));
+        let o = hairtrace(&[
+            "render", "--width", "48", "--height", "36", "--spp", "2", "-o", &out,
+        ]);
+        assert!(o.status.success(), "{o:?}");
+        let img = hairtrace::image::read_image(std::path::Path::new(&out)).unwrap();
+        assert_eq!((img.width, img.height), (48, 36));
+        assert!(img.pixels.iter().all(|v| v.is_finite()));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains("Mrays/s") && err.contains("peak memory"),
+            "{err}"
+        );
+    }
+}
+
+/// A bare groom renders with the automatic camera and default look.
+#[test]
+fn render_a_bare_hair_file() {
+    let path = tmp("cli_quick.hair");
+    let groom = FurBall {
+        strands: 200,
+        segments: 6,
+        ..FurBall::default()
+    }
+    .build()
+    .unwrap();
+    write_hair_file(std::path::Path::new(&path), &groom, Thickness::Diameter).unwrap();
+    let out = tmp("cli_quick.exr");
+    let o = hairtrace(&[
+        "render", &path, "--width", "32", "--height", "32", "--spp", "2", "-o", &out,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let img = hairtrace::image::read_image(std::path::Path::new(&out)).unwrap();
+    assert!(img.pixels.iter().any(|v| *v > 0.0));
+}
+
+#[test]
+fn render_errors_are_one_line() {
+    let out = tmp("cli_never.exr");
+    assert_one_line_error(
+        &hairtrace(&["render", "/nonexistent/groom.hair", "-o", &out]),
+        "/nonexistent/groom.hair",
+    );
+    assert_one_line_error(
+        &hairtrace(&["render", "--demo", "teapot", "-o", &out]),
+        "teapot",
+    );
+    assert_one_line_error(
+        &hairtrace(&["render", "--spp", "1", "-o", "/nonexistent/dir/out.exr"]),
+        "/nonexistent/dir",
+    );
+    assert_one_line_error(
+        &hairtrace(&["render", "--spp", "1", "-o", &tmp("cli_out.bmpx")]),
+        "bmpx",
+    );
+    let bad = tmp("cli_bad.toml");
+    std::fs::write(&bad, "[render]\nwidht = 10\n").unwrap();
+    assert_one_line_error(&hairtrace(&["render", &bad, "-o", &out]), "widht");
+    assert_one_line_error(&hairtrace(&["render", "--spp", "0", "-o", &out]), "spp");
+}

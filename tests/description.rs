@@ -118,7 +118,7 @@ fn example_keys_reach_the_description() {
     let g = &desc.grooms[0];
     assert_eq!(g.basis, CurveBasis::CatmullRom);
     assert_eq!(g.shape, CurveShape::Round);
-    assert_eq!(g.transform.rotate_y_deg, 20.0);
+    assert_eq!(g.transform.rotate_y_deg, 60.0);
     let GroomSource::Scalp(s) = &g.source else {
         panic!("not a scalp: {:?}", g.source)
     };
@@ -132,8 +132,8 @@ fn example_keys_reach_the_description() {
     assert_eq!(
         h.color,
         HairColor::Melanin {
-            eumelanin: 4.0,
-            pheomelanin: 0.3
+            eumelanin: 2.0,
+            pheomelanin: 0.4
         }
     );
     assert_eq!((h.beta_m, h.tip_absorption), (0.25, 0.7));

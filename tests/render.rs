@@ -31,7 +31,7 @@ fn fur_world(hair: HairMaterial, lights: Vec<Light>, strands: usize) -> World {
     let tracer = b.build().unwrap();
     World::new(
         tracer,
-        vec![Material::Hair(hair.prepare().unwrap())],
+        vec![Material::Hair(Box::new(hair.prepare().unwrap()))],
         lights,
     )
     .unwrap()
@@ -194,4 +194,29 @@ fn renders_are_deterministic_across_threads_and_crops() {
             );
         }
     }
+}
+
+/// `--demo furnace`: white fur around a white diffuse sphere under a uniform environment
+/// of radiance 1. Every pixel's expected value is 1; the image mean must be within 1%.
+#[test]
+fn furnace_demo_renders_to_one() {
+    let mut d = hairtrace::scene::description::demo("furnace").unwrap();
+    d.render.width = 48;
+    d.render.height = 36;
+    d.render.spp = 8;
+    let device = Arc::new(Device::new(Some(2)).unwrap());
+    let built = d.build(device).unwrap();
+    let out = render(
+        &built.world,
+        &built.camera,
+        &built.settings,
+        Aovs::default(),
+        &NoProgress,
+    )
+    .unwrap();
+    let rgb = out.film.rgb();
+    assert!(rgb.iter().all(|v| v.is_finite()));
+    let m = mean(rgb);
+    println!("furnace demo mean {m:.5} ({} rays)", out.stats.rays);
+    assert!((m - 1.0).abs() < 0.01, "furnace demo mean {m}");
 }

@@ -171,6 +171,15 @@ impl PixelAccumulator {
     }
 }
 
+/// The camera's [0, 1]^2 image point of a sample at `offset` pixels (from a
+/// [`PixelFilter`]) from the centre of the full-frame `pixel` of a `width` x `height` frame.
+pub fn ndc(width: u32, height: u32, pixel: (u32, u32), offset: [f32; 2]) -> [f32; 2] {
+    [
+        (pixel.0 as f32 + 0.5 + offset[0]) / width as f32,
+        (pixel.1 as f32 + 0.5 + offset[1]) / height as f32,
+    ]
+}
+
 /// Float RGB (and AOV) pixels of a crop window of a `width` x `height` frame.
 #[derive(Debug, Clone)]
 pub struct Film {
@@ -245,13 +254,9 @@ impl Film {
         self.crop
     }
 
-    /// The camera's [0, 1]^2 image point of a sample at `offset` pixels (from a
-    /// [`PixelFilter`]) from the centre of the full-frame `pixel`.
+    /// The camera's [0, 1]^2 image point of a sample; see [`ndc`].
     pub fn ndc(&self, pixel: (u32, u32), offset: [f32; 2]) -> [f32; 2] {
-        [
-            (pixel.0 as f32 + 0.5 + offset[0]) / self.width as f32,
-            (pixel.1 as f32 + 0.5 + offset[1]) / self.height as f32,
-        ]
+        ndc(self.width, self.height, pixel, offset)
     }
 
     /// Interleaved RGB of the crop window, rows from the top: what `write_image` takes,

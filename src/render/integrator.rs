@@ -70,10 +70,10 @@ impl PathSettings {
     }
 }
 
-/// What a geometry is made of.
+/// What a geometry is made of. A hair material holds its prepared BSDF, hence the box.
 #[derive(Debug, Clone)]
 pub enum Material {
-    Hair(PreparedHair),
+    Hair(Box<PreparedHair>),
     Diffuse(Diffuse),
 }
 
@@ -178,7 +178,7 @@ impl World {
             bsdf_pdf = Some(pdf);
             if depth + 1 >= settings.rr_depth {
                 let survive = beta.max_element().min(0.95);
-                if !(u_rr < survive) {
+                if u_rr >= survive {
                     break;
                 }
                 beta /= survive;
@@ -271,7 +271,7 @@ impl World {
         let Some(ls) = light.sample_li(hit.p(), u) else {
             return none;
         };
-        if !(ls.pdf > 0.0) || ls.radiance == Vec3::ZERO {
+        if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.radiance == Vec3::ZERO {
             return none;
         }
         let (f_cos, bsdf_pdf) = shading.eval(ls.wi);
@@ -301,7 +301,7 @@ impl World {
     /// The BSDF at a hit, in its local frame.
     fn shading<'a>(&'a self, hit: &Hit, wo_world: Vec3) -> Option<Shading<'a>> {
         match (hit, self.materials.get(hit.geom_id() as usize)?) {
-            (Hit::Hair(h), Material::Hair(m)) => Some(Shading::hair(h, m, wo_world)),
+            (Hit::Hair(h), Material::Hair(m)) => Some(Shading::hair(h, m.as_ref(), wo_world)),
             (Hit::Surface(s), Material::Diffuse(d)) => Some(Shading::diffuse(s, *d, wo_world)),
             _ => None,
         }

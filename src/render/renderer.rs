@@ -3,7 +3,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use super::film::{Aovs, Film, PixelFilter, Window};
+use super::film::{Aovs, Film, PixelFilter, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::sampler::PixelSampler;
@@ -51,18 +51,14 @@ pub fn render(
         threads: settings.threads.unwrap_or(0),
     };
     let rays = AtomicU64::new(0);
-    let (width, height) = (settings.width as f32, settings.height as f32);
     let start = Instant::now();
     let status = render_tiles(&mut film, &options, progress, |pixel, acc| {
         let mut pixel_rays = 0u64;
         for index in 0..settings.spp {
             let mut sampler = PixelSampler::new(settings.seed, pixel, index);
             let offset = filter.sample(sampler.next_2d());
-            let ndc = [
-                (pixel.0 as f32 + 0.5 + offset[0]) / width,
-                (pixel.1 as f32 + 0.5 + offset[1]) / height,
-            ];
-            let (org, dir) = camera.ray(ndc, sampler.next_2d());
+            let image_point = ndc(settings.width, settings.height, pixel, offset);
+            let (org, dir) = camera.ray(image_point, sampler.next_2d());
             let (radiance, first, traced) = world.radiance(org, dir, &settings.path, &mut sampler);
             pixel_rays += u64::from(traced);
             acc.add(radiance, first.as_ref());

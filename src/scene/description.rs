@@ -498,7 +498,7 @@ impl SceneDescription {
 impl MaterialDesc {
     fn prepare(&self) -> Result<Material> {
         Ok(match self {
-            MaterialDesc::Hair(h) => Material::Hair(h.prepare()?),
+            MaterialDesc::Hair(h) => Material::Hair(Box::new(h.prepare()?)),
             MaterialDesc::Diffuse { albedo } => {
                 Material::Diffuse(Diffuse::new(Vec3::from_array(*albedo))?)
             }
@@ -710,7 +710,7 @@ impl Bounds {
 // Built-in scenes.
 
 /// A built-in scene (see [`DEMOS`]): `"furball"` (the default demo: 20k strands of brown
-/// fur over a floor, under the default lights), `"furnace"` (white fur, sigma_a = 0, around
+/// fur on a ball over a floor, under the default lights), `"furnace"` (white fur, sigma_a = 0, around
 /// a white diffuse sphere under a uniform environment of radiance 1: every pixel's
 /// expected value is 1) or `"scalp"` (wavy auburn hair on a head).
 pub fn demo(name: &str) -> Result<SceneDescription> {
@@ -787,18 +787,34 @@ fn furball_demo() -> SceneDescription {
         materials: BTreeMap::from([
             ("brown".to_string(), MaterialDesc::Hair(hair)),
             (
+                "skin".to_string(),
+                MaterialDesc::Diffuse {
+                    albedo: [0.3, 0.2, 0.15],
+                },
+            ),
+            (
                 "floor".to_string(),
                 MaterialDesc::Diffuse { albedo: [0.4; 3] },
             ),
         ]),
+        meshes: vec![
+            // The skin under the fur, so the floor does not show through the ball.
+            MeshDesc::new(
+                MeshSource::Sphere {
+                    centre: [0.0; 3],
+                    radius: fur.radius,
+                },
+                "skin",
+            ),
+            MeshDesc::new(
+                MeshSource::Ground {
+                    y: floor,
+                    half_size: 10.0,
+                },
+                "floor",
+            ),
+        ],
         grooms: vec![GroomDesc::new(GroomSource::FurBall(fur), "brown")],
-        meshes: vec![MeshDesc::new(
-            MeshSource::Ground {
-                y: floor,
-                half_size: 10.0,
-            },
-            "floor",
-        )],
         lights: default_lights(),
         ..SceneDescription::default()
     }
@@ -843,6 +859,11 @@ fn furnace_demo() -> SceneDescription {
 
 fn scalp_demo() -> SceneDescription {
     let scalp = ScalpPatch::default();
+    // The patch faces +z: turned, the automatic camera sees the head beside the hair.
+    let three_quarter = Transform {
+        rotate_y_deg: 60.0,
+        ..Transform::default()
+    };
     let auburn = HairMaterial {
         color: HairColor::Melanin {
             eumelanin: 0.8,
@@ -863,14 +884,20 @@ fn scalp_demo() -> SceneDescription {
                 },
             ),
         ]),
-        meshes: vec![MeshDesc::new(
-            MeshSource::Sphere {
-                centre: [0.0; 3],
-                radius: scalp.radius,
-            },
-            "skin",
-        )],
-        grooms: vec![GroomDesc::new(GroomSource::Scalp(scalp), "auburn")],
+        meshes: vec![MeshDesc {
+            transform: three_quarter,
+            ..MeshDesc::new(
+                MeshSource::Sphere {
+                    centre: [0.0; 3],
+                    radius: scalp.radius,
+                },
+                "skin",
+            )
+        }],
+        grooms: vec![GroomDesc {
+            transform: three_quarter,
+            ..GroomDesc::new(GroomSource::Scalp(scalp), "auburn")
+        }],
         lights: default_lights(),
         ..SceneDescription::default()
     }
@@ -1076,7 +1103,8 @@ struct Source<'a> {
 
 impl Source<'_> {
     fn position(&self, span: Range<usize>) -> String {
-        let before = &self.text[..span.start.min(self.text.len())];
+        // toml spans sit on character boundaries; anything else counts as the end.
+        let before = self.text.get(..span.start).unwrap_or(self.text);
         let line = before.matches('\n').count() + 1;
         let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
         format!("{}:{line}:{column}", self.origin)

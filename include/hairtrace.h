@@ -45,7 +45,29 @@ typedef enum HtStatus {
      * Embree failed.
      */
     HT_ERR_EMBREE = 6,
+    /**
+     * The progress callback returned false; the render stopped early.
+     */
+    HT_ERR_CANCELLED = 7,
 } HtStatus;
+
+/**
+ * An Embree device: its thread pool builds the scenes made on it. Create one per
+ * process and share it between scenes. Thread safe.
+ */
+typedef struct HtDevice HtDevice;
+
+/**
+ * A scene under construction and, after the first render, its built form. Not thread
+ * safe: call the functions of one scene from one thread at a time (different scenes may
+ * be used concurrently).
+ *
+ * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
+ * later additions, and a rendered scene holds a second copy in Embree's buffers plus the
+ * BVH. For the largest grooms, add everything before the first render and free the scene
+ * when done.
+ */
+typedef struct HtScene HtScene;
 
 /**
  * Parameters of the hair BSDF (see DESIGN.md section 3 for the ranges).
@@ -72,6 +94,202 @@ typedef struct HtHairParams {
      */
     float alpha;
 } HtHairParams;
+
+/**
+ * How a hair material varies over the groom, deterministically from the seed, the
+ * strand and the position along it.
+ */
+typedef struct HtHairVariation {
+    /**
+     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
+     * from [1 - x, 1 + x].
+     */
+    float absorption_variation;
+    /**
+     * Per-strand spread of beta_m and beta_n, in [0, 1].
+     */
+    float roughness_variation;
+    /**
+     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
+     */
+    float tip_absorption;
+    /**
+     * Take the absorption from the curves' per-point colours where they have them.
+     */
+    bool use_vertex_colors;
+    /**
+     * Seed of the per-strand random choices.
+     */
+    uint64_t seed;
+} HtHairVariation;
+
+/**
+ * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
+ */
+typedef uint32_t HtCurveBasis;
+
+/**
+ * The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`.
+ */
+typedef uint32_t HtCurveShape;
+
+/**
+ * Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
+ * when the call returns.
+ *
+ * Every basis draws each strand from its first point (root) to its last (tip), one curve
+ * segment per polyline segment: linear joins the points, Catmull-Rom passes through them,
+ * B-spline smooths between root and tip, Bezier is the Catmull-Rom curve in Bezier form.
+ */
+typedef struct HtCurves {
+    /**
+     * Number of strands, >= 1.
+     */
+    size_t strand_count;
+    /**
+     * Points of each strand (each >= 2), `strand_count` values adding up to `point_count`.
+     */
+    const uint32_t *point_counts;
+    /**
+     * Points of all strands.
+     */
+    size_t point_count;
+    /**
+     * x, y, z of every point, strand after strand: `3 * point_count` floats.
+     */
+    const float *points;
+    /**
+     * Fiber radius (not diameter) at every point, > 0: `point_count` floats; or NULL.
+     */
+    const float *radii;
+    /**
+     * Fiber radius (not diameter) of every point when `radii` is NULL, > 0.
+     */
+    float radius;
+    /**
+     * Linear RGB at every point (`3 * point_count` floats, >= 0), used by hair materials
+     * with `use_vertex_colors`; or NULL.
+     */
+    const float *colors;
+    HtCurveBasis basis;
+    HtCurveShape shape;
+} HtCurves;
+
+/**
+ * Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
+ * that hold that layout. Copied once by `ht_scene_add_curves_xyzr`; the host may free its
+ * arrays when the call returns.
+ *
+ * A strand of n control points has n - 1 linear segments, n - 3 B-spline or Catmull-Rom
+ * segments (the curve runs between the second and the second-to-last point), or (n - 1) / 3
+ * Bezier segments (n = 3k + 1, consecutive segments sharing end points).
+ */
+typedef struct HtCurvesXyzr {
+    /**
+     * Number of strands, >= 1.
+     */
+    size_t strand_count;
+    /**
+     * Control points of each strand, `strand_count` values adding up to `point_count`.
+     */
+    const uint32_t *point_counts;
+    /**
+     * Control points of all strands.
+     */
+    size_t point_count;
+    /**
+     * x, y, z, radius (not diameter, >= 0) of every control point: `4 * point_count`
+     * floats.
+     */
+    const float *points;
+    /**
+     * Linear RGB (>= 0) at every segment end, segments + 1 per strand, strand after
+     * strand; or NULL.
+     */
+    const float *colors;
+    HtCurveBasis basis;
+    HtCurveShape shape;
+} HtCurvesXyzr;
+
+/**
+ * Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
+ * call. Return false to cancel: no new pixel starts and `ht_render` returns
+ * `HT_ERR_CANCELLED` (tiles that finish meanwhile may still report).
+ *
+ * Called from the render's worker threads (not necessarily the one that called
+ * `ht_render`), but never two calls at once, so `user` needs no locking against itself.
+ * The callback must return normally: a C++ exception or a longjmp out of it is undefined
+ * behaviour (catch inside and return false instead).
+ */
+typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
+
+/**
+ * What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
+ * the fields you need.
+ */
+typedef struct HtRenderSettings {
+    /**
+     * Image size in pixels, each in [1, 32768].
+     */
+    uint32_t width;
+    uint32_t height;
+    /**
+     * Samples per pixel, >= 1.
+     */
+    uint32_t spp;
+    /**
+     * The image depends only on the scene, these settings and this seed: never on the
+     * thread count.
+     */
+    uint64_t seed;
+    /**
+     * Render threads; 0: one per hardware thread.
+     */
+    uint32_t threads;
+    /**
+     * Longest path in scattering events, >= 1. Light hair needs many: the default (256)
+     * keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
+     */
+    uint32_t max_depth;
+    /**
+     * May be NULL: no progress reports, no cancellation.
+     */
+    HtProgressFn progress;
+    /**
+     * Passed to `progress` as it is.
+     */
+    void *progress_user;
+} HtRenderSettings;
+
+/**
+ * Straight segments between consecutive points.
+ */
+#define HT_CURVE_LINEAR 0
+
+/**
+ * Cubic Bezier.
+ */
+#define HT_CURVE_BEZIER 1
+
+/**
+ * Uniform cubic B-spline.
+ */
+#define HT_CURVE_BSPLINE 2
+
+/**
+ * Catmull-Rom spline.
+ */
+#define HT_CURVE_CATMULL_ROM 3
+
+/**
+ * A true tube: the reference, and what close-ups need.
+ */
+#define HT_CURVE_ROUND 0
+
+/**
+ * A ribbon facing the ray: faster, approximate up close.
+ */
+#define HT_CURVE_FLAT 1
 
 #ifdef __cplusplus
 extern "C" {
@@ -148,6 +366,191 @@ enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
                                  const float *wi,
                                  float *f,
                                  float *pdf);
+
+/**
+ * Creates a device with `threads` Embree worker threads (0: one per hardware thread).
+ * Free it with `ht_device_free`; scenes keep it alive as long as they need it.
+ */
+enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
+
+/**
+ * Releases a device handle (NULL: nothing to do). Scenes made on it stay valid.
+ */
+enum HtStatus ht_device_free(struct HtDevice *device);
+
+/**
+ * Creates an empty scene on `device`. Free it with `ht_scene_free`.
+ */
+enum HtStatus ht_scene_new(const struct HtDevice *device, struct HtScene **out);
+
+/**
+ * Releases a scene and everything it holds (NULL: nothing to do).
+ */
+enum HtStatus ht_scene_free(struct HtScene *scene);
+
+/**
+ * No variation: every strand has the material's parameters, and seed 0.
+ */
+struct HtHairVariation ht_hair_variation_default(void);
+
+/**
+ * Adds a hair material with the same parameters on every strand; writes its id (0, 1, ...
+ * in the order materials are added) to `material_id`.
+ */
+enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
+                                         const struct HtHairParams *params,
+                                         uint32_t *material_id);
+
+/**
+ * Adds a hair material whose parameters vary over the groom as `variation` says.
+ */
+enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
+                                                const struct HtHairParams *params,
+                                                const struct HtHairVariation *variation,
+                                                uint32_t *material_id);
+
+/**
+ * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1].
+ */
+enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
+                                            const float *albedo,
+                                            uint32_t *material_id);
+
+/**
+ * Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
+ * `material_id`; writes the geometry id (0, 1, ... over curves and meshes, in the order
+ * they are added) to `geom_id`.
+ */
+enum HtStatus ht_scene_add_curves(struct HtScene *scene,
+                                  const struct HtCurves *desc,
+                                  uint32_t material_id,
+                                  uint32_t *geom_id);
+
+/**
+ * Adds strands of float4 control points laid out for the basis (copied once: see
+ * `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
+ */
+enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
+                                       const struct HtCurvesXyzr *desc,
+                                       uint32_t material_id,
+                                       uint32_t *geom_id);
+
+/**
+ * Adds the strands of a Cem Yuksel `.hair` file as polylines for `basis`. The file's
+ * thickness is a diameter unless `thickness_is_radius`.
+ */
+enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
+                                     const char *path,
+                                     bool thickness_is_radius,
+                                     HtCurveBasis basis,
+                                     HtCurveShape shape,
+                                     uint32_t material_id,
+                                     uint32_t *geom_id);
+
+/**
+ * Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
+ * `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
+ * shading), `indices` 3 vertex indices per triangle, counter-clockwise seen from the
+ * front. Writes the geometry id.
+ */
+enum HtStatus ht_scene_add_mesh(struct HtScene *scene,
+                                size_t vertex_count,
+                                const float *positions,
+                                const float *normals,
+                                size_t triangle_count,
+                                const uint32_t *indices,
+                                uint32_t material_id,
+                                uint32_t *geom_id);
+
+/**
+ * Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
+ * material `material_id`; writes the geometry id.
+ */
+enum HtStatus ht_scene_add_mesh_file(struct HtScene *scene,
+                                     const char *path,
+                                     uint32_t material_id,
+                                     uint32_t *geom_id);
+
+/**
+ * Adds an environment of the same linear RGB `radiance` (>= 0) from every direction.
+ */
+enum HtStatus ht_scene_add_environment(struct HtScene *scene, const float *radiance);
+
+/**
+ * Adds a lat-long environment map read through OpenImageIO (EXR, HDR, ...: linear
+ * radiance), turned by `rotation_deg` about +y and its radiance multiplied by `scale`
+ * (>= 0). It is importance sampled.
+ */
+enum HtStatus ht_scene_add_environment_map(struct HtScene *scene,
+                                           const char *path,
+                                           float rotation_deg,
+                                           float scale);
+
+/**
+ * Adds a light at infinity: `direction` points toward it (any non-zero length), it
+ * delivers linear RGB `irradiance` (>= 0) to a surface facing it, and is seen as a disc of
+ * `angular_radius_deg` in [0, 90) (0: a point, with hard shadows).
+ */
+enum HtStatus ht_scene_add_distant_light(struct HtScene *scene,
+                                         const float *direction,
+                                         const float *irradiance,
+                                         float angular_radius_deg);
+
+/**
+ * Adds a parallelogram light with corners `corner`, `corner + edge_u`, `corner + edge_v`
+ * and `corner + edge_u + edge_v`, emitting linear RGB `radiance` (>= 0) toward
+ * `edge_u x edge_v`, or to both sides if `two_sided`.
+ */
+enum HtStatus ht_scene_add_rect_light(struct HtScene *scene,
+                                      const float *corner,
+                                      const float *edge_u,
+                                      const float *edge_v,
+                                      const float *radiance,
+                                      bool two_sided);
+
+/**
+ * Places the pinhole camera at `eye` looking at `target`, `up` giving the image's upward
+ * direction (not parallel to the view), with a vertical field of view of `fov_y_deg` in
+ * (0, 180). Replaces any earlier camera. Without one, renders frame the scene's bounds
+ * from the front (+z), a little to the right and above.
+ */
+enum HtStatus ht_scene_set_camera(struct HtScene *scene,
+                                  const float *eye,
+                                  const float *target,
+                                  const float *up,
+                                  float fov_y_deg);
+
+/**
+ * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, no callback.
+ */
+struct HtRenderSettings ht_render_settings_default(void);
+
+/**
+ * Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
+ * `rgb_len` = width * height * 3 floats owned by the host.
+ *
+ * The first render builds the Embree scene (its time is part of the call); later ones
+ * reuse it until geometry is added. Blocks until the image is done. On
+ * `HT_ERR_CANCELLED`, `rgb` holds the pixels finished before the callback said stop and
+ * 0 elsewhere; on other errors it is left untouched.
+ */
+enum HtStatus ht_render(struct HtScene *scene,
+                        const struct HtRenderSettings *settings,
+                        float *rgb,
+                        size_t rgb_len);
+
+/**
+ * Writes `pixels` (width * height * channels linear floats, interleaved, rows from the
+ * top; channels 1 grey, 2 grey + alpha, 3 RGB or 4 RGBA with premultiplied alpha) through
+ * OpenImageIO. The extension picks the format: `.exr` stores 32-bit floats as they are;
+ * `.png`, `.jpg`, `.tif` store 8-bit sRGB (clamped to [0, 1]). NaN or infinite pixels are
+ * refused rather than written.
+ */
+enum HtStatus ht_image_write(const char *path,
+                             uint32_t width,
+                             uint32_t height,
+                             uint32_t channels,
+                             const float *pixels);
 
 #ifdef __cplusplus
 }  // extern "C"

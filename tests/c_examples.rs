@@ -3,7 +3,9 @@
 //! run, and its output checked against the Rust API.
 
 use glam::Vec3;
+use hairtrace::image::read_image;
 use hairtrace::{HairBsdf, HairParams};
+use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -30,8 +32,9 @@ const NATIVE_LIBS: &[&str] = &[
     "-ldl",
 ];
 
-/// Compiles `c_examples/<name>` with `compiler` and `flags`, links and runs it; returns stdout.
-fn build_and_run(name: &str, compiler: &str, flags: &[&str]) -> String {
+/// Compiles `c_examples/<name>` with `compiler` and `flags`, links and runs it with `args`;
+/// returns stdout.
+fn build_and_run(name: &str, compiler: &str, flags: &[&str], args: &[&OsStr]) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let lib = profile_dir().join("libhairtrace.a");
     assert!(lib.exists(), "{} not built", lib.display());
@@ -54,7 +57,10 @@ fn build_and_run(name: &str, compiler: &str, flags: &[&str]) -> String {
         "{compiler} {name} failed:\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let run = Command::new(&exe).output().expect("run the example");
+    let run = Command::new(&exe)
+        .args(args)
+        .output()
+        .expect("run the example");
     assert!(
         run.status.success(),
         "{name} ({compiler}) exited with {}:\n{}",
@@ -109,7 +115,12 @@ fn check_bsdf_output(out: &str) {
 
 #[test]
 fn bsdf_example_as_c99() {
-    check_bsdf_output(&build_and_run("bsdf.c", "gcc", &["-std=c99", "-pedantic"]));
+    check_bsdf_output(&build_and_run(
+        "bsdf.c",
+        "gcc",
+        &["-std=c99", "-pedantic"],
+        &[],
+    ));
 }
 
 #[test]
@@ -118,5 +129,48 @@ fn bsdf_example_as_cpp() {
         "bsdf.c",
         "g++",
         &["-x", "c++", "-std=c++17"],
+        &[],
     ));
+}
+
+/// Builds and runs `render.c`, which writes its image to a file this test names, and checks
+/// what it printed and wrote.
+fn check_render_example(compiler: &str, flags: &[&str]) {
+    let exr = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("render-{compiler}.exr"));
+    let _ = std::fs::remove_file(&exr);
+    let out = build_and_run("render.c", compiler, flags, &[exr.as_os_str()]);
+    assert_eq!(numbers(&out, "geometry"), [0.0, 1.0], "{out}");
+    assert!(
+        out.contains("mismatch invalid argument: invalid argument: material_id = 1 is a diffuse"),
+        "{out}"
+    );
+    assert_eq!(numbers(&out, "image"), [64.0, 48.0], "{out}");
+    let mean = numbers(&out, "mean")[0];
+    assert!(mean.is_finite() && mean > 0.0, "mean {mean}:\n{out}");
+    // 64 x 48 pixels in 16 x 16 tiles: one call per tile.
+    assert_eq!(numbers(&out, "progress"), [12.0], "{out}");
+    let image = read_image(&exr).unwrap_or_else(|e| panic!("{}: {e}", exr.display()));
+    assert_eq!((image.width, image.height, image.channels), (64, 48, 3));
+    let file_mean =
+        image.pixels.iter().map(|v| f64::from(*v)).sum::<f64>() / image.pixels.len() as f64;
+    assert!(
+        (file_mean - f64::from(mean)).abs() < 1e-5 * f64::from(mean),
+        "the EXR's mean {file_mean} is not the printed {mean}"
+    );
+    // The fur and the sphere stand out from the sky: not a flat image.
+    let (lo, hi) = image
+        .pixels
+        .iter()
+        .fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(*v), hi.max(*v)));
+    assert!(hi > 2.0 * lo, "pixels only span [{lo}, {hi}]");
+}
+
+#[test]
+fn render_example_as_c99() {
+    check_render_example("gcc", &["-std=c99", "-pedantic"]);
+}
+
+#[test]
+fn render_example_as_cpp() {
+    check_render_example("g++", &["-x", "c++", "-std=c++17"]);
 }

@@ -160,3 +160,40 @@ fn render_errors_are_one_line() {
     assert_one_line_error(&hairtrace(&["render", &bad, "-o", &out]), "widht");
     assert_one_line_error(&hairtrace(&["render", "--spp", "0", "-o", &out]), "spp");
 }
+
+/// `--aov` writes the albedo, depth and strand-id images beside the beauty image.
+#[test]
+fn render_writes_aovs() {
+    let out = tmp("cli_aov.exr");
+    let o = hairtrace(&[
+        "render",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--spp",
+        "1",
+        "--aov",
+        "albedo,depth,strand",
+        "-o",
+        &out,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let read = |name: &str| hairtrace::image::read_image(std::path::Path::new(&tmp(name))).unwrap();
+    let (albedo, depth, strand) = (
+        read("cli_aov.albedo.exr"),
+        read("cli_aov.depth.exr"),
+        read("cli_aov.strand.exr"),
+    );
+    assert_eq!(
+        (albedo.channels, depth.channels, strand.channels),
+        (3, 1, 1)
+    );
+    // The fur ball fills the middle of the frame: a strand id and a positive depth there.
+    let centre = 12 * 32 + 16;
+    assert!(strand.pixels[centre] >= 0.0 && depth.pixels[centre] > 0.0);
+    assert_one_line_error(
+        &hairtrace(&["render", "--aov", "normals", "-o", &out]),
+        "normals",
+    );
+}

@@ -424,3 +424,26 @@ fn quick_look_frames_a_hair_file_and_paths_follow_the_scene_file() {
 fn look_distance(desc: &SceneDescription) -> f32 {
     desc.build(device()).unwrap().camera.eye().length()
 }
+
+#[test]
+fn documented_format_parses() {
+    let source = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("src/scene/description.rs"),
+    )
+    .unwrap();
+    let doc: String = source
+        .lines()
+        .filter_map(|l| l.strip_prefix("//!"))
+        .map(|l| l.strip_prefix(' ').unwrap_or(l))
+        .skip_while(|l| *l != "```toml")
+        .skip(1)
+        .take_while(|l| *l != "```")
+        .collect::<Vec<_>>()
+        .join("\n");
+    let desc = parse(&doc).unwrap_or_else(|e| panic!("{e}\n{doc}"));
+    assert_eq!(
+        (desc.grooms.len(), desc.meshes.len(), desc.lights.len()),
+        (2, 2, 3)
+    );
+    assert_eq!(desc.render.crop, Some([0, 0, 320, 240]));
+}

@@ -65,6 +65,10 @@ struct RenderArgs {
     /// Output image.
     #[arg(short, long)]
     output: PathBuf,
+    /// Also write these AOVs, each to OUT's name with `.albedo`, `.depth` or `.strand`
+    /// before the extension: albedo (RGB), depth (camera distance), strand (strand id).
+    #[arg(long, value_delimiter = ',', value_parser = ["albedo", "depth", "strand"])]
+    aov: Vec<String>,
 }
 
 #[derive(Args)]
@@ -206,23 +210,40 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}")
             .expect("a valid progress template"),
     );
-    let out = renderer::render(
-        &world,
-        &camera,
-        &settings,
-        Aovs::default(),
-        &Bar(bar.clone()),
-    )?;
+    let wants = |name: &str| args.aov.iter().any(|a| a == name);
+    let aovs = Aovs {
+        albedo: wants("albedo"),
+        depth: wants("depth"),
+        strand_id: wants("strand"),
+    };
+    let aov_paths: Vec<(PathBuf, &str)> = args
+        .aov
+        .iter()
+        .map(|a| (aov_path(&args.output, a), a.as_str()))
+        .collect();
+    for (path, _) in &aov_paths {
+        image::check_output_path(path)?;
+    }
+    let out = renderer::render(&world, &camera, &settings, aovs, &Bar(bar.clone()))?;
     bar.finish_and_clear();
     let window = out.film.crop();
-    image::write_image(
-        &args.output,
-        window.width() as usize,
-        window.height() as usize,
-        3,
-        out.film.rgb(),
-        &WriteOptions::default(),
-    )?;
+    let write = |path: &PathBuf, channels: usize, pixels: &[f32]| {
+        let (w, h) = (window.width() as usize, window.height() as usize);
+        image::write_image(path, w, h, channels, pixels, &WriteOptions::default())
+    };
+    write(&args.output, 3, out.film.rgb())?;
+    for (path, name) in &aov_paths {
+        let (channels, pixels) = match *name {
+            "albedo" => (3, out.film.albedo()),
+            "depth" => (1, out.film.depth()),
+            _ => (1, out.film.strand_id()),
+        };
+        write(
+            path,
+            channels,
+            pixels.expect("the film keeps every AOV asked for"),
+        )?;
+    }
     let s = out.stats;
     eprintln!(
         "{}: {}x{} at {} spp in {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s, peak memory {}",
@@ -242,6 +263,19 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         );
     }
     Ok(())
+}
+
+/// `out.exr` -> `out.albedo.exr`.
+fn aov_path(output: &std::path::Path, aov: &str) -> PathBuf {
+    let stem = output
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = output
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    output.with_file_name(format!("{stem}.{aov}.{ext}"))
 }
 
 /// The process's peak resident memory, from Linux's /proc ("unknown" elsewhere).
@@ -268,7 +302,29 @@ fn info(args: &InfoArgs) -> hairtrace::Result<()> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        // Help and version go to stdout as clap writes them.
+        Err(e) if !e.use_stderr() => e.exit(),
+        // Usage errors in one line, like every other error.
+        Err(e) => {
+            let text = e.render().to_string();
+            let lines: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .filter(|l| {
+                    !l.is_empty()
+                        && !l.starts_with("For more information")
+                        && !l.starts_with("Usage:")
+                })
+                .collect();
+            eprintln!(
+                "hairtrace: {} (see --help)",
+                lines.join(" ").trim_start_matches("error: ")
+            );
+            return ExitCode::from(2);
+        }
+    };
     let result = match &cli.command {
         Command::Render(a) => render(a),
         Command::Lobes(a) => lobes(a),

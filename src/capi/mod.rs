@@ -6,13 +6,19 @@
 //! module by cbindgen.
 
 pub mod bsdf;
+pub mod scene;
+// After `scene`, so that the header declares scenes before the render that takes them.
+pub mod render;
 
 pub use bsdf::HtHairParams;
 
 use crate::Error;
+use crate::error::invalid_arg;
+use glam::Vec3;
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::PathBuf;
 
 /// Version of the C ABI; bumped on any incompatible change of a signature or struct.
 pub const HT_ABI_VERSION: u32 = 1;
@@ -35,6 +41,8 @@ pub enum HtStatus {
     HT_ERR_IMAGE = 5,
     /// Embree failed.
     HT_ERR_EMBREE = 6,
+    /// The progress callback returned false; the render stopped early.
+    HT_ERR_CANCELLED = 7,
 }
 
 impl HtStatus {
@@ -47,10 +55,11 @@ impl HtStatus {
             HtStatus::HT_ERR_IO => c"i/o error",
             HtStatus::HT_ERR_IMAGE => c"image error",
             HtStatus::HT_ERR_EMBREE => c"embree error",
+            HtStatus::HT_ERR_CANCELLED => c"cancelled",
         }
     }
 
-    const ALL: [HtStatus; 7] = [
+    const ALL: [HtStatus; 8] = [
         HtStatus::HT_OK,
         HtStatus::HT_ERR_NULL_ARG,
         HtStatus::HT_ERR_INVALID_ARG,
@@ -58,6 +67,7 @@ impl HtStatus {
         HtStatus::HT_ERR_IO,
         HtStatus::HT_ERR_IMAGE,
         HtStatus::HT_ERR_EMBREE,
+        HtStatus::HT_ERR_CANCELLED,
     ];
 }
 
@@ -127,6 +137,78 @@ pub(crate) fn non_null<T>(ptr: *const T, name: &str) -> Result<*const T, Failure
 /// [`non_null`] for out-parameters.
 pub(crate) fn non_null_mut<T>(ptr: *mut T, name: &str) -> Result<*mut T, Failure> {
     non_null(ptr.cast_const(), name).map(|p| p.cast_mut())
+}
+
+/// Checks that a host array of `len` elements can be read as a slice: not NULL (unless
+/// empty), aligned for `T`, and no larger than Rust allows an allocation to be. Whether the
+/// host really holds `len` elements there is its promise, as in any C API.
+fn check_host_array<T>(ptr: *const T, len: usize, name: &str) -> Result<(), Failure> {
+    if len == 0 {
+        return Ok(());
+    }
+    non_null(ptr, name)?;
+    if !ptr.is_aligned() {
+        return Err(invalid_arg!(
+            "{name} = {ptr:?} is not aligned to {} bytes",
+            align_of::<T>()
+        )
+        .into());
+    }
+    if len
+        .checked_mul(size_of::<T>())
+        .is_none_or(|b| b > isize::MAX as usize)
+    {
+        return Err(invalid_arg!("{name}: {len} elements do not fit in memory").into());
+    }
+    Ok(())
+}
+
+/// The host array `ptr[0..len]` (see [`check_host_array`]); empty when `len` is 0.
+pub(crate) fn host_slice<'a, T>(ptr: *const T, len: usize, name: &str) -> Result<&'a [T], Failure> {
+    check_host_array(ptr, len, name)?;
+    if len == 0 {
+        return Ok(&[]);
+    }
+    // SAFETY: non-NULL, aligned and of a valid size (checked); the host promises `len`
+    // initialised elements that stay put for the call.
+    Ok(unsafe { std::slice::from_raw_parts(ptr, len) })
+}
+
+/// [`host_slice`] for an output array the host lends to the call.
+pub(crate) fn host_slice_mut<'a, T>(
+    ptr: *mut T,
+    len: usize,
+    name: &str,
+) -> Result<&'a mut [T], Failure> {
+    check_host_array(ptr.cast_const(), len, name)?;
+    if len == 0 {
+        return Ok(&mut []);
+    }
+    // SAFETY: non-NULL, aligned and of a valid size (checked); the host promises `len`
+    // writable elements that nothing else touches during the call.
+    Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })
+}
+
+/// Reads a `float[3]` that must be finite; the message names the argument.
+pub(crate) fn read_vec3(ptr: *const f32, name: &str) -> Result<Vec3, Failure> {
+    let v = Vec3::from_array(host_slice(ptr, 3, name)?.try_into().expect("3 elements"));
+    if !v.is_finite() {
+        return Err(invalid_arg!("{name} = {v}: must be finite").into());
+    }
+    Ok(v)
+}
+
+/// Reads a NUL-terminated UTF-8 path.
+pub(crate) fn read_path(ptr: *const c_char, name: &str) -> Result<PathBuf, Failure> {
+    // SAFETY: non-NULL (checked); the host promises a NUL-terminated string.
+    let c = unsafe { CStr::from_ptr(non_null(ptr, name)?) };
+    let s = c
+        .to_str()
+        .map_err(|_| invalid_arg!("{name} {c:?} is not valid UTF-8"))?;
+    if s.is_empty() {
+        return Err(invalid_arg!("{name} is empty").into());
+    }
+    Ok(PathBuf::from(s))
 }
 
 /// The ABI version this library was built with; compare with `HT_ABI_VERSION`.

@@ -1,0 +1,501 @@
+//! Rendering a scene into the host's buffer, and writing images, through the C ABI.
+
+use super::scene::{HtScene, scene_mut};
+use super::{
+    Failure, HtStatus, boundary, host_slice, host_slice_mut, non_null, non_null_mut, read_path,
+};
+use crate::error::invalid_arg;
+use crate::image::{WriteOptions, write_image};
+use crate::render::integrator::PathSettings;
+use crate::render::renderer::render;
+use crate::render::settings::RenderSettings;
+use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
+use std::ffi::{c_char, c_void};
+
+/// Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
+/// call. Return false to cancel: no new pixel starts and `ht_render` returns
+/// `HT_ERR_CANCELLED` (tiles that finish meanwhile may still report).
+///
+/// Called from the render's worker threads (not necessarily the one that called
+/// `ht_render`), but never two calls at once, so `user` needs no locking against itself.
+/// The callback must return normally: a C++ exception or a longjmp out of it is undefined
+/// behaviour (catch inside and return false instead).
+pub type HtProgressFn =
+    Option<unsafe extern "C" fn(done: u64, total: u64, user: *mut c_void) -> bool>;
+
+/// What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
+/// the fields you need.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct HtRenderSettings {
+    /// Image size in pixels, each in [1, 32768].
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel, >= 1.
+    pub spp: u32,
+    /// The image depends only on the scene, these settings and this seed: never on the
+    /// thread count.
+    pub seed: u64,
+    /// Render threads; 0: one per hardware thread.
+    pub threads: u32,
+    /// Longest path in scattering events, >= 1. Light hair needs many: the default (256)
+    /// keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
+    pub max_depth: u32,
+    /// May be NULL: no progress reports, no cancellation.
+    pub progress: HtProgressFn,
+    /// Passed to `progress` as it is.
+    pub progress_user: *mut c_void,
+}
+
+/// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, no callback.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
+    let d = RenderSettings::default();
+    HtRenderSettings {
+        width: d.width,
+        height: d.height,
+        spp: d.spp,
+        seed: d.seed,
+        threads: 0,
+        max_depth: d.path.max_depth,
+        progress: None,
+        progress_user: std::ptr::null_mut(),
+    }
+}
+
+/// The host's callback as a [`Progress`] sink.
+struct HostProgress {
+    callback: unsafe extern "C" fn(u64, u64, *mut c_void) -> bool,
+    user: *mut c_void,
+}
+
+// SAFETY: the renderer never calls `update` from two threads at once (the Progress
+// contract), and `user` is only handed back to the host's callback in those calls, as
+// HtProgressFn documents.
+unsafe impl Sync for HostProgress {}
+
+impl Progress for HostProgress {
+    fn update(&self, done: u64, total: u64) -> bool {
+        // SAFETY: the host's function pointer and its own user pointer.
+        unsafe { (self.callback)(done, total, self.user) }
+    }
+}
+
+/// Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
+/// `rgb_len` = width * height * 3 floats owned by the host.
+///
+/// The first render builds the Embree scene (its time is part of the call); later ones
+/// reuse it until geometry is added. Blocks until the image is done. On
+/// `HT_ERR_CANCELLED`, `rgb` holds the pixels finished before the callback said stop and
+/// 0 elsewhere; on other errors it is left untouched.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_render(
+    scene: *mut HtScene,
+    settings: *const HtRenderSettings,
+    rgb: *mut f32,
+    rgb_len: usize,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        // SAFETY: non-NULL (checked); the host's struct.
+        let s = unsafe { *non_null(settings, "settings")? };
+        let settings = RenderSettings {
+            width: s.width,
+            height: s.height,
+            spp: s.spp,
+            seed: s.seed,
+            threads: (s.threads > 0).then_some(s.threads as usize),
+            crop: None,
+            path: PathSettings {
+                max_depth: s.max_depth,
+                ..PathSettings::default()
+            },
+        };
+        settings.validate()?;
+        // At most 2^15 x 2^15 x 3 (validated above): no overflow.
+        let want = s.width as usize * s.height as usize * 3;
+        if rgb_len != want {
+            return Err(
+                invalid_arg!("rgb_len = {rgb_len}: must be width * height * 3 = {want}").into(),
+            );
+        }
+        let rgb = host_slice_mut(non_null_mut(rgb, "rgb")?, rgb_len, "rgb")?;
+        let (world, camera) = scene.prepare(s.width as f32 / s.height as f32)?;
+        let host;
+        let progress: &dyn Progress = match s.progress {
+            Some(callback) => {
+                host = HostProgress {
+                    callback,
+                    user: s.progress_user,
+                };
+                &host
+            }
+            None => &NoProgress,
+        };
+        let out = render(world, &camera, &settings, Aovs::default(), progress)?;
+        rgb.copy_from_slice(out.film.rgb());
+        match out.status {
+            RenderStatus::Complete => Ok(()),
+            RenderStatus::Cancelled => Err(Failure(
+                HtStatus::HT_ERR_CANCELLED,
+                "render cancelled by the progress callback".into(),
+            )),
+        }
+    })
+}
+
+/// Writes `pixels` (width * height * channels linear floats, interleaved, rows from the
+/// top; channels 1 grey, 2 grey + alpha, 3 RGB or 4 RGBA with premultiplied alpha) through
+/// OpenImageIO. The extension picks the format: `.exr` stores 32-bit floats as they are;
+/// `.png`, `.jpg`, `.tif` store 8-bit sRGB (clamped to [0, 1]). NaN or infinite pixels are
+/// refused rather than written.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_image_write(
+    path: *const c_char,
+    width: u32,
+    height: u32,
+    channels: u32,
+    pixels: *const f32,
+) -> HtStatus {
+    boundary(|| {
+        let path = read_path(path, "path")?;
+        let (w, h, c) = (width as usize, height as usize, channels as usize);
+        let len = w
+            .checked_mul(h)
+            .and_then(|n| n.checked_mul(c))
+            .ok_or_else(|| {
+                invalid_arg!("{width} x {height} x {channels} values do not fit in memory")
+            })?;
+        let pixels = host_slice(non_null(pixels, "pixels")?, len, "pixels")?;
+        write_image(&path, w, h, c, pixels, &WriteOptions::default())?;
+        Ok(())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::capi::scene::tests::{Handles, fails, last_error, small_fur};
+    use crate::capi::scene::*;
+    use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
+    use crate::image::read_image;
+    use crate::render::integrator::{Material, World};
+    use crate::scene::camera::Camera;
+    use crate::scene::curves::Curves;
+    use crate::scene::envmap::Environment;
+    use crate::scene::light::Light;
+    use crate::scene::material::HairMaterial;
+    use crate::scene::tracer::TracerBuilder;
+    use glam::Vec3;
+    use std::ptr::{null, null_mut};
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicU32, Ordering};
+
+    const EYE: [f32; 3] = [0.0, 0.0, 4.0];
+    const UP: [f32; 3] = [0.0, 1.0, 0.0];
+    const SKY: [f32; 3] = [0.3, 0.35, 0.4];
+    const SUN_DIR: [f32; 3] = [1.0, 1.0, 1.0];
+    const SUN: [f32; 3] = [2.0, 2.0, 1.8];
+    const SUN_RADIUS_DEG: f32 = 2.0;
+
+    fn settings(size: u32) -> HtRenderSettings {
+        HtRenderSettings {
+            width: size,
+            height: size,
+            spp: 4,
+            seed: 7,
+            threads: 2,
+            ..ht_render_settings_default()
+        }
+    }
+
+    /// The small fur ball with hair, sky and sun through the C functions.
+    fn fur_scene(camera: bool) -> Handles {
+        let h = Handles::new();
+        let hair = h.hair_material();
+        assert_eq!(
+            h.add_strands(&small_fur(), hair),
+            HtStatus::HT_OK,
+            "{}",
+            last_error()
+        );
+        assert_eq!(
+            ht_scene_add_environment(h.scene, SKY.as_ptr()),
+            HtStatus::HT_OK
+        );
+        let s = ht_scene_add_distant_light(h.scene, SUN_DIR.as_ptr(), SUN.as_ptr(), SUN_RADIUS_DEG);
+        assert_eq!(s, HtStatus::HT_OK);
+        if camera {
+            let s =
+                ht_scene_set_camera(h.scene, EYE.as_ptr(), [0.0; 3].as_ptr(), UP.as_ptr(), 40.0);
+            assert_eq!(s, HtStatus::HT_OK);
+        }
+        h
+    }
+
+    fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
+        let mut rgb = vec![-1.0f32; (s.width * s.height * 3) as usize];
+        let status = ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len());
+        (status, rgb)
+    }
+
+    fn bits(rgb: &[f32]) -> Vec<u32> {
+        rgb.iter().map(|v| v.to_bits()).collect()
+    }
+
+    #[test]
+    fn c_render_matches_the_rust_api_bit_for_bit() {
+        let h = fur_scene(true);
+        let (status, rgb) = render_c(&h, &settings(32));
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+
+        let device = Arc::new(Device::new(Some(2)).unwrap());
+        let mut builder = TracerBuilder::new(device, SceneOptions::default()).unwrap();
+        let curves = Curves::from_strands(&small_fur(), CurveBasis::BSpline, CurveShape::Round);
+        builder.add_curves(curves.unwrap()).unwrap();
+        let hair = HairMaterial::default().prepare().unwrap();
+        let lights = vec![
+            Light::Environment(Environment::uniform(Vec3::from(SKY)).unwrap()),
+            Light::distant(SUN_DIR.into(), SUN.into(), SUN_RADIUS_DEG.to_radians()).unwrap(),
+        ];
+        let world = World::new(
+            builder.build().unwrap(),
+            vec![Material::Hair(Box::new(hair))],
+            lights,
+        )
+        .unwrap();
+        let camera = Camera::new(EYE.into(), Vec3::ZERO, UP.into(), 40.0, 1.0).unwrap();
+        let rust = RenderSettings {
+            width: 32,
+            height: 32,
+            spp: 4,
+            seed: 7,
+            threads: Some(2),
+            ..RenderSettings::default()
+        };
+        let out = render(&world, &camera, &rust, Aovs::default(), &NoProgress).unwrap();
+        assert_eq!(bits(&rgb), bits(out.film.rgb()));
+        assert!(rgb.iter().any(|v| *v > 0.0));
+    }
+
+    extern "C" fn count_then_cancel(_done: u64, _total: u64, user: *mut c_void) -> bool {
+        let calls = unsafe { &*user.cast::<AtomicU32>() };
+        calls.fetch_add(1, Ordering::Relaxed) < 1
+    }
+
+    extern "C" fn count(done: u64, total: u64, user: *mut c_void) -> bool {
+        assert!(done <= total);
+        unsafe { &*user.cast::<AtomicU32>() }.fetch_add(1, Ordering::Relaxed);
+        true
+    }
+
+    #[test]
+    fn the_callback_reports_progress_and_cancels() {
+        let h = fur_scene(true);
+        let calls = AtomicU32::new(0);
+        let mut s = HtRenderSettings {
+            progress: Some(count),
+            progress_user: std::ptr::from_ref(&calls).cast_mut().cast(),
+            ..settings(64)
+        };
+        let (status, full) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        // 16 x 16 tiles: one call per tile.
+        assert_eq!(calls.load(Ordering::Relaxed), 16);
+
+        calls.store(0, Ordering::Relaxed);
+        s.progress = Some(count_then_cancel);
+        let (status, partial) = render_c(&h, &s);
+        fails(
+            status,
+            HtStatus::HT_ERR_CANCELLED,
+            "cancelled by the progress callback",
+        );
+        assert!(calls.load(Ordering::Relaxed) >= 2);
+        // Finished tiles match the full render; the rest stayed black.
+        let unfinished = partial.iter().filter(|v| **v == 0.0).count();
+        assert!(unfinished >= partial.len() / 2, "{unfinished}");
+        for (p, f) in partial.iter().zip(&full) {
+            assert!(*p == 0.0 || p == f);
+        }
+    }
+
+    #[test]
+    fn adding_geometry_or_lights_rebuilds_what_changed() {
+        let h = fur_scene(true);
+        let s = settings(24);
+        let (status, before) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert_eq!(
+            render_c(&h, &s).1,
+            before,
+            "a second render reuses the build"
+        );
+
+        // A white wall behind the fur, then a rect light: each render equals a scene
+        // built with everything from the start.
+        let wall = h.diffuse_material([0.9; 3]);
+        assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
+        let (status, with_wall) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert_ne!(bits(&with_wall), bits(&before));
+        let add_rect = |h: &Handles| {
+            let (corner, u, v) = ([-1.0f32, 2.0, 2.0], [2.0f32, 0.0, 0.0], [0.0f32, 0.0, -2.0]);
+            let s = ht_scene_add_rect_light(
+                h.scene,
+                corner.as_ptr(),
+                u.as_ptr(),
+                v.as_ptr(),
+                [3.0f32; 3].as_ptr(),
+                false,
+            );
+            assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        };
+        add_rect(&h);
+        let (status, with_rect) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+
+        let fresh = fur_scene(true);
+        let wall = fresh.diffuse_material([0.9; 3]);
+        assert_eq!(fresh.add_triangle(wall), HtStatus::HT_OK);
+        assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_wall));
+        add_rect(&fresh);
+        assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_rect));
+        assert_ne!(bits(&with_rect), bits(&with_wall));
+    }
+
+    #[test]
+    fn without_a_camera_the_scene_is_framed() {
+        let h = fur_scene(false);
+        let (status, rgb) = render_c(&h, &settings(32));
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert!(rgb.iter().all(|v| v.is_finite()));
+        // Pixels that see fur rather than only the sky gather around the image centre.
+        let fur: Vec<(f32, f32)> = (0..32 * 32)
+            .filter(|i| rgb[3 * i] != SKY[0])
+            .map(|i| ((i % 32) as f32, (i / 32) as f32))
+            .collect();
+        assert!(fur.len() > 20, "{} fur pixels", fur.len());
+        let n = fur.len() as f32;
+        let centre = fur
+            .iter()
+            .fold((0.0, 0.0), |(x, y), p| (x + p.0 / n, y + p.1 / n));
+        assert!(
+            (centre.0 - 15.5).abs() < 4.0 && (centre.1 - 15.5).abs() < 4.0,
+            "{centre:?}"
+        );
+    }
+
+    #[test]
+    fn bad_settings_and_incomplete_scenes_are_reported() {
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
+        let h = fur_scene(true);
+        let s = settings(8);
+        let mut rgb = vec![0.0f32; 8 * 8 * 3];
+        let (ptr, len) = (rgb.as_mut_ptr(), rgb.len());
+        fails(ht_render(null_mut(), &s, ptr, len), NULL, "scene");
+        fails(ht_render(h.scene, null(), ptr, len), NULL, "settings");
+        fails(ht_render(h.scene, &s, null_mut(), len), NULL, "rgb");
+        fails(
+            ht_render(h.scene, &s, ptr, len - 1),
+            INVALID,
+            "rgb_len = 191",
+        );
+        let zero = HtRenderSettings { width: 0, ..s };
+        fails(ht_render(h.scene, &zero, ptr, 0), INVALID, "width = 0");
+        let depth = HtRenderSettings { max_depth: 0, ..s };
+        fails(
+            ht_render(h.scene, &depth, ptr, len),
+            INVALID,
+            "max_depth = 0",
+        );
+        let spp = HtRenderSettings { spp: 0, ..s };
+        fails(ht_render(h.scene, &spp, ptr, len), INVALID, "spp = 0");
+        assert!(
+            rgb.iter().all(|v| *v == 0.0),
+            "failed renders leave the buffer alone"
+        );
+
+        let dark = Handles::new();
+        let hair = dark.hair_material();
+        assert_eq!(dark.add_strands(&small_fur(), hair), HtStatus::HT_OK);
+        fails(ht_render(dark.scene, &s, ptr, len), INVALID, "no light");
+        let empty = Handles::new();
+        assert_eq!(
+            ht_scene_add_environment(empty.scene, SKY.as_ptr()),
+            HtStatus::HT_OK
+        );
+        fails(
+            ht_render(empty.scene, &s, ptr, len),
+            INVALID,
+            "ht_scene_set_camera",
+        );
+        // With a camera, an empty scene shows its environment.
+        let z = [0.0f32, 0.0, -1.0];
+        let set = ht_scene_set_camera(
+            empty.scene,
+            [0.0; 3].as_ptr(),
+            z.as_ptr(),
+            UP.as_ptr(),
+            40.0,
+        );
+        assert_eq!(set, HtStatus::HT_OK);
+        assert_eq!(
+            ht_render(empty.scene, &s, ptr, len),
+            HtStatus::HT_OK,
+            "{}",
+            last_error()
+        );
+        for (v, sky) in rgb.iter().zip(SKY.iter().cycle()) {
+            assert!((v - sky).abs() < 1e-6, "{v} {sky}");
+        }
+    }
+
+    #[test]
+    fn images_are_written_through_oiio() {
+        let dir = std::env::temp_dir().join(format!("ht-capi-render-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("ramp.exr");
+        let path = std::ffi::CString::new(file.to_str().unwrap()).unwrap();
+        let pixels: Vec<f32> = (0..4 * 2 * 3).map(|i| i as f32 / 8.0).collect();
+        let s = ht_image_write(path.as_ptr(), 4, 2, 3, pixels.as_ptr());
+        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        let image = read_image(&file).unwrap();
+        assert_eq!((image.width, image.height, image.channels), (4, 2, 3));
+        assert_eq!(image.pixels, pixels);
+
+        fails(
+            ht_image_write(path.as_ptr(), 4, 2, 3, null()),
+            HtStatus::HT_ERR_NULL_ARG,
+            "pixels",
+        );
+        fails(
+            ht_image_write(null(), 4, 2, 3, pixels.as_ptr()),
+            HtStatus::HT_ERR_NULL_ARG,
+            "path",
+        );
+        let bmp = std::ffi::CString::new(dir.join("x.bmp").to_str().unwrap()).unwrap();
+        let s = ht_image_write(bmp.as_ptr(), 4, 2, 3, pixels.as_ptr());
+        assert_ne!(s, HtStatus::HT_OK);
+        assert!(last_error().contains("x.bmp"), "{}", last_error());
+        let nan = [f32::NAN; 3];
+        fails(
+            ht_image_write(path.as_ptr(), 1, 1, 3, nan.as_ptr()),
+            HtStatus::HT_ERR_IMAGE,
+            "NaN",
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn the_default_settings_are_the_rust_defaults() {
+        let d = ht_render_settings_default();
+        let r = RenderSettings::default();
+        assert_eq!(
+            (d.width, d.height, d.spp, d.seed),
+            (r.width, r.height, r.spp, r.seed)
+        );
+        assert_eq!((d.threads, d.max_depth), (0, r.path.max_depth));
+        assert!(d.progress.is_none() && d.progress_user.is_null());
+    }
+}

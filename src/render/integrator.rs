@@ -220,28 +220,24 @@ impl World {
         let dir_n = dir.normalize();
         let mut sum = Vec3::ZERO;
         for (i, light) in self.lights.iter().enumerate() {
-            let le = if light.is_infinite() {
-                if t_hit.is_finite() {
-                    continue;
-                }
-                light.le(dir_n)
+            // Lights at infinity are met by rays that escape; a rect by one that reaches it
+            // before any geometry.
+            let reached = if light.is_infinite() {
+                t_hit == f32::INFINITY
             } else {
-                match light.intersect(org, dir) {
-                    Some(t) if t < t_hit => {
-                        light.eval_li(org, dir_n).map_or(Vec3::ZERO, |e| e.radiance)
-                    }
-                    _ => continue,
-                }
+                light.intersect(org, dir).is_some_and(|t| t < t_hit)
+            };
+            let Some(e) = reached.then(|| light.eval_li(org, dir_n)).flatten() else {
+                continue;
             };
             let weight = match (bsdf_pdf, strategy) {
                 (None, _) | (Some(_), Strategy::BsdfOnly) => 1.0,
                 (Some(_), Strategy::LightOnly) => 0.0,
                 (Some(pdf), Strategy::Mis) => {
-                    let light_pdf = self.choice_pdf(i) * light.pdf_li(org, dir_n);
-                    power_heuristic(1.0, pdf, 1.0, light_pdf)
+                    power_heuristic(1.0, pdf, 1.0, self.choice_pdf(i) * e.pdf)
                 }
             };
-            sum += le * weight;
+            sum += e.radiance * weight;
         }
         sum
     }

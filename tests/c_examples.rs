@@ -37,7 +37,11 @@ const NATIVE_LIBS: &[&str] = &[
 fn build_and_run(name: &str, compiler: &str, flags: &[&str], args: &[&OsStr]) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let lib = profile_dir().join("libhairtrace.a");
-    assert!(lib.exists(), "{} not built", lib.display());
+    assert!(
+        lib.exists(),
+        "{} not built: `cargo test` builds only the rlib; run `cargo build --release` first (the README's test command does)",
+        lib.display()
+    );
     let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{compiler}"));
     let out = Command::new(compiler)
         .args(flags)

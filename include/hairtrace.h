@@ -64,8 +64,9 @@ typedef struct HtDevice HtDevice;
  *
  * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
  * later additions, and a rendered scene holds a second copy in Embree's buffers plus the
- * BVH. For the largest grooms, add everything before the first render and free the scene
- * when done.
+ * BVH; control points added with `ht_scene_add_curves_xyzr_shared` are never copied, by
+ * either. For the largest grooms, share them (or add everything before the first render)
+ * and free the scene when done.
  */
 typedef struct HtScene HtScene;
 
@@ -177,8 +178,9 @@ typedef struct HtCurves {
 
 /**
  * Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
- * that hold that layout. Copied once by `ht_scene_add_curves_xyzr`; the host may free its
- * arrays when the call returns.
+ * that hold that layout. `ht_scene_add_curves_xyzr` copies them, and the host may free its
+ * arrays when the call returns; `ht_scene_add_curves_xyzr_shared` reads `points` in place
+ * for the life of the scene (see there).
  *
  * A strand of n control points has n - 1 linear segments, n - 3 B-spline or Catmull-Rom
  * segments (the curve runs between the second and the second-to-last point), or (n - 1) / 3
@@ -427,13 +429,29 @@ enum HtStatus ht_scene_add_curves(struct HtScene *scene,
                                   uint32_t *geom_id);
 
 /**
- * Adds strands of float4 control points laid out for the basis (copied once: see
+ * Adds strands of float4 control points laid out for the basis (copied: see
  * `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
  */
 enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
                                        const struct HtCurvesXyzr *desc,
                                        uint32_t material_id,
                                        uint32_t *geom_id);
+
+/**
+ * As `ht_scene_add_curves_xyzr`, but `desc->points` is shared, not copied: Embree reads
+ * the host's array in place, through every render and every rebuild after later
+ * additions, and the scene never holds a copy of it. The host keeps those
+ * `4 * point_count` floats allocated and unchanged until `ht_scene_free` returns; writing
+ * to them or freeing them earlier is undefined behaviour. `points` must be aligned to 4
+ * bytes, like any float array (16-byte alignment is not needed, and no padding past the
+ * last point: Embree reads at most the 16 bytes of a float4 from its start). The small
+ * per-strand data are still built and kept by the scene: `point_counts` and `colors` are
+ * read during the call only, and the index buffer takes 4 bytes per segment.
+ */
+enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
+                                              const struct HtCurvesXyzr *desc,
+                                              uint32_t material_id,
+                                              uint32_t *geom_id);
 
 /**
  * Adds the strands of a Cem Yuksel `.hair` file as polylines for `basis`. The file's

@@ -175,9 +175,9 @@ pub extern "C" fn ht_image_write(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::capi::scene::tests::{Handles, fails, last_error, small_fur};
+    use crate::capi::scene::tests::{Handles, fails, last_error, small_fur, xyzr, xyzr_desc};
     use crate::capi::scene::*;
-    use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
+    use crate::embree::{CurveBasis, CurveShape, Device, Geometry, SceneOptions};
     use crate::image::read_image;
     use crate::render::integrator::{Material, World};
     use crate::scene::camera::Camera;
@@ -219,6 +219,12 @@ mod tests {
             "{}",
             last_error()
         );
+        light(&h, camera);
+        h
+    }
+
+    /// Adds sky and sun, and the camera if asked.
+    fn light(h: &Handles, camera: bool) {
         assert_eq!(
             ht_scene_add_environment(h.scene, SKY.as_ptr()),
             HtStatus::HT_OK
@@ -230,7 +236,6 @@ mod tests {
                 ht_scene_set_camera(h.scene, EYE.as_ptr(), [0.0; 3].as_ptr(), UP.as_ptr(), 40.0);
             assert_eq!(s, HtStatus::HT_OK);
         }
-        h
     }
 
     fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
@@ -276,6 +281,52 @@ mod tests {
         let out = render(&world, &camera, &rust, Aovs::default(), &NoProgress).unwrap();
         assert_eq!(bits(&rgb), bits(out.film.rgb()));
         assert!(rgb.iter().any(|v| *v > 0.0));
+    }
+
+    #[test]
+    fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
+        let strands = small_fur();
+        let points = xyzr(&strands);
+        let desc = xyzr_desc(&points, &strands.counts);
+        let scenes = [ht_scene_add_curves_xyzr, ht_scene_add_curves_xyzr_shared].map(|add| {
+            let h = Handles::new();
+            let hair = h.hair_material();
+            let s = add(h.scene, &desc, hair, &mut 0);
+            assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+            light(&h, true);
+            h
+        });
+        let s = settings(24);
+        let render_both = || {
+            scenes.each_ref().map(|h| {
+                let (status, rgb) = render_c(h, &s);
+                assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+                bits(&rgb)
+            })
+        };
+        // The points Embree reads in the shared scene's current build.
+        let embree_points = || {
+            let scene = scene_mut(scenes[1].scene).ok().unwrap();
+            let (world, _) = scene.prepare(1.0).unwrap();
+            match world.tracer.scene().geometry(0) {
+                Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
+                _ => panic!("curves expected"),
+            }
+        };
+        let [copied, shared] = render_both();
+        assert_eq!(copied, shared);
+        assert!(copied.iter().any(|&v| f32::from_bits(v) > 0.0));
+        assert_eq!(embree_points(), points.as_ptr());
+
+        // A wall added later rebuilds the scene, which still reads the host's points.
+        for h in &scenes {
+            let wall = h.diffuse_material([0.9; 3]);
+            assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
+        }
+        let [copied_wall, shared_wall] = render_both();
+        assert_eq!(copied_wall, shared_wall);
+        assert_ne!(copied_wall, copied);
+        assert_eq!(embree_points(), points.as_ptr());
     }
 
     extern "C" fn count_then_cancel(_done: u64, _total: u64, user: *mut c_void) -> bool {

@@ -10,7 +10,7 @@ use super::{
     Failure, HtStatus, boundary, host_slice, non_null, non_null_mut, read_path, read_vec3,
 };
 use crate::bsdf::diffuse::Diffuse;
-use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
+use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::{Material, World};
 use crate::scene::camera::Camera;
@@ -23,6 +23,7 @@ use crate::scene::mesh::Mesh;
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::scene::{Strands, Thickness, read_hair_file};
 use std::ffi::c_char;
+use std::ptr::NonNull;
 use std::sync::Arc;
 
 /// An Embree device: its thread pool builds the scenes made on it. Create one per
@@ -37,8 +38,9 @@ pub struct HtDevice {
 ///
 /// Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
 /// later additions, and a rendered scene holds a second copy in Embree's buffers plus the
-/// BVH. For the largest grooms, add everything before the first render and free the scene
-/// when done.
+/// BVH; control points added with `ht_scene_add_curves_xyzr_shared` are never copied, by
+/// either. For the largest grooms, share them (or add everything before the first render)
+/// and free the scene when done.
 pub struct HtScene {
     device: Arc<Device>,
     materials: Vec<Material>,
@@ -108,8 +110,9 @@ pub struct HtCurves {
 }
 
 /// Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
-/// that hold that layout. Copied once by `ht_scene_add_curves_xyzr`; the host may free its
-/// arrays when the call returns.
+/// that hold that layout. `ht_scene_add_curves_xyzr` copies them, and the host may free its
+/// arrays when the call returns; `ht_scene_add_curves_xyzr_shared` reads `points` in place
+/// for the life of the scene (see there).
 ///
 /// A strand of n control points has n - 1 linear segments, n - 3 B-spline or Catmull-Rom
 /// segments (the curve runs between the second and the second-to-last point), or (n - 1) / 3
@@ -476,7 +479,7 @@ pub extern "C" fn ht_scene_add_curves(
     })
 }
 
-/// Adds strands of float4 control points laid out for the basis (copied once: see
+/// Adds strands of float4 control points laid out for the basis (copied: see
 /// `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_scene_add_curves_xyzr(
@@ -484,6 +487,44 @@ pub extern "C" fn ht_scene_add_curves_xyzr(
     desc: *const HtCurvesXyzr,
     material_id: u32,
     geom_id: *mut u32,
+) -> HtStatus {
+    add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+        points.to_vec().into()
+    })
+}
+
+/// As `ht_scene_add_curves_xyzr`, but `desc->points` is shared, not copied: Embree reads
+/// the host's array in place, through every render and every rebuild after later
+/// additions, and the scene never holds a copy of it. The host keeps those
+/// `4 * point_count` floats allocated and unchanged until `ht_scene_free` returns; writing
+/// to them or freeing them earlier is undefined behaviour. `points` must be aligned to 4
+/// bytes, like any float array (16-byte alignment is not needed, and no padding past the
+/// last point: Embree reads at most the 16 bytes of a float4 from its start). The small
+/// per-strand data are still built and kept by the scene: `point_counts` and `colors` are
+/// read during the call only, and the index buffer takes 4 bytes per segment.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_curves_xyzr_shared(
+    scene: *mut HtScene,
+    desc: *const HtCurvesXyzr,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+        // SAFETY: `points` is the host's checked array (aligned, in bounds); the host keeps it
+        // valid and unchanged until ht_scene_free (the documented contract), and the scene
+        // is the last owner of every clone of this buffer.
+        unsafe { SharedBuffer::from_raw_parts(NonNull::from(points).cast(), points.len()) }
+    })
+}
+
+/// The body of both `ht_scene_add_curves_xyzr` entry points; `vertices` turns the checked
+/// host array of control points into the buffer Embree reads.
+fn add_curves_xyzr(
+    scene: *mut HtScene,
+    desc: *const HtCurvesXyzr,
+    material_id: u32,
+    geom_id: *mut u32,
+    vertices: impl FnOnce(&[[f32; 4]]) -> SharedBuffer<[f32; 4]>,
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
         // SAFETY: non-NULL (checked); the host's struct.
@@ -508,7 +549,7 @@ pub extern "C" fn ht_scene_add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
-        let curves = Curves::from_control_points(points.to_vec(), counts, colors, basis, shape)?;
+        let curves = Curves::from_control_points(vertices(points), counts, colors, basis, shape)?;
         Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
     })
 }
@@ -708,6 +749,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::capi::bsdf::ht_hair_params_default;
     use crate::capi::ht_last_error;
+    use crate::embree::{MemoryMonitor, padding_for};
     use crate::scene::{FurBall, write_hair_file};
     use std::ffi::CStr;
     use std::ptr::{null, null_mut};
@@ -800,6 +842,26 @@ pub(crate) mod tests {
                 .as_ref()
                 .map_or(null(), |c| c.as_ptr().cast()),
             basis: HT_CURVE_BSPLINE,
+            shape: HT_CURVE_ROUND,
+        }
+    }
+
+    /// `strands` as float4 control points of linear curves.
+    pub(crate) fn xyzr(strands: &Strands) -> Vec<[f32; 4]> {
+        let radii = strands.radii.iter();
+        let points = strands.points.iter().zip(radii);
+        points.map(|(&[x, y, z], &r)| [x, y, z, r]).collect()
+    }
+
+    /// Linear round curves of `counts` strands over `points`.
+    pub(crate) fn xyzr_desc(points: &[[f32; 4]], counts: &[u32]) -> HtCurvesXyzr {
+        HtCurvesXyzr {
+            strand_count: counts.len(),
+            point_counts: counts.as_ptr(),
+            point_count: points.len(),
+            points: points.as_ptr().cast(),
+            colors: null(),
+            basis: HT_CURVE_LINEAR,
             shape: HT_CURVE_ROUND,
         }
     }
@@ -1196,5 +1258,113 @@ pub(crate) mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
         assert_eq!(h.add_triangle(diffuse), HtStatus::HT_OK);
         assert_eq!(h.scene().geometries.len(), 5);
+    }
+
+    #[test]
+    fn shared_xyzr_points_are_checked_then_read_in_place() {
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
+        let h = Handles::new();
+        let hair = h.hair_material();
+        let strands = small_fur();
+        let points = xyzr(&strands);
+        // The host's points start 4 bytes into its array: aligned for floats, not to 16.
+        let mut host = vec![0.0f32; 4 * points.len() + 1];
+        host[1..].copy_from_slice(points.as_flattened());
+        let desc = HtCurvesXyzr {
+            points: host[1..].as_ptr(),
+            ..xyzr_desc(&points, &strands.counts)
+        };
+        assert_ne!(desc.points as usize % 16, 0);
+        let add = |d: &HtCurvesXyzr| ht_scene_add_curves_xyzr_shared(h.scene, d, hair, &mut 0);
+        let s = ht_scene_add_curves_xyzr_shared(h.scene, null(), hair, &mut 0);
+        fails(s, NULL, "desc is NULL");
+        let no_points = HtCurvesXyzr {
+            points: null(),
+            ..desc
+        };
+        fails(add(&no_points), NULL, "desc->points is NULL");
+        let misaligned = HtCurvesXyzr {
+            points: unsafe { desc.points.cast::<u8>().add(2).cast() },
+            ..desc
+        };
+        fails(add(&misaligned), INVALID, "not aligned to 4 bytes");
+        let short = HtCurvesXyzr {
+            point_count: desc.point_count - 1,
+            ..desc
+        };
+        fails(add(&short), INVALID, "counts add up");
+        assert!(h.scene().geometries.is_empty());
+
+        assert_eq!(add(&desc), HtStatus::HT_OK, "{}", last_error());
+        let Shape::Curves(c) = &h.scene().geometries[0].shape else {
+            panic!("curves expected");
+        };
+        assert_eq!(c.vertices().as_ptr().cast(), desc.points);
+        assert_eq!(c.vertices(), &points[..]);
+        // Only the index buffer and the strand table are the scene's.
+        let indices = (strands.segment_count() + padding_for::<u32>()) * 4;
+        assert_eq!(c.heap_bytes(), indices + c.strands().heap_bytes());
+    }
+
+    /// Bytes hairtrace holds for a scene of curves: what it keeps to rebuild, and the built
+    /// tracer.
+    fn held_bytes(scene: &HtScene) -> usize {
+        let kept: usize = (scene.geometries.iter())
+            .map(|g| match &g.shape {
+                Shape::Curves(c) => c.heap_bytes(),
+                Shape::Mesh(_) => unreachable!("curves only"),
+            })
+            .sum();
+        kept + scene.world.as_ref().map_or(0, |w| w.tracer.heap_bytes())
+    }
+
+    /// Memory of a built groom through each entry point: sharing saves the scene's copy of
+    /// the control points and the tracer's, and Embree copies them in neither case.
+    /// `--nocapture` prints bytes per segment.
+    #[test]
+    fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
+        const STRANDS: usize = 10_000;
+        let strands = FurBall {
+            strands: STRANDS,
+            segments: 16,
+            ..FurBall::default()
+        }
+        .build()
+        .unwrap();
+        let points = xyzr(&strands);
+        let desc = xyzr_desc(&points, &strands.counts);
+        let [copied, shared] =
+            [ht_scene_add_curves_xyzr, ht_scene_add_curves_xyzr_shared].map(|add| {
+                let h = Handles::new();
+                let monitor = MemoryMonitor::attach(h.scene().device.clone());
+                let hair = h.hair_material();
+                assert_eq!(add(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
+                let sky = [0.5f32; 3];
+                assert_eq!(
+                    ht_scene_add_environment(h.scene, sky.as_ptr()),
+                    HtStatus::HT_OK
+                );
+                scene_mut(h.scene).ok().unwrap().prepare(1.0).unwrap();
+                (held_bytes(h.scene()), monitor.current() as usize)
+            });
+        let segments = strands.segment_count() as f64;
+        let per_segment = |(ours, embree): (usize, usize)| {
+            let (o, e) = (ours as f64 / segments, embree as f64 / segments);
+            format!("ours {o:.1} + Embree {e:.1} = {:.1} B/segment", o + e)
+        };
+        println!("{STRANDS} strands x 16 linear round segments");
+        println!("copied: {}", per_segment(copied));
+        println!("shared: {}", per_segment(shared));
+        let vertex_bytes = (points.len() + padding_for::<[f32; 4]>()) * 16;
+        assert_eq!(copied.0 - shared.0, 2 * vertex_bytes);
+        // Embree's total varies by a few percent from build to build (its per-thread
+        // allocation blocks), far less than a copy of the points would add.
+        let embree = copied.1.abs_diff(shared.1);
+        assert!(
+            embree < vertex_bytes / 4,
+            "Embree: {} vs {} bytes",
+            copied.1,
+            shared.1
+        );
     }
 }

@@ -1,13 +1,16 @@
-//! Embree geometries (curves and triangle meshes) over buffers that hairtrace owns.
+//! Embree geometries (curves and triangle meshes) over buffers that Embree reads in place.
 //!
 //! Every buffer is handed to Embree with `rtcSetSharedGeometryBuffer`, so Embree never keeps
-//! a second copy: a host that already holds float4 xyzr control points gives its `Vec` away
-//! and no vertex is copied at all; converted data (see `scene::curves`) is written once, by
-//! us, straight into the buffer Embree reads. The geometry owns its buffers, so they live
-//! exactly as long as Embree may read them.
+//! a second copy. A [`SharedBuffer`] either owns its memory (converted data, written once by
+//! us straight into the buffer Embree reads, or a `Vec` given away) or shares memory someone
+//! else owns: an `Arc<[T]>` it keeps alive, or a host's array under the contract of
+//! [`SharedBuffer::from_raw_parts`]. A host that already holds float4 xyzr control points
+//! thus has none of them copied. The geometry holds its buffers, so they live exactly as
+//! long as Embree may read them.
 
 use std::ffi::c_void;
 use std::ptr::NonNull;
+use std::sync::Arc;
 
 use super::{Device, sys};
 use crate::error::invalid_arg;
@@ -90,37 +93,113 @@ fn curve_type(basis: CurveBasis, shape: CurveShape) -> sys::RTCGeometryType {
     }
 }
 
-/// Bytes Embree may read past the last element of a shared buffer: it loads elements with
-/// 16-byte SSE instructions, so a 12-byte float3 needs 4 more bytes after it. 16 spare bytes
-/// cover every element size.
-const PADDING_BYTES: usize = 16;
+/// Bytes Embree reads from the start of the last element of a shared buffer: it loads
+/// elements with 16-byte SSE instructions (its `checkPadding16` probes the 4 bytes at offset
+/// 12 of the last element when a vertex buffer is set), so a 12-byte float3 needs 4 more
+/// bytes after it, while an element of 16 bytes or more needs none.
+const EMBREE_LOAD_BYTES: usize = 16;
 
 /// A buffer Embree reads in place, padded at the end as Embree requires.
 ///
-/// The padding elements are real, initialised elements of the `Vec` (zeros), so Embree
-/// never reads past memory Rust owns. A caller that reserves `padding_for::<T>()` spare
-/// elements before handing its `Vec` over avoids the one reallocation this may cost.
-#[derive(Debug, Clone, PartialEq)]
+/// Owned buffers append padding elements that are real, initialised elements of the `Vec`
+/// (zeros), so Embree never reads past memory Rust owns. A caller that reserves
+/// `padding_for::<T>()` spare elements before handing its `Vec` over avoids the one
+/// reallocation this may cost. Shared buffers (from an `Arc<[T]>`, or
+/// [`Self::from_raw_parts`]) take no padding, so their elements must be at least 16 bytes
+/// (float4) and 4-byte aligned, checked at compile time: Embree's widest read then stays
+/// inside the last element. Cloning a shared buffer shares the same memory again.
+#[derive(Debug, Clone)]
 pub struct SharedBuffer<T> {
-    data: Vec<T>,
+    storage: Storage<T>,
     len: usize,
 }
 
+#[derive(Debug, Clone)]
+enum Storage<T> {
+    /// `len` elements, then the padding.
+    Owned(Vec<T>),
+    /// Kept alive by the reference count; a slice behind an `Arc` never moves or changes.
+    Arc(Arc<[T]>),
+    /// Someone else's memory, valid under the contract of [`SharedBuffer::from_raw_parts`].
+    Borrowed(NonNull<T>),
+}
+
+// SAFETY: owned and `Arc` storage are `Send` and `Sync` for such `T`; borrowed memory is
+// only read, and `from_raw_parts`' contract keeps it valid and unmodified for as long as
+// any clone of the buffer lives, whichever thread that is on.
+unsafe impl<T: Send + Sync> Send for SharedBuffer<T> {}
+// SAFETY: as above; nothing mutates a buffer through `&self`.
+unsafe impl<T: Send + Sync> Sync for SharedBuffer<T> {}
+
 /// Spare elements a [`SharedBuffer`] of `T` appends.
 pub const fn padding_for<T>() -> usize {
-    PADDING_BYTES.div_ceil(size_of::<T>())
+    EMBREE_LOAD_BYTES.div_ceil(size_of::<T>())
 }
 
 impl<T: Copy + Default> SharedBuffer<T> {
     pub fn new(mut data: Vec<T>) -> Self {
         let len = data.len();
+        // Exact: `resize` alone may double the capacity of a full `Vec`.
+        data.reserve_exact(padding_for::<T>());
         data.resize(len + padding_for::<T>(), T::default());
-        SharedBuffer { data, len }
+        SharedBuffer {
+            storage: Storage::Owned(data),
+            len,
+        }
+    }
+}
+
+impl<T: Copy + Default> From<Vec<T>> for SharedBuffer<T> {
+    fn from(data: Vec<T>) -> Self {
+        SharedBuffer::new(data)
+    }
+}
+
+/// Shares the slice, no copy: the buffer keeps one reference to it.
+impl<T> From<Arc<[T]>> for SharedBuffer<T> {
+    fn from(data: Arc<[T]>) -> Self {
+        let () = SharedBuffer::<T>::SHAREABLE;
+        SharedBuffer {
+            len: data.len(),
+            storage: Storage::Arc(data),
+        }
+    }
+}
+
+impl<T> SharedBuffer<T> {
+    /// Evaluated (at compile time) by the constructors that share memory without padding:
+    /// Embree requires 4-byte alignment and reads 16 bytes from the last element's start.
+    const SHAREABLE: () = assert!(
+        size_of::<T>() >= EMBREE_LOAD_BYTES && align_of::<T>() >= 4,
+        "memory shared with Embree without padding needs elements of >= 16 bytes, 4-aligned"
+    );
+
+    /// Shares `len` elements at `ptr`, owned by someone else (a C host): no copy, no padding.
+    ///
+    /// # Safety
+    /// As for [`std::slice::from_raw_parts`]: `ptr` is aligned for `T` and points to `len`
+    /// initialised elements, at most `isize::MAX` bytes. Those stay valid for reads and are
+    /// neither modified nor freed until this buffer and every clone of it are dropped,
+    /// with the geometries and scenes built from them. Embree needs no more: it requires
+    /// 4-byte alignment and reads at most 16 bytes from the start of the last element, both
+    /// guaranteed by the compile-time check on `T` (no padding past the `len` elements).
+    pub unsafe fn from_raw_parts(ptr: NonNull<T>, len: usize) -> Self {
+        let () = Self::SHAREABLE;
+        SharedBuffer {
+            storage: Storage::Borrowed(ptr),
+            len,
+        }
     }
 
     /// The elements, without the padding.
     pub fn as_slice(&self) -> &[T] {
-        &self.data[..self.len]
+        match &self.storage {
+            Storage::Owned(data) => &data[..self.len],
+            Storage::Arc(data) => data,
+            // SAFETY: the contract of `from_raw_parts`: aligned, `len` initialised elements,
+            // unmodified while `self` lives.
+            Storage::Borrowed(ptr) => unsafe { std::slice::from_raw_parts(ptr.as_ptr(), self.len) },
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -131,13 +210,25 @@ impl<T: Copy + Default> SharedBuffer<T> {
         self.len == 0
     }
 
-    /// Heap bytes held, padding and spare capacity included.
+    /// Heap bytes this buffer allocated, padding and spare capacity included; 0 for memory
+    /// it shares, which its owner (the `Arc`'s creator, the host) accounts for.
     pub fn heap_bytes(&self) -> usize {
-        self.data.capacity() * size_of::<T>()
+        match &self.storage {
+            Storage::Owned(data) => data.capacity() * size_of::<T>(),
+            Storage::Arc(_) | Storage::Borrowed(_) => 0,
+        }
     }
 
-    fn as_ptr(&self) -> *const c_void {
-        self.data.as_ptr().cast()
+    /// The address Embree reads: the shared memory itself when the buffer is shared.
+    fn as_ptr(&self) -> *const T {
+        self.as_slice().as_ptr()
+    }
+}
+
+/// Equal elements (padding and storage aside).
+impl<T: PartialEq> PartialEq for SharedBuffer<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.as_slice() == other.as_slice()
     }
 }
 
@@ -169,21 +260,22 @@ impl RawGeometry {
     /// # Safety
     /// `buffer` must outlive every use of this geometry by Embree; the caller stores it
     /// next to the handle, which is released first.
-    unsafe fn share<T: Copy + Default>(
+    unsafe fn share<T>(
         &self,
         kind: sys::RTCBufferType,
         format: sys::RTCFormat,
         buffer: &SharedBuffer<T>,
     ) {
-        // SAFETY: live geometry; pointer and count describe initialised memory of
-        // `len + padding` elements, which the caller keeps alive.
+        // SAFETY: live geometry; pointer and count describe `len` initialised elements
+        // readable as Embree requires (padded, or of 16 bytes each), which the caller keeps
+        // alive.
         unsafe {
             sys::rtcSetSharedGeometryBuffer(
                 self.0.as_ptr(),
                 kind,
                 0,
                 format,
-                buffer.as_ptr(),
+                buffer.as_ptr().cast::<c_void>(),
                 0,
                 size_of::<T>(),
                 buffer.len(),
@@ -490,10 +582,167 @@ mod tests {
         let b = SharedBuffer::new(vec![[1.0f32; 3]; 5]);
         assert_eq!(b.len(), 5);
         assert_eq!(b.as_slice(), &[[1.0; 3]; 5]);
-        assert_eq!(b.data.len(), 5 + 2);
-        assert_eq!(b.data[5..], [[0.0; 3]; 2]);
+        let Storage::Owned(data) = &b.storage else {
+            panic!("a Vec is owned")
+        };
+        assert_eq!(data[5..], [[0.0; 3]; 2]);
+        // A full Vec grows by the padding only.
+        assert_eq!(b.heap_bytes(), (5 + 2) * 12);
         assert_eq!(padding_for::<[f32; 4]>(), 1);
         assert_eq!(padding_for::<u32>(), 4);
+    }
+
+    /// The vertex buffer Embree holds for `c`.
+    fn embree_vertices(c: &CurveGeometry) -> *const [f32; 4] {
+        let vertex = sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX;
+        // SAFETY: live geometry with a vertex buffer in slot 0.
+        unsafe { sys::rtcGetGeometryBufferData(c.raw(), vertex, 0) }
+            .cast_const()
+            .cast()
+    }
+
+    #[test]
+    fn shared_vertices_are_read_in_place() {
+        let device = Device::new(Some(1)).unwrap();
+        // The host's points start 4 bytes into its array: 4-byte aligned, not 16.
+        let host: Vec<f32> = (0..17).map(|i| (i / 4) as f32 * 0.1).collect();
+        let points = NonNull::from(&host[1..]).cast::<[f32; 4]>();
+        assert_ne!(points.as_ptr() as usize % 16, 0);
+        let arc: Arc<[[f32; 4]]> = (0..4).map(|i| [i as f32, 0.0, 0.0, 0.1]).collect();
+        // SAFETY: 16 floats from `host[1]`, which outlives the geometry and is not modified.
+        let borrowed = unsafe { SharedBuffer::from_raw_parts(points, 4) };
+        for vertices in [borrowed, SharedBuffer::from(arc.clone())] {
+            let ptr = vertices.as_ptr();
+            assert_eq!(vertices.clone().as_ptr(), ptr, "clones share the memory");
+            assert_eq!(vertices.heap_bytes(), 0);
+            let indices = SharedBuffer::new(vec![0, 1, 2]);
+            let ours = indices.heap_bytes();
+            let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
+            let c = CurveGeometry::new(&device, linear, round, vertices, indices, 1).unwrap();
+            assert_eq!(embree_vertices(&c), ptr);
+            assert_eq!(c.heap_bytes(), ours);
+            assert_eq!(c.interpolate(2, 1.0).unwrap().p[0], c.vertices()[3][0]);
+        }
+    }
+
+    /// Float4 control points need no padding: Embree builds (compact BVHs too, which read
+    /// the vertex buffer while tracing), traces and interpolates every basis and shape with
+    /// the last point right before an unreadable page.
+    #[cfg(all(
+        target_os = "linux",
+        any(target_arch = "x86_64", target_arch = "aarch64")
+    ))]
+    mod unpadded {
+        use super::*;
+        use crate::embree::{Ray, SceneBuilder, SceneOptions};
+        use glam::Vec3;
+
+        /// Memory whose last bytes are followed by an unreadable page: a read past them faults.
+        struct Guarded {
+            map: *mut c_void,
+            bytes: usize,
+            data: NonNull<[f32; 4]>,
+        }
+
+        unsafe extern "C" {
+            fn mmap(
+                addr: *mut c_void,
+                len: usize,
+                prot: i32,
+                flags: i32,
+                fd: i32,
+                off: i64,
+            ) -> *mut c_void;
+            fn mprotect(addr: *mut c_void, len: usize, prot: i32) -> i32;
+            fn munmap(addr: *mut c_void, len: usize) -> i32;
+        }
+
+        impl Guarded {
+            /// A multiple of every page size these targets use.
+            const GUARD: usize = 1 << 16;
+
+            fn new(points: &[[f32; 4]]) -> Self {
+                let size = size_of_val(points);
+                let bytes = size.next_multiple_of(Self::GUARD) + Self::GUARD;
+                let (read_write, private_anonymous) = (1 | 2, 0x02 | 0x20);
+                // SAFETY: a fresh anonymous mapping; checked below.
+                let map = unsafe {
+                    mmap(
+                        std::ptr::null_mut(),
+                        bytes,
+                        read_write,
+                        private_anonymous,
+                        -1,
+                        0,
+                    )
+                };
+                assert_ne!(map as isize, -1, "mmap failed");
+                // SAFETY: the last GUARD bytes of our mapping (page aligned) become unreadable;
+                // the points are copied to end exactly where they start.
+                unsafe {
+                    assert_eq!(mprotect(map.add(bytes - Self::GUARD), Self::GUARD, 0), 0);
+                    let data = map.add(bytes - Self::GUARD - size).cast::<[f32; 4]>();
+                    data.copy_from_nonoverlapping(points.as_ptr(), points.len());
+                    Guarded {
+                        map,
+                        bytes,
+                        data: NonNull::new_unchecked(data),
+                    }
+                }
+            }
+        }
+
+        impl Drop for Guarded {
+            fn drop(&mut self) {
+                // SAFETY: our mapping, no longer read (the scenes are dropped first).
+                unsafe { munmap(self.map, self.bytes) };
+            }
+        }
+
+        #[test]
+        fn unpadded_float4_points_are_read_within_bounds() {
+            let device = Arc::new(Device::new(Some(2)).unwrap());
+            let points: Vec<[f32; 4]> = (0..7).map(|i| [i as f32, 0.0, 0.0, 0.2]).collect();
+            let guarded = Guarded::new(&points);
+            for basis in CurveBasis::ALL {
+                for shape in CurveShape::ALL {
+                    let segments = basis.segments_for(points.len()).unwrap();
+                    let stride = basis.segment_stride() as u32;
+                    let indices = (0..segments as u32).map(|i| i * stride).collect();
+                    let options = SceneOptions {
+                        compact: true,
+                        ..SceneOptions::default()
+                    };
+                    let mut scene = SceneBuilder::new(device.clone(), options).unwrap();
+                    // SAFETY: `guarded` outlives the scene and is not modified.
+                    let vertices =
+                        unsafe { SharedBuffer::from_raw_parts(guarded.data, points.len()) };
+                    let geometry = CurveGeometry::new(
+                        &device,
+                        basis,
+                        shape,
+                        vertices,
+                        SharedBuffer::new(indices),
+                        1,
+                    )
+                    .unwrap();
+                    let last = geometry.interpolate(segments as u32 - 1, 1.0).unwrap();
+                    assert!(last.p.iter().all(|v| v.is_finite()), "{basis:?}");
+                    scene.attach(geometry).unwrap();
+                    let scene = scene.commit().unwrap();
+                    // Rays across the whole strand, up to its tip: every segment is traced.
+                    let (lo, hi) = scene.bounds();
+                    let hits = (0..=32)
+                        .map(|k| lo[0] + (hi[0] - lo[0]) * k as f32 / 32.0)
+                        .filter(|&x| {
+                            let ray = Ray::new(Vec3::new(x, 0.0, 5.0), -Vec3::Z);
+                            scene.intersect(&ray, None).is_some()
+                        })
+                        .count();
+                    assert!(hits > 16, "{basis:?} {shape:?}: {hits} hits");
+                }
+            }
+        }
     }
 
     #[test]

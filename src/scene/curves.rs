@@ -16,7 +16,10 @@
 //!     form (inner control points `p_i + (p_{i+1} - p_{i-1}) / 6` and
 //!     `p_{i+1} - (p_{i+2} - p_i) / 6`), consecutive segments sharing end points.
 //! - [`Curves::from_control_points`] takes float4 (x, y, z, radius) control points already
-//!   laid out for the basis and shares the host's buffer with Embree without copying it.
+//!   laid out for the basis and hands them to Embree without copying them: a `Vec` given
+//!   away, an `Arc<[[f32; 4]]>` shared (safe, for hosts that keep their points), or a host's
+//!   array under the contract of [`SharedBuffer::from_raw_parts`] (the C ABI). Only the
+//!   index buffer (4 bytes per segment, plus 16 of padding) and the strand table are built.
 //!
 //! Either way, attributes survive to the hit through [`StrandIndex`]: the strand of a
 //! primitive (a prefix table of segment counts, 4 bytes per strand rather than 4 per
@@ -224,32 +227,35 @@ impl Curves {
         })
     }
 
-    /// Control points already laid out for `basis`, `counts[i]` of them for strand i, shared
-    /// with Embree as they are (no copy when `vertices` has
-    /// `padding_for::<[f32; 4]>()` spare capacity; one reallocation otherwise).
+    /// Control points already laid out for `basis`, `counts[i]` of them for strand i, read by
+    /// Embree where they are: an `Arc<[[f32; 4]]>` or a [`SharedBuffer`] of the host's memory
+    /// is shared, never copied (its clones share it too); a `Vec` is moved in, with no copy
+    /// when it has `padding_for::<[f32; 4]>()` spare capacity (one reallocation otherwise).
     /// `colors`, if any, holds one linear RGB value per segment end: segments + 1 per strand.
     pub fn from_control_points(
-        vertices: Vec<[f32; 4]>,
+        vertices: impl Into<SharedBuffer<[f32; 4]>>,
         counts: &[u32],
         colors: Option<Vec<[f32; 3]>>,
         basis: CurveBasis,
         shape: CurveShape,
     ) -> Result<Self> {
+        let vertices = vertices.into();
+        let points = vertices.as_slice();
         let total: u64 = counts.iter().map(|&c| u64::from(c)).sum();
-        if total != vertices.len() as u64 {
+        if total != points.len() as u64 {
             return Err(invalid_arg!(
                 "strand counts add up to {total} control points but {} are given",
-                vertices.len()
+                points.len()
             ));
         }
-        check_vertex_count(vertices.len())?;
-        if let Some(i) = vertices
+        check_vertex_count(points.len())?;
+        if let Some(i) = points
             .iter()
             .position(|v| !(v.iter().all(|c| c.is_finite()) && v[3] >= 0.0))
         {
             return Err(invalid_arg!(
                 "control point {i} = {:?}: must be finite with a radius >= 0",
-                vertices[i]
+                points[i]
             ));
         }
         let mut segments = Vec::with_capacity(counts.len());
@@ -271,7 +277,7 @@ impl Curves {
         Ok(Curves {
             basis,
             shape,
-            vertices: SharedBuffer::new(vertices),
+            vertices,
             indices: SharedBuffer::new(indices),
             strands: StrandIndex::new(segments.into_iter(), colors)?,
         })
@@ -299,7 +305,8 @@ impl Curves {
         &self.strands
     }
 
-    /// Heap bytes of everything hairtrace keeps for these curves.
+    /// Heap bytes of everything hairtrace keeps for these curves (shared control points are
+    /// their owner's, not counted).
     pub fn heap_bytes(&self) -> usize {
         self.vertices.heap_bytes() + self.indices.heap_bytes() + self.strands.heap_bytes()
     }
@@ -338,6 +345,7 @@ fn check_vertex_count(n: usize) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::sync::Arc;
 
     fn strands() -> Strands {
         Strands {
@@ -425,6 +433,20 @@ mod tests {
                 .unwrap();
         assert_eq!(c.vertices().as_ptr(), ptr);
         assert_eq!(c.indices(), &[0, 1, 2, 4]);
+        // An Arc is shared by the curves and their clones: only the index buffer and the
+        // strand table are ours.
+        let arc: Arc<[[f32; 4]]> = (0..6).map(|i| [i as f32, 0.0, 0.0, 0.1]).collect();
+        let c = Curves::from_control_points(
+            arc.clone(),
+            &[4, 2],
+            None,
+            CurveBasis::Linear,
+            CurveShape::Round,
+        )
+        .unwrap();
+        assert_eq!(c.clone().vertices().as_ptr(), arc.as_ptr());
+        let index_bytes = (4 + padding_for::<u32>()) * 4;
+        assert_eq!(c.heap_bytes(), index_bytes + c.strands().heap_bytes());
         let bez = vec![[0.0, 0.0, 0.0, 0.1]; 7];
         let c = Curves::from_control_points(bez, &[7], None, CurveBasis::Bezier, CurveShape::Flat)
             .unwrap();

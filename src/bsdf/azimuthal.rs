@@ -2,7 +2,7 @@
 //! deflection angle, trimmed to [-pi, pi] and renormalised there.
 
 use crate::math::Lanes;
-use crate::math::fast::{exp_neg, round};
+use crate::math::fast::{exp_neg, ln, round};
 use std::f32::consts::PI;
 
 /// Azimuthal logistic scale for roughness beta_n (Chiang et al. 2016, eq. 8).
@@ -53,7 +53,7 @@ impl TrimmedLogistic {
     pub fn sample(&self, u: f32) -> f32 {
         let p = self.cdf_lo + u * self.mass;
         let q = self.cdf_lo + (1.0 - u) * self.mass;
-        (self.s * (p / q).ln()).clamp(-PI, PI)
+        (self.s * ln(p / q)).clamp(-PI, PI)
     }
 }
 

@@ -7,7 +7,7 @@
 //! the exponent is computed without cancellation, and one exp suffices.
 
 use crate::math::bessel::{SPLIT, i0_large_scaled, i0_small};
-use crate::math::fast::exp_neg;
+use crate::math::fast::{exp_neg, ln};
 use crate::math::{Lanes, safe_sqrt};
 
 /// Variance v of the R lobe for longitudinal roughness beta_m (Chiang et al. 2016, eq. 7).
@@ -70,7 +70,7 @@ impl LongitudinalLobe {
     #[inline]
     pub fn sample(&self, sin_to: f32, cos_to: f32, u: [f32; 2]) -> (f32, f32) {
         // x = 1 - cos psi directly, so that small variances keep their precision.
-        let x = (-self.v * (u[0] + (1.0 - u[0]) * self.exp_m2v).ln()).clamp(0.0, 2.0);
+        let x = (-self.v * ln(u[0] + (1.0 - u[0]) * self.exp_m2v)).clamp(0.0, 2.0);
         let sin_psi = safe_sqrt(x * (2.0 - x));
         let cos_psi = 1.0 - x;
         let cos_phi = (std::f32::consts::TAU * u[1]).cos();

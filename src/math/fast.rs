@@ -1,4 +1,4 @@
-//! exp, asin and atan2 for the BSDF's hot path, written once over [`Lanes`] so that the
+//! exp, asin and atan2 (and ln, for the samplers) for the BSDF's hot path, written once over [`Lanes`] so that the
 //! scalar and the batched evaluation compute the same bits. They use the classic range
 //! reductions with short polynomials (Cephes' coefficients for asin and atan, the Taylor
 //! series of e^r on |r| <= ln2/2) and cost no function call: about 2 ulp, measured
@@ -81,6 +81,34 @@ pub fn atan2<T: Lanes>(y: T, x: T) -> T {
     T::select(left, c(PI) - a, a).copysign(y)
 }
 
+/// ln(x) for finite x > 0 (scalar: only the samplers need it): x = m 2^e with m in
+/// [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s) with s = (m - 1) / (m + 1), |s| < 0.172, from
+/// its odd series to s^9. 0 gives -inf; subnormals are scaled up first.
+#[inline(always)]
+pub fn ln(x: f32) -> f32 {
+    if x <= 0.0 {
+        return if x == 0.0 {
+            f32::NEG_INFINITY
+        } else {
+            f32::NAN
+        };
+    }
+    let (x, bias) = if x < f32::MIN_POSITIVE {
+        (x * 16_777_216.0, -24)
+    } else {
+        (x, 0)
+    };
+    let bits = x.to_bits() as i32;
+    // Exponent relative to sqrt(1/2), so that the mantissa lands around 1.
+    let e = (bits - 0x3f35_04f3) >> 23;
+    let m = f32::from_bits((bits - (e << 23)) as u32);
+    let e = e + bias;
+    let s = (m - 1.0) / (m + 1.0);
+    let z = s * s;
+    let series = 2.0 * s * (1.0 + z * (1.0 / 3.0 + z * (0.2 + z * (1.0 / 7.0 + z * (1.0 / 9.0)))));
+    e as f32 * std::f32::consts::LN_2 + series
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -139,6 +167,24 @@ mod tests {
                 "atan2({y}, {x})"
             );
         }
+    }
+
+    #[test]
+    fn ln_is_accurate_over_the_whole_range() {
+        let mut worst = 0.0f64;
+        let mut x = 1e-44f32;
+        while x < 1e38 {
+            for k in 0..64 {
+                let v = x * (1.0 + k as f32 / 64.0);
+                let want = f64::from(v).ln();
+                worst = worst.max((f64::from(ln(v)) - want).abs() / want.abs().max(1.0));
+            }
+            x *= 2.0;
+        }
+        assert!(worst < 3e-7, "ln worst error {worst}");
+        assert_eq!(ln(1.0), 0.0);
+        assert_eq!(ln(0.0), f32::NEG_INFINITY);
+        assert!(ln(-1.0).is_nan());
     }
 
     #[test]

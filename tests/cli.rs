@@ -197,3 +197,42 @@ fn render_writes_aovs() {
         "normals",
     );
 }
+
+/// `--crop` renders exactly the full frame's pixels of the window (EXR keeps the bits).
+#[test]
+fn render_crop_matches_the_full_frame() {
+    let (full, part) = (tmp("cli_full.exr"), tmp("cli_crop.exr"));
+    let common = [
+        "render", "--width", "32", "--height", "24", "--spp", "2", "--seed", "5",
+    ];
+    for (out, crop) in [(&full, None), (&part, Some("8,4,24,20"))] {
+        let mut args: Vec<&str> = common.to_vec();
+        if let Some(c) = crop {
+            args.extend(["--crop", c]);
+        }
+        args.extend(["-o", out.as_str()]);
+        let o = hairtrace(&args);
+        assert!(o.status.success(), "{o:?}");
+    }
+    let read = |p: &str| hairtrace::image::read_image(std::path::Path::new(p)).unwrap();
+    let (f, c) = (read(&full), read(&part));
+    assert_eq!((c.width, c.height), (16, 16));
+    for y in 0..16 {
+        for x in 0..16 {
+            let (i, j) = (3 * ((y + 4) * 32 + x + 8), 3 * (y * 16 + x));
+            assert_eq!(f.pixels[i..i + 3], c.pixels[j..j + 3], "pixel ({x}, {y})");
+        }
+    }
+    assert_one_line_error(
+        &hairtrace(&[
+            "render",
+            "--width",
+            "32",
+            "--crop",
+            "8,4,40,20",
+            "-o",
+            &part,
+        ]),
+        "crop",
+    );
+}

@@ -62,6 +62,10 @@ struct RenderArgs {
     /// Longest path, in scattering events.
     #[arg(long)]
     max_depth: Option<u32>,
+    /// Render only the pixels x0..x1, y0..y1 (ends exclusive) of the full frame, exactly
+    /// as the full render has them: a farm can split a frame and reassemble the pieces.
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_list::<u32, 4>)]
+    crop: Option<[u32; 4]>,
     /// Output image.
     #[arg(short, long)]
     output: PathBuf,
@@ -89,7 +93,7 @@ struct LobesArgs {
     #[arg(long, default_value_t = 0.0)]
     pheomelanin: f32,
     /// Take sigma_a from a reflectance colour "r,g,b" instead of melanin.
-    #[arg(long, value_parser = parse_rgb, conflicts_with_all = ["eumelanin", "pheomelanin"])]
+    #[arg(long, value_parser = parse_list::<f32, 3>, conflicts_with_all = ["eumelanin", "pheomelanin"])]
     color: Option<[f32; 3]>,
     /// Longitudinal roughness, [0.01, 1].
     #[arg(long, default_value_t = 0.3)]
@@ -105,14 +109,18 @@ struct LobesArgs {
     eta: f32,
 }
 
-fn parse_rgb(s: &str) -> Result<[f32; 3], String> {
-    let v: Vec<f32> = s
+/// N comma-separated values, e.g. "0.8,0.5,0.3" or "0,0,64,48".
+fn parse_list<T: std::str::FromStr, const N: usize>(s: &str) -> Result<[T; N], String>
+where
+    T::Err: std::fmt::Display,
+{
+    let v: Vec<T> = s
         .split(',')
-        .map(|x| x.trim().parse::<f32>())
+        .map(|x| x.trim().parse::<T>())
         .collect::<Result<_, _>>()
         .map_err(|e| format!("{s:?}: {e}"))?;
     v.try_into()
-        .map_err(|_| format!("{s:?}: expected three comma-separated numbers"))
+        .map_err(|_| format!("{s:?}: expected {N} comma-separated numbers"))
 }
 
 fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
@@ -199,6 +207,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     r.seed = args.seed.unwrap_or(r.seed);
     r.threads = args.threads.or(r.threads);
     r.max_depth = args.max_depth.unwrap_or(r.max_depth);
+    r.crop = args.crop.or(r.crop);
     let device = Arc::new(Device::new(r.threads)?);
     let BuiltScene {
         world,

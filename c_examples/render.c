@@ -7,12 +7,18 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define STRANDS 500
 #define SEGMENTS 16
 #define POINTS_PER_STRAND (SEGMENTS + 1)
 #define WIDTH 64
 #define HEIGHT 48
+/* A window of the frame, rendered again on its own. */
+#define CROP_X0 20
+#define CROP_Y0 10
+#define CROP_W 24
+#define CROP_H 20
 
 static const float PI = 3.14159265f;
 
@@ -172,6 +178,26 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     printf("image %d %d\n", WIDTH, HEIGHT);
     printf("mean %.6f\n", sum / (WIDTH * HEIGHT * 3));
     printf("progress %u\n", progress_calls);
+
+    /* A crop renders exactly the full frame's pixels there, so a farm can split a frame;
+     * this one also asks for the depth AOV (the other AOVs are not wanted: NULL). */
+    float crop[CROP_W * CROP_H * 3], depth[CROP_W * CROP_H];
+    settings.crop_x0 = CROP_X0;
+    settings.crop_y0 = CROP_Y0;
+    settings.crop_x1 = CROP_X0 + CROP_W;
+    settings.crop_y1 = CROP_Y0 + CROP_H;
+    settings.progress = NULL;
+    if (check(ht_render_aovs(scene, &settings, crop, CROP_W * CROP_H * 3, NULL, depth, NULL,
+                             CROP_W * CROP_H),
+              "ht_render_aovs"))
+        return 1;
+    int same = 1, hits = 0;
+    for (int y = 0; y < CROP_H; y++) {
+        const float *full = b->rgb + ((y + CROP_Y0) * WIDTH + CROP_X0) * 3;
+        same &= memcmp(crop + y * CROP_W * 3, full, CROP_W * 3 * sizeof(float)) == 0;
+    }
+    for (int i = 0; i < CROP_W * CROP_H; i++) hits += depth[i] > 0.0f;
+    printf("crop %d %d same %d hits %d\n", CROP_W, CROP_H, same, hits);
     if (check(ht_image_write(out, WIDTH, HEIGHT, 3, b->rgb), "ht_image_write")) return 1;
     printf("wrote %s\n", out);
     return 0;

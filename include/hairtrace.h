@@ -14,7 +14,7 @@
 /**
  * Version of the C ABI; bumped on any incompatible change of a signature or struct.
  */
-#define HT_ABI_VERSION 1
+#define HT_ABI_VERSION 2
 
 /**
  * Result of every C entry point; `HT_OK` is 0.
@@ -253,6 +253,19 @@ typedef struct HtRenderSettings {
      * keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
      */
     uint32_t max_depth;
+    /**
+     * Crop window: render only the pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
+     * full width x height frame (x0 < x1 <= width, y0 < y1 <= height); all four 0 renders
+     * the full frame. The output buffers then hold the window's pixels alone, rows from
+     * its top. A crop renders exactly the values the full frame has at those pixels (the
+     * camera still sees the full frame, and every sample depends only on the seed and its
+     * full-frame pixel), so a render farm can split a frame into windows and reassemble
+     * them bit for bit.
+     */
+    uint32_t crop_x0;
+    uint32_t crop_y0;
+    uint32_t crop_x1;
+    uint32_t crop_y1;
     /**
      * May be NULL: no progress reports, no cancellation.
      */
@@ -539,13 +552,26 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
                                   float fov_y_deg);
 
 /**
- * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, no callback.
+ * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
+ * units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
+ * view direction, > 0), so that what lies nearer or farther blurs. Holds for the camera
+ * of `ht_scene_set_camera`, whether set before or after, and for the camera that frames a
+ * scene without one. Replaces any earlier lens.
+ */
+enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
+                                     float aperture_radius,
+                                     float focus_distance);
+
+/**
+ * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
+ * crop), no callback.
  */
 struct HtRenderSettings ht_render_settings_default(void);
 
 /**
  * Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
- * `rgb_len` = width * height * 3 floats owned by the host.
+ * `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
+ * owned by the host. `ht_render_aovs` without AOVs.
  *
  * The first render builds the Embree scene (its time is part of the call); later ones
  * reuse it until geometry is added. Blocks until the image is done. On
@@ -556,6 +582,34 @@ enum HtStatus ht_render(struct HtScene *scene,
                         const struct HtRenderSettings *settings,
                         float *rgb,
                         size_t rgb_len);
+
+/**
+ * As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
+ * and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
+ * `pixel_count` is the crop window's pixel count (width * height without a crop), and
+ * each buffer holds that many pixels, rows from the top, in memory of its own:
+ *
+ * - `albedo`: 3 floats per pixel, the mean reflectance colour (hair colour, diffuse
+ *   albedo, linear RGB in [0, 1]) of the surfaces the pixel's camera rays hit first;
+ *   escaped rays count as 0. What denoisers take as their albedo guide.
+ * - `depth`: 1 float per pixel, the distance from the camera (world units, along the
+ *   ray) to the nearest first hit among the pixel's samples; 0 where nothing was hit.
+ * - `strand_id`: 1 float per pixel, the index of the strand in its curve geometry (in
+ *   the order the host gave the strands; exact up to 2^24) of that nearest hit; -1 where
+ *   it is not hair or nothing was hit. Nearest rather than averaged: an average of ids is
+ *   no id.
+ *
+ * On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the finished pixels and the values of
+ * "nothing hit" elsewhere; on other errors every buffer is left untouched.
+ */
+enum HtStatus ht_render_aovs(struct HtScene *scene,
+                             const struct HtRenderSettings *settings,
+                             float *rgb,
+                             size_t rgb_len,
+                             float *albedo,
+                             float *depth,
+                             float *strand_id,
+                             size_t pixel_count);
 
 /**
  * Writes `pixels` (width * height * channels linear floats, interleaved, rows from the

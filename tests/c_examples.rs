@@ -87,7 +87,11 @@ fn numbers(out: &str, key: &str) -> Vec<f32> {
 
 fn check_bsdf_output(out: &str) {
     assert!(
-        out.starts_with(&format!("version {} abi 1", hairtrace::VERSION)),
+        out.starts_with(&format!(
+            "version {} abi {}",
+            hairtrace::VERSION,
+            hairtrace::capi::HT_ABI_VERSION
+        )),
         "{out}"
     );
     let bsdf = HairBsdf::new(&HairParams::default()).unwrap();
@@ -153,6 +157,11 @@ fn check_render_example(compiler: &str, flags: &[&str]) {
     assert!(mean.is_finite() && mean > 0.0, "mean {mean}:\n{out}");
     // 64 x 48 pixels in 16 x 16 tiles: one call per tile.
     assert_eq!(numbers(&out, "progress"), [12.0], "{out}");
+    // A 24 x 20 crop equals the full frame's pixels bit for bit, and its depth AOV sees the
+    // fur and the sphere in the middle of the frame.
+    let crop = numbers(&out, "crop");
+    assert_eq!(crop[..3], [24.0, 20.0, 1.0], "{out}");
+    assert!(crop[3] > 0.0, "{out}");
     let image = read_image(&exr).unwrap_or_else(|e| panic!("{}: {e}", exr.display()));
     assert_eq!((image.width, image.height, image.channels), (64, 48, 3));
     let file_mean =

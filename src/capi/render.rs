@@ -11,6 +11,7 @@ use crate::render::renderer::render;
 use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
 use std::ffi::{c_char, c_void};
+use std::ptr::null_mut;
 
 /// Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
 /// call. Return false to cancel: no new pixel starts and `ht_render` returns
@@ -41,16 +42,29 @@ pub struct HtRenderSettings {
     /// Longest path in scattering events, >= 1. Light hair needs many: the default (256)
     /// keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
     pub max_depth: u32,
+    /// Crop window: render only the pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
+    /// full width x height frame (x0 < x1 <= width, y0 < y1 <= height); all four 0 renders
+    /// the full frame. The output buffers then hold the window's pixels alone, rows from
+    /// its top. A crop renders exactly the values the full frame has at those pixels (the
+    /// camera still sees the full frame, and every sample depends only on the seed and its
+    /// full-frame pixel), so a render farm can split a frame into windows and reassemble
+    /// them bit for bit.
+    pub crop_x0: u32,
+    pub crop_y0: u32,
+    pub crop_x1: u32,
+    pub crop_y1: u32,
     /// May be NULL: no progress reports, no cancellation.
     pub progress: HtProgressFn,
     /// Passed to `progress` as it is.
     pub progress_user: *mut c_void,
 }
 
-/// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, no callback.
+/// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
+/// crop), no callback.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
     let d = RenderSettings::default();
+    let [crop_x0, crop_y0, crop_x1, crop_y1] = d.crop.unwrap_or_default();
     HtRenderSettings {
         width: d.width,
         height: d.height,
@@ -58,8 +72,31 @@ pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
         seed: d.seed,
         threads: 0,
         max_depth: d.path.max_depth,
+        crop_x0,
+        crop_y0,
+        crop_x1,
+        crop_y1,
         progress: None,
-        progress_user: std::ptr::null_mut(),
+        progress_user: null_mut(),
+    }
+}
+
+impl HtRenderSettings {
+    /// The Rust settings these stand for (not yet validated).
+    fn to_rust(self) -> RenderSettings {
+        let crop = [self.crop_x0, self.crop_y0, self.crop_x1, self.crop_y1];
+        RenderSettings {
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            seed: self.seed,
+            threads: (self.threads > 0).then_some(self.threads as usize),
+            crop: (crop != [0; 4]).then_some(crop),
+            path: PathSettings {
+                max_depth: self.max_depth,
+                ..PathSettings::default()
+            },
+        }
     }
 }
 
@@ -82,7 +119,8 @@ impl Progress for HostProgress {
 }
 
 /// Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
-/// `rgb_len` = width * height * 3 floats owned by the host.
+/// `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
+/// owned by the host. `ht_render_aovs` without AOVs.
 ///
 /// The first render builds the Embree scene (its time is part of the call); later ones
 /// reuse it until geometry is added. Blocks until the image is done. On
@@ -95,31 +133,78 @@ pub extern "C" fn ht_render(
     rgb: *mut f32,
     rgb_len: usize,
 ) -> HtStatus {
+    // A wrong rgb_len is reported as such before the pixel count derived from it.
+    let pixel_count = rgb_len / 3;
+    ht_render_aovs(
+        scene,
+        settings,
+        rgb,
+        rgb_len,
+        null_mut(),
+        null_mut(),
+        null_mut(),
+        pixel_count,
+    )
+}
+
+/// As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
+/// and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
+/// `pixel_count` is the crop window's pixel count (width * height without a crop), and
+/// each buffer holds that many pixels, rows from the top, in memory of its own:
+///
+/// - `albedo`: 3 floats per pixel, the mean reflectance colour (hair colour, diffuse
+///   albedo, linear RGB in [0, 1]) of the surfaces the pixel's camera rays hit first;
+///   escaped rays count as 0. What denoisers take as their albedo guide.
+/// - `depth`: 1 float per pixel, the distance from the camera (world units, along the
+///   ray) to the nearest first hit among the pixel's samples; 0 where nothing was hit.
+/// - `strand_id`: 1 float per pixel, the index of the strand in its curve geometry (in
+///   the order the host gave the strands; exact up to 2^24) of that nearest hit; -1 where
+///   it is not hair or nothing was hit. Nearest rather than averaged: an average of ids is
+///   no id.
+///
+/// On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the finished pixels and the values of
+/// "nothing hit" elsewhere; on other errors every buffer is left untouched.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)] // the C signature: one argument per buffer
+pub extern "C" fn ht_render_aovs(
+    scene: *mut HtScene,
+    settings: *const HtRenderSettings,
+    rgb: *mut f32,
+    rgb_len: usize,
+    albedo: *mut f32,
+    depth: *mut f32,
+    strand_id: *mut f32,
+    pixel_count: usize,
+) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
         // SAFETY: non-NULL (checked); the host's struct.
         let s = unsafe { *non_null(settings, "settings")? };
-        let settings = RenderSettings {
-            width: s.width,
-            height: s.height,
-            spp: s.spp,
-            seed: s.seed,
-            threads: (s.threads > 0).then_some(s.threads as usize),
-            crop: None,
-            path: PathSettings {
-                max_depth: s.max_depth,
-                ..PathSettings::default()
-            },
-        };
+        let settings = s.to_rust();
         settings.validate()?;
+        // The crop window's size (the full frame without one).
+        let [x0, y0, x1, y1] = settings.window();
+        let (w, h) = (x1 - x0, y1 - y0);
         // At most 2^15 x 2^15 x 3 (validated above): no overflow.
-        let want = s.width as usize * s.height as usize * 3;
+        let pixels = w as usize * h as usize;
+        let want = 3 * pixels;
         if rgb_len != want {
-            return Err(
-                invalid_arg!("rgb_len = {rgb_len}: must be width * height * 3 = {want}").into(),
-            );
+            return Err(invalid_arg!("rgb_len = {rgb_len}: must be 3 * {w} * {h} = {want}").into());
         }
         let rgb = host_slice_mut(non_null_mut(rgb, "rgb")?, rgb_len, "rgb")?;
+        if pixel_count != pixels {
+            return Err(
+                invalid_arg!("pixel_count = {pixel_count}: must be {w} * {h} = {pixels}").into(),
+            );
+        }
+        let albedo = optional_slice(albedo, 3 * pixels, "albedo")?;
+        let depth = optional_slice(depth, pixels, "depth")?;
+        let strand_id = optional_slice(strand_id, pixels, "strand_id")?;
+        let aovs = Aovs {
+            albedo: albedo.is_some(),
+            depth: depth.is_some(),
+            strand_id: strand_id.is_some(),
+        };
         let (world, camera) = scene.prepare(s.width as f32 / s.height as f32)?;
         let host;
         let progress: &dyn Progress = match s.progress {
@@ -132,8 +217,18 @@ pub extern "C" fn ht_render(
             }
             None => &NoProgress,
         };
-        let out = render(world, &camera, &settings, Aovs::default(), progress)?;
-        rgb.copy_from_slice(out.film.rgb());
+        let out = render(world, &camera, &settings, aovs, progress)?;
+        let film = &out.film;
+        rgb.copy_from_slice(film.rgb());
+        for (host, aov) in [
+            (albedo, film.albedo()),
+            (depth, film.depth()),
+            (strand_id, film.strand_id()),
+        ] {
+            if let (Some(host), Some(aov)) = (host, aov) {
+                host.copy_from_slice(aov);
+            }
+        }
         match out.status {
             RenderStatus::Complete => Ok(()),
             RenderStatus::Cancelled => Err(Failure(
@@ -142,6 +237,18 @@ pub extern "C" fn ht_render(
             )),
         }
     })
+}
+
+/// An AOV buffer of `len` floats the host lends, or None where it passed NULL (not
+/// wanted).
+fn optional_slice<'a>(
+    ptr: *mut f32,
+    len: usize,
+    name: &str,
+) -> Result<Option<&'a mut [f32]>, Failure> {
+    (!ptr.is_null())
+        .then(|| host_slice_mut(ptr, len, name))
+        .transpose()
 }
 
 /// Writes `pixels` (width * height * channels linear floats, interleaved, rows from the
@@ -244,6 +351,26 @@ mod tests {
         (status, rgb)
     }
 
+    /// Renders through `ht_render_aovs` with every AOV: rgb, albedo, depth, strand id.
+    fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
+        let [x0, y0, x1, y1] = s.to_rust().window();
+        let pixels = ((x1 - x0) * (y1 - y0)) as usize;
+        let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
+        let [rgb, albedo, depth, strand_id] = &mut out;
+        let status = ht_render_aovs(
+            h.scene,
+            s,
+            rgb.as_mut_ptr(),
+            rgb.len(),
+            albedo.as_mut_ptr(),
+            depth.as_mut_ptr(),
+            strand_id.as_mut_ptr(),
+            pixels,
+        );
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        out
+    }
+
     fn bits(rgb: &[f32]) -> Vec<u32> {
         rgb.iter().map(|v| v.to_bits()).collect()
     }
@@ -327,6 +454,113 @@ mod tests {
         assert_eq!(copied_wall, shared_wall);
         assert_ne!(copied_wall, copied);
         assert_eq!(embree_points(), points.as_ptr());
+    }
+
+    #[test]
+    fn crops_reassemble_into_the_full_frame_bit_for_bit() {
+        let h = fur_scene(true);
+        let full_settings = settings(32);
+        let full = render_aovs_c(&h, &full_settings);
+        assert!(full[0].iter().any(|v| *v > 0.0));
+        // Three windows that tile the frame, cutting through the renderer's 16 x 16 tiles.
+        let mut assembled = full.clone().map(|buffer| vec![f32::NAN; buffer.len()]);
+        for [x0, y0, x1, y1] in [[0, 0, 13, 21], [13, 0, 32, 21], [0, 21, 32, 32]] {
+            let s = HtRenderSettings {
+                crop_x0: x0,
+                crop_y0: y0,
+                crop_x1: x1,
+                crop_y1: y1,
+                ..full_settings
+            };
+            let crop = render_aovs_c(&h, &s);
+            for ((whole, piece), channels) in assembled.iter_mut().zip(&crop).zip([3, 3, 1, 1]) {
+                let row = (x1 - x0) as usize * channels;
+                for (y, piece_row) in (y0..y1).zip(piece.chunks_exact(row)) {
+                    let start = (y as usize * 32 + x0 as usize) * channels;
+                    whole[start..start + row].copy_from_slice(piece_row);
+                }
+            }
+        }
+        for (whole, pieces) in full.iter().zip(&assembled) {
+            assert_eq!(bits(whole), bits(pieces));
+        }
+    }
+
+    #[test]
+    fn aovs_report_the_first_hits_and_null_ones_are_skipped() {
+        let h = fur_scene(true);
+        let s = settings(32);
+        let [rgb, albedo, depth, strand_id] = render_aovs_c(&h, &s);
+        assert_eq!(
+            bits(&rgb),
+            bits(&render_c(&h, &s).1),
+            "AOVs change no pixel"
+        );
+        assert!(albedo.iter().all(|a| (0.0..=1.0).contains(a)), "{albedo:?}");
+        let strands = small_fur().counts.len() as f32;
+        for (d, id) in depth.iter().zip(&strand_id) {
+            if *id >= 0.0 {
+                assert!(d.is_finite() && *d > 0.0, "depth {d} of strand {id}");
+                assert!(id.fract() == 0.0 && *id < strands, "{id}");
+            } else {
+                assert_eq!(*id, -1.0);
+            }
+        }
+        let hair = strand_id.iter().filter(|id| **id >= 0.0).count();
+        assert!(hair > 20, "{hair} hair pixels");
+        // Pixels of sky alone hit nothing: depth 0, albedo 0.
+        let sky = (depth.iter().zip(albedo.chunks_exact(3)))
+            .filter(|(d, a)| **d == 0.0 && *a == [0.0; 3]);
+        assert!(sky.count() > 20);
+
+        // Only the depth: the other buffers may be NULL, and it is the same depth.
+        let mut rgb_only = vec![0.0f32; rgb.len()];
+        let mut depth_only = vec![0.0f32; depth.len()];
+        let status = ht_render_aovs(
+            h.scene,
+            &s,
+            rgb_only.as_mut_ptr(),
+            rgb_only.len(),
+            null_mut(),
+            depth_only.as_mut_ptr(),
+            null_mut(),
+            depth.len(),
+        );
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert_eq!(bits(&rgb_only), bits(&rgb));
+        assert_eq!(bits(&depth_only), bits(&depth));
+    }
+
+    #[test]
+    fn a_thin_lens_blurs_whichever_comes_first_lens_or_camera() {
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL, HT_OK};
+        let s = settings(24);
+        let h = fur_scene(true);
+        let (status, pinhole) = render_c(&h, &s);
+        assert_eq!(status, HT_OK, "{}", last_error());
+        let set = |h: &Handles, aperture, focus| ht_scene_set_thin_lens(h.scene, aperture, focus);
+        fails(set(&h, f32::NAN, 4.0), INVALID, "aperture_radius = NaN");
+        fails(set(&h, -0.1, 4.0), INVALID, "aperture_radius = -0.1");
+        fails(set(&h, 0.1, 0.0), INVALID, "focus_distance = 0");
+        fails(set(&h, 0.1, f32::INFINITY), INVALID, "focus_distance = inf");
+        fails(ht_scene_set_thin_lens(null_mut(), 0.1, 4.0), NULL, "scene");
+        // Refused lenses leave the pinhole, and aperture 0 is one.
+        assert_eq!(bits(&render_c(&h, &s).1), bits(&pinhole));
+        assert_eq!(set(&h, 0.0, 4.0), HT_OK);
+        assert_eq!(bits(&render_c(&h, &s).1), bits(&pinhole));
+
+        // Focused far behind the fur, which blurs; the lens set before the camera holds too.
+        assert_eq!(set(&h, 0.5, 10.0), HT_OK);
+        let (status, blurred) = render_c(&h, &s);
+        assert_eq!(status, HT_OK, "{}", last_error());
+        assert!(blurred.iter().all(|v| v.is_finite()));
+        assert_ne!(bits(&blurred), bits(&pinhole));
+        let lens_first = Handles::new();
+        let hair = lens_first.hair_material();
+        assert_eq!(lens_first.add_strands(&small_fur(), hair), HT_OK);
+        assert_eq!(set(&lens_first, 0.5, 10.0), HT_OK);
+        light(&lens_first, true);
+        assert_eq!(bits(&render_c(&lens_first, &s).1), bits(&blurred));
     }
 
     extern "C" fn count_then_cancel(_done: u64, _total: u64, user: *mut c_void) -> bool {
@@ -462,6 +696,44 @@ mod tests {
         );
         let spp = HtRenderSettings { spp: 0, ..s };
         fails(ht_render(h.scene, &spp, ptr, len), INVALID, "spp = 0");
+        let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
+            let n = null_mut();
+            ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)
+        };
+        fails(
+            aovs(&s, len, 63),
+            INVALID,
+            "pixel_count = 63: must be 8 * 8 = 64",
+        );
+        // A 4 x 3 window: 12 pixels.
+        let crop = HtRenderSettings {
+            crop_x0: 2,
+            crop_y0: 1,
+            crop_x1: 6,
+            crop_y1: 4,
+            ..s
+        };
+        fails(
+            aovs(&crop, len, 12),
+            INVALID,
+            "rgb_len = 192: must be 3 * 4 * 3 = 36",
+        );
+        fails(
+            aovs(&crop, 36, 64),
+            INVALID,
+            "pixel_count = 64: must be 4 * 3 = 12",
+        );
+        let outside = HtRenderSettings { crop_x1: 9, ..crop };
+        fails(aovs(&outside, 36, 12), INVALID, "crop = [2, 1, 9, 4]");
+        let reversed = HtRenderSettings { crop_x0: 6, ..crop };
+        fails(aovs(&reversed, 36, 12), INVALID, "crop = [6, 1, 6, 4]");
+        // Only all four zero mean the full frame.
+        let partial = HtRenderSettings { crop_x1: 4, ..s };
+        fails(
+            ht_render(h.scene, &partial, ptr, len),
+            INVALID,
+            "crop = [0, 0, 4, 0]",
+        );
         assert!(
             rgb.iter().all(|v| *v == 0.0),
             "failed renders leave the buffer alone"
@@ -547,6 +819,7 @@ mod tests {
             (r.width, r.height, r.spp, r.seed)
         );
         assert_eq!((d.threads, d.max_depth), (0, r.path.max_depth));
+        assert_eq!(d.to_rust().crop, None, "the full frame");
         assert!(d.progress.is_none() && d.progress_user.is_null());
     }
 }

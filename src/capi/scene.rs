@@ -47,6 +47,9 @@ pub struct HtScene {
     geometries: Vec<Geometry>,
     lights: Vec<Light>,
     camera: Option<Camera>,
+    /// Aperture radius and focus distance of a thin lens, validated; kept apart from the
+    /// camera so that either may be set first, and the framing camera gets it too.
+    lens: Option<(f32, f32)>,
     /// The last build; None until the first render and after geometry is added.
     world: Option<World>,
     /// Lights were added since `world` was built.
@@ -225,6 +228,12 @@ impl HtScene {
                 Camera::frame_bounds(lo.into(), hi.into(), aspect, DEFAULT_FOV_DEG)?
             }
         };
+        let camera = match self.lens {
+            Some((aperture_radius, focus_distance)) => {
+                camera.with_thin_lens(aperture_radius, focus_distance)?
+            }
+            None => camera,
+        };
         Ok((world, camera))
     }
 }
@@ -343,6 +352,7 @@ pub extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut HtScene) 
             geometries: Vec::new(),
             lights: Vec::new(),
             camera: None,
+            lens: None,
             world: None,
             lights_changed: false,
         });
@@ -740,6 +750,36 @@ pub extern "C" fn ht_scene_set_camera(
             1.0,
         )?;
         scene.camera = Some(camera);
+        Ok(())
+    })
+}
+
+/// Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
+/// units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
+/// view direction, > 0), so that what lies nearer or farther blurs. Holds for the camera
+/// of `ht_scene_set_camera`, whether set before or after, and for the camera that frames a
+/// scene without one. Replaces any earlier lens.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_set_thin_lens(
+    scene: *mut HtScene,
+    aperture_radius: f32,
+    focus_distance: f32,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        // Checked here, with the C names, rather than at the next render.
+        if !(aperture_radius.is_finite() && aperture_radius >= 0.0) {
+            return Err(invalid_arg!(
+                "aperture_radius = {aperture_radius}: must be finite and >= 0"
+            )
+            .into());
+        }
+        if !(focus_distance.is_finite() && focus_distance > 0.0) {
+            return Err(
+                invalid_arg!("focus_distance = {focus_distance}: must be finite and > 0").into(),
+            );
+        }
+        scene.lens = Some((aperture_radius, focus_distance));
         Ok(())
     })
 }

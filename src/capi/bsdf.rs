@@ -4,7 +4,7 @@
 //! about as much as an evaluation, so each thread keeps the last parameter set it saw and
 //! its prepared BSDF, and reuses them while the parameters stay the same.
 
-use super::{Failure, HtStatus, boundary, non_null, non_null_mut};
+use super::{Failure, HtStatus, boundary, non_null, non_null_mut, read_vec3};
 use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
 use crate::error::invalid_arg;
 use glam::Vec3;
@@ -77,7 +77,7 @@ fn bits(p: &HairParams) -> [u32; 7] {
 
 /// Reads a float[3] direction and checks that it is a finite unit vector.
 fn read_dir(ptr: *const f32, name: &str) -> Result<Vec3, Failure> {
-    let v = Vec3::from_array(unsafe { *non_null(ptr, name)?.cast::<[f32; 3]>() });
+    let v = read_vec3(ptr, name)?;
     check_dir(v, name)?;
     Ok(v)
 }
@@ -132,7 +132,7 @@ pub extern "C" fn ht_hair_sigma_a_from_color(
     sigma_a: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        let color = unsafe { *non_null(color, "color")?.cast::<[f32; 3]>() };
+        let color = read_vec3(color, "color")?.to_array();
         let out = non_null_mut(sigma_a, "sigma_a")?;
         write3(out, sigma_a_from_color(color, beta_n)?);
         Ok(())
@@ -176,7 +176,7 @@ pub extern "C" fn ht_hair_sample(
     boundary(|| {
         check_h(h)?;
         let wo = read_dir(wo, "wo")?;
-        let u = unsafe { *non_null(u, "u")?.cast::<[f32; 3]>() };
+        let u = read_vec3(u, "u")?.to_array();
         if let Some(bad) = u.iter().position(|x| !(0.0..1.0).contains(x)) {
             return Err(invalid_arg!("u[{bad}] = {}: must be in [0, 1)", u[bad]).into());
         }

@@ -14,7 +14,7 @@
 /**
  * Version of the C ABI; bumped on any incompatible change of a signature or struct.
  */
-#define HT_ABI_VERSION 2
+#define HT_ABI_VERSION 3
 
 /**
  * Result of every C entry point; `HT_OK` is 0.
@@ -214,6 +214,11 @@ typedef struct HtCurvesXyzr {
 } HtCurvesXyzr;
 
 /**
+ * A pixel filter: one of the `HT_FILTER_*` constants.
+ */
+typedef uint32_t HtPixelFilter;
+
+/**
  * Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
  * call. Return false to cancel: no new pixel starts and `ht_render` returns
  * `HT_ERR_CANCELLED` (tiles that finish meanwhile may still report).
@@ -267,6 +272,15 @@ typedef struct HtRenderSettings {
     uint32_t crop_x1;
     uint32_t crop_y1;
     /**
+     * Pixel filter: `HT_FILTER_TENT` (the default: thin strands alias under a box) or
+     * `HT_FILTER_BOX` (one pixel, for comparisons with renderers that use it).
+     */
+    HtPixelFilter filter;
+    /**
+     * The tent's half-width in pixels, in (0, 8]; ignored by the box. Default 1.
+     */
+    float filter_radius;
+    /**
      * May be NULL: no progress reports, no cancellation.
      */
     HtProgressFn progress;
@@ -305,6 +319,16 @@ typedef struct HtRenderSettings {
  * A ribbon facing the ray: faster, approximate up close.
  */
 #define HT_CURVE_FLAT 1
+
+/**
+ * A separable tent of half-width `filter_radius` pixels.
+ */
+#define HT_FILTER_TENT 0
+
+/**
+ * The one-pixel box.
+ */
+#define HT_FILTER_BOX 1
 
 #ifdef __cplusplus
 extern "C" {
@@ -564,7 +588,7 @@ enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
 
 /**
  * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
- * crop), no callback.
+ * crop), a tent filter of radius 1, no callback.
  */
 struct HtRenderSettings ht_render_settings_default(void);
 

@@ -236,3 +236,57 @@ fn render_crop_matches_the_full_frame() {
         "crop",
     );
 }
+
+/// What the peer benchmark drives: a box-filtered render with its figures in JSON,
+/// `compare` against another seed, `export` for Cycles.
+#[test]
+fn render_stats_compare_and_export() {
+    let small = [
+        "--width", "32", "--height", "24", "--spp", "2", "--filter", "box",
+    ];
+    let render = |seed: &str, out: &str, stats: &str| {
+        let mut args = vec!["render", "--seed", seed, "-o", out, "--stats", stats];
+        args.extend(small);
+        let o = hairtrace(&args);
+        assert!(o.status.success(), "{o:?}");
+    };
+    let (a, b) = (tmp("cli_seed1.exr"), tmp("cli_seed2.exr"));
+    let stats = tmp("cli_stats.json");
+    render("1", &a, &stats);
+    render("2", &b, &tmp("cli_stats2.json"));
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(s["samples"], 32 * 24 * 2);
+    assert_eq!(s["spp"], 2);
+    assert!(s["rays"].as_u64().unwrap() >= 32 * 24 * 2, "{s}");
+    assert!(s["seconds"].as_f64().unwrap() > 0.0 && s["build_seconds"].as_f64().is_some());
+
+    let o = hairtrace(&["compare", &a, &b, "--json"]);
+    assert!(o.status.success(), "{o:?}");
+    let c: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let rmse = c["rmse"].as_f64().unwrap();
+    assert!(rmse > 0.0 && rmse < 1.0, "two seeds differ by noise: {c}");
+    let o = hairtrace(&["compare", &a, &a]);
+    assert!(stdout(&o).starts_with("RMSE 0.000000"), "{}", stdout(&o));
+
+    // Another size is an error, in one line.
+    let wide = tmp("cli_wide.exr");
+    let o = hairtrace(&[
+        "render", "--width", "40", "--height", "24", "--spp", "1", "-o", &wide,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    assert_one_line_error(&hairtrace(&["compare", &wide, &a]), "size");
+    assert_one_line_error(
+        &hairtrace(&["render", "--filter", "gauss", "-o", &a]),
+        "gauss",
+    );
+
+    let dir = tmp("cli_export");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/bench/scenes/fur_ball.toml");
+    let o = hairtrace(&["export", scene, "-o", &dir]);
+    assert!(o.status.success(), "{o:?}");
+    let json = std::fs::read_to_string(format!("{dir}/scene.json")).unwrap();
+    assert!(json.contains("groom0.hair") && json.contains("\"fov_y_deg\": 33.0"));
+    // The demo's camera is automatic: not exportable, and said so.
+    assert_one_line_error(&hairtrace(&["export", "-o", &dir]), "eye and target");
+}

@@ -7,11 +7,14 @@ use std::sync::Arc;
 use glam::Vec3;
 use hairtrace::Error;
 use hairtrace::embree::{CurveBasis, CurveShape, Device};
+use hairtrace::render::PixelFilter;
+use hairtrace::render::integrator::Roulette;
 use hairtrace::scene::description::{
     DEMOS, EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource, SceneDescription,
     demo, quick_look,
 };
 use hairtrace::scene::material::HairColor;
+use hairtrace::scene::peer::export_for_peer;
 use hairtrace::scene::{FurBall, HairStyle, Thickness, write_hair_file};
 
 fn device() -> Arc<Device> {
@@ -345,6 +348,75 @@ fn missing_files_are_io_errors_that_name_them() {
         matches!(&e, Error::Io(m) if m.contains("/no/such/groom.hair")),
         "{e:?}"
     );
+}
+
+#[test]
+fn render_keys_pick_the_filter_and_the_roulette() {
+    let d = parse(&format!(
+        "[render]\nfilter = \"box\"\nroulette = \"throughput\"\nrr_depth = 3\n{BASE}"
+    ))
+    .unwrap();
+    let s = d.render.settings().unwrap();
+    assert_eq!(s.filter, PixelFilter::BOX);
+    assert_eq!(
+        (s.path.roulette, s.path.rr_depth),
+        (Roulette::Throughput, 3)
+    );
+    let d = parse(&format!("[render]\nfilter_radius = 2\n{BASE}")).unwrap();
+    assert_eq!(
+        d.render.settings().unwrap().filter,
+        PixelFilter::tent(2.0).unwrap()
+    );
+    // The defaults: a tent of one pixel, roulette on sqrt(throughput) after two events.
+    let s = parse(BASE).unwrap().render.settings().unwrap();
+    assert_eq!(s.filter, PixelFilter::default());
+    assert_eq!(
+        (s.path.roulette, s.path.rr_depth),
+        (Roulette::SqrtThroughput, 2)
+    );
+
+    for (keys, expect) in [
+        (
+            "filter = \"gauss\"",
+            &["render", "\"gauss\"", "box or tent"][..],
+        ),
+        (
+            "filter = \"box\"\nfilter_radius = 2",
+            &["render", "filter_radius = 2"],
+        ),
+        ("filter_radius = 0", &["render", "radius 0"]),
+        (
+            "roulette = \"maybe\"",
+            &["render", "\"maybe\"", "sqrt or throughput"],
+        ),
+        ("rr_depth = 0", &["render", "rr_depth = 0"]),
+    ] {
+        let e = build_error(&format!("[render]\n{keys}\n{BASE}")).to_string();
+        assert_contains(&e, expect);
+    }
+}
+
+/// The peer benchmark's scenes are scene files like any other: they parse, build and
+/// export for the peer.
+#[test]
+fn bench_scenes_build_and_export() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/scenes");
+    let mut found = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "toml") {
+            let mut desc = SceneDescription::from_file(&path).unwrap();
+            shrink(&mut desc);
+            desc.build(device())
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            let out = scratch(&format!("peer-{found}"));
+            export_for_peer(&desc, &out).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            assert!(out.join("scene.json").is_file());
+            std::fs::remove_dir_all(&out).unwrap();
+            found += 1;
+        }
+    }
+    assert!(found >= 4, "only {found} bench scenes");
 }
 
 #[test]

@@ -72,6 +72,45 @@ fn white_fur_in_a_white_furnace_is_invisible() {
     assert!((m - 1.0).abs() < 0.01, "furnace mean {m}");
 }
 
+/// The efficiency issue's bound: a 30k-strand white fur ball at default path settings
+/// (early Russian roulette, no shadow rays toward the uniform sky) stays at 1 within
+/// 0.1%. Every pixel's expected value is 1, so the spread of the pixel values gives the
+/// standard error of their mean.
+#[test]
+fn white_fur_ball_of_30k_strands_keeps_the_furnace_within_a_thousandth() {
+    let white = HairMaterial {
+        color: HairColor::SigmaA([0.0; 3]),
+        ..HairMaterial::default()
+    };
+    let env = Light::Environment(Environment::uniform(Vec3::ONE).unwrap());
+    let world = fur_world(white, vec![env], 30_000);
+    // The ball (radius 1.4 with its fur) fills the frame.
+    let camera = Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 30.0, 1.0).unwrap();
+    let settings = RenderSettings {
+        width: 48,
+        height: 48,
+        spp: 32,
+        seed: 9,
+        ..RenderSettings::default()
+    };
+    let out = render(&world, &camera, &settings, Aovs::default(), &NoProgress).unwrap();
+    let luminance: Vec<f64> = out
+        .film
+        .rgb()
+        .chunks_exact(3)
+        .map(|p| p.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0)
+        .collect();
+    let n = luminance.len() as f64;
+    let m = luminance.iter().sum::<f64>() / n;
+    let se = (luminance.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    println!(
+        "30k white fur ball: mean {m:.5} ± {se:.5}, {:.2} rays per sample",
+        out.stats.rays as f64 / out.stats.samples as f64
+    );
+    assert!(se < 2.5e-4, "too noisy to judge 0.1%: standard error {se}");
+    assert!((m - 1.0).abs() < 1e-3, "furnace mean {m} ± {se}");
+}
+
 /// A brown fur ball lit by three non-delta lights of different kinds.
 fn lit_world() -> World {
     let lights = vec![
@@ -95,9 +134,17 @@ fn lit_world() -> World {
 }
 
 /// Light-only, BSDF-only and MIS estimate the same image: the means of each image
-/// quadrant agree within 4 standard errors, estimated from independent seeds.
+/// quadrant agree within 4 standard errors, estimated from independent seeds. At the
+/// default depth, and at a depth of one event, where BSDF sampling must still reach the
+/// lights from the last vertex as next-event estimation does.
 #[test]
 fn mis_agrees_with_light_and_bsdf_sampling() {
+    for max_depth in [PathSettings::default().max_depth, 1] {
+        strategies_agree(max_depth);
+    }
+}
+
+fn strategies_agree(max_depth: u32) {
     let world = lit_world();
     const SEEDS: u64 = 64;
     let quadrant_means = |strategy: Strategy| -> Vec<(f64, f64)> {
@@ -105,6 +152,7 @@ fn mis_agrees_with_light_and_bsdf_sampling() {
             .map(|seed| {
                 let path = PathSettings {
                     strategy,
+                    max_depth,
                     ..PathSettings::default()
                 };
                 let settings = RenderSettings {
@@ -144,13 +192,53 @@ fn mis_agrees_with_light_and_bsdf_sampling() {
         for k in 0..4 {
             let ((a, sa), (b, sb)) = (mis[k], o[k]);
             let bound = 4.0 * (sa * sa + sb * sb).sqrt() + 1e-4;
-            println!("quadrant {k}: MIS {a:.4} ± {sa:.4}, {other:?} {b:.4} ± {sb:.4}");
+            println!(
+                "depth {max_depth}, quadrant {k}: MIS {a:.4} ± {sa:.4}, {other:?} {b:.4} ± {sb:.4}"
+            );
             assert!(
                 (a - b).abs() < bound,
-                "quadrant {k}: MIS {a} vs {other:?} {b} (bound {bound})"
+                "depth {max_depth}, quadrant {k}: MIS {a} vs {other:?} {b} (bound {bound})"
             );
         }
     }
+}
+
+/// The indirect clamp leaves light that scattered once alone, whichever strategy found
+/// it: with one event allowed, a clamp far below every contribution changes no bit;
+/// with more, it darkens the image.
+#[test]
+fn clamp_indirect_touches_only_indirect_light() {
+    let world = lit_world();
+    let image = |max_depth: u32, clamp_indirect: Option<f32>| {
+        let settings = RenderSettings {
+            width: 24,
+            height: 24,
+            spp: 8,
+            seed: 5,
+            path: PathSettings {
+                max_depth,
+                clamp_indirect,
+                ..PathSettings::default()
+            },
+            ..RenderSettings::default()
+        };
+        render(&world, &camera(), &settings, Aovs::default(), &NoProgress)
+            .unwrap()
+            .film
+            .rgb()
+            .to_vec()
+    };
+    let tiny = Some(1e-4);
+    let direct = image(1, None);
+    assert!(mean(&direct) > 0.01, "the scene is lit: {}", mean(&direct));
+    assert_eq!(direct, image(1, tiny), "direct light was clamped");
+    let (free, clamped) = (mean(&image(4, None)), mean(&image(4, tiny)));
+    println!("depth 4: mean {free:.5} unclamped, {clamped:.5} clamped");
+    assert!(
+        clamped < free - 1e-3,
+        "indirect light not clamped: {clamped} vs {free}"
+    );
+    assert!(clamped > mean(&direct) - 1e-6, "direct light lost");
 }
 
 /// The same seed gives the same bits with one and two threads, and a crop renders

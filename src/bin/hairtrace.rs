@@ -1,6 +1,7 @@
 //! The hairtrace command line: `render` a scene file, a .hair groom or a built-in demo;
 //! `info` describes a .hair groom; `lobes` prints how a hair splits energy between its
-//! lobes.
+//! lobes; `compare` measures how far a render is from a reference; `export` writes a
+//! scene for a peer renderer.
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
@@ -9,6 +10,7 @@ use hairtrace::embree::Device;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::description::{self, BuiltScene, SceneDescription};
+use hairtrace::scene::peer::export_for_peer;
 use hairtrace::scene::{Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -38,6 +40,33 @@ enum Command {
     Lobes(LobesArgs),
     /// Print a .hair groom's strand, point and segment counts, bounds and radius range.
     Info(InfoArgs),
+    /// Write a scene (file or demo) for a peer renderer: world-space .hair grooms, OBJ
+    /// meshes and scene.json, what bench/peer hands to Blender Cycles.
+    Export(ExportArgs),
+    /// Compare an image with a reference of the same size: RMSE, largest difference and
+    /// both means over the RGB channels (one JSON line with --json).
+    Compare(CompareArgs),
+}
+
+#[derive(Args)]
+struct ExportArgs {
+    /// A scene description (.toml).
+    scene: Option<PathBuf>,
+    /// A built-in scene instead of a file.
+    #[arg(long, conflicts_with = "scene")]
+    demo: Option<String>,
+    /// The folder to write into (created if missing).
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+#[derive(Args)]
+struct CompareArgs {
+    image: PathBuf,
+    reference: PathBuf,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args)]
@@ -62,6 +91,23 @@ struct RenderArgs {
     /// Longest path, in scattering events.
     #[arg(long)]
     max_depth: Option<u32>,
+    /// Russian roulette may end paths after this many scattering events (default 2).
+    #[arg(long)]
+    rr_depth: Option<u32>,
+    /// Russian roulette survival: sqrt (of the path throughput, the default) or
+    /// throughput.
+    #[arg(long, value_parser = ["sqrt", "throughput"])]
+    roulette: Option<String>,
+    /// Pixel filter: tent (the default) or box (one pixel).
+    #[arg(long, value_parser = ["tent", "box"])]
+    filter: Option<String>,
+    /// The tent filter's half-width in pixels (default 1).
+    #[arg(long)]
+    filter_radius: Option<f32>,
+    /// Also write the render's figures (seconds of path tracing, scene build seconds,
+    /// camera samples, rays) to this JSON file: what benchmarks read.
+    #[arg(long, value_name = "FILE.json")]
+    stats: Option<PathBuf>,
     /// Render only the pixels x0..x1, y0..y1 (ends exclusive) of the full frame, exactly
     /// as the full render has them: a farm can split a frame and reassemble the pieces.
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_list::<u32, 4>)]
@@ -185,20 +231,31 @@ impl Progress for Bar {
     }
 }
 
-fn render(args: &RenderArgs) -> hairtrace::Result<()> {
-    // Refuse an output the writer will not take before spending minutes on the render.
-    image::check_output_path(&args.output)?;
-    let mut description = match (&args.scene, &args.demo) {
-        (Some(path), _)
+/// The scene a command names: a scene file, a bare .hair groom or a demo (by default
+/// the fur ball).
+fn load_scene(scene: Option<&PathBuf>, demo: Option<&str>) -> hairtrace::Result<SceneDescription> {
+    match scene {
+        Some(path)
             if path
                 .extension()
                 .is_some_and(|e| e.eq_ignore_ascii_case("hair")) =>
         {
-            description::quick_look(path)?
+            description::quick_look(path)
         }
-        (Some(path), _) => SceneDescription::from_file(path)?,
-        (None, name) => description::demo(name.as_deref().unwrap_or("furball"))?,
-    };
+        Some(path) => SceneDescription::from_file(path),
+        None => description::demo(demo.unwrap_or("furball")),
+    }
+}
+
+fn export(args: &ExportArgs) -> hairtrace::Result<()> {
+    let description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
+    export_for_peer(&description, &args.output)
+}
+
+fn render(args: &RenderArgs) -> hairtrace::Result<()> {
+    // Refuse an output the writer will not take before spending minutes on the render.
+    image::check_output_path(&args.output)?;
+    let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
     // Overrides go into the description, so that the camera's aspect follows the size.
     let r = &mut description.render;
     r.spp = args.spp.unwrap_or(r.spp);
@@ -208,12 +265,22 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     r.threads = args.threads.or(r.threads);
     r.max_depth = args.max_depth.unwrap_or(r.max_depth);
     r.crop = args.crop.or(r.crop);
+    r.rr_depth = args.rr_depth.unwrap_or(r.rr_depth);
+    if let Some(roulette) = &args.roulette {
+        r.roulette.clone_from(roulette);
+    }
+    if let Some(filter) = &args.filter {
+        r.filter.clone_from(filter);
+    }
+    r.filter_radius = args.filter_radius.or(r.filter_radius);
+    let build_start = std::time::Instant::now();
     let device = Arc::new(Device::new(r.threads)?);
     let BuiltScene {
         world,
         camera,
         settings,
     } = description.build(device)?;
+    let build_seconds = build_start.elapsed().as_secs_f64();
 
     let bar = ProgressBar::new(0).with_style(
         ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}")
@@ -265,6 +332,18 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         s.rays as f64 / s.seconds / 1e6,
         peak_memory()
     );
+    if let Some(path) = &args.stats {
+        let json = format!(
+            "{{\"seconds\": {}, \"build_seconds\": {build_seconds}, \"samples\": {}, \"rays\": {}, \"spp\": {}, \"threads\": {}}}\n",
+            s.seconds,
+            s.samples,
+            s.rays,
+            settings.spp,
+            settings.threads.unwrap_or_else(rayon::current_num_threads),
+        );
+        std::fs::write(path, json)
+            .map_err(|e| hairtrace::Error::Io(format!("{}: {e}", path.display())))?;
+    }
     if out.film.rejected_samples() > 0 {
         eprintln!(
             "warning: {} samples were not finite and were dropped",
@@ -310,6 +389,25 @@ fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
+fn compare(args: &CompareArgs) -> hairtrace::Result<()> {
+    let c = image::compare(
+        &image::read_image(&args.image)?,
+        &image::read_image(&args.reference)?,
+    )?;
+    if args.json {
+        println!(
+            "{{\"rmse\": {}, \"max_abs\": {}, \"mean\": {}, \"reference_mean\": {}}}",
+            c.rmse, c.max_abs, c.mean, c.reference_mean
+        );
+    } else {
+        println!(
+            "RMSE {:.6}, max |difference| {:.6}, mean {:.6} (reference {:.6})",
+            c.rmse, c.max_abs, c.mean, c.reference_mean
+        );
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -338,6 +436,8 @@ fn main() -> ExitCode {
         Command::Render(a) => render(a),
         Command::Lobes(a) => lobes(a),
         Command::Info(a) => info(a),
+        Command::Compare(a) => compare(a),
+        Command::Export(a) => export(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

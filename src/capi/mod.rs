@@ -21,7 +21,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
 /// Version of the C ABI; bumped on any incompatible change of a signature or struct.
-pub const HT_ABI_VERSION: u32 = 2;
+pub const HT_ABI_VERSION: u32 = 3;
 
 /// Result of every C entry point; `HT_OK` is 0.
 #[repr(C)]

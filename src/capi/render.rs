@@ -9,7 +9,7 @@ use crate::image::{WriteOptions, write_image};
 use crate::render::integrator::PathSettings;
 use crate::render::renderer::render;
 use crate::render::settings::RenderSettings;
-use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
+use crate::render::{Aovs, NoProgress, PixelFilter, Progress, RenderStatus};
 use std::ffi::{c_char, c_void};
 use std::ptr::null_mut;
 
@@ -23,6 +23,13 @@ use std::ptr::null_mut;
 /// behaviour (catch inside and return false instead).
 pub type HtProgressFn =
     Option<unsafe extern "C" fn(done: u64, total: u64, user: *mut c_void) -> bool>;
+
+/// A pixel filter: one of the `HT_FILTER_*` constants.
+pub type HtPixelFilter = u32;
+/// A separable tent of half-width `filter_radius` pixels.
+pub const HT_FILTER_TENT: HtPixelFilter = 0;
+/// The one-pixel box.
+pub const HT_FILTER_BOX: HtPixelFilter = 1;
 
 /// What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
 /// the fields you need.
@@ -53,6 +60,11 @@ pub struct HtRenderSettings {
     pub crop_y0: u32,
     pub crop_x1: u32,
     pub crop_y1: u32,
+    /// Pixel filter: `HT_FILTER_TENT` (the default: thin strands alias under a box) or
+    /// `HT_FILTER_BOX` (one pixel, for comparisons with renderers that use it).
+    pub filter: HtPixelFilter,
+    /// The tent's half-width in pixels, in (0, 8]; ignored by the box. Default 1.
+    pub filter_radius: f32,
     /// May be NULL: no progress reports, no cancellation.
     pub progress: HtProgressFn,
     /// Passed to `progress` as it is.
@@ -60,7 +72,7 @@ pub struct HtRenderSettings {
 }
 
 /// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
-/// crop), no callback.
+/// crop), a tent filter of radius 1, no callback.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
     let d = RenderSettings::default();
@@ -76,27 +88,39 @@ pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
         crop_y0,
         crop_x1,
         crop_y1,
+        filter: HT_FILTER_TENT,
+        filter_radius: d.filter.name().1.unwrap_or(1.0),
         progress: None,
         progress_user: null_mut(),
     }
 }
 
 impl HtRenderSettings {
-    /// The Rust settings these stand for (not yet validated).
-    fn to_rust(self) -> RenderSettings {
+    /// The Rust settings these stand for (the filter checked, the rest not yet validated).
+    fn to_rust(self) -> crate::Result<RenderSettings> {
         let crop = [self.crop_x0, self.crop_y0, self.crop_x1, self.crop_y1];
-        RenderSettings {
+        let filter = match self.filter {
+            HT_FILTER_TENT => PixelFilter::tent(self.filter_radius)?,
+            HT_FILTER_BOX => PixelFilter::BOX,
+            other => {
+                return Err(invalid_arg!(
+                    "filter = {other}: must be HT_FILTER_TENT (0) or HT_FILTER_BOX (1)"
+                ));
+            }
+        };
+        Ok(RenderSettings {
             width: self.width,
             height: self.height,
             spp: self.spp,
             seed: self.seed,
             threads: (self.threads > 0).then_some(self.threads as usize),
             crop: (crop != [0; 4]).then_some(crop),
+            filter,
             path: PathSettings {
                 max_depth: self.max_depth,
                 ..PathSettings::default()
             },
-        }
+        })
     }
 }
 
@@ -180,7 +204,7 @@ pub extern "C" fn ht_render_aovs(
         let scene = scene_mut(scene)?;
         // SAFETY: non-NULL (checked); the host's struct.
         let s = unsafe { *non_null(settings, "settings")? };
-        let settings = s.to_rust();
+        let settings = s.to_rust()?;
         settings.validate()?;
         // The crop window's size (the full frame without one).
         let [x0, y0, x1, y1] = settings.window();
@@ -353,7 +377,7 @@ mod tests {
 
     /// Renders through `ht_render_aovs` with every AOV: rgb, albedo, depth, strand id.
     fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
-        let [x0, y0, x1, y1] = s.to_rust().window();
+        let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
         let pixels = ((x1 - x0) * (y1 - y0)) as usize;
         let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
         let [rgb, albedo, depth, strand_id] = &mut out;
@@ -408,6 +432,21 @@ mod tests {
         let out = render(&world, &camera, &rust, Aovs::default(), &NoProgress).unwrap();
         assert_eq!(bits(&rgb), bits(out.film.rgb()));
         assert!(rgb.iter().any(|v| *v > 0.0));
+
+        // The filter field reaches the renderer: a box render is the Rust box render.
+        let boxed = HtRenderSettings {
+            filter: HT_FILTER_BOX,
+            ..settings(32)
+        };
+        let (status, box_rgb) = render_c(&h, &boxed);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        let rust_box = RenderSettings {
+            filter: PixelFilter::BOX,
+            ..rust
+        };
+        let out = render(&world, &camera, &rust_box, Aovs::default(), &NoProgress).unwrap();
+        assert_eq!(bits(&box_rgb), bits(out.film.rgb()));
+        assert_ne!(bits(&box_rgb), bits(&rgb));
     }
 
     #[test]
@@ -696,6 +735,13 @@ mod tests {
         );
         let spp = HtRenderSettings { spp: 0, ..s };
         fails(ht_render(h.scene, &spp, ptr, len), INVALID, "spp = 0");
+        let filter = HtRenderSettings { filter: 7, ..s };
+        fails(ht_render(h.scene, &filter, ptr, len), INVALID, "filter = 7");
+        let radius = HtRenderSettings {
+            filter_radius: f32::NAN,
+            ..s
+        };
+        fails(ht_render(h.scene, &radius, ptr, len), INVALID, "radius NaN");
         let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
             let n = null_mut();
             ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)
@@ -819,7 +865,9 @@ mod tests {
             (r.width, r.height, r.spp, r.seed)
         );
         assert_eq!((d.threads, d.max_depth), (0, r.path.max_depth));
-        assert_eq!(d.to_rust().crop, None, "the full frame");
+        let rust = d.to_rust().unwrap();
+        assert_eq!(rust.crop, None, "the full frame");
+        assert_eq!(rust.filter, r.filter);
         assert!(d.progress.is_none() && d.progress_user.is_null());
     }
 }

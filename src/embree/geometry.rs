@@ -412,11 +412,24 @@ impl CurveGeometry {
         self.vertices.heap_bytes() + self.indices.heap_bytes()
     }
 
-    /// The curve of segment `prim` at parameter `u` in [0, 1], through `rtcInterpolate`, so
-    /// it is exactly the curve Embree intersects. `None` when `prim` is out of range.
+    /// The curve of segment `prim` at parameter `u` in [0, 1]: a lerp for linear curves,
+    /// `rtcInterpolate` for cubic ones, so it is exactly the curve Embree intersects.
+    /// `None` when `prim` is out of range.
     pub fn interpolate(&self, prim: u32, u: f32) -> Option<CurvePoint> {
-        if prim as usize >= self.indices.len() {
-            return None;
+        let &first = self.indices().get(prim as usize)?;
+        if self.basis == CurveBasis::Linear {
+            // A straight segment needs no call into Embree: its point and radius are a
+            // lerp of the two control points (both inside the buffer: checked in `new`).
+            let v = self.vertices();
+            let (a, b) = (v[first as usize], v[first as usize + 1]);
+            let u = u.clamp(0.0, 1.0);
+            let lerp = |i: usize| a[i] + u * (b[i] - a[i]);
+            return Some(CurvePoint {
+                p: [lerp(0), lerp(1), lerp(2)],
+                radius: lerp(3),
+                dp_du: [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                d2p_du2: [0.0; 3],
+            });
         }
         // rtcInterpolate writes with 16-byte stores: aligned, padded outputs.
         #[repr(C, align(16))]
@@ -433,13 +446,7 @@ impl CurveGeometry {
             bufferSlot: 0,
             P: p.0.as_mut_ptr(),
             dPdu: dp.0.as_mut_ptr(),
-            // A linear curve has no second derivative, and Embree 3.13 returns a zero first
-            // derivative for linear curves when the second is requested too.
-            ddPdudu: if self.basis == CurveBasis::Linear {
-                std::ptr::null_mut()
-            } else {
-                ddp.0.as_mut_ptr()
-            },
+            ddPdudu: ddp.0.as_mut_ptr(),
             valueCount: 4,
             ..Default::default()
         };

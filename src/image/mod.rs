@@ -13,6 +13,9 @@ use std::path::Path;
 use crate::error::invalid_arg;
 use crate::{Error, Result};
 
+mod compare;
+pub use compare::{Comparison, compare};
+
 /// How samples are stored in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PixelType {

@@ -48,6 +48,13 @@ pub struct Aovs {
     pub strand_id: bool,
 }
 
+impl Aovs {
+    /// Whether any AOV is asked for: without one, first hits need not be described.
+    pub fn any(&self) -> bool {
+        self.albedo || self.depth || self.strand_id
+    }
+}
+
 /// What the first camera-ray hit of a sample reports for the AOVs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FirstHit {
@@ -63,15 +70,50 @@ pub struct FirstHit {
 /// is drawn from the filter (filter importance sampling), so every sample has weight 1
 /// and belongs to exactly one pixel, which keeps pixels independent of each other (and of
 /// tiles and crops). A wider filter trades sharpness for less aliasing of thin strands.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+///
+/// The default is a tent of radius 1 pixel: strands thinner than a pixel alias into
+/// stair-steps and crawling highlights under a box, and the tent's overlap between
+/// neighbours removes most of that for the price of a slightly softer image. The box is
+/// there for comparisons with renderers that use it, and for exact pixel coverage.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PixelFilter {
     /// Half-width of a tent in pixels; 0 is the one-pixel box.
     tent_radius: f32,
 }
 
+impl Default for PixelFilter {
+    fn default() -> Self {
+        PixelFilter { tent_radius: 1.0 }
+    }
+}
+
 impl PixelFilter {
-    /// The one-pixel box filter (the default).
+    /// The one-pixel box filter.
     pub const BOX: PixelFilter = PixelFilter { tent_radius: 0.0 };
+
+    /// The filter named `name` ("box" or "tent"); `radius` is the tent's half-width in
+    /// pixels (default 1) and must not be given for the box.
+    pub fn named(name: &str, radius: Option<f32>) -> Result<Self> {
+        match (name, radius) {
+            ("box", None) => Ok(Self::BOX),
+            ("box", Some(r)) => Err(invalid_arg!(
+                "filter_radius = {r} applies to the tent filter, not the box (always one pixel)"
+            )),
+            ("tent", r) => Self::tent(r.unwrap_or(1.0)),
+            _ => Err(invalid_arg!(
+                "unknown pixel filter {name:?} (choose box or tent)"
+            )),
+        }
+    }
+
+    /// The filter's name, as [`Self::named`] takes it, and the tent's radius.
+    pub fn name(&self) -> (&'static str, Option<f32>) {
+        if self.tent_radius == 0.0 {
+            ("box", None)
+        } else {
+            ("tent", Some(self.tent_radius))
+        }
+    }
 
     /// A separable tent (triangle) of half-width `radius` pixels, in (0, 8].
     pub fn tent(radius: f32) -> Result<Self> {

@@ -10,10 +10,11 @@ use super::film::FirstHit;
 use super::sampler::PixelSampler;
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
+use crate::bsdf::{HairBsdf, HairPoint};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
-use crate::scene::hit::{HairHit, Hit, SurfaceHit};
+use crate::scene::hit::{HairFrame, HairHit, Hit, SurfaceHit};
 use crate::scene::light::{Light, luminance};
 use crate::scene::material::PreparedHair;
 use crate::scene::tracer::{SpawnedRay, Tracer};
@@ -24,23 +25,74 @@ use crate::scene::tracer::{SpawnedRay, Tracer};
 pub enum Strategy {
     #[default]
     Mis,
-    /// Next-event estimation only: emission found by BSDF sampling is ignored (except
-    /// what the camera sees directly).
+    /// Next-event estimation only: emission found by BSDF sampling is ignored, except
+    /// what the camera sees directly and lights that next-event estimation never samples
+    /// (see [`Light::needs_light_sampling`]).
     LightOnly,
     /// BSDF sampling only: no shadow rays.
     BsdfOnly,
+}
+
+/// How Russian roulette turns a path's throughput into its chance to go on. Both are
+/// unbiased (a surviving path is reweighted by 1 / survival); they differ in where they
+/// spend rays. Measured on the bench scenes (README, "Render efficiency").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Roulette {
+    /// Survival = min(1, sqrt(max channel of the throughput)): a dim path lives longer
+    /// than its throughput alone says, which keeps long chains through light hair.
+    #[default]
+    SqrtThroughput,
+    /// Survival = min(1, max channel of the throughput) (pbrt's rule): fewer rays per
+    /// sample, more variance per ray.
+    Throughput,
+}
+
+impl Roulette {
+    /// The rule named `name`: "sqrt" or "throughput".
+    pub fn named(name: &str) -> Result<Self> {
+        match name {
+            "sqrt" => Ok(Roulette::SqrtThroughput),
+            "throughput" => Ok(Roulette::Throughput),
+            _ => Err(invalid_arg!(
+                "unknown roulette {name:?} (choose sqrt or throughput)"
+            )),
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Roulette::SqrtThroughput => "sqrt",
+            Roulette::Throughput => "throughput",
+        }
+    }
+
+    /// The probability that a path with throughput `beta` goes on.
+    pub fn survival(self, beta: Vec3) -> f32 {
+        let m = beta.max_element();
+        let p = match self {
+            Roulette::SqrtThroughput => m.sqrt(),
+            Roulette::Throughput => m,
+        };
+        // NaN (a degenerate weight) ends the path.
+        if p.is_nan() { 0.0 } else { p.min(1.0) }
+    }
 }
 
 /// Path settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathSettings {
     /// Longest path, in scattering events. 256 keeps a white fur ball's furnace above
-    /// 0.9999 (DESIGN.md 4b); Russian roulette ends most paths far earlier.
+    /// 0.9999 (white fibres scatter for hundreds of bounces); Russian roulette ends most
+    /// paths far earlier.
     pub max_depth: u32,
-    /// Russian roulette starts after this many events.
+    /// Russian roulette may end a path after this many events (1: after the first).
+    /// The default, 2, always traces the ray that leaves the first hit: on the bench
+    /// scenes that is 1.2-1.25x more efficient than 1 and than 3 (README, "Render
+    /// efficiency"), because the first bounce carries most of the image's light.
     pub rr_depth: u32,
-    /// Upper bound on the luminance of any one contribution after the first bounce
-    /// (biased, reduces fireflies); None = off, the default.
+    pub roulette: Roulette,
+    /// Upper bound on the luminance of any one contribution of indirect light (two or
+    /// more scattering events; biased, reduces fireflies); None = off, the default.
     pub clamp_indirect: Option<f32>,
     pub strategy: Strategy,
 }
@@ -49,7 +101,8 @@ impl Default for PathSettings {
     fn default() -> Self {
         PathSettings {
             max_depth: 256,
-            rr_depth: 8,
+            rr_depth: 2,
+            roulette: Roulette::default(),
             clamp_indirect: None,
             strategy: Strategy::Mis,
         }
@@ -60,6 +113,11 @@ impl PathSettings {
     pub fn validate(&self) -> Result<()> {
         if self.max_depth == 0 {
             return Err(invalid_arg!("max_depth = 0: must be at least 1"));
+        }
+        if self.rr_depth == 0 {
+            return Err(invalid_arg!(
+                "rr_depth = 0: must be at least 1 (roulette decides after an event)"
+            ));
         }
         if let Some(c) = self.clamp_indirect {
             if !(c.is_finite() && c > 0.0) {
@@ -104,7 +162,18 @@ impl World {
         } else {
             1.0
         };
-        let power: Vec<f32> = lights.iter().map(|l| l.power(radius)).collect();
+        // Lights that BSDF sampling serves as well on its own get no shadow rays: they
+        // are left out of the choice, so their MIS weight on BSDF-sampled rays is 1.
+        let power: Vec<f32> = lights
+            .iter()
+            .map(|l| {
+                if l.needs_light_sampling() {
+                    l.power(radius)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
         let total: f32 = power.iter().sum();
         let (light_choice, light_prob) = if total > 0.0 && total.is_finite() {
             (
@@ -124,12 +193,18 @@ impl World {
     }
 
     /// Radiance arriving along the camera ray (org, dir), what its first hit reports for
-    /// the AOVs (None when it escapes), and the number of rays traced.
+    /// the AOVs (None when it escapes or when `aovs` is false), and the number of rays
+    /// traced.
+    ///
+    /// A path of at most `max_depth` scattering events traces up to `max_depth + 1`
+    /// closest-hit rays: the last one only looks for emission, so that BSDF sampling
+    /// reaches exactly as deep as next-event estimation and MIS stays unbiased at the cap.
     pub fn radiance(
         &self,
         org: Vec3,
         dir: Vec3,
         settings: &PathSettings,
+        aovs: bool,
         sampler: &mut PixelSampler,
     ) -> (Vec3, Option<FirstHit>, u32) {
         let mut first = None;
@@ -143,41 +218,59 @@ impl World {
         // The BSDF pdf of the direction that produced `ray`, for MIS on the emission it
         // finds; None for camera rays, which see emission with full weight.
         let mut bsdf_pdf: Option<f32> = None;
-        for depth in 0..settings.max_depth {
+        // `events` scattering events precede the ray traced in this iteration.
+        for events in 0..=settings.max_depth {
             let hit = self.tracer.intersect_spawned(&ray);
             rays += 1;
             let t_hit = hit.as_ref().map_or(f32::INFINITY, Hit::t);
             let contribution =
                 self.emission(ray.ray.org, ray.ray.dir, t_hit, bsdf_pdf, settings.strategy);
-            l += clamp(beta * contribution, depth, settings);
+            l += clamp(beta * contribution, events, settings);
             let Some(hit) = hit else { break };
-            if depth == 0 {
+            if events == 0 && aovs {
                 first = Some(self.first_hit(&hit));
             }
+            if events == settings.max_depth {
+                break;
+            }
             let wo_world = -ray.ray.dir.normalize();
-            // A fixed number of dimensions per bounce keeps the sample sequence aligned.
-            let choice = sampler.next_1d();
-            let u_light = sampler.next_2d();
+            // A fixed number of requests per bounce keeps the sample sequence aligned;
+            // the light's are skipped when no light is sampled.
+            let sample_light =
+                settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some();
+            let (choice, u_light) = if sample_light {
+                (sampler.next_1d(), sampler.next_2d())
+            } else {
+                sampler.skip();
+                sampler.skip();
+                (0.0, [0.0; 2])
+            };
             let u_lobe = sampler.next_1d();
             let u_dir = sampler.next_2d();
             let u_rr = sampler.next_1d();
-            let shading = match self.shading(&hit, wo_world) {
-                Some(s) => s,
-                None => break,
+            // A varied hair material builds its BSDF per hit; the shading point borrows it.
+            let varied_bsdf;
+            let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
+                (Hit::Hair(h), Some(Material::Hair(m))) => {
+                    varied_bsdf = m.bsdf_at(h.strand.strand, h.s, h.color);
+                    Shading::hair(h, &varied_bsdf, wo_world)
+                }
+                (Hit::Surface(s), Some(Material::Diffuse(d))) => Shading::diffuse(s, *d, wo_world),
+                _ => break,
             };
-            if settings.strategy != Strategy::BsdfOnly {
+            if sample_light {
                 let (direct, shadow_rays) =
                     self.direct(&hit, &shading, choice, u_light, settings.strategy);
                 rays += shadow_rays;
-                l += clamp(beta * direct, depth + 1, settings);
+                l += clamp(beta * direct, events + 1, settings);
             }
             let Some((wi, weight, pdf)) = shading.sample([u_lobe, u_dir[0], u_dir[1]]) else {
                 break;
             };
             beta *= weight;
             bsdf_pdf = Some(pdf);
-            if depth + 1 >= settings.rr_depth {
-                let survive = beta.max_element().min(0.95);
+            if events + 1 >= settings.rr_depth {
+                let survive = settings.roulette.survival(beta);
                 if u_rr >= survive {
                     break;
                 }
@@ -230,12 +323,13 @@ impl World {
             let Some(e) = reached.then(|| light.eval_li(org, dir_n)).flatten() else {
                 continue;
             };
+            // A light never chosen for next-event estimation is found only this way.
+            let light_pdf = self.choice_pdf(i) * e.pdf;
             let weight = match (bsdf_pdf, strategy) {
                 (None, _) | (Some(_), Strategy::BsdfOnly) => 1.0,
+                (Some(_), _) if light_pdf == 0.0 => 1.0,
                 (Some(_), Strategy::LightOnly) => 0.0,
-                (Some(pdf), Strategy::Mis) => {
-                    power_heuristic(1.0, pdf, 1.0, self.choice_pdf(i) * e.pdf)
-                }
+                (Some(pdf), Strategy::Mis) => power_heuristic(1.0, pdf, 1.0, light_pdf),
             };
             sum += e.radiance * weight;
         }
@@ -293,24 +387,14 @@ impl World {
         };
         (f_cos * ls.radiance * (weight / light_pdf), 1)
     }
-
-    /// The BSDF at a hit, in its local frame.
-    fn shading<'a>(&'a self, hit: &Hit, wo_world: Vec3) -> Option<Shading<'a>> {
-        match (hit, self.materials.get(hit.geom_id() as usize)?) {
-            (Hit::Hair(h), Material::Hair(m)) => Some(Shading::hair(h, m.as_ref(), wo_world)),
-            (Hit::Surface(s), Material::Diffuse(d)) => Some(Shading::diffuse(s, *d, wo_world)),
-            _ => None,
-        }
-    }
 }
 
-/// A BSDF at a path vertex with its local frame.
+/// A BSDF at a path vertex with its local frame. A hair point holds the work that
+/// depends on (h, wo) only, shared by next-event estimation and BSDF sampling.
 enum Shading<'a> {
     Hair {
-        frame: crate::scene::hit::HairFrame,
-        bsdf: std::borrow::Cow<'a, crate::bsdf::HairBsdf>,
-        h: f32,
-        wo: Vec3,
+        frame: HairFrame,
+        point: HairPoint<'a>,
     },
     Diffuse {
         frame: [Vec3; 3],
@@ -320,13 +404,10 @@ enum Shading<'a> {
 }
 
 impl<'a> Shading<'a> {
-    fn hair(h: &HairHit, m: &'a PreparedHair, wo_world: Vec3) -> Self {
-        let wo = h.frame.to_local(wo_world);
+    fn hair(h: &HairHit, bsdf: &'a HairBsdf, wo_world: Vec3) -> Self {
         Shading::Hair {
             frame: h.frame,
-            bsdf: m.bsdf_at(h.strand.strand, h.s, h.color),
-            h: h.h,
-            wo,
+            point: bsdf.at(h.h, h.frame.to_local(wo_world)),
         }
     }
 
@@ -340,9 +421,9 @@ impl<'a> Shading<'a> {
     /// f * |cos| and the BSDF pdf toward the world direction wi.
     fn eval(&self, wi: Vec3) -> (Vec3, f32) {
         match self {
-            Shading::Hair { frame, bsdf, h, wo } => {
+            Shading::Hair { frame, point } => {
                 let local = frame.to_local(wi);
-                let e = bsdf.eval(*h, *wo, local);
+                let e = point.eval(local);
                 (e.f * local.z.abs(), e.pdf)
             }
             Shading::Diffuse { frame, bsdf, wo } => {
@@ -356,8 +437,8 @@ impl<'a> Shading<'a> {
     /// A world direction, its path weight f |cos| / pdf and its pdf.
     fn sample(&self, u: [f32; 3]) -> Option<(Vec3, Vec3, f32)> {
         match self {
-            Shading::Hair { frame, bsdf, h, wo } => {
-                let s = bsdf.sample(*h, *wo, u)?;
+            Shading::Hair { frame, point } => {
+                let s = point.sample(u)?;
                 Some((frame.to_world(s.wi), s.f * s.wi.z.abs() / s.pdf, s.pdf))
             }
             Shading::Diffuse { frame, bsdf, wo } => {
@@ -369,10 +450,12 @@ impl<'a> Shading<'a> {
     }
 }
 
-/// Applies the indirect clamp to a contribution found at `depth` (0 = seen directly).
-fn clamp(c: Vec3, depth: u32, settings: &PathSettings) -> Vec3 {
+/// Applies the indirect clamp to a contribution that reached the camera after `events`
+/// scattering events: 0 is light seen directly, 1 direct lighting (by either strategy),
+/// 2 and more indirect light, the only kind clamped.
+fn clamp(c: Vec3, events: u32, settings: &PathSettings) -> Vec3 {
     match settings.clamp_indirect {
-        Some(max) if depth > 0 => {
+        Some(max) if events > 1 => {
             let y = luminance(c);
             if y > max { c * (max / y) } else { c }
         }

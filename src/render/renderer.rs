@@ -3,7 +3,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use super::film::{Aovs, Film, PixelFilter, Window, ndc};
+use super::film::{Aovs, Film, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::sampler::PixelSampler;
@@ -44,8 +44,7 @@ pub fn render(
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
     let mut film = Film::new(settings.width, settings.height, crop, aovs)?;
-    // A tent of one pixel: thin strands alias badly under a box.
-    let filter = PixelFilter::tent(1.0)?;
+    let filter = settings.filter;
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),
@@ -58,8 +57,15 @@ pub fn render(
             let mut sampler = PixelSampler::new(settings.seed, pixel, index);
             let offset = filter.sample(sampler.next_2d());
             let image_point = ndc(settings.width, settings.height, pixel, offset);
-            let (org, dir) = camera.ray(image_point, sampler.next_2d());
-            let (radiance, first, traced) = world.radiance(org, dir, &settings.path, &mut sampler);
+            let lens = if camera.has_lens() {
+                sampler.next_2d()
+            } else {
+                sampler.skip();
+                [0.5; 2]
+            };
+            let (org, dir) = camera.ray(image_point, lens);
+            let (radiance, first, traced) =
+                world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
             pixel_rays += u64::from(traced);
             acc.add(radiance, first.as_ref());
         }

@@ -53,13 +53,19 @@ impl PixelSampler {
         sobol_burley::sample(self.index, 0, s)
     }
 
-    /// Two numbers in [0, 1), jointly stratified.
+    /// Two numbers in [0, 1), jointly stratified. (The crate's four-dimensional call
+    /// returns the same bits as two one-dimensional ones and scrambles the index once.)
     pub fn next_2d(&mut self) -> [f32; 2] {
         let s = self.next_sequence();
-        [
-            sobol_burley::sample(self.index, 0, s),
-            sobol_burley::sample(self.index, 1, s),
-        ]
+        let v = sobol_burley::sample_4d(self.index, 0, s);
+        [v[0], v[1]]
+    }
+
+    /// Passes over one request that this path does not need (a lens sample for a
+    /// pinhole, a light sample where no light is sampled): later requests keep the
+    /// sequences they would have had, at no cost.
+    pub fn skip(&mut self) {
+        self.request = self.request.wrapping_add(1);
     }
 
     /// Three numbers in [0, 1), jointly stratified (what the hair BSDF's sample takes).

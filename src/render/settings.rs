@@ -1,5 +1,6 @@
 //! What a render is asked to do: image size, samples, seed, threads, crop window, paths.
 
+use super::film::PixelFilter;
 use super::integrator::PathSettings;
 use crate::error::{Result, invalid_arg};
 
@@ -17,6 +18,8 @@ pub struct RenderSettings {
     /// Pixels [x0, x1) x [y0, y1) of the full frame to render; None = all. A crop renders
     /// exactly the pixels the full frame has there, so pieces assemble bit for bit.
     pub crop: Option<[u32; 4]>,
+    /// Where in and around its pixel each sample lands (validated when built).
+    pub filter: PixelFilter,
     pub path: PathSettings,
 }
 
@@ -29,6 +32,7 @@ impl Default for RenderSettings {
             seed: 0,
             threads: None,
             crop: None,
+            filter: PixelFilter::default(),
             path: PathSettings::default(),
         }
     }

@@ -156,6 +156,11 @@ impl Camera {
         self.forward
     }
 
+    /// Whether [`Self::ray`] uses its lens point (a thin lens) or ignores it (a pinhole).
+    pub fn has_lens(&self) -> bool {
+        self.lens_radius > 0.0
+    }
+
     /// The ray through the image point `ndc` in [0, 1]^2 (x right, y down, over the full
     /// frame), from the lens point picked by `lens` in [0, 1)^2 (ignored by a pinhole):
     /// `(origin, unit direction)`.

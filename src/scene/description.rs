@@ -13,9 +13,12 @@
 //! seed = 0
 //! threads = 2              # absent: all cores
 //! max_depth = 256
-//! rr_depth = 8
+//! rr_depth = 2            # Russian roulette after this many events
+//! roulette = "sqrt"        # survival sqrt(throughput), or "throughput"
 //! clamp_indirect = 10.0    # absent: no clamping
 //! crop = [0, 0, 320, 240]  # [x0, y0, x1, y1) of the full frame
+//! filter = "tent"          # or "box" (one pixel)
+//! filter_radius = 1.0      # the tent's half-width in pixels
 //!
 //! [camera]                 # optional: without eye and target, an automatic camera frames
 //! eye = [0, 1, 5]          # the grooms (or, with no groom, the meshes other than ground
@@ -112,7 +115,8 @@ use super::tracer::TracerBuilder;
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
 use crate::error::{Error, Result, invalid_arg};
-use crate::render::integrator::{Material, PathSettings, World};
+use crate::render::PixelFilter;
+use crate::render::integrator::{Material, PathSettings, Roulette, World};
 use crate::render::settings::RenderSettings;
 
 /// Vertical field of view of a camera that does not give one: a portrait lens's.
@@ -148,8 +152,14 @@ pub struct RenderDesc {
     pub threads: Option<usize>,
     pub max_depth: u32,
     pub rr_depth: u32,
+    /// "sqrt" (the default) or "throughput": see [`Roulette`].
+    pub roulette: String,
     pub clamp_indirect: Option<f32>,
     pub crop: Option<[u32; 4]>,
+    /// "tent" (the default) or "box".
+    pub filter: String,
+    /// The tent's half-width in pixels (default 1).
+    pub filter_radius: Option<f32>,
 }
 
 impl Default for RenderDesc {
@@ -163,8 +173,11 @@ impl Default for RenderDesc {
             threads: s.threads,
             max_depth: s.path.max_depth,
             rr_depth: s.path.rr_depth,
+            roulette: s.path.roulette.name().to_string(),
             clamp_indirect: s.path.clamp_indirect,
             crop: s.crop,
+            filter: s.filter.name().0.to_string(),
+            filter_radius: None,
         }
     }
 }
@@ -179,9 +192,11 @@ impl RenderDesc {
             seed: self.seed,
             threads: self.threads,
             crop: self.crop,
+            filter: PixelFilter::named(&self.filter, self.filter_radius)?,
             path: PathSettings {
                 max_depth: self.max_depth,
                 rr_depth: self.rr_depth,
+                roulette: Roulette::named(&self.roulette)?,
                 clamp_indirect: self.clamp_indirect,
                 ..PathSettings::default()
             },
@@ -550,7 +565,7 @@ impl GroomDesc {
     }
 
     /// The strands, transformed and with their radii scaled.
-    fn strands(&self) -> Result<Strands> {
+    pub(crate) fn strands(&self) -> Result<Strands> {
         let linear = self.transform.linear()?;
         if !(self.radius_scale.is_finite() && self.radius_scale > 0.0) {
             return Err(invalid_arg!(
@@ -588,7 +603,7 @@ impl MeshDesc {
     }
 
     /// The mesh, transformed.
-    fn mesh(&self) -> Result<Mesh> {
+    pub(crate) fn mesh(&self) -> Result<Mesh> {
         let linear = self.transform.linear()?;
         let mut mesh = match &self.source {
             MeshSource::File(path) => Mesh::load(path)?,

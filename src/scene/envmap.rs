@@ -227,6 +227,11 @@ impl Environment {
         }
     }
 
+    /// The same radiance from every direction.
+    pub fn is_uniform(&self) -> bool {
+        matches!(self.source, Source::Uniform(_))
+    }
+
     /// Luminance of the radiance averaged over all directions.
     pub fn mean_luminance(&self) -> f32 {
         self.scale

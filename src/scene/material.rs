@@ -122,6 +122,11 @@ impl HairMaterial {
 }
 
 impl PreparedHair {
+    /// Every hit shares one BSDF: nothing varies per strand, along strands or by colour.
+    pub fn is_uniform(&self) -> bool {
+        self.uniform.is_some()
+    }
+
     /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's colour
     /// at the hit when it has one.
     pub fn params_at(&self, strand: u32, s: f32, vertex_color: Option<[f32; 3]>) -> HairParams {

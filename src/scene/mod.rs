@@ -11,6 +11,7 @@ pub mod hit;
 pub mod light;
 pub mod material;
 pub mod mesh;
+pub mod peer;
 pub mod shapes;
 pub mod strands;
 pub mod tracer;

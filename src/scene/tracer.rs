@@ -52,7 +52,10 @@ pub enum Escape {
 const EXIT_RADII: f32 = 3.0;
 /// Floor of that sine, so a ray along the fiber still gets a finite exclusion distance.
 const MIN_EXIT_SINE: f32 = 1e-3;
-/// Offset of a continued ray's origin, in fiber radii, plus a few ulps of the position.
+/// Offset of a continued ray's origin, in fiber radii, plus a few ulps of the larger of
+/// the position and the distance the hit was found at: the hit point's error grows with
+/// both (a point near the world origin, reached from afar, is no more accurate than the
+/// ray that found it).
 const OFFSET_RADII: f32 = 1e-3;
 const OFFSET_ULPS: f32 = 64.0 * f32::EPSILON;
 
@@ -184,12 +187,16 @@ impl Tracer {
             Hit::Surface(s) => (s.p, s.ng),
         };
         let side = if dir.dot(ng) >= 0.0 { ng } else { -ng };
-        let ulps = OFFSET_ULPS * p.abs().max_element();
-        let (org, exclude) = match (from, escape) {
-            (Hit::Surface(_), _) => (p + side * ulps, None),
-            (Hit::Hair(h), Escape::Offset) => (p + side * (OFFSET_RADII * h.radius + ulps), None),
+        let ulps = OFFSET_ULPS * p.abs().max_element().max(from.t());
+        // The origin, and how far along the ray it was moved (the ray's end stays put).
+        let (org, advance, exclude) = match (from, escape) {
+            (Hit::Surface(_), _) => (p + side * ulps, 0.0, None),
+            (Hit::Hair(h), Escape::Offset) => {
+                (p + side * (OFFSET_RADII * h.radius + ulps), 0.0, None)
+            }
             (Hit::Hair(h), Escape::OffsetAndFilter) => (
                 p + side * (OFFSET_RADII * h.radius + ulps),
+                0.0,
                 self.exclusion(h, dir),
             ),
             (Hit::Hair(h), Escape::ExitAndFilter) => {
@@ -197,22 +204,24 @@ impl Tracer {
                 match (exit_distance(h, dir), exclude) {
                     (Some(t), Some(ex)) => (
                         p + dir * t,
+                        t,
                         Some(Exclude {
                             max_t: ex.max_t - t,
                             ..ex
                         }),
                     ),
-                    _ => (p + side * (OFFSET_RADII * h.radius + ulps), exclude),
+                    _ => (p + side * (OFFSET_RADII * h.radius + ulps), 0.0, exclude),
                 }
             }
-            (Hit::Hair(h), Escape::Filter) => (p, self.exclusion(h, dir)),
+            (Hit::Hair(h), Escape::Filter) => (p, 0.0, self.exclusion(h, dir)),
         };
         SpawnedRay {
             ray: Ray {
                 org,
                 dir,
                 tnear: 0.0,
-                tfar,
+                // A target nearer than the fibre's far wall leaves nothing to test.
+                tfar: (tfar - advance).max(0.0),
                 mask: u32::MAX,
             },
             exclude,
@@ -526,6 +535,79 @@ mod tests {
         );
         let at = t.strands(0).unwrap().locate(1).unwrap();
         assert_eq!(tangent(geometry(&t), 1, Vec3::ZERO, 0.1, &at), Vec3::ZERO);
+    }
+
+    #[test]
+    fn a_ray_moved_past_the_far_wall_still_ends_at_its_target() {
+        // A thick fibre along x, hit from +z at its axis; a mesh 0.3 below the axis.
+        let device = Arc::new(Device::new(Some(1)).unwrap());
+        let mut b = TracerBuilder::new(device, SceneOptions::default()).unwrap();
+        let pts = [-1.0f32, 1.0].map(|x| [x, 0.0, 0.0, 0.1]);
+        b.add_curves(
+            Curves::from_control_points(
+                pts.to_vec(),
+                &[2],
+                None,
+                CurveBasis::Linear,
+                CurveShape::Round,
+            )
+            .unwrap(),
+        )
+        .unwrap();
+        let floor = Mesh::new(
+            vec![[-2.0, -2.0, -0.3], [2.0, -2.0, -0.3], [0.0, 2.0, -0.3]],
+            vec![[0, 1, 2]],
+            None,
+        )
+        .unwrap();
+        b.add_mesh(floor).unwrap();
+        let t = b.build().unwrap();
+        let hit = t
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z))
+            .unwrap();
+        assert!((hit.p().z - 0.1).abs() < 1e-4, "{}", hit.p());
+        // A light point 0.25 below the hit, between the far wall (0.2) and the mesh (0.4).
+        let target = hit.p() - 0.25 * Vec3::Z;
+        let s = t.spawn(&hit, -Vec3::Z, 0.25);
+        let end = s.ray.org + s.ray.dir * s.ray.tfar;
+        assert!(
+            end.distance(target) < 1e-5,
+            "ray ends at {end}, not {target}"
+        );
+        assert!(s.ray.org.z < -0.099, "the exit point is past the far wall");
+        assert!(!t.occluded_spawned(&s), "the mesh lies beyond the light");
+        // Beyond the mesh, the same ray is blocked.
+        assert!(t.occluded_spawned(&t.spawn(&hit, -Vec3::Z, 0.5)));
+    }
+
+    #[test]
+    fn rays_leaving_a_surface_at_the_world_origin_do_not_hit_it_again() {
+        // A floor through the origin, seen from 5 units away: the hit points are tiny
+        // numbers with the error of the ray that found them, which an offset relative to
+        // the position alone would not clear.
+        let device = Arc::new(Device::new(Some(1)).unwrap());
+        let mut b = TracerBuilder::new(device, SceneOptions::default()).unwrap();
+        let floor = Mesh::new(
+            vec![[-3.0, 0.0, -3.0], [3.0, 0.0, -3.0], [0.0, 0.0, 3.0]],
+            vec![[0, 2, 1]],
+            None,
+        )
+        .unwrap();
+        b.add_mesh(floor).unwrap();
+        let t = b.build().unwrap();
+        let eye = Vec3::new(0.3, 4.0, 3.0);
+        let mut blocked = 0;
+        for i in 0..4096 {
+            // Targets within 1e-5 of the origin.
+            let k = i as f32;
+            let target = Vec3::new((k * 0.37).sin(), 0.0, (k * 0.91).cos()) * 1e-5;
+            let hit = t
+                .intersect(&Ray::new(eye, (target - eye).normalize()))
+                .unwrap();
+            let up = Vec3::new(0.2, 1.0, -0.4).normalize();
+            blocked += usize::from(t.occluded_spawned(&t.spawn(&hit, up, f32::INFINITY)));
+        }
+        assert_eq!(blocked, 0, "{blocked} of 4096 rays hit the floor they left");
     }
 
     #[test]

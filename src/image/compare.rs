@@ -1,0 +1,108 @@
+//! How far apart two renders of the same frame are: the error measure behind every
+//! speed-against-error figure (efficiency = 1 / (RMSE^2 x seconds)).
+
+use super::Image;
+use crate::Result;
+use crate::error::invalid_arg;
+
+/// Differences between an image and a reference, over their RGB channels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Comparison {
+    /// Root mean square of the per-channel differences.
+    pub rmse: f64,
+    /// Largest absolute per-channel difference.
+    pub max_abs: f64,
+    /// Mean of every RGB value of each image: a bias shows here first.
+    pub mean: f64,
+    pub reference_mean: f64,
+}
+
+/// Compares `image` with `reference`: same size, at least three channels each (the first
+/// three are RGB; alpha and AOVs are ignored). Sums in f64, so that a 4k frame's RMSE does
+/// not depend on summation order.
+pub fn compare(image: &Image, reference: &Image) -> Result<Comparison> {
+    if (image.width, image.height) != (reference.width, reference.height) {
+        return Err(invalid_arg!(
+            "images differ in size: {}x{} against a {}x{} reference",
+            image.width,
+            image.height,
+            reference.width,
+            reference.height
+        ));
+    }
+    if image.channels < 3 || reference.channels < 3 {
+        return Err(invalid_arg!(
+            "RGB images needed: {} and {} channels",
+            image.channels,
+            reference.channels
+        ));
+    }
+    let rgb = |img: &Image| {
+        img.pixels
+            .chunks_exact(img.channels)
+            .flat_map(|p| p[..3].iter().map(|&v| f64::from(v)))
+            .collect::<Vec<_>>()
+    };
+    let (a, b) = (rgb(image), rgb(reference));
+    if let Some(v) = a.iter().chain(&b).find(|v| !v.is_finite()) {
+        return Err(invalid_arg!("images must be finite: found {v}"));
+    }
+    let n = a.len().max(1) as f64;
+    let (mut sq, mut max_abs) = (0.0, 0.0f64);
+    for (x, y) in a.iter().zip(&b) {
+        let d = x - y;
+        sq += d * d;
+        max_abs = max_abs.max(d.abs());
+    }
+    Ok(Comparison {
+        rmse: (sq / n).sqrt(),
+        max_abs,
+        mean: a.iter().sum::<f64>() / n,
+        reference_mean: b.iter().sum::<f64>() / n,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(pixels: Vec<f32>, channels: usize) -> Image {
+        Image {
+            width: 2,
+            height: 1,
+            channels,
+            pixels,
+        }
+    }
+
+    #[test]
+    fn rmse_of_known_differences() {
+        let a = image(vec![1.0, 2.0, 3.0, 0.0, 0.0, 0.0], 3);
+        // Alpha is ignored.
+        let b = image(vec![1.0, 2.0, 5.0, 9.0, 0.0, 0.0, 2.0, 7.0], 4);
+        let c = compare(&a, &b).unwrap();
+        assert!((c.rmse - (8.0f64 / 6.0).sqrt()).abs() < 1e-12, "{c:?}");
+        assert_eq!(c.max_abs, 2.0);
+        assert_eq!(c.mean, 1.0);
+        assert!((c.reference_mean - 10.0 / 6.0).abs() < 1e-12);
+        assert_eq!(compare(&a, &a).unwrap().rmse, 0.0);
+    }
+
+    #[test]
+    fn mismatches_are_errors() {
+        let a = image(vec![0.0; 6], 3);
+        let wide = Image {
+            width: 3,
+            ..image(vec![0.0; 9], 3)
+        };
+        assert!(compare(&a, &wide).unwrap_err().to_string().contains("size"));
+        assert!(compare(&image(vec![0.0; 2], 1), &a).is_err());
+        let nan = image(vec![f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0], 3);
+        assert!(
+            compare(&nan, &a)
+                .unwrap_err()
+                .to_string()
+                .contains("finite")
+        );
+    }
+}

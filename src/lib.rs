@@ -7,6 +7,7 @@
 /// cbindgen:ignore
 pub mod bsdf;
 pub mod capi;
+pub mod description;
 /// cbindgen:ignore
 pub mod embree;
 mod error;

@@ -6,15 +6,15 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use hairtrace::Error;
-use hairtrace::embree::{CurveBasis, CurveShape, Device};
-use hairtrace::render::PixelFilter;
-use hairtrace::render::integrator::Roulette;
-use hairtrace::scene::description::{
+use hairtrace::description::peer::export_for_peer;
+use hairtrace::description::{
     DEMOS, EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource, SceneDescription,
     demo, quick_look,
 };
+use hairtrace::embree::{CurveBasis, CurveShape, Device};
+use hairtrace::render::PixelFilter;
+use hairtrace::render::integrator::Roulette;
 use hairtrace::scene::material::HairColor;
-use hairtrace::scene::peer::export_for_peer;
 use hairtrace::scene::{FurBall, HairStyle, Thickness, write_hair_file};
 
 fn device() -> Arc<Device> {
@@ -500,7 +500,7 @@ fn look_distance(desc: &SceneDescription) -> f32 {
 #[test]
 fn documented_format_parses() {
     let source = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("src/scene/description.rs"),
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("src/description/mod.rs"),
     )
     .unwrap();
     let doc: String = source

@@ -3,7 +3,7 @@
 
 use glam::Vec3;
 use hairtrace::embree::{CurveBasis, CurveShape, Device, SceneOptions};
-use hairtrace::render::integrator::{Material, PathSettings, Strategy, World};
+use hairtrace::render::integrator::{PathSettings, Strategy, World};
 use hairtrace::render::renderer::render;
 use hairtrace::render::settings::RenderSettings;
 use hairtrace::render::{Aovs, NoProgress, RenderStatus};
@@ -12,7 +12,7 @@ use hairtrace::scene::camera::Camera;
 use hairtrace::scene::curves::Curves;
 use hairtrace::scene::envmap::Environment;
 use hairtrace::scene::light::Light;
-use hairtrace::scene::material::{HairColor, HairMaterial};
+use hairtrace::scene::material::{HairColor, HairMaterial, Material};
 use hairtrace::scene::tracer::TracerBuilder;
 use std::sync::Arc;
 
@@ -288,7 +288,7 @@ fn renders_are_deterministic_across_threads_and_crops() {
 /// of radiance 1. Every pixel's expected value is 1; the image mean must be within 1%.
 #[test]
 fn furnace_demo_renders_to_one() {
-    let mut d = hairtrace::scene::description::demo("furnace").unwrap();
+    let mut d = hairtrace::description::demo("furnace").unwrap();
     d.render.width = 48;
     d.render.height = 36;
     d.render.spp = 8;

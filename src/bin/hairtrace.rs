@@ -6,11 +6,11 @@
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use hairtrace::description::peer::export_for_peer;
+use hairtrace::description::{self, BuiltScene, SceneDescription};
 use hairtrace::embree::Device;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
-use hairtrace::scene::description::{self, BuiltScene, SceneDescription};
-use hairtrace::scene::peer::export_for_peer;
 use hairtrace::scene::{Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};

@@ -1,7 +1,7 @@
 //! Where the absorption coefficient sigma_a comes from: melanin concentrations, or a
 //! desired diffuse-looking colour.
 
-use super::params::check_beta;
+use super::limits::check_beta;
 use crate::error::{Result, invalid_arg};
 
 /// Absorption of eumelanin and pheomelanin per unit concentration, linear RGB, per unit

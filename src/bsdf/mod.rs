@@ -6,6 +6,7 @@ pub mod absorption;
 pub mod azimuthal;
 pub mod diffuse;
 pub mod hair;
+mod limits;
 pub mod longitudinal;
 pub mod params;
 

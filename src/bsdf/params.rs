@@ -1,6 +1,7 @@
 //! The user-facing parameters of the hair BSDF and their validation.
 
 use super::absorption::sigma_a_from_melanin;
+use super::limits::{ALPHA_MAX_DEG, ETA_MAX, check_beta};
 use crate::error::{Result, invalid_arg};
 
 /// Parameters of the Chiang 2016 hair model (DESIGN.md section 3).
@@ -35,13 +36,6 @@ impl Default for HairParams {
     }
 }
 
-/// Valid range of both roughnesses.
-pub(crate) const BETA_RANGE: (f32, f32) = (0.01, 1.0);
-/// Largest accepted index of refraction (the lower bound 1 is excluded).
-pub(crate) const ETA_MAX: f32 = 3.0;
-/// Largest accepted |alpha| in degrees.
-pub(crate) const ALPHA_MAX_DEG: f32 = 20.0;
-
 impl HairParams {
     /// Checks every parameter against its range; the error names the first bad one.
     /// Out-of-range values are refused rather than clamped, so a mistake is seen.
@@ -66,15 +60,5 @@ impl HairParams {
             ));
         }
         Ok(())
-    }
-}
-
-/// Checks a roughness against [`BETA_RANGE`]; `name` goes into the message.
-pub(crate) fn check_beta(name: &str, beta: f32) -> Result<()> {
-    let (lo, hi) = BETA_RANGE;
-    if beta >= lo && beta <= hi {
-        Ok(())
-    } else {
-        Err(invalid_arg!("{name} = {beta}: must be in [{lo}, {hi}]"))
     }
 }

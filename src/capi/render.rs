@@ -310,12 +310,12 @@ mod tests {
     use crate::capi::scene::*;
     use crate::embree::{CurveBasis, CurveShape, Device, Geometry, SceneOptions};
     use crate::image::read_image;
-    use crate::render::integrator::{Material, World};
+    use crate::render::integrator::World;
     use crate::scene::camera::Camera;
     use crate::scene::curves::Curves;
     use crate::scene::envmap::Environment;
     use crate::scene::light::Light;
-    use crate::scene::material::HairMaterial;
+    use crate::scene::material::{HairMaterial, Material};
     use crate::scene::tracer::TracerBuilder;
     use glam::Vec3;
     use std::ptr::{null, null_mut};

@@ -12,13 +12,12 @@ use super::{
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions, SharedBuffer};
 use crate::error::{Result, invalid_arg};
-use crate::render::integrator::{Material, World};
+use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
-use crate::scene::description::DEFAULT_FOV_DEG;
 use crate::scene::envmap::Environment;
 use crate::scene::light::Light;
-use crate::scene::material::{HairColor, HairMaterial};
+use crate::scene::material::{HairColor, HairMaterial, Material};
 use crate::scene::mesh::Mesh;
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::scene::{Strands, Thickness, read_hair_file};
@@ -225,7 +224,7 @@ impl HtScene {
             }
             None => {
                 let (lo, hi) = world.tracer.scene().bounds();
-                Camera::frame_bounds(lo.into(), hi.into(), aspect, DEFAULT_FOV_DEG)?
+                Camera::frame_bounds(lo.into(), hi.into(), aspect, Camera::DEFAULT_FOV_Y_DEG)?
             }
         };
         let camera = match self.lens {

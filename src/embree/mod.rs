@@ -7,9 +7,10 @@
 //!
 //! Embree 3 (Debian) and Embree 4 differ in the ray query calls (`rtcIntersect1` and
 //! `rtcOccluded1` arguments, intersect context versus arguments, default geometry mask).
-//! Those differences live in `query.rs` (under `cfg(embree3)` / `cfg(embree4)`, set by
+//! Those differences live in `compat.rs` (under `cfg(embree3)` / `cfg(embree4)`, set by
 //! `build.rs` from the installed header); every other file stays version-agnostic.
 
+mod compat;
 mod device;
 mod geometry;
 mod memory;

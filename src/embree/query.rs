@@ -1,22 +1,13 @@
 //! Ray queries: closest hit and occlusion for single rays, with an optional per-query
 //! exclusion filter.
 //!
-//! This is the only file that knows Embree 3 from Embree 4. The differences it hides:
-//! - Embree 3 passes an `RTCIntersectContext` (flags, filter) as the second argument of
-//!   `rtcIntersect1`/`rtcOccluded1`; Embree 4 takes the ray first and an optional
-//!   `RTCIntersectArguments`/`RTCOccludedArguments` (flags, feature mask, context, filter).
-//! - A per-query filter needs `RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION` on the scene in
-//!   Embree 3, `RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS` plus the query flag
-//!   `RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER` in Embree 4.
-//! - Geometry masks default to all bits in Embree 3 and to 1 in Embree 4; the geometry layer
-//!   always sets them and rays always carry one, so both behave the same.
-//!
 //! The exclusion data reaches the filter callback through the context pointer Embree passes
 //! to it: the context is the first field of a `#[repr(C)]` struct that also holds the
 //! [`Exclude`], so the callback can cast back (Embree's documented way to extend a ray).
 
 use glam::Vec3;
 
+use super::compat::{self, Filter, INVALID_ID, RawContext};
 use super::scene::Scene;
 use super::sys;
 
@@ -90,22 +81,6 @@ pub struct Exclude {
     pub max_t: f32,
 }
 
-/// Embree's "no geometry" id.
-const INVALID_ID: u32 = u32::MAX;
-
-/// The scene flag that lets a query bring its own filter.
-#[cfg(embree3)]
-pub(super) const FILTER_SCENE_FLAG: sys::RTCSceneFlags =
-    sys::RTCSceneFlags::RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION;
-#[cfg(embree4)]
-pub(super) const FILTER_SCENE_FLAG: sys::RTCSceneFlags =
-    sys::RTCSceneFlags::RTC_SCENE_FLAG_FILTER_FUNCTION_IN_ARGUMENTS;
-
-#[cfg(embree3)]
-type RawContext = sys::RTCIntersectContext;
-#[cfg(embree4)]
-type RawContext = sys::RTCRayQueryContext;
-
 /// Embree's context extended with the exclusion the filter reads.
 #[repr(C)]
 struct QueryContext {
@@ -118,18 +93,7 @@ impl QueryContext {
     /// The equivalent of Embree's inline `rtcInitIntersectContext`/`rtcInitRayQueryContext`,
     /// which bindgen cannot translate.
     fn new(exclude: Option<&Exclude>) -> Self {
-        #[cfg(embree3)]
-        let raw = sys::RTCIntersectContext {
-            flags: sys::RTCIntersectContextFlags::RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT,
-            filter: exclude.map(|_| exclude_filter as _),
-            instID: [INVALID_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT as usize],
-        };
-        #[cfg(embree4)]
-        let raw = {
-            let mut raw = sys::RTCRayQueryContext::default();
-            raw.instID = [INVALID_ID; sys::RTC_MAX_INSTANCE_LEVEL_COUNT as usize];
-            raw
-        };
+        let raw = compat::new_context(filter_for(exclude));
         QueryContext {
             raw,
             exclude: exclude.copied().unwrap_or(Exclude {
@@ -189,24 +153,9 @@ impl Scene {
                 ..Default::default()
             },
         };
-        #[cfg(embree3)]
         // SAFETY: committed scene (a `Scene` is only made by commit); context and ray live
         // across the call; the filter reads the context as a `QueryContext`, which it is.
-        unsafe {
-            sys::rtcIntersect1(self.raw(), &mut ctx.raw, &mut rayhit)
-        };
-        #[cfg(embree4)]
-        // SAFETY: as above; the arguments point at the context, alive across the call.
-        unsafe {
-            let mut args = sys::RTCIntersectArguments {
-                flags: query_flags(exclude),
-                feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
-                context: &mut ctx.raw,
-                filter: exclude.map(|_| exclude_filter as _),
-                ..Default::default()
-            };
-            sys::rtcIntersect1(self.raw(), &mut rayhit, &mut args)
-        };
+        unsafe { compat::intersect1(self.raw(), &mut ctx.raw, &mut rayhit, filter_for(exclude)) };
         let h = rayhit.hit;
         (h.geomID != INVALID_ID).then(|| RayHit {
             t: rayhit.ray.tfar,
@@ -222,33 +171,14 @@ impl Scene {
     pub fn occluded(&self, ray: &Ray, exclude: Option<&Exclude>) -> bool {
         let mut ctx = QueryContext::new(exclude);
         let mut r = ray.to_sys();
-        #[cfg(embree3)]
         // SAFETY: as in `intersect`.
-        unsafe {
-            sys::rtcOccluded1(self.raw(), &mut ctx.raw, &mut r)
-        };
-        #[cfg(embree4)]
-        // SAFETY: as in `intersect`.
-        unsafe {
-            let mut args = sys::RTCOccludedArguments {
-                flags: query_flags(exclude),
-                feature_mask: sys::RTCFeatureFlags::RTC_FEATURE_FLAG_ALL,
-                context: &mut ctx.raw,
-                filter: exclude.map(|_| exclude_filter as _),
-                ..Default::default()
-            };
-            sys::rtcOccluded1(self.raw(), &mut r, &mut args)
-        };
+        unsafe { compat::occluded1(self.raw(), &mut ctx.raw, &mut r, filter_for(exclude)) };
         // Embree marks an occluded ray by setting tfar to -infinity.
         r.tfar < 0.0 && ray.tfar >= 0.0
     }
 }
 
-#[cfg(embree4)]
-fn query_flags(exclude: Option<&Exclude>) -> sys::RTCRayQueryFlags {
-    if exclude.is_some() {
-        sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER
-    } else {
-        sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT
-    }
+/// The exclusion filter when there is something to exclude.
+fn filter_for(exclude: Option<&Exclude>) -> Option<Filter> {
+    exclude.map(|_| exclude_filter as Filter)
 }

@@ -8,8 +8,8 @@
 use std::ptr::NonNull;
 use std::sync::Arc;
 
+use super::compat::FILTER_SCENE_FLAG;
 use super::geometry::Geometry;
-use super::query::FILTER_SCENE_FLAG;
 use super::{Device, sys};
 use crate::error::invalid_arg;
 use crate::{Error, Result};

@@ -8,6 +8,11 @@ pub mod sampling;
 
 pub use lanes::Lanes;
 
+/// Rec. 709 luminance of linear RGB: the weight of a colour for importance sampling.
+pub fn luminance(rgb: glam::Vec3) -> f32 {
+    rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 /// sqrt that treats tiny negative round-off as zero instead of returning NaN.
 #[inline(always)]
 pub fn safe_sqrt<T: Lanes>(x: T) -> T {

@@ -13,10 +13,11 @@ use crate::bsdf::diffuse::Diffuse;
 use crate::bsdf::{HairBsdf, HairPoint};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
+use crate::math::luminance;
 use crate::math::sampling::{Distribution1D, power_heuristic};
 use crate::scene::hit::{HairFrame, HairHit, Hit, SurfaceHit};
-use crate::scene::light::{Light, luminance};
-use crate::scene::material::PreparedHair;
+use crate::scene::light::Light;
+use crate::scene::material::Material;
 use crate::scene::tracer::{SpawnedRay, Tracer};
 
 /// How a path's light is gathered. `Mis` is the renderer; the two others exist so that
@@ -126,13 +127,6 @@ impl PathSettings {
         }
         Ok(())
     }
-}
-
-/// What a geometry is made of. A hair material holds its prepared BSDF, hence the box.
-#[derive(Debug, Clone)]
-pub enum Material {
-    Hair(Box<PreparedHair>),
-    Diffuse(Diffuse),
 }
 
 /// Everything a path needs: geometry, one material per geometry id, lights.

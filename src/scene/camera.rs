@@ -26,6 +26,9 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// Vertical field of view of a camera that does not give one: a portrait lens's.
+    pub const DEFAULT_FOV_Y_DEG: f32 = 35.0;
+
     /// A pinhole camera at `eye` looking at `target`, with `up` giving the image's
     /// upward direction (it need not be perpendicular to the view, only not parallel),
     /// `fov_y_deg` the vertical field of view in degrees, in (0, 180), and `aspect` the

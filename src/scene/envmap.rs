@@ -17,9 +17,10 @@ use std::path::Path;
 
 use glam::{Mat3, Vec3};
 
-use super::light::{LightSample, luminance};
+use super::light_sample::{LightSample, check_radiance};
 use crate::error::invalid_arg;
 use crate::image::read_image;
+use crate::math::luminance;
 use crate::math::sampling::{Distribution2D, UNIFORM_SPHERE_PDF, uniform_sphere};
 use crate::{Error, Result};
 
@@ -273,14 +274,4 @@ fn dir_to_uv(dir: Vec3) -> [f32; 2] {
 /// 2 pi^2 sin(theta). `None` at the poles, where the map has no area.
 fn uv_to_solid_angle(uv_pdf: f32, sin_theta: f32) -> Option<f32> {
     (sin_theta > 0.0).then(|| uv_pdf / (2.0 * PI * PI * sin_theta))
-}
-
-pub(super) fn check_radiance(what: &str, radiance: Vec3) -> Result<()> {
-    if radiance.is_finite() && radiance.cmpge(Vec3::ZERO).all() {
-        Ok(())
-    } else {
-        Err(invalid_arg!(
-            "{what} {radiance} must be finite and >= 0 per channel"
-        ))
-    }
 }

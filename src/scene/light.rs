@@ -10,41 +10,13 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 
-use super::envmap::{Environment, check_radiance};
+use super::envmap::Environment;
+use super::light_sample::check_radiance;
+pub use super::light_sample::{LightEval, LightSample};
 use crate::Result;
 use crate::error::invalid_arg;
+use crate::math::luminance;
 use crate::math::sampling::{uniform_cone, uniform_cone_pdf};
-
-/// Rec. 709 luminance of linear RGB: the weight of a colour for importance sampling.
-pub fn luminance(rgb: Vec3) -> f32 {
-    rgb.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
-
-/// A direction toward a light, drawn by [`Light::sample_li`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LightSample {
-    /// Unit direction from the shading point toward the light.
-    pub wi: Vec3,
-    /// Radiance arriving along `-wi`, unoccluded. For a delta light, the irradiance it
-    /// delivers at normal incidence.
-    pub radiance: Vec3,
-    /// Solid-angle pdf of `wi`; 1 for a delta light (whose `radiance / pdf` is then the
-    /// right weight), which MIS must not weigh against BSDF sampling.
-    pub pdf: f32,
-    /// Distance to the light along `wi`; `f32::INFINITY` for lights at infinity.
-    pub distance: f32,
-    pub is_delta: bool,
-}
-
-/// What a light contributes along a direction the BSDF drew: see [`Light::eval_li`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LightEval {
-    pub radiance: Vec3,
-    /// Pdf with which [`Light::sample_li`] would have drawn this direction.
-    pub pdf: f32,
-    /// Distance to the light; `f32::INFINITY` for lights at infinity.
-    pub distance: f32,
-}
 
 /// A light source. Built through the validating constructors; `Send + Sync`.
 #[derive(Debug, Clone)]

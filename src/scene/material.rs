@@ -1,8 +1,16 @@
 //! Materials a hair scene needs: the hair BSDF with its colour source and per-strand
 //! variation, and a diffuse surface for scalps, heads and floors.
 
+use crate::bsdf::diffuse::Diffuse;
 use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
 use crate::error::{Result, invalid_arg};
+
+/// What a geometry is made of. A hair material holds its prepared BSDF, hence the box.
+#[derive(Debug, Clone)]
+pub enum Material {
+    Hair(Box<PreparedHair>),
+    Diffuse(Diffuse),
+}
 
 /// Where a hair material's absorption comes from.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,17 +1,18 @@
-//! What a hair scene is made of, independent of Embree: strands (from files, hosts or
-//! procedural grooms).
+//! What a hair scene is made of, as data: strands (from files, hosts or procedural
+//! grooms), curves, meshes, materials, lights and the camera; and the tracer, which puts
+//! the geometry into Embree and turns its hits into hit records. Nothing here knows how a
+//! picture is rendered (`render`) or described in a file (`description`).
 
 pub mod camera;
 pub mod curves;
-pub mod description;
 pub mod envmap;
 pub mod groom;
 pub mod hair_file;
 pub mod hit;
 pub mod light;
+mod light_sample;
 pub mod material;
 pub mod mesh;
-pub mod peer;
 pub mod shapes;
 pub mod strands;
 pub mod tracer;

@@ -14,10 +14,11 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::description::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
-use super::hair_file::{Thickness, write_hair_file};
+use super::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
+use crate::scene::hair_file::{Thickness, write_hair_file};
+use crate::scene::mesh::Mesh;
 
 #[derive(Serialize)]
 struct PeerScene {
@@ -216,7 +217,7 @@ fn peer_light(i: usize, light: &LightDesc) -> Result<PeerLight> {
 }
 
 /// A mesh as OBJ text: positions, normals when it has them, 1-based faces.
-fn obj_text(mesh: &super::mesh::Mesh) -> String {
+fn obj_text(mesh: &Mesh) -> String {
     let mut s = String::new();
     for p in &mesh.positions {
         let _ = writeln!(s, "v {} {} {}", p[0], p[1], p[2]);

@@ -1,0 +1,370 @@
+//! Turning a description into a renderable world: every value checked, files read,
+//! grooms and meshes built into one Embree scene, the camera placed.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use glam::{Mat3, Vec3};
+
+use super::{
+    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
+    MeshDesc, MeshSource, SceneDescription, Transform,
+};
+use crate::bsdf::diffuse::Diffuse;
+use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
+use crate::error::{Error, Result, invalid_arg};
+use crate::render::integrator::World;
+use crate::scene::camera::Camera;
+use crate::scene::curves::Curves;
+use crate::scene::envmap::Environment;
+use crate::scene::hair_file::read_hair_file;
+use crate::scene::light::Light;
+use crate::scene::material::Material;
+use crate::scene::mesh::Mesh;
+use crate::scene::shapes;
+use crate::scene::strands::Strands;
+use crate::scene::tracer::TracerBuilder;
+
+/// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
+/// from the true sphere by under 0.05% of its radius.
+const SPHERE_SUBDIVISIONS: u32 = 4;
+
+impl SceneDescription {
+    /// Checks every value, reads the files, builds the grooms and meshes into one Embree
+    /// scene on `device`, and places the camera. Cheap checks (settings, materials and their
+    /// assignment, lights) come before any groom is read or built, so that a typo does not
+    /// wait for a large groom.
+    pub fn build(&self, device: Arc<Device>) -> Result<BuiltScene> {
+        let settings = self
+            .render
+            .settings()
+            .map_err(|e| self.error("render", e))?;
+        let mut prepared = BTreeMap::new();
+        for (name, m) in &self.materials {
+            let material = m
+                .prepare()
+                .map_err(|e| self.error(&format!("materials.{name}"), e))?;
+            prepared.insert(name.as_str(), material);
+        }
+        let assign = |kind: &str, i: usize, name: &str, hair: bool| {
+            self.assigned(&prepared, name, hair)
+                .cloned()
+                .map_err(|e| self.error(&format!("{kind}[{i}].material"), e))
+        };
+        let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
+        for (i, g) in self.grooms.iter().enumerate() {
+            materials.push(assign("groom", i, &g.material, true)?);
+        }
+        for (i, m) in self.meshes.iter().enumerate() {
+            materials.push(assign("mesh", i, &m.material, false)?);
+        }
+        if self.lights.is_empty() {
+            return Err(invalid_arg!(
+                "{}: no lights: add a [[light]] (environment, distant or rect)",
+                self.origin
+            ));
+        }
+        let lights = self
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, l)| l.build().map_err(|e| self.error(&format!("light[{i}]"), e)))
+            .collect::<Result<Vec<_>>>()?;
+
+        let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
+        let mut hair_bounds = Bounds::EMPTY;
+        for (i, g) in self.grooms.iter().enumerate() {
+            let at = format!("groom[{i}]");
+            let strands = g.strands().map_err(|e| self.error(&at, e))?;
+            for (p, r) in strands.points.iter().zip(&strands.radii) {
+                hair_bounds.add(Vec3::from_array(*p), *r);
+            }
+            Curves::from_strands(&strands, g.basis, g.shape)
+                .and_then(|c| tracer.add_curves(c))
+                .map_err(|e| self.error(&at, e))?;
+        }
+        let mut prop_bounds = Bounds::EMPTY;
+        for (i, m) in self.meshes.iter().enumerate() {
+            let at = format!("mesh[{i}]");
+            let mesh = m.mesh().map_err(|e| self.error(&at, e))?;
+            // A ground quad is the stage, not the subject: framing it would shrink the
+            // subject to a speck.
+            if !matches!(m.source, MeshSource::Ground { .. }) {
+                for p in &mesh.positions {
+                    prop_bounds.add(Vec3::from_array(*p), 0.0);
+                }
+            }
+            tracer.add_mesh(mesh).map_err(|e| self.error(&at, e))?;
+        }
+        let framed = if hair_bounds.is_empty() {
+            prop_bounds
+        } else {
+            hair_bounds
+        };
+        let aspect = settings.width as f32 / settings.height as f32;
+        let camera = self
+            .camera
+            .build(framed, aspect)
+            .map_err(|e| self.error("camera", e))?;
+        let world = World::new(tracer.build()?, materials, lights)?;
+        Ok(BuiltScene {
+            world,
+            camera,
+            settings,
+        })
+    }
+
+    /// The prepared material `name`, if it exists and suits the geometry.
+    fn assigned<'a>(
+        &self,
+        prepared: &'a BTreeMap<&str, Material>,
+        name: &str,
+        hair: bool,
+    ) -> Result<&'a Material> {
+        let material = prepared.get(name).ok_or_else(|| {
+            let defined: Vec<&str> = prepared.keys().copied().collect();
+            invalid_arg!(
+                "no material named {name:?} (defined: {})",
+                if defined.is_empty() {
+                    "none".to_string()
+                } else {
+                    defined.join(", ")
+                }
+            )
+        })?;
+        match (material, hair) {
+            (Material::Hair(_), true) | (Material::Diffuse(_), false) => Ok(material),
+            (Material::Diffuse(_), true) => Err(invalid_arg!(
+                "{name:?} is a diffuse material; grooms need a hair material"
+            )),
+            (Material::Hair(_), false) => Err(invalid_arg!(
+                "{name:?} is a hair material; meshes need a diffuse material"
+            )),
+        }
+    }
+
+    /// `e` with this description's origin and the entry or key `at` in front, same kind.
+    fn error(&self, at: &str, e: Error) -> Error {
+        let prefix = |m: String| format!("{}: {at}: {m}", self.origin);
+        match e {
+            Error::InvalidArg(m) => Error::InvalidArg(prefix(m)),
+            Error::Io(m) => Error::Io(prefix(m)),
+            Error::Image(m) => Error::Image(prefix(m)),
+            Error::Embree { code, message } => Error::Embree {
+                code,
+                message: prefix(message),
+            },
+        }
+    }
+}
+
+impl MaterialDesc {
+    fn prepare(&self) -> Result<Material> {
+        Ok(match self {
+            MaterialDesc::Hair(h) => Material::Hair(Box::new(h.prepare()?)),
+            MaterialDesc::Diffuse { albedo } => {
+                Material::Diffuse(Diffuse::new(Vec3::from_array(*albedo))?)
+            }
+        })
+    }
+}
+
+impl Transform {
+    /// The linear part (the turn times the scale), once every field is checked.
+    fn linear(&self) -> Result<Mat3> {
+        if !self.translate.iter().all(|v| v.is_finite()) {
+            return Err(invalid_arg!(
+                "translate = {:?}: must be finite",
+                self.translate
+            ));
+        }
+        if !(self.scale.is_finite() && self.scale > 0.0) {
+            return Err(invalid_arg!(
+                "scale = {}: must be finite and > 0",
+                self.scale
+            ));
+        }
+        if !self.rotate_y_deg.is_finite() {
+            return Err(invalid_arg!(
+                "rotate_y_deg = {}: must be finite",
+                self.rotate_y_deg
+            ));
+        }
+        Ok(Mat3::from_rotation_y(self.rotate_y_deg.to_radians()) * self.scale)
+    }
+
+    fn point(&self, linear: Mat3, p: [f32; 3]) -> [f32; 3] {
+        (linear * Vec3::from_array(p) + Vec3::from_array(self.translate)).to_array()
+    }
+}
+
+impl GroomDesc {
+    /// A groom with the defaults of a `[[groom]]` entry: B-spline round curves, no
+    /// transform.
+    pub fn new(source: GroomSource, material: &str) -> Self {
+        GroomDesc {
+            source,
+            basis: CurveBasis::BSpline,
+            shape: CurveShape::Round,
+            radius_scale: 1.0,
+            transform: Transform::default(),
+            material: material.to_string(),
+        }
+    }
+
+    /// The strands, transformed and with their radii scaled.
+    pub(crate) fn strands(&self) -> Result<Strands> {
+        let linear = self.transform.linear()?;
+        if !(self.radius_scale.is_finite() && self.radius_scale > 0.0) {
+            return Err(invalid_arg!(
+                "radius_scale = {}: must be finite and > 0",
+                self.radius_scale
+            ));
+        }
+        let mut strands = match &self.source {
+            GroomSource::File { path, thickness } => read_hair_file(path, *thickness)?,
+            GroomSource::FurBall(f) => f.build()?,
+            GroomSource::Scalp(s) => s.build()?,
+        };
+        if self.transform != Transform::default() {
+            for p in &mut strands.points {
+                *p = self.transform.point(linear, *p);
+            }
+        }
+        let radius_factor = self.transform.scale * self.radius_scale;
+        if radius_factor != 1.0 {
+            for r in &mut strands.radii {
+                *r *= radius_factor;
+            }
+        }
+        Ok(strands)
+    }
+}
+
+impl MeshDesc {
+    pub fn new(source: MeshSource, material: &str) -> Self {
+        MeshDesc {
+            source,
+            transform: Transform::default(),
+            material: material.to_string(),
+        }
+    }
+
+    /// The mesh, transformed.
+    pub(crate) fn mesh(&self) -> Result<Mesh> {
+        let linear = self.transform.linear()?;
+        let mut mesh = match &self.source {
+            MeshSource::File(path) => Mesh::load(path)?,
+            MeshSource::Sphere { centre, radius } => {
+                shapes::sphere(Vec3::from_array(*centre), *radius, SPHERE_SUBDIVISIONS)?
+            }
+            MeshSource::Ground { y, half_size } => shapes::ground(*y, *half_size)?,
+        };
+        if self.transform != Transform::default() {
+            for p in &mut mesh.positions {
+                *p = self.transform.point(linear, *p);
+            }
+            // The scale is uniform, so the linear part maps normals to normals.
+            for n in mesh.normals.iter_mut().flatten() {
+                *n = (linear * Vec3::from_array(*n))
+                    .normalize_or_zero()
+                    .to_array();
+            }
+        }
+        Ok(mesh)
+    }
+}
+
+impl LightDesc {
+    pub fn build(&self) -> Result<Light> {
+        let v = Vec3::from_array;
+        match self {
+            LightDesc::Environment {
+                source,
+                rotation_deg,
+                scale,
+            } => {
+                let env = match source {
+                    EnvironmentSource::Uniform(radiance) => Environment::uniform(v(*radiance))?,
+                    EnvironmentSource::Map(path) => Environment::from_file(path)?,
+                };
+                Ok(Light::Environment(
+                    env.with_rotation(*rotation_deg)?.with_scale(*scale)?,
+                ))
+            }
+            LightDesc::Distant {
+                direction,
+                irradiance,
+                angular_radius_deg,
+            } => Light::distant(
+                v(*direction),
+                v(*irradiance),
+                angular_radius_deg.to_radians(),
+            ),
+            LightDesc::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+                two_sided,
+            } => Light::rect(v(*corner), v(*edge_u), v(*edge_v), v(*radiance), *two_sided),
+        }
+    }
+}
+
+impl CameraDesc {
+    /// The camera for an image of `aspect`, framing `framed` when no eye and target are
+    /// given.
+    fn build(&self, framed: Bounds, aspect: f32) -> Result<Camera> {
+        let (camera, target) = match (self.eye, self.target) {
+            (Some(eye), Some(target)) => {
+                let (eye, target) = (Vec3::from_array(eye), Vec3::from_array(target));
+                let up = Vec3::from_array(self.up);
+                (Camera::new(eye, target, up, self.fov_deg, aspect)?, target)
+            }
+            (None, None) if framed.is_empty() => {
+                return Err(invalid_arg!(
+                    "nothing to frame (no groom and no mesh but ground quads): give `eye` \
+                     and `target`"
+                ));
+            }
+            (None, None) => (
+                Camera::frame_bounds(framed.lo, framed.hi, aspect, self.fov_deg)?,
+                (framed.lo + framed.hi) / 2.0,
+            ),
+            _ => {
+                return Err(invalid_arg!(
+                    "give both `eye` and `target`, or neither for an automatic camera"
+                ));
+            }
+        };
+        let focus = self
+            .focus_distance
+            .unwrap_or_else(|| camera.eye().distance(target));
+        camera.with_thin_lens(self.aperture_radius, focus)
+    }
+}
+
+/// An axis-aligned box grown point by point.
+#[derive(Debug, Clone, Copy)]
+struct Bounds {
+    lo: Vec3,
+    hi: Vec3,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        lo: Vec3::INFINITY,
+        hi: Vec3::NEG_INFINITY,
+    };
+
+    /// Grows the box to hold a ball of `radius` around `p`.
+    fn add(&mut self, p: Vec3, radius: f32) {
+        self.lo = self.lo.min(p - radius);
+        self.hi = self.hi.max(p + radius);
+    }
+
+    fn is_empty(&self) -> bool {
+        self.lo.cmpgt(self.hi).any()
+    }
+}

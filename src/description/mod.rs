@@ -1,0 +1,327 @@
+//! Scene descriptions: a TOML description of a render (settings, camera, materials, grooms,
+//! meshes, lights), the built-in demos and the quick look at a bare groom. All of them are
+//! a [`SceneDescription`], plain data that a caller may adjust (the CLI's `--spp`,
+//! `--width`, ...) before [`SceneDescription::build`] turns it into a renderable world.
+//!
+//! # The file format
+//!
+//! ```toml
+//! [render]                 # every key optional; defaults from RenderSettings::default()
+//! width = 640
+//! height = 480
+//! spp = 16
+//! seed = 0
+//! threads = 2              # absent: all cores
+//! max_depth = 256
+//! rr_depth = 2            # Russian roulette after this many events
+//! roulette = "sqrt"        # survival sqrt(throughput), or "throughput"
+//! clamp_indirect = 10.0    # absent: no clamping
+//! crop = [0, 0, 320, 240]  # [x0, y0, x1, y1) of the full frame
+//! filter = "tent"          # or "box" (one pixel)
+//! filter_radius = 1.0      # the tent's half-width in pixels
+//!
+//! [camera]                 # optional: without eye and target, an automatic camera frames
+//! eye = [0, 1, 5]          # the grooms (or, with no groom, the meshes other than ground
+//! target = [0, 0, 0]       # quads) at fov_deg
+//! up = [0, 1, 0]
+//! fov_deg = 35             # vertical field of view
+//! aperture_radius = 0.0    # thin lens; 0 is a pinhole
+//! focus_distance = 5.0     # default: the distance from eye to target
+//!
+//! [materials.brown]
+//! type = "hair"            # exactly one of sigma_a = [r, g, b], melanin = [eu, pheo], color = [r, g, b]
+//! melanin = [1.3, 0.2]     # then, optional: eta, beta_m, beta_n, alpha (degrees),
+//! beta_m = 0.3             # absorption_variation, roughness_variation, tip_absorption,
+//!                          # use_vertex_colors, seed (see HairMaterial)
+//! [materials.skin]
+//! type = "diffuse"
+//! albedo = [0.6, 0.45, 0.4]
+//!
+//! [[groom]]
+//! file = "curly.hair"      # relative to the scene file's folder
+//! thickness = "diameter"   # how the file's thickness is read: "diameter" (default) or "radius"
+//! basis = "bspline"        # "linear", "bezier", "bspline" (default) or "catmull_rom"
+//! shape = "round"          # "round" (default) or "flat"
+//! radius_scale = 1.0       # multiplies every fibre radius
+//! translate = [0, 0, 0]    # the transform: points scaled, turned about +y, then moved;
+//! scale = 1.0              # radii scaled too
+//! rotate_y_deg = 0.0
+//! material = "brown"
+//!
+//! [[groom]]
+//! procedural = "fur_ball"  # or "scalp"; the [groom.params] keys are the fields of FurBall
+//! material = "brown"       # or ScalpPatch (style = "straight" | "wavy" | "curly"), each
+//! [groom.params]           # defaulting to that struct's Default
+//! strands = 20000
+//!
+//! [[mesh]]
+//! shape = "sphere"         # or file = "head.obj" (.obj or .ply)
+//! centre = [0, 0, 0]       # default the origin
+//! radius = 1.0
+//! material = "skin"        # plus translate, scale, rotate_y_deg as for grooms
+//!
+//! [[mesh]]
+//! shape = "ground"         # a square facing +y, from -half_size to half_size in x and z
+//! y = -1.5                 # default 0
+//! half_size = 10.0
+//! material = "skin"
+//!
+//! [[light]]
+//! type = "environment"     # radiance = [r, g, b] (uniform) or map = "sky.exr" (lat-long)
+//! map = "sky.exr"
+//! rotation_deg = 0.0       # about +y
+//! scale = 1.0
+//!
+//! [[light]]
+//! type = "distant"
+//! direction = [-0.5, 1, 0.8]     # toward the light
+//! irradiance = [3, 3, 3]         # at a surface facing it
+//! angular_radius_deg = 1.0       # default 0: a delta light
+//!
+//! [[light]]
+//! type = "rect"
+//! corner = [-1, 3, -1]
+//! edge_u = [2, 0, 0]
+//! edge_v = [0, 0, 2]             # emits toward edge_u x edge_v
+//! radiance = [5, 5, 5]
+//! two_sided = false
+//! ```
+//!
+//! Every table rejects keys it does not know, so a misspelt key is an error, not a silent
+//! default. Errors found while reading the file name it, the line and the key
+//! (`scene.toml:12:1: groom[1].params.strands: ...`); errors found while building name the
+//! entry and key (`scene.toml: groom[1].material: no material named "blond" ...`).
+
+mod build;
+mod demos;
+mod file;
+pub mod peer;
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use serde::Deserialize;
+
+use crate::embree::{CurveBasis, CurveShape};
+use crate::error::Result;
+use crate::render::PixelFilter;
+use crate::render::integrator::{PathSettings, Roulette, World};
+use crate::render::settings::RenderSettings;
+use crate::scene::camera::Camera;
+use crate::scene::groom::{FurBall, ScalpPatch};
+use crate::scene::hair_file::Thickness;
+use crate::scene::material::HairMaterial;
+
+pub use demos::{DEMOS, default_lights, demo, quick_look};
+
+
+/// A whole scene as plain data. Adjust fields before [`SceneDescription::build`], not the
+/// settings after it: the camera's aspect follows `render.width / render.height`.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SceneDescription {
+    pub render: RenderDesc,
+    pub camera: CameraDesc,
+    pub materials: BTreeMap<String, MaterialDesc>,
+    pub grooms: Vec<GroomDesc>,
+    pub meshes: Vec<MeshDesc>,
+    pub lights: Vec<LightDesc>,
+    /// What error messages call this description: the scene file's path, or "demo NAME".
+    pub origin: String,
+}
+
+/// The `[render]` table: [`RenderSettings`] with its path settings flattened.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderDesc {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub seed: u64,
+    pub threads: Option<usize>,
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    /// "sqrt" (the default) or "throughput": see [`Roulette`].
+    pub roulette: String,
+    pub clamp_indirect: Option<f32>,
+    pub crop: Option<[u32; 4]>,
+    /// "tent" (the default) or "box".
+    pub filter: String,
+    /// The tent's half-width in pixels (default 1).
+    pub filter_radius: Option<f32>,
+}
+
+impl Default for RenderDesc {
+    fn default() -> Self {
+        let s = RenderSettings::default();
+        RenderDesc {
+            width: s.width,
+            height: s.height,
+            spp: s.spp,
+            seed: s.seed,
+            threads: s.threads,
+            max_depth: s.path.max_depth,
+            rr_depth: s.path.rr_depth,
+            roulette: s.path.roulette.name().to_string(),
+            clamp_indirect: s.path.clamp_indirect,
+            crop: s.crop,
+            filter: s.filter.name().0.to_string(),
+            filter_radius: None,
+        }
+    }
+}
+
+impl RenderDesc {
+    /// The validated settings.
+    pub fn settings(&self) -> Result<RenderSettings> {
+        let settings = RenderSettings {
+            width: self.width,
+            height: self.height,
+            spp: self.spp,
+            seed: self.seed,
+            threads: self.threads,
+            crop: self.crop,
+            filter: PixelFilter::named(&self.filter, self.filter_radius)?,
+            path: PathSettings {
+                max_depth: self.max_depth,
+                rr_depth: self.rr_depth,
+                roulette: Roulette::named(&self.roulette)?,
+                clamp_indirect: self.clamp_indirect,
+                ..PathSettings::default()
+            },
+        };
+        settings.validate()?;
+        Ok(settings)
+    }
+}
+
+/// The `[camera]` table.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Both, or neither for a camera that frames the grooms (see the module doc); `up` does
+    /// not apply then (+y is up).
+    pub eye: Option<[f32; 3]>,
+    pub target: Option<[f32; 3]>,
+    pub up: [f32; 3],
+    pub fov_deg: f32,
+    pub aperture_radius: f32,
+    /// None: focus on the target (the framed box's centre for an automatic camera).
+    pub focus_distance: Option<f32>,
+}
+
+impl Default for CameraDesc {
+    fn default() -> Self {
+        CameraDesc {
+            eye: None,
+            target: None,
+            up: [0.0, 1.0, 0.0],
+            fov_deg: Camera::DEFAULT_FOV_Y_DEG,
+            aperture_radius: 0.0,
+            focus_distance: None,
+        }
+    }
+}
+
+/// A `[materials.NAME]` table.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MaterialDesc {
+    Hair(HairMaterial),
+    Diffuse { albedo: [f32; 3] },
+}
+
+/// Scale (uniform, so fibres stay round), then a turn about +y, then a translation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transform {
+    pub translate: [f32; 3],
+    pub scale: f32,
+    pub rotate_y_deg: f32,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Transform {
+            translate: [0.0; 3],
+            scale: 1.0,
+            rotate_y_deg: 0.0,
+        }
+    }
+}
+
+/// A `[[groom]]` entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroomDesc {
+    pub source: GroomSource,
+    pub basis: CurveBasis,
+    pub shape: CurveShape,
+    /// Multiplies every fibre radius, on top of the transform's scale: thins or thickens a
+    /// groom without editing its file.
+    pub radius_scale: f32,
+    pub transform: Transform,
+    pub material: String,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum GroomSource {
+    File { path: PathBuf, thickness: Thickness },
+    FurBall(FurBall),
+    Scalp(ScalpPatch),
+}
+
+/// A `[[mesh]]` entry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshDesc {
+    pub source: MeshSource,
+    pub transform: Transform,
+    pub material: String,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum MeshSource {
+    /// An `.obj` or `.ply` file.
+    File(PathBuf),
+    Sphere {
+        centre: [f32; 3],
+        radius: f32,
+    },
+    Ground {
+        y: f32,
+        half_size: f32,
+    },
+}
+
+/// A `[[light]]` entry; see [`Light`] for what each parameter means.
+#[derive(Debug, Clone, PartialEq)]
+pub enum LightDesc {
+    Environment {
+        source: EnvironmentSource,
+        rotation_deg: f32,
+        scale: f32,
+    },
+    Distant {
+        /// Toward the light.
+        direction: [f32; 3],
+        irradiance: [f32; 3],
+        angular_radius_deg: f32,
+    },
+    Rect {
+        corner: [f32; 3],
+        edge_u: [f32; 3],
+        edge_v: [f32; 3],
+        radiance: [f32; 3],
+        two_sided: bool,
+    },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum EnvironmentSource {
+    Uniform([f32; 3]),
+    /// A lat-long image (see [`Environment`] for its orientation).
+    Map(PathBuf),
+}
+
+/// What a render needs, built from a description.
+pub struct BuiltScene {
+    pub world: World,
+    pub camera: Camera,
+    pub settings: RenderSettings,
+}

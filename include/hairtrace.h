@@ -71,7 +71,10 @@ typedef struct HtDevice HtDevice;
 typedef struct HtScene HtScene;
 
 /**
- * Parameters of the hair BSDF (see DESIGN.md section 3 for the ranges).
+ * Parameters of the hair BSDF: sigma_a per unit fibre radius (linear RGB, finite, >= 0),
+ * eta in (1, 3], beta_m and beta_n in [0.01, 1], alpha (cuticle tilt) in degrees,
+ * |alpha| <= 20. The frame: x along the fibre, y across it (h = offset along y over the
+ * radius, in [-1, 1]), z toward the viewer; wo and wi unit vectors pointing away.
  */
 typedef struct HtHairParams {
     /**

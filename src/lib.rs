@@ -1,8 +1,11 @@
 //! hairtrace: physically based hair and fur rendering.
 //!
-//! The crate is layered one way only (see DESIGN.md): [`math`] and [`bsdf`] know nothing of
-//! ray tracing; [`embree`] wraps Embree and knows nothing of shading; [`image`] writes
-//! pictures through OpenImageIO; [`capi`] is a thin C shell over the same Rust API.
+//! The crate is layered one way only (docs/architecture.md; `tests/architecture.rs`
+//! checks it): [`math`] and [`bsdf`] know nothing of ray tracing; [`embree`] wraps Embree
+//! and knows nothing of shading; [`image`] reads and writes pictures through OpenImageIO;
+//! [`scene`] is the scene as data plus the tracer; [`render`] makes images of it;
+//! [`description`] reads scene files and builds the demos; [`capi`] is a thin C shell
+//! over the same Rust API. Conventions (frames, units, signs): docs/conventions.md.
 
 /// cbindgen:ignore
 pub mod bsdf;

@@ -1,7 +1,7 @@
 //! Geometry of the lobes: with low roughness the peaks of the R and TT lobes sit where
 //! the model's geometry puts them (R: phi_i - phi_o = -2 asin(h), theta_i = -theta_o +
 //! 2 alpha; TT: phi_i - phi_o = 2 gamma_t - 2 gamma_o + pi, theta_i = -theta_o - alpha),
-//! and DESIGN.md's worked example of the frame holds.
+//! and the worked example of docs/conventions.md holds.
 
 mod common;
 
@@ -152,7 +152,7 @@ fn r_and_tt_peaks_are_where_the_geometry_puts_them() {
     );
 }
 
-/// DESIGN.md section 3's worked example: fiber along +x, viewer looking along -z (so
+/// The worked example of docs/conventions.md: fiber along +x, viewer looking along -z (so
 /// wo = +z), ray passing at y = +0.5 (h = +0.5). The strongest R direction is the true
 /// mirror direction of the tube surface, (0, 0.866, 0.5): light from above (+y). With
 /// alpha = 2 degrees the peak lifts to theta_i = 4 degrees along the tangent. Within one

@@ -2,7 +2,7 @@
 //! longitudinal (Mp), attenuation (Ap) and azimuthal (Np) terms, plus a residual lobe
 //! that carries all higher orders of internal reflection.
 //!
-//! Frame and conventions are DESIGN.md section 3: x is the fiber tangent, h the signed
+//! Frame and conventions are those of docs/conventions.md: x is the fiber tangent, h the signed
 //! offset across the fiber, `f` includes the 1/|wi.z| of pbrt's convention.
 //!
 //! Work is split by what it depends on: [`HairBsdf::new`] computes everything that

@@ -4,7 +4,7 @@ use super::absorption::sigma_a_from_melanin;
 use super::limits::{ALPHA_MAX_DEG, ETA_MAX, check_beta};
 use crate::error::{Result, invalid_arg};
 
-/// Parameters of the Chiang 2016 hair model (DESIGN.md section 3).
+/// Parameters of the Chiang 2016 hair model (units and ranges: docs/conventions.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HairParams {
     /// Absorption per unit fiber radius, linear RGB; finite, >= 0.

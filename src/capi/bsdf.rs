@@ -1,4 +1,5 @@
-//! The hair BSDF through the C ABI: exactly the signatures of DESIGN.md section 5.
+//! The hair BSDF through the C ABI: the Rust model's eval and sample, with every input
+//! checked (docs/c-abi.md).
 //!
 //! Hosts pass the parameters with every call. Building the per-parameter constants costs
 //! about as much as an evaluation, so each thread keeps the last parameter set it saw and
@@ -10,7 +11,10 @@ use crate::error::invalid_arg;
 use glam::Vec3;
 use std::cell::RefCell;
 
-/// Parameters of the hair BSDF (see DESIGN.md section 3 for the ranges).
+/// Parameters of the hair BSDF: sigma_a per unit fibre radius (linear RGB, finite, >= 0),
+/// eta in (1, 3], beta_m and beta_n in [0.01, 1], alpha (cuticle tilt) in degrees,
+/// |alpha| <= 20. The frame: x along the fibre, y across it (h = offset along y over the
+/// radius, in [-1, 1]), z toward the viewer; wo and wi unit vectors pointing away.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HtHairParams {

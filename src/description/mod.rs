@@ -114,7 +114,6 @@ use crate::scene::material::HairMaterial;
 
 pub use demos::{DEMOS, default_lights, demo, quick_look};
 
-
 /// A whole scene as plain data. Adjust fields before [`SceneDescription::build`], not the
 /// settings after it: the camera's aspect follows `render.width / render.height`.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -1,8 +1,9 @@
 //! Unidirectional path tracing with next-event estimation and multiple importance
 //! sampling (power heuristic) between light sampling and BSDF sampling.
 //!
-//! Hair keeps energy through very many bounces (DESIGN.md section 4b), so the depth cap is
-//! high and paths end mostly by Russian roulette on their throughput, which is unbiased.
+//! Light hair keeps energy through very many bounces, so the depth cap is high and paths
+//! end mostly by Russian roulette on their throughput, which is unbiased. Which rays are
+//! traced where was chosen by measurement (README, "Render efficiency").
 
 use glam::Vec3;
 

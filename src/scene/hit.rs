@@ -1,4 +1,4 @@
-//! Hit records and the hair shading frame of DESIGN.md section 3.
+//! Hit records and the hair shading frame (docs/conventions.md).
 //!
 //! The frame and h are computed in f64 from the f32 inputs: h is a small offset (a fraction
 //! of a fiber radius) taken from the difference of two points that may be far from the
@@ -85,7 +85,7 @@ pub struct HairHit {
     /// ray-facing normal (the frame's z) for flat ones.
     pub ng: Vec3,
     pub frame: HairFrame,
-    /// Offset across the fiber in [-1, 1] (DESIGN.md section 3).
+    /// Offset across the fiber in [-1, 1] (docs/conventions.md).
     pub h: f32,
     /// Axis point and fiber radius at the hit's curve parameter.
     pub axis: Vec3,

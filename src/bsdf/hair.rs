@@ -6,7 +6,7 @@
 //! offset across the fiber, `f` includes the 1/|wi.z| of pbrt's convention.
 //!
 //! Work is split by what it depends on: [`HairBsdf::new`] computes everything that
-//! depends on the parameters alone; [`Outgoing`] what depends on (h, wo) (Fresnel,
+//! depends on the parameters alone; `Outgoing` what depends on (h, wo) (Fresnel,
 //! absorption, deflection angles), shared by sampling and evaluation; the per-wi part is
 //! the four lobes. Both stages are generic over [`Lanes`], so `eval_batch` runs the same
 //! code eight inputs at a time.
@@ -119,8 +119,8 @@ impl HairBsdf {
         self.at(h, wo).o.ap.map(Vec3::from_array)
     }
 
-    /// Samples wi: u[0] picks the lobe (proportionally to its mean attenuation) and is
-    /// then reused, rescaled, for the azimuth; u[1] and u[2] sample the longitudinal lobe.
+    /// Samples wi: `u[0]` picks the lobe (proportionally to its mean attenuation) and is
+    /// then reused, rescaled, for the azimuth; `u[1]` and `u[2]` sample the longitudinal lobe.
     /// Returns None only when the density at the sampled direction is zero.
     pub fn sample(&self, h: f32, wo: Vec3, u: [f32; 3]) -> Option<HairSample> {
         self.at(h, wo).sample(u)

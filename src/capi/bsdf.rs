@@ -200,7 +200,7 @@ pub extern "C" fn ht_hair_sample(
     })
 }
 
-/// n evaluations at once (SIMD inside); h[n], wo[3n], wi[3n], f[3n], pdf[n], tightly
+/// n evaluations at once (SIMD inside); `h[n]`, `wo[3n]`, `wi[3n]`, `f[3n]`, `pdf[n]`, tightly
 /// packed. Every input is checked before anything is written.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_hair_eval_batch(

@@ -1,6 +1,6 @@
 //! The C ABI: `extern "C"` functions over the same Rust API (the contract: docs/c-abi.md).
 //!
-//! Every entry point goes through [`boundary`]: NULL pointers and bad values become an
+//! Every entry point goes through `boundary`: NULL pointers and bad values become an
 //! [`HtStatus`] with a message for `ht_last_error`, and a panic is caught here instead of
 //! unwinding into the host. The header `include/hairtrace.h` is generated from this
 //! module by cbindgen.

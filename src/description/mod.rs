@@ -288,7 +288,7 @@ pub enum MeshSource {
     },
 }
 
-/// A `[[light]]` entry; see [`Light`] for what each parameter means.
+/// A `[[light]]` entry; see [`crate::scene::light::Light`] for what each parameter means.
 #[derive(Debug, Clone, PartialEq)]
 pub enum LightDesc {
     Environment {
@@ -314,7 +314,7 @@ pub enum LightDesc {
 #[derive(Debug, Clone, PartialEq)]
 pub enum EnvironmentSource {
     Uniform([f32; 3]),
-    /// A lat-long image (see [`Environment`] for its orientation).
+    /// A lat-long image (see [`crate::scene::envmap::Environment`] for its orientation).
     Map(PathBuf),
 }
 

@@ -1,8 +1,13 @@
 //! Safe layer over Embree, the ray tracing kernels that intersect the hair curves.
 //!
-//! [`sys`] is the raw bindgen output; [`Device`] owns an Embree device; [`SceneBuilder`]
-//! attaches [`CurveGeometry`] and [`TriangleGeometry`] and commits into a [`Scene`], which
-//! answers closest-hit and occlusion queries ([`Ray`], [`RayHit`], [`Exclude`]). This module
+//! [`sys`](crate::embree::sys) is the raw bindgen output;
+//! [`Device`](crate::embree::Device) owns an Embree device;
+//! [`SceneBuilder`](crate::embree::SceneBuilder) attaches
+//! [`CurveGeometry`](crate::embree::CurveGeometry) and
+//! [`TriangleGeometry`](crate::embree::TriangleGeometry) and commits into a
+//! [`Scene`](crate::embree::Scene), which answers closest-hit and occlusion queries
+//! ([`Ray`](crate::embree::Ray), [`RayHit`](crate::embree::RayHit),
+//! [`Exclude`](crate::embree::Exclude)). This module
 //! knows nothing of shading: it hands back hit records and leaves the rest to the renderer.
 //!
 //! Embree 3 (Debian) and Embree 4 differ in the ray query calls (`rtcIntersect1` and

@@ -100,34 +100,6 @@ typedef struct HtHairParams {
 } HtHairParams;
 
 /**
- * How a hair material varies over the groom, deterministically from the seed, the
- * strand and the position along it.
- */
-typedef struct HtHairVariation {
-    /**
-     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
-     * from [1 - x, 1 + x].
-     */
-    float absorption_variation;
-    /**
-     * Per-strand spread of beta_m and beta_n, in [0, 1].
-     */
-    float roughness_variation;
-    /**
-     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
-     */
-    float tip_absorption;
-    /**
-     * Take the absorption from the curves' per-point colours where they have them.
-     */
-    bool use_vertex_colors;
-    /**
-     * Seed of the per-strand random choices.
-     */
-    uint64_t seed;
-} HtHairVariation;
-
-/**
  * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
  */
 typedef uint32_t HtCurveBasis;
@@ -215,6 +187,34 @@ typedef struct HtCurvesXyzr {
     HtCurveBasis basis;
     HtCurveShape shape;
 } HtCurvesXyzr;
+
+/**
+ * How a hair material varies over the groom, deterministically from the seed, the
+ * strand and the position along it.
+ */
+typedef struct HtHairVariation {
+    /**
+     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
+     * from [1 - x, 1 + x].
+     */
+    float absorption_variation;
+    /**
+     * Per-strand spread of beta_m and beta_n, in [0, 1].
+     */
+    float roughness_variation;
+    /**
+     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
+     */
+    float tip_absorption;
+    /**
+     * Take the absorption from the curves' per-point colours where they have them.
+     */
+    bool use_vertex_colors;
+    /**
+     * Seed of the per-strand random choices.
+     */
+    uint64_t seed;
+} HtHairVariation;
 
 /**
  * A pixel filter: one of the `HT_FILTER_*` constants.
@@ -398,7 +398,7 @@ enum HtStatus ht_hair_sample(const struct HtHairParams *params,
                              float *pdf);
 
 /**
- * n evaluations at once (SIMD inside); h[n], wo[3n], wi[3n], f[3n], pdf[n], tightly
+ * n evaluations at once (SIMD inside); `h[n]`, `wo[3n]`, `wi[3n]`, `f[3n]`, `pdf[n]`, tightly
  * packed. Every input is checked before anything is written.
  */
 enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
@@ -431,32 +431,27 @@ enum HtStatus ht_scene_new(const struct HtDevice *device, struct HtScene **out);
 enum HtStatus ht_scene_free(struct HtScene *scene);
 
 /**
- * No variation: every strand has the material's parameters, and seed 0.
+ * Places the pinhole camera at `eye` looking at `target`, `up` giving the image's upward
+ * direction (not parallel to the view), with a vertical field of view of `fov_y_deg` in
+ * (0, 180). Replaces any earlier camera. Without one, renders frame the scene's bounds
+ * from the front (+z), a little to the right and above.
  */
-struct HtHairVariation ht_hair_variation_default(void);
+enum HtStatus ht_scene_set_camera(struct HtScene *scene,
+                                  const float *eye,
+                                  const float *target,
+                                  const float *up,
+                                  float fov_y_deg);
 
 /**
- * Adds a hair material with the same parameters on every strand; writes its id (0, 1, ...
- * in the order materials are added) to `material_id`.
+ * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
+ * units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
+ * view direction, > 0), so that what lies nearer or farther blurs. Holds for the camera
+ * of `ht_scene_set_camera`, whether set before or after, and for the camera that frames a
+ * scene without one. Replaces any earlier lens.
  */
-enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
-                                         const struct HtHairParams *params,
-                                         uint32_t *material_id);
-
-/**
- * Adds a hair material whose parameters vary over the groom as `variation` says.
- */
-enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
-                                                const struct HtHairParams *params,
-                                                const struct HtHairVariation *variation,
-                                                uint32_t *material_id);
-
-/**
- * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1].
- */
-enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
-                                            const float *albedo,
-                                            uint32_t *material_id);
+enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
+                                     float aperture_radius,
+                                     float focus_distance);
 
 /**
  * Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
@@ -567,27 +562,32 @@ enum HtStatus ht_scene_add_rect_light(struct HtScene *scene,
                                       bool two_sided);
 
 /**
- * Places the pinhole camera at `eye` looking at `target`, `up` giving the image's upward
- * direction (not parallel to the view), with a vertical field of view of `fov_y_deg` in
- * (0, 180). Replaces any earlier camera. Without one, renders frame the scene's bounds
- * from the front (+z), a little to the right and above.
+ * No variation: every strand has the material's parameters, and seed 0.
  */
-enum HtStatus ht_scene_set_camera(struct HtScene *scene,
-                                  const float *eye,
-                                  const float *target,
-                                  const float *up,
-                                  float fov_y_deg);
+struct HtHairVariation ht_hair_variation_default(void);
 
 /**
- * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
- * units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
- * view direction, > 0), so that what lies nearer or farther blurs. Holds for the camera
- * of `ht_scene_set_camera`, whether set before or after, and for the camera that frames a
- * scene without one. Replaces any earlier lens.
+ * Adds a hair material with the same parameters on every strand; writes its id (0, 1, ...
+ * in the order materials are added) to `material_id`.
  */
-enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
-                                     float aperture_radius,
-                                     float focus_distance);
+enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
+                                         const struct HtHairParams *params,
+                                         uint32_t *material_id);
+
+/**
+ * Adds a hair material whose parameters vary over the groom as `variation` says.
+ */
+enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
+                                                const struct HtHairParams *params,
+                                                const struct HtHairVariation *variation,
+                                                uint32_t *material_id);
+
+/**
+ * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1].
+ */
+enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
+                                            const float *albedo,
+                                            uint32_t *material_id);
 
 /**
  * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no

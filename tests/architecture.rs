@@ -25,9 +25,10 @@ fn layer(module: &str) -> usize {
         .unwrap_or_else(|| panic!("module {module:?} is in no layer: add it to LAYERS"))
 }
 
-/// Every library source file as (module path, source without its unit tests).
-fn modules() -> BTreeMap<String, String> {
-    fn walk(dir: &Path, root: &Path, out: &mut BTreeMap<String, String>) {
+/// Every library source file as (module path, (source without its unit tests, lines of the
+/// whole file)).
+fn modules() -> BTreeMap<String, (String, usize)> {
+    fn walk(dir: &Path, root: &Path, out: &mut BTreeMap<String, (String, usize)>) {
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
             if path.is_dir() {
@@ -44,11 +45,12 @@ fn modules() -> BTreeMap<String, String> {
                     parts.pop();
                 }
                 let text = std::fs::read_to_string(&path).unwrap();
+                let lines = text.lines().count();
                 let code = match text.find("#[cfg(test)]\nmod tests") {
                     Some(i) => text[..i].to_string(),
                     None => text,
                 };
-                out.insert(parts.join("::"), code);
+                out.insert(parts.join("::"), (code, lines));
             }
         }
     }
@@ -125,7 +127,7 @@ fn layers_go_one_way_and_files_form_no_cycle() {
     let modules = modules();
     let known: BTreeSet<String> = modules.keys().cloned().collect();
     let mut uses: BTreeMap<&str, BTreeSet<String>> = BTreeMap::new();
-    for (module, code) in &modules {
+    for (module, (code, _)) in &modules {
         for path in named_paths(code) {
             if let Some(target) = resolve(module, &path, &known) {
                 // A file's own module and its parents (re-exports) are not dependencies.
@@ -179,4 +181,14 @@ fn the_scan_sees_what_it_must() {
         Some("math")
     );
     assert_eq!(layer("description::peer"), 5);
+}
+
+/// Rooms stay small enough to read: no library source file over about 800 lines.
+#[test]
+fn no_source_file_is_over_800_lines() {
+    let long: Vec<String> = modules()
+        .iter()
+        .filter_map(|(module, &(_, n))| (n > 800).then(|| format!("{module}: {n} lines")))
+        .collect();
+    assert!(long.is_empty(), "split these: {}", long.join(", "));
 }

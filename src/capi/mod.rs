@@ -7,8 +7,16 @@
 
 pub mod bsdf;
 pub mod scene;
+// Scenes first: the header declares them before the calls that fill them.
+pub mod geometry;
+pub mod lights;
+pub mod materials;
+#[cfg(test)]
+mod scene_tests;
 // After `scene`, so that the header declares scenes before the render that takes them.
 pub mod render;
+#[cfg(test)]
+mod render_tests;
 
 pub use bsdf::HtHairParams;
 

@@ -1,0 +1,327 @@
+//! Geometry through the C ABI: curves from host arrays (copied, or float4 xyzr points
+//! shared in place), `.hair` files, and triangle meshes from arrays or files.
+
+use super::scene::{HtScene, Shape, add_with_id};
+use super::{Failure, HtStatus, host_slice, non_null, read_path};
+use crate::embree::{CurveBasis, CurveShape, SharedBuffer};
+use crate::error::{Result, invalid_arg};
+use crate::scene::curves::Curves;
+use crate::scene::mesh::Mesh;
+use crate::scene::{Strands, Thickness, read_hair_file};
+use std::ffi::c_char;
+use std::ptr::NonNull;
+
+/// The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
+pub type HtCurveBasis = u32;
+/// Straight segments between consecutive points.
+pub const HT_CURVE_LINEAR: HtCurveBasis = 0;
+/// Cubic Bezier.
+pub const HT_CURVE_BEZIER: HtCurveBasis = 1;
+/// Uniform cubic B-spline.
+pub const HT_CURVE_BSPLINE: HtCurveBasis = 2;
+/// Catmull-Rom spline.
+pub const HT_CURVE_CATMULL_ROM: HtCurveBasis = 3;
+
+/// The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`.
+pub type HtCurveShape = u32;
+/// A true tube: the reference, and what close-ups need.
+pub const HT_CURVE_ROUND: HtCurveShape = 0;
+/// A ribbon facing the ray: faster, approximate up close.
+pub const HT_CURVE_FLAT: HtCurveShape = 1;
+
+/// Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
+/// when the call returns.
+///
+/// Every basis draws each strand from its first point (root) to its last (tip), one curve
+/// segment per polyline segment: linear joins the points, Catmull-Rom passes through them,
+/// B-spline smooths between root and tip, Bezier is the Catmull-Rom curve in Bezier form.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct HtCurves {
+    /// Number of strands, >= 1.
+    pub strand_count: usize,
+    /// Points of each strand (each >= 2), `strand_count` values adding up to `point_count`.
+    pub point_counts: *const u32,
+    /// Points of all strands.
+    pub point_count: usize,
+    /// x, y, z of every point, strand after strand: `3 * point_count` floats.
+    pub points: *const f32,
+    /// Fiber radius (not diameter) at every point, > 0: `point_count` floats; or NULL.
+    pub radii: *const f32,
+    /// Fiber radius (not diameter) of every point when `radii` is NULL, > 0.
+    pub radius: f32,
+    /// Linear RGB at every point (`3 * point_count` floats, >= 0), used by hair materials
+    /// with `use_vertex_colors`; or NULL.
+    pub colors: *const f32,
+    pub basis: HtCurveBasis,
+    pub shape: HtCurveShape,
+}
+
+/// Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
+/// that hold that layout. `ht_scene_add_curves_xyzr` copies them, and the host may free its
+/// arrays when the call returns; `ht_scene_add_curves_xyzr_shared` reads `points` in place
+/// for the life of the scene (see there).
+///
+/// A strand of n control points has n - 1 linear segments, n - 3 B-spline or Catmull-Rom
+/// segments (the curve runs between the second and the second-to-last point), or (n - 1) / 3
+/// Bezier segments (n = 3k + 1, consecutive segments sharing end points).
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct HtCurvesXyzr {
+    /// Number of strands, >= 1.
+    pub strand_count: usize,
+    /// Control points of each strand, `strand_count` values adding up to `point_count`.
+    pub point_counts: *const u32,
+    /// Control points of all strands.
+    pub point_count: usize,
+    /// x, y, z, radius (not diameter, >= 0) of every control point: `4 * point_count`
+    /// floats.
+    pub points: *const f32,
+    /// Linear RGB (>= 0) at every segment end, segments + 1 per strand, strand after
+    /// strand; or NULL.
+    pub colors: *const f32,
+    pub basis: HtCurveBasis,
+    pub shape: HtCurveShape,
+}
+
+fn curve_basis(basis: HtCurveBasis) -> Result<CurveBasis> {
+    Ok(match basis {
+        HT_CURVE_LINEAR => CurveBasis::Linear,
+        HT_CURVE_BEZIER => CurveBasis::Bezier,
+        HT_CURVE_BSPLINE => CurveBasis::BSpline,
+        HT_CURVE_CATMULL_ROM => CurveBasis::CatmullRom,
+        _ => {
+            return Err(invalid_arg!(
+                "basis = {basis}: not an HT_CURVE_* basis (0 to 3)"
+            ));
+        }
+    })
+}
+
+fn curve_shape(shape: HtCurveShape) -> Result<CurveShape> {
+    Ok(match shape {
+        HT_CURVE_ROUND => CurveShape::Round,
+        HT_CURVE_FLAT => CurveShape::Flat,
+        _ => {
+            return Err(invalid_arg!(
+                "shape = {shape}: not HT_CURVE_ROUND (0) or HT_CURVE_FLAT (1)"
+            ));
+        }
+    })
+}
+
+fn check_strand_count(n: usize) -> Result<()> {
+    if n == 0 {
+        return Err(invalid_arg!(
+            "desc->strand_count = 0: at least one strand is needed"
+        ));
+    }
+    Ok(())
+}
+
+/// `n` host float triples (3 n floats).
+fn host_triples<'a>(
+    ptr: *const f32,
+    n: usize,
+    name: &str,
+) -> std::result::Result<&'a [[f32; 3]], Failure> {
+    host_slice(ptr.cast(), n, name)
+}
+
+/// Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
+/// `material_id`; writes the geometry id (0, 1, ... over curves and meshes, in the order
+/// they are added) to `geom_id`.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_curves(
+    scene: *mut HtScene,
+    desc: *const HtCurves,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_with_id(scene, geom_id, "geom_id", |scene| {
+        // SAFETY: non-NULL (checked); the host's struct.
+        let d = unsafe { *non_null(desc, "desc")? };
+        scene.check_material(material_id, true)?;
+        let (basis, shape) = (curve_basis(d.basis)?, curve_shape(d.shape)?);
+        check_strand_count(d.strand_count)?;
+        let counts = host_slice(d.point_counts, d.strand_count, "desc->point_counts")?;
+        let points = host_triples(d.points, d.point_count, "desc->points")?;
+        let radii = if d.radii.is_null() {
+            if !(d.radius.is_finite() && d.radius > 0.0) {
+                return Err(invalid_arg!(
+                    "desc->radius = {}: must be finite and > 0 when desc->radii is NULL",
+                    d.radius
+                )
+                .into());
+            }
+            vec![d.radius; d.point_count]
+        } else {
+            host_slice(d.radii, d.point_count, "desc->radii")?.to_vec()
+        };
+        let colors = (!d.colors.is_null())
+            .then(|| host_triples(d.colors, d.point_count, "desc->colors").map(<[_]>::to_vec))
+            .transpose()?;
+        let strands = Strands {
+            points: points.to_vec(),
+            radii,
+            counts: counts.to_vec(),
+            colors,
+        };
+        let curves = Curves::from_strands(&strands, basis, shape)?;
+        Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+    })
+}
+
+/// Adds strands of float4 control points laid out for the basis (copied: see
+/// `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_curves_xyzr(
+    scene: *mut HtScene,
+    desc: *const HtCurvesXyzr,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+        points.to_vec().into()
+    })
+}
+
+/// As `ht_scene_add_curves_xyzr`, but `desc->points` is shared, not copied: Embree reads
+/// the host's array in place, through every render and every rebuild after later
+/// additions, and the scene never holds a copy of it. The host keeps those
+/// `4 * point_count` floats allocated and unchanged until `ht_scene_free` returns; writing
+/// to them or freeing them earlier is undefined behaviour. `points` must be aligned to 4
+/// bytes, like any float array (16-byte alignment is not needed, and no padding past the
+/// last point: Embree reads at most the 16 bytes of a float4 from its start). The small
+/// per-strand data are still built and kept by the scene: `point_counts` and `colors` are
+/// read during the call only, and the index buffer takes 4 bytes per segment.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_curves_xyzr_shared(
+    scene: *mut HtScene,
+    desc: *const HtCurvesXyzr,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+        // SAFETY: `points` is the host's checked array (aligned, in bounds); the host keeps it
+        // valid and unchanged until ht_scene_free (the documented contract), and the scene
+        // is the last owner of every clone of this buffer.
+        unsafe { SharedBuffer::from_raw_parts(NonNull::from(points).cast(), points.len()) }
+    })
+}
+
+/// The body of both `ht_scene_add_curves_xyzr` entry points; `vertices` turns the checked
+/// host array of control points into the buffer Embree reads.
+fn add_curves_xyzr(
+    scene: *mut HtScene,
+    desc: *const HtCurvesXyzr,
+    material_id: u32,
+    geom_id: *mut u32,
+    vertices: impl FnOnce(&[[f32; 4]]) -> SharedBuffer<[f32; 4]>,
+) -> HtStatus {
+    add_with_id(scene, geom_id, "geom_id", |scene| {
+        // SAFETY: non-NULL (checked); the host's struct.
+        let d = unsafe { *non_null(desc, "desc")? };
+        scene.check_material(material_id, true)?;
+        let (basis, shape) = (curve_basis(d.basis)?, curve_shape(d.shape)?);
+        check_strand_count(d.strand_count)?;
+        let counts = host_slice(d.point_counts, d.strand_count, "desc->point_counts")?;
+        let points: &[[f32; 4]] = host_slice(d.points.cast(), d.point_count, "desc->points")?;
+        let colors = if d.colors.is_null() {
+            None
+        } else {
+            // One colour per segment end: the strand counts say how many to read.
+            let mut ends = 0usize;
+            for (s, &n) in counts.iter().enumerate() {
+                let segments = basis.segments_for(n as usize).ok_or_else(|| {
+                    invalid_arg!(
+                        "desc->point_counts[{s}] = {n}: not a whole number of {basis:?} segments"
+                    )
+                })?;
+                ends += segments + 1;
+            }
+            Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
+        };
+        let curves = Curves::from_control_points(vertices(points), counts, colors, basis, shape)?;
+        Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+    })
+}
+
+/// Adds the strands of a Cem Yuksel `.hair` file as polylines for `basis`. The file's
+/// thickness is a diameter unless `thickness_is_radius`.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_hair_file(
+    scene: *mut HtScene,
+    path: *const c_char,
+    thickness_is_radius: bool,
+    basis: HtCurveBasis,
+    shape: HtCurveShape,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_with_id(scene, geom_id, "geom_id", |scene| {
+        let path = read_path(path, "path")?;
+        scene.check_material(material_id, true)?;
+        let (basis, shape) = (curve_basis(basis)?, curve_shape(shape)?);
+        let thickness = if thickness_is_radius {
+            Thickness::Radius
+        } else {
+            Thickness::Diameter
+        };
+        let strands = read_hair_file(&path, thickness)?;
+        let curves = Curves::from_strands(&strands, basis, shape)?;
+        Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+    })
+}
+
+/// Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
+/// `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
+/// shading), `indices` 3 vertex indices per triangle, counter-clockwise seen from the
+/// front. Writes the geometry id.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)] // the C signature: one argument per array
+pub extern "C" fn ht_scene_add_mesh(
+    scene: *mut HtScene,
+    vertex_count: usize,
+    positions: *const f32,
+    normals: *const f32,
+    triangle_count: usize,
+    indices: *const u32,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_with_id(scene, geom_id, "geom_id", |scene| {
+        scene.check_material(material_id, false)?;
+        if vertex_count == 0 || triangle_count == 0 {
+            return Err(invalid_arg!(
+                "vertex_count = {vertex_count}, triangle_count = {triangle_count}: a mesh needs \
+                 at least one triangle"
+            )
+            .into());
+        }
+        let positions = host_triples(positions, vertex_count, "positions")?.to_vec();
+        let normals = (!normals.is_null())
+            .then(|| host_triples(normals, vertex_count, "normals").map(<[_]>::to_vec))
+            .transpose()?;
+        let triangles: &[[u32; 3]] = host_slice(indices.cast(), triangle_count, "indices")?;
+        let mesh = Mesh::new(positions, triangles.to_vec(), normals)?;
+        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id)?)
+    })
+}
+
+/// Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
+/// material `material_id`; writes the geometry id.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_mesh_file(
+    scene: *mut HtScene,
+    path: *const c_char,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    add_with_id(scene, geom_id, "geom_id", |scene| {
+        let path = read_path(path, "path")?;
+        scene.check_material(material_id, false)?;
+        let mesh = Mesh::load(&path)?;
+        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id)?)
+    })
+}

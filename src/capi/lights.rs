@@ -1,0 +1,92 @@
+//! Lights through the C ABI: uniform or mapped environments, distant and rect lights.
+
+use super::scene::{HtScene, scene_mut};
+use super::{Failure, HtStatus, boundary, read_path, read_vec3};
+use crate::scene::envmap::Environment;
+use crate::scene::light::Light;
+use std::ffi::c_char;
+
+/// Adds a light to the scene; `light` runs inside the boundary.
+fn add_light(
+    scene: *mut HtScene,
+    light: impl FnOnce() -> std::result::Result<Light, Failure>,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        scene.lights.push(light()?);
+        scene.lights_changed = true;
+        Ok(())
+    })
+}
+
+/// Adds an environment of the same linear RGB `radiance` (>= 0) from every direction.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_environment(scene: *mut HtScene, radiance: *const f32) -> HtStatus {
+    add_light(scene, || {
+        let env = Environment::uniform(read_vec3(radiance, "radiance")?)?;
+        Ok(Light::Environment(env))
+    })
+}
+
+/// Adds a lat-long environment map read through OpenImageIO (EXR, HDR, ...: linear
+/// radiance), turned by `rotation_deg` about +y and its radiance multiplied by `scale`
+/// (>= 0). It is importance sampled.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_environment_map(
+    scene: *mut HtScene,
+    path: *const c_char,
+    rotation_deg: f32,
+    scale: f32,
+) -> HtStatus {
+    add_light(scene, || {
+        let path = read_path(path, "path")?;
+        let env = Environment::from_file(&path)?
+            .with_rotation(rotation_deg)?
+            .with_scale(scale)?;
+        Ok(Light::Environment(env))
+    })
+}
+
+/// Adds a light at infinity: `direction` points toward it (any non-zero length), it
+/// delivers linear RGB `irradiance` (>= 0) to a surface facing it, and is seen as a disc of
+/// `angular_radius_deg` in [0, 90) (0: a point, with hard shadows).
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_distant_light(
+    scene: *mut HtScene,
+    direction: *const f32,
+    irradiance: *const f32,
+    angular_radius_deg: f32,
+) -> HtStatus {
+    add_light(scene, || {
+        let light = Light::distant(
+            read_vec3(direction, "direction")?,
+            read_vec3(irradiance, "irradiance")?,
+            angular_radius_deg.to_radians(),
+        )?;
+        Ok(light)
+    })
+}
+
+/// Adds a parallelogram light with corners `corner`, `corner + edge_u`, `corner + edge_v`
+/// and `corner + edge_u + edge_v`, emitting linear RGB `radiance` (>= 0) toward
+/// `edge_u x edge_v`, or to both sides if `two_sided`.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_scene_add_rect_light(
+    scene: *mut HtScene,
+    corner: *const f32,
+    edge_u: *const f32,
+    edge_v: *const f32,
+    radiance: *const f32,
+    two_sided: bool,
+) -> HtStatus {
+    add_light(scene, || {
+        let light = Light::rect(
+            read_vec3(corner, "corner")?,
+            read_vec3(edge_u, "edge_u")?,
+            read_vec3(edge_v, "edge_v")?,
+            read_vec3(radiance, "radiance")?,
+            two_sided,
+        )?;
+        Ok(light)
+    })
+}

@@ -167,6 +167,17 @@ fn link_embree(embree: &Embree) {
     println!("cargo:rustc-check-cfg=cfg(embree4)");
     println!("cargo:rustc-cfg=embree{}", embree.major);
     println!("cargo:rustc-env=HT_EMBREE_VERSION={}", embree.version);
+    // What a C program linking the static archive needs for Embree (tests/c_abi links
+    // the examples with it): the library this build found, not a guess.
+    let search = embree
+        .lib_dir
+        .as_ref()
+        .map(|d| format!("-L{} ", d.display()))
+        .unwrap_or_default();
+    println!(
+        "cargo:rustc-env=HT_EMBREE_LINK={search}-lembree{}",
+        embree.major
+    );
     if let Some(dir) = &embree.lib_dir {
         println!("cargo:rustc-link-search=native={}", dir.display());
     }

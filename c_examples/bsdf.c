@@ -1,5 +1,5 @@
 /* Evaluates and samples the default (brown) hair through the C header only.
- * Compiles as C99 and as C++ with -Wall -Wextra -Werror; tests/c_examples.rs runs it
+ * Compiles as C99 and as C++ with -Wall -Wextra -Werror; tests/c_abi/c_examples.rs runs it
  * and checks what it prints. */
 #include "hairtrace.h"
 

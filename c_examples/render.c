@@ -1,6 +1,6 @@
 /* Renders a small curly fur ball, groomed here in C, around a white sphere, through the C
  * header only, and writes it to the EXR path given as the first argument.
- * Compiles as C99 and as C++ with -Wall -Wextra -Werror; tests/c_examples.rs runs it and
+ * Compiles as C99 and as C++ with -Wall -Wextra -Werror; tests/c_abi/c_examples.rs runs it and
  * checks what it prints and the image it writes. */
 #include "hairtrace.h"
 

@@ -1,6 +1,6 @@
 //! hairtrace: physically based hair and fur rendering.
 //!
-//! The crate is layered one way only (docs/architecture.md; `tests/architecture.rs`
+//! The crate is layered one way only (docs/architecture.md; `tests/pipeline/architecture.rs`
 //! checks it): [`math`] and [`bsdf`] know nothing of ray tracing; [`embree`] wraps Embree
 //! and knows nothing of shading; [`image`] reads and writes pictures through OpenImageIO;
 //! [`scene`] is the scene as data plus the tracer; [`render`] makes images of it;

@@ -22,7 +22,7 @@ pub const SURFACE_MASK: u32 = 2;
 
 /// How a continued ray (reflection, transmission, shadow) leaves a fiber.
 ///
-/// Measured re-hit rates (`tests/rehit.rs`: ~2500 round-curve hits x 64 random directions,
+/// Measured re-hit rates (`tests/pipeline/rehit.rs`: ~2500 round-curve hits x 64 random directions,
 /// every basis, straight and bent strands): `Offset` re-hits ~100% of transmitted and ~50%
 /// of shadow rays; the three filtered strategies at most 0.005%. `ExitAndFilter` is the
 /// default because it is the fastest of those on round cubic curves (`benches/groom.rs`:
@@ -316,7 +316,7 @@ fn hair_hit(
     let tangent = tangent(geom, hit.prim_id, Vec3::from_array(c.dp_du), c.radius, &at);
     // One formula for every shape: on flat cubic curves it beats Embree's v (the offset
     // across the tessellated ribbon) by two orders of magnitude on bent fibers
-    // (tests/curves_geometry.rs prints both).
+    // (tests/pipeline/curves_geometry.rs prints both).
     let (frame, h) = HairFrame::with_offset(tangent, ray.dir, ray.org, axis, c.radius);
     let ng = match geom.shape() {
         CurveShape::Round => hit.ng.try_normalize().unwrap_or(frame.z),

@@ -3,11 +3,9 @@
 //! 2 alpha; TT: phi_i - phi_o = 2 gamma_t - 2 gamma_o + pi, theta_i = -theta_o - alpha),
 //! and the worked example of docs/conventions.md holds.
 
-mod common;
-
-use common::reference::{RefHair, wrap_pi};
-use common::sphere::{dir, dot};
-use common::{Timer, bsdf, d3, dir_deg, par_map, params, v3};
+use crate::common::reference::{RefHair, wrap_pi};
+use crate::common::sphere::{dir, dot};
+use crate::common::{Timer, bsdf, d3, dir_deg, par_map, params, v3};
 use hairtrace::HairBsdf;
 use std::f64::consts::PI;
 
@@ -123,8 +121,8 @@ fn r_and_tt_peaks_are_where_the_geometry_puts_them() {
         } else {
             (-to + 2.0 * a, -2.0 * h.asin())
         };
-        let v =
-            common::reference::longitudinal_variance(c.beta as f64) / if c.tt { 4.0 } else { 1.0 };
+        let v = crate::common::reference::longitudinal_variance(c.beta as f64)
+            / if c.tt { 4.0 } else { 1.0 };
         let dt = (ti - want_t).abs();
         let dp = wrap_pi(pi - po - want_dphi).abs();
         let t_tol = 1.5 * FINE + 0.6 * v * want_t.tan().abs();

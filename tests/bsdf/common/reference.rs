@@ -98,12 +98,6 @@ pub fn mp(theta_i: f64, theta_o: f64, v: f64) -> f64 {
     (-one_minus_cos / v).exp() * i0_scaled(x) / (v * -(-2.0 / v).exp_m1())
 }
 
-/// [`mp`] from sines and cosines (cosines >= 0), as the crate's `LongitudinalLobe::eval`
-/// takes them.
-pub fn mp_sin_cos(sin_ti: f64, cos_ti: f64, sin_to: f64, cos_to: f64, v: f64) -> f64 {
-    mp(sin_ti.atan2(cos_ti), sin_to.atan2(cos_to), v)
-}
-
 /// The normalised logistic on [-pi, pi]: `L(x, s) / (C(pi) - C(-pi))`,
 /// with `C(pi) - C(-pi) = tanh(pi / 2s)`.
 pub fn trimmed_logistic(x: f64, s: f64) -> f64 {
@@ -158,8 +152,6 @@ pub type Centres = Vec<(f64, f64)>;
 pub struct RefHair {
     pub sigma_a: [f64; 3],
     pub eta: f64,
-    pub beta_m: f64,
-    pub beta_n: f64,
     /// Cuticle tilt in degrees.
     pub alpha_deg: f64,
     /// Lobe variances [R, TT, TRT, residual].
@@ -193,8 +185,6 @@ impl RefHair {
         RefHair {
             sigma_a,
             eta,
-            beta_m,
-            beta_n,
             alpha_deg,
             v: lobe_variances(beta_m),
             s: azimuthal_scale(beta_n),

@@ -9,12 +9,10 @@
 //! (Bonferroni: the whole file then has a false-alarm rate below 1%). 10^6 samples make
 //! a relative error of ~1% in a lobe holding 10% of the mass a ~30-sigma effect.
 
-mod common;
-
-use common::chi2::{Chi2Result, Grid, dump_tables, pearson};
-use common::quad::gauss_legendre;
-use common::reference::RefHair;
-use common::{Timer, bsdf, d3, dir_deg, par_map, params, random_u, reference, rng, v3};
+use crate::common::chi2::{Chi2Result, Grid, dump_tables, pearson};
+use crate::common::quad::gauss_legendre;
+use crate::common::reference::RefHair;
+use crate::common::{Timer, bsdf, d3, dir_deg, par_map, params, random_u, reference, rng, v3};
 use hairtrace::{HairBsdf, HairParams};
 use std::path::Path;
 
@@ -69,7 +67,7 @@ fn configs() -> Vec<Config> {
     let mut out = Vec::new();
     for beta in BETAS {
         for alpha in ALPHAS {
-            for sigma_a in [common::brown(), [0.0; 3]] {
+            for sigma_a in [crate::common::brown(), [0.0; 3]] {
                 for (theta_o, phi_o, h) in VIEWS {
                     out.push(Config {
                         p: params(sigma_a, 1.55, beta, beta, alpha),
@@ -245,7 +243,7 @@ fn chi2_beta_0_8() {
 fn chi2_rejects_wrong_distributions() {
     let _t = Timer::start("chi2_rejects_wrong_distributions");
     let c = Config {
-        p: params(common::brown(), 1.55, 0.3, 0.3, 2.0),
+        p: params(crate::common::brown(), 1.55, 0.3, 0.3, 2.0),
         theta_o: 20.0,
         phi_o: 60.0,
         h: 0.3,
@@ -265,7 +263,7 @@ fn chi2_rejects_wrong_distributions() {
 
     // (a) phi shifted by 0.01 rad.
     let (shifted, _) = histogram(&b, &c, 901, |w| {
-        common::sphere::rotate(w, [1.0, 0.0, 0.0], 0.01)
+        crate::common::sphere::rotate(w, [1.0, 0.0, 0.0], 0.01)
     });
     let a = pearson(&shifted, &expected, 5.0);
     // Exercise the failure dump on this expected rejection, so its format can be looked at.

@@ -18,9 +18,9 @@ fn profile_dir() -> PathBuf {
         .to_path_buf()
 }
 
-/// Libraries the static library needs, as `--print native-static-libs` lists them.
+/// Libraries the static library needs besides Embree, as `--print native-static-libs`
+/// lists them; Embree's come from the build script ([`embree_link`]).
 const NATIVE_LIBS: &[&str] = &[
-    "-lembree3",
     "-lOpenImageIO",
     "-lOpenImageIO_Util",
     "-lstdc++",
@@ -32,16 +32,53 @@ const NATIVE_LIBS: &[&str] = &[
     "-ldl",
 ];
 
+/// The Embree link arguments of the Embree this build found (`-L<dir>` when it is not in
+/// a system path, then `-lembree3` or `-lembree4`).
+fn embree_link() -> Vec<&'static str> {
+    env!("HT_EMBREE_LINK").split(' ').collect()
+}
+
+/// `libhairtrace.a`, checked to be newer than every source file and the build script:
+/// `cargo test` builds only the rlib, so an archive left by an older build would test old
+/// code under the new name.
+fn fresh_archive() -> PathBuf {
+    let lib = profile_dir().join("libhairtrace.a");
+    let built = std::fs::metadata(&lib)
+        .and_then(|m| m.modified())
+        .unwrap_or_else(|_| {
+            panic!(
+                "{} not built: `cargo test` builds only the rlib; run `cargo build --release` \
+                 first (the README's test command does)",
+                lib.display()
+            )
+        });
+    fn newest(path: &Path) -> std::time::SystemTime {
+        let meta = std::fs::metadata(path).expect("source metadata");
+        if meta.is_dir() {
+            std::fs::read_dir(path)
+                .expect("source folder")
+                .map(|e| newest(&e.expect("source entry").path()))
+                .max()
+                .unwrap_or(std::time::UNIX_EPOCH)
+        } else {
+            meta.modified().expect("source mtime")
+        }
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let sources = newest(&root.join("src")).max(newest(&root.join("build.rs")));
+    assert!(
+        built >= sources,
+        "{} is older than the sources: run `cargo build --release` before the tests",
+        lib.display()
+    );
+    lib
+}
+
 /// Compiles `c_examples/<name>` with `compiler` and `flags`, links and runs it with `args`;
 /// returns stdout.
 fn build_and_run(name: &str, compiler: &str, flags: &[&str], args: &[&OsStr]) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let lib = profile_dir().join("libhairtrace.a");
-    assert!(
-        lib.exists(),
-        "{} not built: `cargo test` builds only the rlib; run `cargo build --release` first (the README's test command does)",
-        lib.display()
-    );
+    let lib = fresh_archive();
     let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{compiler}"));
     let out = Command::new(compiler)
         .args(flags)
@@ -51,6 +88,7 @@ fn build_and_run(name: &str, compiler: &str, flags: &[&str], args: &[&OsStr]) ->
         // Ends a `-x c++` so that the archive is not read as source.
         .args(["-x", "none"])
         .arg(&lib)
+        .args(embree_link())
         .args(NATIVE_LIBS)
         .arg("-o")
         .arg(&exe)

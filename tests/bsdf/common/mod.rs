@@ -1,7 +1,6 @@
 //! Shared helpers of the BSDF integration tests: an independent f64 reference of the hair
 //! model ([`reference`]), quadrature ([`quad`]), the chi-square harness ([`chi2`]) and
 //! direction helpers ([`sphere`]), plus the glue between them and the crate's f32 API.
-#![allow(dead_code)]
 
 pub mod chi2;
 pub mod quad;
@@ -128,11 +127,6 @@ pub fn random_h(g: &mut impl rand::Rng) -> f32 {
         1 => 1.0,
         _ => g.random_range(-1.0..=1.0),
     }
-}
-
-/// |a - b| within `rel` of |b|, or within `abs`.
-pub fn close(a: f64, b: f64, rel: f64, abs: f64) -> bool {
-    (a - b).abs() <= rel * b.abs() || (a - b).abs() <= abs
 }
 
 /// Maps `f` over `items` on all cores, keeping the order (deterministic as long as each

@@ -166,10 +166,6 @@ impl SphereRule {
         }
     }
 
-    pub fn len(&self) -> usize {
-        self.theta.len() * self.phi.len()
-    }
-
     /// Integral of f(direction) d omega over the sphere.
     pub fn integrate(&self, f: impl Fn([f64; 3]) -> f64) -> f64 {
         self.integrate_n(|w| [f(w)])[0]

@@ -89,8 +89,6 @@ pub struct Chi2Result {
     pub p_value: f64,
     /// Cells merged into the pool because their expected count was below the minimum.
     pub pooled_cells: usize,
-    /// Samples that fell in cells whose expected count is exactly zero.
-    pub impossible_samples: f64,
 }
 
 /// Pearson's chi-square of `observed` against `expected` counts. Cells are taken in
@@ -131,7 +129,6 @@ pub fn pearson(observed: &[f64], expected: &[f64], min_expected: f64) -> Chi2Res
         dof,
         p_value,
         pooled_cells: pooled,
-        impossible_samples: impossible,
     }
 }
 

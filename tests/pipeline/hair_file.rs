@@ -172,9 +172,9 @@ fn a_hand_made_file_reads_as_written() {
 #[test]
 fn fuzz_seeds_parse() {
     for seed in [
-        &include_bytes!("../fuzz/seeds/all_arrays.hair")[..],
-        include_bytes!("../fuzz/seeds/defaults.hair"),
-        include_bytes!("../fuzz/seeds/segments_thickness.hair"),
+        &include_bytes!("../../fuzz/seeds/all_arrays.hair")[..],
+        include_bytes!("../../fuzz/seeds/defaults.hair"),
+        include_bytes!("../../fuzz/seeds/segments_thickness.hair"),
     ] {
         parse_hair(seed, Thickness::Diameter).unwrap();
     }

@@ -33,7 +33,7 @@ fn header_matches_the_sources() {
             .unwrap_or(checked_in.lines().count().min(generated.lines().count()));
         panic!(
             "{} is out of date with the Rust sources (first difference at line {}).\n\
-             Regenerate it with:\n    HT_BLESS_HEADER=1 cargo test --release --test header\n\
+             Regenerate it with:\n    HT_BLESS_HEADER=1 cargo test --release --test c_abi header\n\
              and review the diff before committing.\n--- generated header ---\n{generated}",
             path.display(),
             first_difference + 1

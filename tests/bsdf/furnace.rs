@@ -2,12 +2,10 @@
 //! integral of f |wi.z| over the sphere is exactly 1 for every (h, wo) and roughness;
 //! with absorption it is sum_p A_p, strictly between 0 and 1.
 
-mod common;
-
-use common::quad::{SphereRule, gauss_legendre};
-use common::reference::RefHair;
-use common::sphere::uniform_sphere;
-use common::{Timer, bsdf, d3, dir_deg, par_map, params, reference, rng, v3};
+use crate::common::quad::{SphereRule, gauss_legendre};
+use crate::common::reference::RefHair;
+use crate::common::sphere::uniform_sphere;
+use crate::common::{Timer, bsdf, d3, dir_deg, par_map, params, reference, rng, v3};
 use hairtrace::HairBsdf;
 use rand::Rng;
 use std::f64::consts::PI;
@@ -119,7 +117,7 @@ fn absorbing_furnace_quadrature() {
     for (bm, bn) in [(0.1, 0.3), (0.5, 0.5), (0.9, 0.9)] {
         for (to, po) in WO_DEG {
             for h in [-0.9, 0.0, 0.5] {
-                let p = params(common::brown(), 1.55, bm, bn, 2.0);
+                let p = params(crate::common::brown(), 1.55, bm, bn, 2.0);
                 let r = reference(&p);
                 let wo = dir_deg(to, po);
                 let (f, pdf) = crate_integrals(&bsdf(&p), &r, h, wo);
@@ -155,8 +153,8 @@ fn monte_carlo_furnace() {
         (0.1, 0.1, [0.0; 3], 0.0, 100.0, 0.5),
         (0.3, 0.7, [0.0; 3], -60.0, 10.0, -0.9),
         (0.9, 0.3, [0.0; 3], 80.0, 170.0, 0.99),
-        (0.1, 0.3, common::brown(), 30.0, -135.0, -0.3),
-        (0.5, 0.5, common::brown(), 0.0, 100.0, 0.0),
+        (0.1, 0.3, crate::common::brown(), 30.0, -135.0, -0.3),
+        (0.5, 0.5, crate::common::brown(), 0.0, 100.0, 0.0),
         (0.3, 0.1, [0.2, 3.0, 0.0], -60.0, 10.0, 0.5),
     ];
     // Worst |mean - quadrature| as a fraction of the allowed 4 se + 1e-4.

@@ -4,13 +4,11 @@
 //! largest tilts) plus random inputs: every output finite and non-negative, and the f32
 //! evaluation accurate against the f64 reference wherever the inputs are well conditioned.
 
-mod common;
-
-use common::reference::RefHair;
-use common::sphere::{
+use crate::common::reference::RefHair;
+use crate::common::sphere::{
     dir, f32_step, normalize, round_f32, tilt, ulp_jitter, uniform_sphere, widen,
 };
-use common::{
+use crate::common::{
     Timer, bsdf, par_map, params, random_beta, random_params, random_sigma, random_u, reference,
     rng, v3f,
 };

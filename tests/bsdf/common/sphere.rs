@@ -62,12 +62,6 @@ pub fn tilt(v: [f64; 3], angle: f64, rng: &mut impl Rng) -> [f64; 3] {
     }
 }
 
-/// A random direction within `max_angle` of `v` (angle uniform in [0, max_angle]).
-pub fn near(v: [f64; 3], max_angle: f64, rng: &mut impl Rng) -> [f64; 3] {
-    let a = rng.random_range(0.0..=max_angle);
-    tilt(v, a, rng)
-}
-
 /// The f32 `steps` ulps away from x (negative steps go down); +-0 handled.
 pub fn f32_step(x: f32, steps: i32) -> f32 {
     let mut y = x;

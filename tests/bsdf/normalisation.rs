@@ -5,10 +5,8 @@
 //! residual at the roughest); the lobe must integrate to 1 over that whole span and at
 //! outgoing angles up to grazing the tangent.
 
-mod common;
-
-use common::quad::{gauss_legendre, integrate_1d};
-use common::reference as r;
+use crate::common::quad::{gauss_legendre, integrate_1d};
+use crate::common::reference as r;
 use hairtrace::bsdf::{LongitudinalLobe, longitudinal_variance};
 use hairtrace::math::bessel::i0_scaled;
 use std::f64::consts::FRAC_PI_2;
@@ -49,7 +47,7 @@ fn lobe_integral(m: impl Fn(f64) -> f64, theta_o: f64, v: f64) -> f64 {
 /// by up to ~1e-7 / v relative) while catching any normalisation-constant mistake.
 #[test]
 fn crate_longitudinal_lobe_integrates_to_one() {
-    let _t = common::Timer::start("crate_longitudinal_lobe_integrates_to_one");
+    let _t = crate::common::Timer::start("crate_longitudinal_lobe_integrates_to_one");
     let mut worst = (0.0f64, 0.0, 0.0);
     for v in variances() {
         let lobe = LongitudinalLobe::new(v as f32);

@@ -1,0 +1,6 @@
+//! The C ABI as a C or C++ host meets it: the generated header matches the sources, and the
+//! example programs compile as C99 and C++ with warnings as errors, link the static
+//! archive and run.
+
+mod c_examples;
+mod header;

@@ -1,0 +1,17 @@
+//! Everything between a groom and an image, end to end: grooms and .hair files, curves
+//! in Embree against analytic tubes, leaving fibres, lights, camera and film, scene files,
+//! image files, renders, the command line, and the layering of the sources. One test
+//! binary, so that the crate (with Embree and OpenImageIO) is linked once.
+
+mod architecture;
+mod camera_film;
+mod cli;
+mod curves_geometry;
+mod description;
+mod groom;
+mod hair_file;
+mod image_io;
+mod large_groom;
+mod lights;
+mod rehit;
+mod render;

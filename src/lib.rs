@@ -22,6 +22,7 @@ pub mod math;
 pub mod render;
 /// cbindgen:ignore
 pub mod scene;
+mod validate;
 
 pub use bsdf::{HairBsdf, HairEval, HairParams, HairPoint, HairSample};
 pub use error::{Error, Result};

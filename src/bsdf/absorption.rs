@@ -3,6 +3,7 @@
 
 use super::limits::check_beta;
 use crate::error::{Result, invalid_arg};
+use crate::validate::non_negative;
 
 /// Absorption of eumelanin and pheomelanin per unit concentration, linear RGB, per unit
 /// fiber radius (d'Eon et al. 2011, as used by Chiang et al. 2016 and pbrt).
@@ -12,11 +13,8 @@ const PHEOMELANIN_SIGMA_A: [f32; 3] = [0.187, 0.4, 1.05];
 /// sigma_a from eumelanin and pheomelanin concentrations (finite, >= 0). About 8 is jet
 /// black, 1.3 brown, 0.3 blonde; pheomelanin adds red.
 pub fn sigma_a_from_melanin(eumelanin: f32, pheomelanin: f32) -> Result<[f32; 3]> {
-    for (name, c) in [("eumelanin", eumelanin), ("pheomelanin", pheomelanin)] {
-        if !(c.is_finite() && c >= 0.0) {
-            return Err(invalid_arg!("{name} = {c}: must be finite and >= 0"));
-        }
-    }
+    non_negative("eumelanin", eumelanin)?;
+    non_negative("pheomelanin", pheomelanin)?;
     Ok(std::array::from_fn(|i| {
         eumelanin * EUMELANIN_SIGMA_A[i] + pheomelanin * PHEOMELANIN_SIGMA_A[i]
     }))

@@ -41,10 +41,6 @@ impl LongitudinalLobe {
         }
     }
 
-    pub fn variance(&self) -> f32 {
-        self.v
-    }
-
     /// The constants of four lobes side by side, for [`MpConstants`] over f32x4.
     pub(crate) fn pack(lobes: &[LongitudinalLobe; 4]) -> MpConstants<wide::f32x4> {
         MpConstants {

@@ -3,6 +3,7 @@
 use super::absorption::sigma_a_from_melanin;
 use super::limits::{ALPHA_MAX_DEG, ETA_MAX, check_beta};
 use crate::error::{Result, invalid_arg};
+use crate::validate::non_negative;
 
 /// Parameters of the Chiang 2016 hair model (units and ranges: docs/conventions.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,9 +42,7 @@ impl HairParams {
     /// Out-of-range values are refused rather than clamped, so a mistake is seen.
     pub fn validate(&self) -> Result<()> {
         for (c, &s) in self.sigma_a.iter().enumerate() {
-            if !(s.is_finite() && s >= 0.0) {
-                return Err(invalid_arg!("sigma_a[{c}] = {s}: must be finite and >= 0"));
-            }
+            non_negative(&format!("sigma_a[{c}]"), s)?;
         }
         if !(self.eta > 1.0 && self.eta <= ETA_MAX) {
             return Err(invalid_arg!(

@@ -15,6 +15,7 @@ use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::tracer::{Tracer, TracerBuilder};
+use crate::validate::{non_negative, positive};
 use std::sync::Arc;
 
 /// An Embree device: its thread pool builds the scenes made on it. Create one per
@@ -60,19 +61,13 @@ pub(super) struct Geometry {
 impl HtScene {
     /// The material `id` for a geometry; hair goes on curves, diffuse on meshes.
     pub(super) fn check_material(&self, id: u32, on_curves: bool) -> Result<()> {
-        match (self.materials.get(id as usize), on_curves) {
-            (None, _) => Err(invalid_arg!(
+        let material = self.materials.get(id as usize).ok_or_else(|| {
+            invalid_arg!(
                 "material_id = {id}: the scene has {} materials",
                 self.materials.len()
-            )),
-            (Some(Material::Hair(_)), true) | (Some(Material::Diffuse(_)), false) => Ok(()),
-            (Some(Material::Diffuse(_)), true) => Err(invalid_arg!(
-                "material_id = {id} is a diffuse material; curves need a hair material"
-            )),
-            (Some(Material::Hair(_)), false) => Err(invalid_arg!(
-                "material_id = {id} is a hair material; meshes need a diffuse material"
-            )),
-        }
+            )
+        })?;
+        material.check_suits(&format!("material_id = {id}"), on_curves)
     }
 
     pub(super) fn add_geometry(&mut self, shape: Shape, material: u32) -> Result<u32> {
@@ -267,17 +262,8 @@ pub extern "C" fn ht_scene_set_thin_lens(
     boundary(|| {
         let scene = scene_mut(scene)?;
         // Checked here, with the C names, rather than at the next render.
-        if !(aperture_radius.is_finite() && aperture_radius >= 0.0) {
-            return Err(invalid_arg!(
-                "aperture_radius = {aperture_radius}: must be finite and >= 0"
-            )
-            .into());
-        }
-        if !(focus_distance.is_finite() && focus_distance > 0.0) {
-            return Err(
-                invalid_arg!("focus_distance = {focus_distance}: must be finite and > 0").into(),
-            );
-        }
+        non_negative("aperture_radius", aperture_radius)?;
+        positive("focus_distance", focus_distance)?;
         scene.lens = Some((aperture_radius, focus_distance));
         Ok(())
     })

@@ -24,6 +24,7 @@ use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 use crate::scene::strands::Strands;
 use crate::scene::tracer::TracerBuilder;
+use crate::validate::positive;
 
 /// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
 /// from the true sphere by under 0.05% of its radius.
@@ -132,15 +133,8 @@ impl SceneDescription {
                 }
             )
         })?;
-        match (material, hair) {
-            (Material::Hair(_), true) | (Material::Diffuse(_), false) => Ok(material),
-            (Material::Diffuse(_), true) => Err(invalid_arg!(
-                "{name:?} is a diffuse material; grooms need a hair material"
-            )),
-            (Material::Hair(_), false) => Err(invalid_arg!(
-                "{name:?} is a hair material; meshes need a diffuse material"
-            )),
-        }
+        material.check_suits(&format!("{name:?}"), hair)?;
+        Ok(material)
     }
 
     /// `e` with this description's origin and the entry or key `at` in front, same kind.
@@ -178,12 +172,7 @@ impl Transform {
                 self.translate
             ));
         }
-        if !(self.scale.is_finite() && self.scale > 0.0) {
-            return Err(invalid_arg!(
-                "scale = {}: must be finite and > 0",
-                self.scale
-            ));
-        }
+        positive("scale", self.scale)?;
         if !self.rotate_y_deg.is_finite() {
             return Err(invalid_arg!(
                 "rotate_y_deg = {}: must be finite",
@@ -215,12 +204,7 @@ impl GroomDesc {
     /// The strands, transformed and with their radii scaled.
     pub(crate) fn strands(&self) -> Result<Strands> {
         let linear = self.transform.linear()?;
-        if !(self.radius_scale.is_finite() && self.radius_scale > 0.0) {
-            return Err(invalid_arg!(
-                "radius_scale = {}: must be finite and > 0",
-                self.radius_scale
-            ));
-        }
+        positive("radius_scale", self.radius_scale)?;
         let mut strands = match &self.source {
             GroomSource::File { path, thickness } => read_hair_file(path, *thickness)?,
             GroomSource::FurBall(f) => f.build()?,

@@ -716,10 +716,7 @@ mod tests {
                     let segments = basis.segments_for(points.len()).unwrap();
                     let stride = basis.segment_stride() as u32;
                     let indices = (0..segments as u32).map(|i| i * stride).collect();
-                    let options = SceneOptions {
-                        compact: true,
-                        ..SceneOptions::default()
-                    };
+                    let options = SceneOptions { compact: true };
                     let mut scene = SceneBuilder::new(device.clone(), options).unwrap();
                     // SAFETY: `guarded` outlives the scene and is not modified.
                     let vertices =

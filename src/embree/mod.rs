@@ -30,7 +30,7 @@ pub use geometry::{
 };
 pub use memory::MemoryMonitor;
 pub use query::{Exclude, Ray, RayHit};
-pub use scene::{BuildQuality, Scene, SceneBuilder, SceneOptions};
+pub use scene::{Scene, SceneBuilder, SceneOptions};
 
 /// The Embree version hairtrace was built against, as `major.minor.patch`, read from the
 /// installed `rtcore_config.h` at build time.

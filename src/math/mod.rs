@@ -8,6 +8,14 @@ pub mod sampling;
 
 pub use lanes::Lanes;
 
+/// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,
+/// such as neighbouring pixels or strand ids, get unrelated hashes.
+pub fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
 /// Rec. 709 luminance of linear RGB: the weight of a colour for importance sampling.
 pub fn luminance(rgb: glam::Vec3) -> f32 {
     rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722))

@@ -16,22 +16,12 @@ pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Pdf of [`uniform_sphere`] per unit solid angle.
 pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
-/// Pdf of [`uniform_hemisphere`] per unit solid angle.
-pub const UNIFORM_HEMISPHERE_PDF: f32 = 1.0 / (2.0 * PI);
 
 /// A direction uniformly distributed over the unit sphere.
 pub fn uniform_sphere(u: [f32; 2]) -> Vec3 {
     let z = 1.0 - 2.0 * u[0];
     // (1 - z)(1 + z) rather than 1 - z^2: no cancellation near the poles.
     let r = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
-    let phi = 2.0 * PI * u[1];
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
-}
-
-/// A direction uniformly distributed over the hemisphere z >= 0.
-pub fn uniform_hemisphere(u: [f32; 2]) -> Vec3 {
-    let z = 1.0 - u[0];
-    let r = (u[0] * (2.0 - u[0])).max(0.0).sqrt();
     let phi = 2.0 * PI * u[1];
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
@@ -320,19 +310,10 @@ mod tests {
     }
 
     #[test]
-    fn sphere_and_hemisphere() {
+    fn uniform_sphere_matches_its_pdf() {
         let sphere = |_: Vec3| UNIFORM_SPHERE_PDF;
-        let hemi = |w: Vec3| {
-            if w.z >= 0.0 {
-                UNIFORM_HEMISPHERE_PDF
-            } else {
-                0.0
-            }
-        };
         assert_pdf_integrates_to_one(sphere);
-        assert_pdf_integrates_to_one(hemi);
         assert_warp_matches(uniform_sphere, sphere);
-        assert_warp_matches(uniform_hemisphere, hemi);
     }
 
     #[test]

@@ -20,6 +20,7 @@ use crate::scene::hit::{HairFrame, HairHit, Hit, SurfaceHit};
 use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::tracer::{SpawnedRay, Tracer};
+use crate::validate::positive;
 
 /// How a path's light is gathered. `Mis` is the renderer; the two others exist so that
 /// tests can show MIS is unbiased (all three converge to the same image).
@@ -122,9 +123,7 @@ impl PathSettings {
             ));
         }
         if let Some(c) = self.clamp_indirect {
-            if !(c.is_finite() && c > 0.0) {
-                return Err(invalid_arg!("clamp_indirect = {c}: must be finite and > 0"));
-            }
+            positive("clamp_indirect", c)?;
         }
         Ok(())
     }

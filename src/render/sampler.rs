@@ -5,11 +5,13 @@
 //! which the path asks for them): never on the thread, the tile order or the crop, so
 //! renders are reproducible bit for bit and crops assemble into the full frame.
 //!
-//! Each request (`next_1d`, `next_2d`, `next_3d`) takes the first dimensions of its own
+//! Each request (`next_1d`, `next_2d`) takes the first dimensions of its own
 //! independently scrambled sequence, seeded from the pixel and the request's position
 //! ("padding", as pbrt-v4's PaddedSobolSampler does): every 2D request (a lens point, a
 //! light sample) is stratified across the pixel's samples, requests never correlate with
 //! each other, and a path may ask for any number of them, as deep hair paths do.
+
+use crate::math::mix64;
 
 /// `sobol_burley` holds 2^16 samples per sequence; past that, blocks of 2^16 get their own
 /// scramble, which keeps values valid and independent (only the stratification across
@@ -34,7 +36,7 @@ impl PixelSampler {
         let pixel_key = (u64::from(pixel.0) << 32) | u64::from(pixel.1);
         let block = u64::from(sample_index >> BLOCK_BITS);
         Self {
-            seed: mix(mix(mix(seed) ^ pixel_key) ^ block),
+            seed: mix64(mix64(mix64(seed) ^ pixel_key) ^ block),
             index: sample_index & ((1 << BLOCK_BITS) - 1),
             request: 0,
         }
@@ -42,7 +44,7 @@ impl PixelSampler {
 
     /// The scramble of the next request's sequence.
     fn next_sequence(&mut self) -> u32 {
-        let s = mix(self.seed ^ u64::from(self.request));
+        let s = mix64(self.seed ^ u64::from(self.request));
         self.request = self.request.wrapping_add(1);
         (s >> 32) as u32
     }
@@ -67,21 +69,6 @@ impl PixelSampler {
     pub fn skip(&mut self) {
         self.request = self.request.wrapping_add(1);
     }
-
-    /// Three numbers in [0, 1), jointly stratified (what the hair BSDF's sample takes).
-    pub fn next_3d(&mut self) -> [f32; 3] {
-        let s = self.next_sequence();
-        let v = sobol_burley::sample_4d(self.index, 0, s);
-        [v[0], v[1], v[2]]
-    }
-}
-
-/// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,
-/// such as neighbouring pixels, get unrelated seeds.
-fn mix(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 #[cfg(test)]
@@ -108,8 +95,8 @@ mod tests {
             let mut s = PixelSampler::new(seed, pixel, i);
             let a = s.next_1d();
             let [b, c] = s.next_2d();
-            let [d, e, f] = s.next_3d();
-            [a, b, c, d, e, f]
+            let [d, e] = s.next_2d();
+            [a, b, c, d, e]
         };
         for i in [0, 1, 17, 65_535, 65_536, 1 << 20, u32::MAX] {
             let v = draw(42, (3, 9), i);

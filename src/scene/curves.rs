@@ -31,6 +31,7 @@ use std::ops::Range;
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer, padding_for};
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
+use crate::validate;
 
 /// Curves ready for Embree: control points, index buffer and strand table.
 #[derive(Debug, Clone, PartialEq)]
@@ -99,15 +100,7 @@ impl StrandIndex {
                     c.len()
                 ));
             }
-            if let Some(i) = c
-                .iter()
-                .position(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0))
-            {
-                return Err(invalid_arg!(
-                    "colour {i} = {:?}: must be finite and >= 0",
-                    c[i]
-                ));
-            }
+            validate::colors(c)?;
         }
         Ok(index)
     }
@@ -133,12 +126,6 @@ impl StrandIndex {
             segments: self.segment_starts[strand + 1] - first_prim,
             first_prim,
         })
-    }
-
-    /// The segments of `strand`, as primitive ids.
-    pub fn strand_prims(&self, strand: u32) -> Option<Range<u32>> {
-        let s = strand as usize;
-        (s < self.strand_count()).then(|| self.segment_starts[s]..self.segment_starts[s + 1])
     }
 
     /// The colour at parameter u of segment `at`, if the curves have colours.
@@ -420,7 +407,7 @@ mod tests {
         );
         assert_eq!(idx.color(&at, 0.25), Some([0.75; 3]));
         assert_eq!(idx.locate(3), None);
-        assert_eq!(idx.strand_prims(1), Some(2..3));
+        assert_eq!(idx.locate(2).unwrap().prims(), 2..3);
     }
 
     #[test]

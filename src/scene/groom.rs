@@ -8,12 +8,14 @@
 
 use super::strands::Strands;
 use crate::error::{Result, invalid_arg};
+use crate::validate::{non_negative, positive};
 use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 /// Most control points a procedural groom may have: 2^28 points take 4 GiB as points and
-/// radii, a sixth of this machine class's memory; more is surely a mistake in the inputs.
+/// radii, as much as a workstation can spare for one groom; more is surely a mistake in
+/// the inputs.
 pub const MAX_GROOM_POINTS: usize = 1 << 28;
 /// Bytes per control point in [`Strands`] without colours (xyz + radius).
 const BYTES_PER_POINT: usize = 16;
@@ -129,22 +131,6 @@ impl Default for ScalpPatch {
             gravity: 3.0,
             seed: 0,
         }
-    }
-}
-
-fn positive(what: &str, v: f32) -> Result<()> {
-    if v.is_finite() && v > 0.0 {
-        Ok(())
-    } else {
-        Err(invalid_arg!("{what} = {v}: must be finite and > 0"))
-    }
-}
-
-fn non_negative(what: &str, v: f32) -> Result<()> {
-    if v.is_finite() && v >= 0.0 {
-        Ok(())
-    } else {
-        Err(invalid_arg!("{what} = {v}: must be finite and >= 0"))
     }
 }
 

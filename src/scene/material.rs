@@ -4,12 +4,30 @@
 use crate::bsdf::diffuse::Diffuse;
 use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
 use crate::error::{Result, invalid_arg};
+use crate::math::mix64;
+use crate::validate::positive;
 
 /// What a geometry is made of. A hair material holds its prepared BSDF, hence the box.
 #[derive(Debug, Clone)]
 pub enum Material {
     Hair(Box<PreparedHair>),
     Diffuse(Diffuse),
+}
+
+impl Material {
+    /// Checks that the material suits the geometry: hair on curves (`on_curves`), diffuse
+    /// on meshes. `what` names the material in the error.
+    pub fn check_suits(&self, what: &str, on_curves: bool) -> Result<()> {
+        match (self, on_curves) {
+            (Material::Hair(_), true) | (Material::Diffuse(_), false) => Ok(()),
+            (Material::Diffuse(_), true) => Err(invalid_arg!(
+                "{what} is a diffuse material; curves need a hair material"
+            )),
+            (Material::Hair(_), false) => Err(invalid_arg!(
+                "{what} is a hair material; meshes need a diffuse material"
+            )),
+        }
+    }
 }
 
 /// Where a hair material's absorption comes from.
@@ -106,12 +124,7 @@ impl HairMaterial {
                 return Err(invalid_arg!("{name} = {v}: must be in [0, 1]"));
             }
         }
-        if !(self.tip_absorption.is_finite() && self.tip_absorption > 0.0) {
-            return Err(invalid_arg!(
-                "tip_absorption = {}: must be finite and > 0",
-                self.tip_absorption
-            ));
-        }
+        positive("tip_absorption", self.tip_absorption)?;
         let varies = self.absorption_variation > 0.0
             || self.roughness_variation > 0.0
             || self.tip_absorption != 1.0
@@ -178,11 +191,7 @@ impl PreparedHair {
 
 /// Two uniform numbers in [0, 1) for a strand, from a 64-bit mix of (seed, strand).
 fn strand_uniforms(seed: u64, strand: u32) -> [f32; 2] {
-    let mut x = seed ^ (u64::from(strand).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    // SplitMix64 finaliser: every input bit affects every output bit.
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x ^= x >> 31;
+    let x = mix64(seed ^ (u64::from(strand).wrapping_mul(0x9E37_79B9_7F4A_7C15)));
     [
         (x >> 40) as f32 / (1u64 << 24) as f32,
         ((x >> 16) & 0xFF_FFFF) as f32 / (1u64 << 24) as f32,

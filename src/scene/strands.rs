@@ -1,6 +1,7 @@
 //! A groom as plain data: control points of many strands, concatenated.
 
 use crate::error::{Result, invalid_arg};
+use crate::validate;
 
 /// Strands of control points. Radii are radii (not the diameters that USD, Alembic and
 /// .hair thickness use), one per control point.
@@ -101,15 +102,7 @@ impl Strands {
                     self.points.len()
                 ));
             }
-            if let Some(i) = colors
-                .iter()
-                .position(|c| !c.iter().all(|v| v.is_finite() && *v >= 0.0))
-            {
-                return Err(invalid_arg!(
-                    "colour {i} = {:?}: must be finite and >= 0",
-                    colors[i]
-                ));
-            }
+            validate::colors(colors)?;
         }
         Ok(())
     }

@@ -174,7 +174,7 @@ impl Tracer {
     }
 
     /// The ray that continues a path from `from` along `dir` up to `tfar`, leaving the fiber
-    /// the default way ([`Escape::Filter`]).
+    /// the default way ([`Escape::ExitAndFilter`]).
     pub fn spawn(&self, from: &Hit, dir: Vec3, tfar: f32) -> SpawnedRay {
         self.spawn_with(from, dir, tfar, Escape::default())
     }

@@ -24,7 +24,7 @@ pub mod render;
 pub mod scene;
 mod validate;
 
-pub use bsdf::{HairBsdf, HairEval, HairParams, HairPoint, HairSample};
+pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, LocalBsdf};
 pub use error::{Error, Result};
 
 /// The crate version, as the C ABI reports it.

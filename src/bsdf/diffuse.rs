@@ -9,6 +9,7 @@ use std::f32::consts::FRAC_1_PI;
 
 use glam::Vec3;
 
+use super::{BsdfEval, BsdfSample, LocalBsdf};
 use crate::Result;
 use crate::error::invalid_arg;
 use crate::math::sampling::{cosine_hemisphere, cosine_hemisphere_pdf};
@@ -36,32 +37,56 @@ impl Diffuse {
         self.albedo
     }
 
-    /// `(f, pdf)` for unit `wo`, `wi`: albedo / pi and the cosine-weighted pdf when both
-    /// are on the same side of the surface, zero otherwise.
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
-        if wo.z * wi.z > 0.0 {
-            (self.albedo * FRAC_1_PI, cosine_hemisphere_pdf(wi.z.abs()))
+    /// The BRDF seen from `wo` (local frame, z the shading normal).
+    pub fn at(&self, wo: Vec3) -> DiffusePoint {
+        DiffusePoint { bsdf: *self, wo }
+    }
+}
+
+/// [`Diffuse`] at a fixed `wo`; see [`Diffuse::at`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DiffusePoint {
+    bsdf: Diffuse,
+    wo: Vec3,
+}
+
+impl LocalBsdf for DiffusePoint {
+    /// Albedo / pi and the cosine-weighted pdf when `wo` and `wi` are on the same side of
+    /// the surface, zero otherwise.
+    fn eval(&self, wi: Vec3) -> BsdfEval {
+        if self.wo.z * wi.z > 0.0 {
+            BsdfEval {
+                f: self.bsdf.albedo * FRAC_1_PI,
+                pdf: cosine_hemisphere_pdf(wi.z.abs()),
+            }
         } else {
-            (Vec3::ZERO, 0.0)
+            BsdfEval {
+                f: Vec3::ZERO,
+                pdf: 0.0,
+            }
         }
     }
 
-    /// A cosine-weighted direction on `wo`'s side: `(wi, f, pdf)`, whose weight
-    /// `f * |wi.z| / pdf` is exactly the albedo. `None` when `wo` lies in the surface
-    /// plane or the sample grazes it (pdf 0).
-    pub fn sample(&self, wo: Vec3, u: [f32; 2]) -> Option<(Vec3, Vec3, f32)> {
-        if wo.z == 0.0 {
+    /// A cosine-weighted direction on `wo`'s side from `u[1]` and `u[2]` (one lobe: `u[0]`
+    /// is not needed), whose weight `f * |wi.z| / pdf` is exactly the albedo. `None` when
+    /// `wo` lies in the surface plane or the sample grazes it (pdf 0).
+    fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        if self.wo.z == 0.0 {
             return None;
         }
-        let mut wi = cosine_hemisphere(u);
+        let mut wi = cosine_hemisphere([u[1], u[2]]);
         if wi.z <= 0.0 {
             return None;
         }
         let pdf = cosine_hemisphere_pdf(wi.z);
-        if wo.z < 0.0 {
+        if self.wo.z < 0.0 {
             wi.z = -wi.z;
         }
-        Some((wi, self.albedo * FRAC_1_PI, pdf))
+        Some(BsdfSample {
+            wi,
+            f: self.bsdf.albedo * FRAC_1_PI,
+            pdf,
+        })
     }
 }
 
@@ -85,7 +110,7 @@ mod tests {
         let n = 400_000;
         for wo in [Vec3::Z, Vec3::new(0.6, 0.0, -0.8)] {
             let sum: Vec3 = directions(1, n)
-                .map(|wi| bsdf.eval(wo, wi).0 * wi.z.abs() / UNIFORM_SPHERE_PDF)
+                .map(|wi| bsdf.at(wo).eval(wi).f * wi.z.abs() / UNIFORM_SPHERE_PDF)
                 .sum();
             let estimate = sum / n as f32;
             // Relative standard error of this estimator is about 1 / sqrt(n) = 0.0016.
@@ -101,25 +126,31 @@ mod tests {
         let bsdf = Diffuse::new(ALBEDO).unwrap();
         let mut rng = Pcg64::seed_from_u64(2);
         for wo in directions(3, 2000) {
-            let Some((wi, f, pdf)) = bsdf.sample(wo, [rng.random(), rng.random()]) else {
+            let Some(BsdfSample { wi, f, pdf }) =
+                bsdf.at(wo).sample([0.0, rng.random(), rng.random()])
+            else {
                 continue;
             };
             assert!((wi.length() - 1.0).abs() < 1e-5);
             assert!(wi.z * wo.z > 0.0, "wi {wi} on the other side of wo {wo}");
             let weight = f * wi.z.abs() / pdf;
             assert!((weight - ALBEDO).abs().max_element() < 1e-5, "{weight}");
-            let (fe, pe) = bsdf.eval(wo, wi);
-            assert_eq!(fe, f);
-            assert!((pe - pdf).abs() <= 1e-6 * pdf);
+            let e = bsdf.at(wo).eval(wi);
+            assert_eq!(e.f, f);
+            assert!((e.pdf - pdf).abs() <= 1e-6 * pdf);
         }
     }
 
     #[test]
     fn opposite_sides_and_grazing_are_zero_and_bad_albedo_is_an_error() {
         let bsdf = Diffuse::new(Vec3::ONE).unwrap();
-        assert_eq!(bsdf.eval(Vec3::Z, -Vec3::Z), (Vec3::ZERO, 0.0));
-        assert_eq!(bsdf.eval(Vec3::X, Vec3::Z), (Vec3::ZERO, 0.0));
-        assert!(bsdf.sample(Vec3::X, [0.3, 0.3]).is_none());
+        let zero = BsdfEval {
+            f: Vec3::ZERO,
+            pdf: 0.0,
+        };
+        assert_eq!(bsdf.at(Vec3::Z).eval(-Vec3::Z), zero);
+        assert_eq!(bsdf.at(Vec3::X).eval(Vec3::Z), zero);
+        assert!(bsdf.at(Vec3::X).sample([0.0, 0.3, 0.3]).is_none());
         for bad in [
             Vec3::new(1.1, 0.0, 0.0),
             Vec3::new(-0.1, 0.0, 0.0),

@@ -14,6 +14,7 @@
 use super::azimuthal::{TrimmedLogistic, azimuthal_scale, wrap_angle};
 use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
 use super::params::HairParams;
+use super::{BsdfEval, BsdfSample, LocalBsdf};
 use crate::error::{Result, invalid_arg};
 use crate::math::fast::atan2;
 use crate::math::{Lanes, safe_asin, safe_sqrt};
@@ -26,23 +27,6 @@ const EXPLICIT_LOBES: usize = 3;
 /// Below this |wi.z| the 1/|wi.z| factor is skipped, as pbrt does at exactly zero; the
 /// threshold keeps f finite for every unit wi (the largest lobe value is ~1e7).
 const MIN_COS_WI: f32 = 1e-20;
-
-/// The value of the BSDF for a pair of directions.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HairEval {
-    /// RGB; `f * |wi.z|` is the scattered fraction per unit solid angle.
-    pub f: Vec3,
-    /// Density of [`HairBsdf::sample`] at wi, per unit solid angle.
-    pub pdf: f32,
-}
-
-/// A sampled incident direction with the BSDF value and density there.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HairSample {
-    pub wi: Vec3,
-    pub f: Vec3,
-    pub pdf: f32,
-}
 
 /// The hair BSDF for one parameter set, with every parameter-only constant precomputed.
 #[derive(Debug, Clone, PartialEq)]
@@ -104,7 +88,7 @@ impl HairBsdf {
     }
 
     /// f and pdf for outgoing wo and incident wi (unit vectors, local frame), h in [-1, 1].
-    pub fn eval(&self, h: f32, wo: Vec3, wi: Vec3) -> HairEval {
+    pub fn eval(&self, h: f32, wo: Vec3, wi: Vec3) -> BsdfEval {
         self.at(h, wo).eval(wi)
     }
 
@@ -122,7 +106,7 @@ impl HairBsdf {
     /// Samples wi: `u[0]` picks the lobe (proportionally to its mean attenuation) and is
     /// then reused, rescaled, for the azimuth; `u[1]` and `u[2]` sample the longitudinal lobe.
     /// Returns None only when the density at the sampled direction is zero.
-    pub fn sample(&self, h: f32, wo: Vec3, u: [f32; 3]) -> Option<HairSample> {
+    pub fn sample(&self, h: f32, wo: Vec3, u: [f32; 3]) -> Option<BsdfSample> {
         self.at(h, wo).sample(u)
     }
 
@@ -301,6 +285,16 @@ impl HairBsdf {
     }
 }
 
+impl LocalBsdf for HairPoint<'_> {
+    fn eval(&self, wi: Vec3) -> BsdfEval {
+        HairPoint::eval(self, wi)
+    }
+
+    fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        HairPoint::sample(self, u)
+    }
+}
+
 /// [`HairBsdf`] at a fixed (h, wo); see [`HairBsdf::at`].
 pub struct HairPoint<'a> {
     bsdf: &'a HairBsdf,
@@ -310,16 +304,16 @@ pub struct HairPoint<'a> {
 
 impl HairPoint<'_> {
     /// f and pdf for the incident direction wi.
-    pub fn eval(&self, wi: Vec3) -> HairEval {
+    pub fn eval(&self, wi: Vec3) -> BsdfEval {
         let (f, pdf) = self.bsdf.eval_lobes_packed(&self.o, self.wo, wi.to_array());
-        HairEval {
+        BsdfEval {
             f: Vec3::from_array(f),
             pdf,
         }
     }
 
     /// Samples wi; see [`HairBsdf::sample`].
-    pub fn sample(&self, u: [f32; 3]) -> Option<HairSample> {
+    pub fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
         let (bsdf, o, wo) = (self.bsdf, &self.o, self.wo);
         let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
         // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
@@ -352,7 +346,7 @@ impl HairPoint<'_> {
             cos_ti * (sin_po * cos_d + cos_po * sin_d),
         );
         let e = self.eval(wi);
-        (e.pdf > 0.0).then_some(HairSample {
+        (e.pdf > 0.0).then_some(BsdfSample {
             wi,
             f: e.f,
             pdf: e.pdf,

@@ -12,6 +12,38 @@ pub mod params;
 
 pub use absorption::{sigma_a_from_color, sigma_a_from_melanin};
 pub use diffuse::Diffuse;
-pub use hair::{HairBsdf, HairEval, HairPoint, HairSample};
+pub use diffuse::DiffusePoint;
+pub use hair::{HairBsdf, HairPoint};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
 pub use params::HairParams;
+
+use glam::Vec3;
+
+/// The value of a BSDF for a pair of directions, in its local frame.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfEval {
+    /// RGB; includes 1/|wi.z|, so `f * |wi.z|` is the scattered fraction per unit solid
+    /// angle.
+    pub f: Vec3,
+    /// Density of the BSDF's sampling at wi, per unit solid angle.
+    pub pdf: f32,
+}
+
+/// A sampled incident direction with the BSDF's value and density there; `f * |wi.z| /
+/// pdf` is the path weight.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    pub f: Vec3,
+    pub pdf: f32,
+}
+
+/// A BSDF at one shading point, its outgoing direction (and, for hair, h) fixed: what a
+/// path vertex evaluates toward lights and samples to go on, in the local frame.
+pub trait LocalBsdf {
+    /// f and pdf toward the unit direction `wi`.
+    fn eval(&self, wi: Vec3) -> BsdfEval;
+    /// A direction drawn from `u` in [0, 1)^3 (`u[0]` picks among lobes where there are
+    /// several); None where the density is zero.
+    fn sample(&self, u: [f32; 3]) -> Option<BsdfSample>;
+}

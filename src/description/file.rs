@@ -412,21 +412,39 @@ impl RawMaterial {
                 }))
             }
             MaterialKind::Diffuse => {
+                // Spelt out without `..`: a key added to RawMaterial does not compile
+                // until it is placed on one side or the other here.
+                let RawMaterial {
+                    kind: _,
+                    albedo: _,
+                    sigma_a,
+                    melanin,
+                    color,
+                    eta,
+                    beta_m,
+                    beta_n,
+                    alpha,
+                    absorption_variation,
+                    roughness_variation,
+                    tip_absorption,
+                    use_vertex_colors,
+                    seed,
+                } = &self;
                 reject(
                     "a diffuse material",
                     &[
-                        ("sigma_a", self.sigma_a.is_some()),
-                        ("melanin", self.melanin.is_some()),
-                        ("color", self.color.is_some()),
-                        ("eta", self.eta.is_some()),
-                        ("beta_m", self.beta_m.is_some()),
-                        ("beta_n", self.beta_n.is_some()),
-                        ("alpha", self.alpha.is_some()),
-                        ("absorption_variation", self.absorption_variation.is_some()),
-                        ("roughness_variation", self.roughness_variation.is_some()),
-                        ("tip_absorption", self.tip_absorption.is_some()),
-                        ("use_vertex_colors", self.use_vertex_colors.is_some()),
-                        ("seed", self.seed.is_some()),
+                        ("sigma_a", sigma_a.is_some()),
+                        ("melanin", melanin.is_some()),
+                        ("color", color.is_some()),
+                        ("eta", eta.is_some()),
+                        ("beta_m", beta_m.is_some()),
+                        ("beta_n", beta_n.is_some()),
+                        ("alpha", alpha.is_some()),
+                        ("absorption_variation", absorption_variation.is_some()),
+                        ("roughness_variation", roughness_variation.is_some()),
+                        ("tip_absorption", tip_absorption.is_some()),
+                        ("use_vertex_colors", use_vertex_colors.is_some()),
+                        ("seed", seed.is_some()),
                     ],
                 )?;
                 Ok(MaterialDesc::Diffuse {

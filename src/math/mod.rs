@@ -3,9 +3,11 @@
 
 pub mod bessel;
 pub mod fast;
+pub mod frame;
 pub mod lanes;
 pub mod sampling;
 
+pub use frame::Frame;
 pub use lanes::Lanes;
 
 /// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,

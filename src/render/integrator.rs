@@ -11,12 +11,12 @@ use super::film::FirstHit;
 use super::sampler::PixelSampler;
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
-use crate::bsdf::{HairBsdf, HairPoint};
+use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, LocalBsdf};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
-use crate::math::luminance;
 use crate::math::sampling::{Distribution1D, power_heuristic};
-use crate::scene::hit::{HairFrame, HairHit, Hit, SurfaceHit};
+use crate::math::{Frame, luminance};
+use crate::scene::hit::{HairHit, Hit, SurfaceHit};
 use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::tracer::{SpawnedRay, Tracer};
@@ -383,64 +383,54 @@ impl World {
     }
 }
 
-/// A BSDF at a path vertex with its local frame. A hair point holds the work that
-/// depends on (h, wo) only, shared by next-event estimation and BSDF sampling.
-enum Shading<'a> {
-    Hair {
-        frame: HairFrame,
-        point: HairPoint<'a>,
-    },
-    Diffuse {
-        frame: [Vec3; 3],
-        bsdf: Diffuse,
-        wo: Vec3,
-    },
+/// A BSDF at a path vertex with its local frame: world directions go through the frame
+/// once, here, whatever the material.
+struct Shading<'a> {
+    frame: Frame,
+    point: Point<'a>,
+}
+
+/// The BSDF at the vertex, its (h, wo) work done once and shared by next-event estimation
+/// and BSDF sampling.
+enum Point<'a> {
+    Hair(HairPoint<'a>),
+    Diffuse(DiffusePoint),
 }
 
 impl<'a> Shading<'a> {
     fn hair(h: &HairHit, bsdf: &'a HairBsdf, wo_world: Vec3) -> Self {
-        Shading::Hair {
+        Shading {
             frame: h.frame,
-            point: bsdf.at(h.h, h.frame.to_local(wo_world)),
+            point: Point::Hair(bsdf.at(h.h, h.frame.to_local(wo_world))),
         }
     }
 
     fn diffuse(s: &SurfaceHit, bsdf: Diffuse, wo_world: Vec3) -> Self {
-        let (t, b) = s.ns.any_orthonormal_pair();
-        let frame = [t, b, s.ns];
-        let wo = Vec3::new(wo_world.dot(t), wo_world.dot(b), wo_world.dot(s.ns));
-        Shading::Diffuse { frame, bsdf, wo }
+        let frame = Frame::from_z(s.ns);
+        Shading {
+            frame,
+            point: Point::Diffuse(bsdf.at(frame.to_local(wo_world))),
+        }
+    }
+
+    fn local(&self) -> &dyn LocalBsdf {
+        match &self.point {
+            Point::Hair(p) => p,
+            Point::Diffuse(p) => p,
+        }
     }
 
     /// f * |cos| and the BSDF pdf toward the world direction wi.
     fn eval(&self, wi: Vec3) -> (Vec3, f32) {
-        match self {
-            Shading::Hair { frame, point } => {
-                let local = frame.to_local(wi);
-                let e = point.eval(local);
-                (e.f * local.z.abs(), e.pdf)
-            }
-            Shading::Diffuse { frame, bsdf, wo } => {
-                let local = Vec3::new(wi.dot(frame[0]), wi.dot(frame[1]), wi.dot(frame[2]));
-                let (f, pdf) = bsdf.eval(*wo, local);
-                (f * local.z.abs(), pdf)
-            }
-        }
+        let local = self.frame.to_local(wi);
+        let e = self.local().eval(local);
+        (e.f * local.z.abs(), e.pdf)
     }
 
     /// A world direction, its path weight f |cos| / pdf and its pdf.
     fn sample(&self, u: [f32; 3]) -> Option<(Vec3, Vec3, f32)> {
-        match self {
-            Shading::Hair { frame, point } => {
-                let s = point.sample(u)?;
-                Some((frame.to_world(s.wi), s.f * s.wi.z.abs() / s.pdf, s.pdf))
-            }
-            Shading::Diffuse { frame, bsdf, wo } => {
-                let (wi, f, pdf) = bsdf.sample(*wo, [u[1], u[2]])?;
-                let world = frame[0] * wi.x + frame[1] * wi.y + frame[2] * wi.z;
-                Some((world, f * wi.z.abs() / pdf, pdf))
-            }
-        }
+        let s = self.local().sample(u)?;
+        Some((self.frame.to_world(s.wi), s.f * s.wi.z.abs() / s.pdf, s.pdf))
     }
 }
 

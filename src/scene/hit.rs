@@ -10,68 +10,44 @@ use glam::{DVec3, Vec3};
 
 use super::curves::StrandSegment;
 use crate::embree::CurveShape;
+use crate::math::Frame;
 
-/// The local frame of a hair hit: x the tangent (root to tip), y = normalize(cross(x, d))
-/// for the ray direction d, z = cross(x, y), facing back toward the viewer (z . d <= 0).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HairFrame {
-    pub x: Vec3,
-    pub y: Vec3,
-    pub z: Vec3,
-}
-
-impl HairFrame {
-    /// The frame for `tangent` (any length) and ray direction `dir`, with the offset h of
-    /// the ray from the axis point `axis` in units of `radius`, clamped to [-1, 1].
-    ///
-    /// Degenerate input never gives NaN: a zero tangent becomes a direction perpendicular
-    /// to the ray, and a ray along the tangent gets an arbitrary y perpendicular to x
-    /// (every y is then equally valid: the ray sees the fiber end-on).
-    pub fn with_offset(
-        tangent: Vec3,
-        dir: Vec3,
-        org: Vec3,
-        axis: Vec3,
-        radius: f32,
-    ) -> (HairFrame, f32) {
-        let d = dir.as_dvec3();
-        let x = tangent.as_dvec3().try_normalize().unwrap_or_else(|| {
-            d.try_normalize()
-                .unwrap_or(DVec3::Z)
-                .any_orthonormal_vector()
-        });
-        let y = x
-            .cross(d)
-            .try_normalize()
-            .unwrap_or_else(|| x.any_orthonormal_vector());
-        let z = x.cross(y);
-        let h = if radius > 0.0 {
-            let offset = (org.as_dvec3() - axis.as_dvec3()).dot(y) / f64::from(radius);
-            if offset.is_finite() {
-                offset.clamp(-1.0, 1.0) as f32
-            } else {
-                0.0
-            }
+/// The local frame of a hair hit and the ray's offset h across the fibre: x the tangent
+/// (root to tip), y = normalize(cross(x, d)) for the ray direction d, z = cross(x, y),
+/// facing back toward the viewer (z . d <= 0); h the offset of the ray from the axis point
+/// `axis` along y in units of `radius`, clamped to [-1, 1].
+///
+/// Degenerate input never gives NaN: a zero tangent becomes a direction perpendicular
+/// to the ray, and a ray along the tangent gets an arbitrary y perpendicular to x
+/// (every y is then equally valid: the ray sees the fiber end-on).
+pub fn hair_frame(tangent: Vec3, dir: Vec3, org: Vec3, axis: Vec3, radius: f32) -> (Frame, f32) {
+    let d = dir.as_dvec3();
+    let x = tangent.as_dvec3().try_normalize().unwrap_or_else(|| {
+        d.try_normalize()
+            .unwrap_or(DVec3::Z)
+            .any_orthonormal_vector()
+    });
+    let y = x
+        .cross(d)
+        .try_normalize()
+        .unwrap_or_else(|| x.any_orthonormal_vector());
+    let z = x.cross(y);
+    let h = if radius > 0.0 {
+        let offset = (org.as_dvec3() - axis.as_dvec3()).dot(y) / f64::from(radius);
+        if offset.is_finite() {
+            offset.clamp(-1.0, 1.0) as f32
         } else {
             0.0
-        };
-        let frame = HairFrame {
-            x: x.as_vec3(),
-            y: y.as_vec3(),
-            z: z.as_vec3(),
-        };
-        (frame, h)
-    }
-
-    /// A world direction in the BSDF's local frame.
-    pub fn to_local(&self, w: Vec3) -> Vec3 {
-        Vec3::new(w.dot(self.x), w.dot(self.y), w.dot(self.z))
-    }
-
-    /// A local direction back in world space.
-    pub fn to_world(&self, l: Vec3) -> Vec3 {
-        self.x * l.x + self.y * l.y + self.z * l.z
-    }
+        }
+    } else {
+        0.0
+    };
+    let frame = Frame {
+        x: x.as_vec3(),
+        y: y.as_vec3(),
+        z: z.as_vec3(),
+    };
+    (frame, h)
 }
 
 /// A hit on a hair curve, with everything shading needs.
@@ -84,7 +60,7 @@ pub struct HairHit {
     /// Unit geometric normal: the tube's outward normal for round curves, the ribbon's
     /// ray-facing normal (the frame's z) for flat ones.
     pub ng: Vec3,
-    pub frame: HairFrame,
+    pub frame: Frame,
     /// Offset across the fiber in [-1, 1] (docs/conventions.md).
     pub h: f32,
     /// Axis point and fiber radius at the hit's curve parameter.
@@ -167,7 +143,7 @@ mod tests {
     #[test]
     fn design_worked_example() {
         // Fiber along +x, ray along -z passing at y = +0.5 radius.
-        let (f, h) = HairFrame::with_offset(
+        let (f, h) = hair_frame(
             Vec3::X,
             -Vec3::Z,
             Vec3::new(0.3, 0.5, 10.0),
@@ -189,7 +165,7 @@ mod tests {
             (Vec3::ZERO, Vec3::ZERO),
             (Vec3::new(1e-30, 0.0, 0.0), Vec3::Y),
         ] {
-            let (f, h) = HairFrame::with_offset(t, d, Vec3::ONE, Vec3::ZERO, 0.0);
+            let (f, h) = hair_frame(t, d, Vec3::ONE, Vec3::ZERO, 0.0);
             for v in [f.x, f.y, f.z] {
                 assert!((v.length() - 1.0).abs() < 1e-6, "{t} {d} {f:?}");
             }
@@ -197,7 +173,7 @@ mod tests {
             assert!(f.z.dot(d) <= 1e-6);
             assert_eq!(h, 0.0);
         }
-        let (_, h) = HairFrame::with_offset(Vec3::X, -Vec3::Z, Vec3::Y * 5.0, Vec3::ZERO, 1.0);
+        let (_, h) = hair_frame(Vec3::X, -Vec3::Z, Vec3::Y * 5.0, Vec3::ZERO, 1.0);
         assert_eq!(h, 1.0);
     }
 }

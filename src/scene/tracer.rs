@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::curves::{Curves, StrandIndex, StrandSegment};
-use super::hit::{HairFrame, HairHit, Hit, SurfaceHit};
+use super::hit::{HairHit, Hit, SurfaceHit, hair_frame};
 use super::mesh::Mesh;
 use crate::Result;
 use crate::embree::{
@@ -317,7 +317,7 @@ fn hair_hit(
     // One formula for every shape: on flat cubic curves it beats Embree's v (the offset
     // across the tessellated ribbon) by two orders of magnitude on bent fibers
     // (tests/pipeline/curves_geometry.rs prints both).
-    let (frame, h) = HairFrame::with_offset(tangent, ray.dir, ray.org, axis, c.radius);
+    let (frame, h) = hair_frame(tangent, ray.dir, ray.org, axis, c.radius);
     let ng = match geom.shape() {
         CurveShape::Round => hit.ng.try_normalize().unwrap_or(frame.z),
         // Embree reports the tangent as Ng of flat curves; the ribbon faces the ray.

@@ -19,6 +19,28 @@ pub enum Error {
     Embree { code: u32, message: String },
 }
 
+impl Error {
+    /// The same error, of the same kind, with `context` (a file, a scene entry) in front
+    /// of its message: `"{context}: {message}"`.
+    pub fn context(self, context: impl std::fmt::Display) -> Error {
+        let prefix = |m: String| format!("{context}: {m}");
+        match self {
+            Error::InvalidArg(m) => Error::InvalidArg(prefix(m)),
+            Error::Io(m) => Error::Io(prefix(m)),
+            Error::Image(m) => Error::Image(prefix(m)),
+            Error::Embree { code, message } => Error::Embree {
+                code,
+                message: prefix(message),
+            },
+        }
+    }
+
+    /// An i/o failure on `path`, naming it.
+    pub fn io(path: &std::path::Path, e: std::io::Error) -> Error {
+        Error::Io(format!("{}: {e}", path.display()))
+    }
+}
+
 /// Shorthand used across the crate.
 pub type Result<T> = std::result::Result<T, Error>;
 
@@ -27,3 +49,29 @@ macro_rules! invalid_arg {
     ($($arg:tt)*) => { $crate::Error::InvalidArg(format!($($arg)*)) };
 }
 pub(crate) use invalid_arg;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn context_keeps_the_kind() {
+        let e = Error::Embree {
+            code: 3,
+            message: "bad".into(),
+        }
+        .context("scene.toml: groom[0]");
+        assert_eq!(
+            e,
+            Error::Embree {
+                code: 3,
+                message: "scene.toml: groom[0]: bad".into()
+            }
+        );
+        let e = Error::io(
+            std::path::Path::new("/x.hair"),
+            std::io::Error::other("gone"),
+        );
+        assert_eq!(e.context("a").to_string(), "i/o error: a: /x.hair: gone");
+    }
+}

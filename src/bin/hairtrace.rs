@@ -341,8 +341,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
             settings.spp,
             settings.threads.unwrap_or_else(rayon::current_num_threads),
         );
-        std::fs::write(path, json)
-            .map_err(|e| hairtrace::Error::Io(format!("{}: {e}", path.display())))?;
+        std::fs::write(path, json).map_err(|e| hairtrace::Error::io(path, e))?;
     }
     if out.film.rejected_samples() > 0 {
         eprintln!(

@@ -139,16 +139,7 @@ impl SceneDescription {
 
     /// `e` with this description's origin and the entry or key `at` in front, same kind.
     fn error(&self, at: &str, e: Error) -> Error {
-        let prefix = |m: String| format!("{}: {at}: {m}", self.origin);
-        match e {
-            Error::InvalidArg(m) => Error::InvalidArg(prefix(m)),
-            Error::Io(m) => Error::Io(prefix(m)),
-            Error::Image(m) => Error::Image(prefix(m)),
-            Error::Embree { code, message } => Error::Embree {
-                code,
-                message: prefix(message),
-            },
-        }
+        e.context(format!("{}: {at}", self.origin))
     }
 }
 

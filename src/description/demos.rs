@@ -41,7 +41,7 @@ pub fn demo(name: &str) -> Result<SceneDescription> {
 /// B-spline round curves, [`default_lights`] and an automatic camera. Fails early, before
 /// any scene is built, when the file cannot be read.
 pub fn quick_look(hair_file: &Path) -> Result<SceneDescription> {
-    std::fs::metadata(hair_file).map_err(|e| Error::Io(format!("{}: {e}", hair_file.display())))?;
+    std::fs::metadata(hair_file).map_err(|e| Error::io(hair_file, e))?;
     let file = GroomSource::File {
         path: hair_file.to_path_buf(),
         thickness: Thickness::default(),

@@ -22,8 +22,7 @@ use crate::scene::material::{HairColor, HairMaterial};
 impl SceneDescription {
     /// Reads and checks a scene file; relative paths in it are relative to its folder.
     pub fn from_file(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
         let base_dir = path.parent().unwrap_or(Path::new(""));
         Self::from_toml(&text, base_dir, &path.display().to_string())
     }

@@ -82,7 +82,7 @@ enum PeerLight {
 /// Writes `description` into the folder `dir` (created if missing) for a peer renderer.
 pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()> {
     let d = description;
-    let io = |e: std::io::Error| Error::Io(format!("{}: {e}", dir.display()));
+    let io = |e: std::io::Error| Error::io(dir, e);
     std::fs::create_dir_all(dir).map_err(io)?;
     let (Some(eye), Some(target)) = (d.camera.eye, d.camera.target) else {
         return Err(invalid_arg!(
@@ -192,7 +192,7 @@ fn peer_light(i: usize, light: &LightDesc) -> Result<PeerLight> {
             scale,
         } => PeerLight::EnvironmentMap {
             file: std::path::absolute(path)
-                .map_err(|e| Error::Io(format!("{}: {e}", path.display())))?
+                .map_err(|e| Error::io(path, e))?
                 .display()
                 .to_string(),
             scale: *scale,

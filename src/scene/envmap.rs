@@ -18,11 +18,11 @@ use std::path::Path;
 use glam::{Mat3, Vec3};
 
 use super::light_sample::{LightSample, check_radiance};
+use crate::Result;
 use crate::error::invalid_arg;
 use crate::image::read_image;
 use crate::math::luminance;
 use crate::math::sampling::{Distribution2D, UNIFORM_SPHERE_PDF, uniform_sphere};
-use crate::{Error, Result};
 
 /// An environment light. Cheap to query from many threads at once (`Send + Sync`, no
 /// interior mutability).
@@ -143,12 +143,8 @@ impl Environment {
     /// A lat-long map read through OpenImageIO (EXR, HDR, TIFF, ...), linear.
     pub fn from_file(path: &Path) -> Result<Self> {
         let image = read_image(path)?;
-        Self::from_pixels(image.width, image.height, image.channels, &image.pixels).map_err(|e| {
-            match e {
-                Error::InvalidArg(m) => invalid_arg!("{}: {m}", path.display()),
-                e => e,
-            }
-        })
+        Self::from_pixels(image.width, image.height, image.channels, &image.pixels)
+            .map_err(|e| e.context(path.display()))
     }
 
     /// The same environment turned by `degrees` about +y (see the module doc).

@@ -77,17 +77,14 @@ impl Thickness {
 
 /// Reads a `.hair` file; see [`parse_hair`] for what is checked. Errors name the path.
 pub fn read_hair_file(path: &Path, thickness: Thickness) -> Result<Strands> {
-    let bytes = std::fs::read(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
-    parse_hair(&bytes, thickness).map_err(|e| match e {
-        Error::InvalidArg(m) => invalid_arg!("{}: {m}", path.display()),
-        other => other,
-    })
+    let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    parse_hair(&bytes, thickness).map_err(|e| e.context(path.display()))
 }
 
 /// Writes `strands` as a `.hair` file (see [`encode_hair`]). Errors name the path.
 pub fn write_hair_file(path: &Path, strands: &Strands, thickness: Thickness) -> Result<()> {
     let bytes = encode_hair(strands, thickness)?;
-    std::fs::write(path, bytes).map_err(|e| Error::Io(format!("{}: {e}", path.display())))
+    std::fs::write(path, bytes).map_err(|e| Error::io(path, e))
 }
 
 /// Little-endian cursor over a slice whose length was checked before reading.

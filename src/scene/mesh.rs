@@ -102,7 +102,7 @@ impl Mesh {
     /// binary.
     pub fn from_ply(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
-        let file = File::open(path).map_err(|e| Error::Io(format!("{}: {e}", path.display())))?;
+        let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let ply = Parser::<DefaultElement>::new()
             .read_ply(&mut BufReader::new(file))
             .map_err(|e| file_error(path, format_args!("cannot read PLY: {e}")))?;

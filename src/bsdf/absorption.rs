@@ -41,7 +41,7 @@ pub fn sigma_a_from_color(color: [f32; 3], beta_n: f32) -> Result<[f32; 3]> {
 
 /// The reflectance colour a fiber of absorption sigma_a looks like at roughness beta_n:
 /// the inverse of [`sigma_a_from_color`] (for AOVs and previews; not range-checked).
-pub fn color_from_sigma_a(sigma_a: [f32; 3], beta_n: f32) -> [f32; 3] {
+pub(crate) fn color_from_sigma_a(sigma_a: [f32; 3], beta_n: f32) -> [f32; 3] {
     let d = color_fit(beta_n);
     sigma_a.map(|s| (-f64::from(s.max(0.0)).sqrt() * d).exp() as f32)
 }

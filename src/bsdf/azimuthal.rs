@@ -14,7 +14,7 @@ pub fn azimuthal_scale(beta_n: f32) -> f32 {
 
 /// A logistic of scale s trimmed to [-pi, pi], with its constants precomputed.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TrimmedLogistic {
+pub(crate) struct TrimmedLogistic {
     inv_s: f32,
     s: f32,
     /// 1 / (s (CDF(pi) - CDF(-pi))): the density's constant factor.

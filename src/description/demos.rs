@@ -38,7 +38,7 @@ pub fn demo(name: &str) -> Result<SceneDescription> {
 }
 
 /// A quick look at a groom file: the default brown hair ([`HairMaterial::default`]),
-/// B-spline round curves, [`default_lights`] and an automatic camera. Fails early, before
+/// B-spline round curves, the default lights and an automatic camera. Fails early, before
 /// any scene is built, when the file cannot be read.
 pub fn quick_look(hair_file: &Path) -> Result<SceneDescription> {
     std::fs::metadata(hair_file).map_err(|e| Error::io(hair_file, e))?;
@@ -61,7 +61,7 @@ pub fn quick_look(hair_file: &Path) -> Result<SceneDescription> {
 /// The lights of the demos and quick looks: a soft bluish sky and a warm key light from
 /// above, left of the automatic camera (which looks from the front right), small enough
 /// to give the hair a crisp highlight and soft enough to avoid aliased shadow edges.
-pub fn default_lights() -> Vec<LightDesc> {
+pub(crate) fn default_lights() -> Vec<LightDesc> {
     vec![
         LightDesc::Environment {
             source: EnvironmentSource::Uniform([0.25, 0.28, 0.32]),

@@ -112,7 +112,7 @@ use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::HairMaterial;
 
-pub use demos::{DEMOS, default_lights, demo, quick_look};
+pub use demos::{DEMOS, demo, quick_look};
 
 /// A whole scene as plain data. Adjust fields before [`SceneDescription::build`], not the
 /// settings after it: the camera's aspect follows `render.width / render.height`.

@@ -47,7 +47,7 @@ impl CurveBasis {
     ];
 
     /// Control points one segment reads, starting at its index.
-    pub fn points_per_segment(self) -> usize {
+    pub(crate) fn points_per_segment(self) -> usize {
         match self {
             CurveBasis::Linear => 2,
             _ => 4,
@@ -55,7 +55,7 @@ impl CurveBasis {
     }
 
     /// Index distance between consecutive segments of one strand.
-    pub fn segment_stride(self) -> usize {
+    pub(crate) fn segment_stride(self) -> usize {
         match self {
             CurveBasis::Bezier => 3,
             _ => 1,
@@ -192,7 +192,7 @@ impl<T> SharedBuffer<T> {
     }
 
     /// The elements, without the padding.
-    pub fn as_slice(&self) -> &[T] {
+    pub(crate) fn as_slice(&self) -> &[T] {
         match &self.storage {
             Storage::Owned(data) => &data[..self.len],
             Storage::Arc(data) => data,

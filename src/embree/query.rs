@@ -34,7 +34,7 @@ impl Ray {
         }
     }
 
-    pub fn point_at(&self, t: f32) -> Vec3 {
+    pub(crate) fn point_at(&self, t: f32) -> Vec3 {
         self.org + t * self.dir
     }
 
@@ -168,7 +168,7 @@ impl Scene {
     }
 
     /// Whether anything (not named by `exclude`) lies along `ray` within [tnear, tfar].
-    pub fn occluded(&self, ray: &Ray, exclude: Option<&Exclude>) -> bool {
+    pub(crate) fn occluded(&self, ray: &Ray, exclude: Option<&Exclude>) -> bool {
         let mut ctx = QueryContext::new(exclude);
         let mut r = ray.to_sys();
         // SAFETY: as in `intersect`.

@@ -96,7 +96,7 @@ impl SceneBuilder {
     }
 
     /// Builds the BVH. Embree's build uses the device's worker threads.
-    pub fn commit(self) -> Result<Scene> {
+    pub(crate) fn commit(self) -> Result<Scene> {
         // SAFETY: live scene with committed geometries.
         unsafe { sys::rtcCommitScene(self.raw.0.as_ptr()) };
         self.device.check()?;

@@ -21,7 +21,7 @@ pub fn round<T: Lanes>(x: T) -> T {
 /// e^x for x <= 0 (every exponent in the hair model is): 0 below -87.3, where f32 would
 /// go subnormal.
 #[inline(always)]
-pub fn exp_neg<T: Lanes>(x: T) -> T {
+pub(crate) fn exp_neg<T: Lanes>(x: T) -> T {
     const LOWEST: f32 = -87.33;
     let c = T::splat;
     let xc = x.max(c(LOWEST)).min(c(0.0));
@@ -85,7 +85,7 @@ pub fn atan2<T: Lanes>(y: T, x: T) -> T {
 /// [sqrt(1/2), sqrt(2)), ln m = 2 atanh(s) with s = (m - 1) / (m + 1), |s| < 0.172, from
 /// its odd series to s^9. 0 gives -inf; subnormals are scaled up first.
 #[inline(always)]
-pub fn ln(x: f32) -> f32 {
+pub(crate) fn ln(x: f32) -> f32 {
     if x <= 0.0 {
         return if x == 0.0 {
             f32::NEG_INFINITY

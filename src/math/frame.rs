@@ -14,7 +14,7 @@ pub struct Frame {
 
 impl Frame {
     /// A frame whose z is the unit vector `n`, with any x and y around it.
-    pub fn from_z(n: Vec3) -> Self {
+    pub(crate) fn from_z(n: Vec3) -> Self {
         let (x, y) = n.any_orthonormal_pair();
         Frame { x, y, z: n }
     }

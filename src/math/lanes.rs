@@ -36,7 +36,7 @@ pub trait Lanes:
     /// Per lane: `if mask { a() } else { b() }`. A scalar runs only the branch taken,
     /// a vector runs both and selects.
     fn branch(mask: Self::Mask, a: impl FnOnce() -> Self, b: impl FnOnce() -> Self) -> Self;
-    /// [`super::fast::exp_neg`] of three values (an RGB absorption); a scalar packs them
+    /// `exp_neg` of three values (an RGB absorption); a scalar packs them
     /// into one SIMD evaluation, with the same bits as three separate ones.
     #[inline(always)]
     fn exp_neg3(x: [Self; 3]) -> [Self; 3] {

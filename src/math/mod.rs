@@ -12,7 +12,7 @@ pub use lanes::Lanes;
 
 /// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,
 /// such as neighbouring pixels or strand ids, get unrelated hashes.
-pub fn mix64(mut z: u64) -> u64 {
+pub(crate) fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
@@ -25,12 +25,12 @@ pub fn luminance(rgb: glam::Vec3) -> f32 {
 
 /// sqrt that treats tiny negative round-off as zero instead of returning NaN.
 #[inline(always)]
-pub fn safe_sqrt<T: Lanes>(x: T) -> T {
+pub(crate) fn safe_sqrt<T: Lanes>(x: T) -> T {
     x.max(T::splat(0.0)).sqrt()
 }
 
 /// asin of a value that round-off may have pushed just outside [-1, 1].
 #[inline(always)]
-pub fn safe_asin<T: Lanes>(x: T) -> T {
+pub(crate) fn safe_asin<T: Lanes>(x: T) -> T {
     fast::asin(x.max(T::splat(-1.0)).min(T::splat(1.0)))
 }

@@ -12,7 +12,7 @@ use crate::Result;
 use crate::error::invalid_arg;
 
 /// The largest f32 below 1: where a warp must stay inside a half-open [0, 1).
-pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+pub(crate) const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Pdf of [`uniform_sphere`] per unit solid angle.
 pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
@@ -29,7 +29,7 @@ pub fn uniform_sphere(u: [f32; 2]) -> Vec3 {
 /// A point uniformly distributed over the unit disk, by Shirley and Chiu's concentric
 /// map: it keeps strata of the square as compact strata of the disk, which a
 /// low-discrepancy sampler needs to keep its advantage.
-pub fn concentric_disk(u: [f32; 2]) -> Vec2 {
+pub(crate) fn concentric_disk(u: [f32; 2]) -> Vec2 {
     let o = Vec2::new(2.0 * u[0] - 1.0, 2.0 * u[1] - 1.0);
     if o == Vec2::ZERO {
         return Vec2::ZERO;
@@ -51,7 +51,7 @@ pub fn cosine_hemisphere(u: [f32; 2]) -> Vec3 {
 }
 
 /// Pdf of [`cosine_hemisphere`] per unit solid angle for a direction with that cosine.
-pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+pub(crate) fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) * FRAC_1_PI
 }
 
@@ -60,7 +60,7 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
 ///
 /// Taking 1 - cos rather than cos keeps small cones exact: the sun's 0.27 degrees give
 /// 1 - cos = 1.1e-5, which `1.0 - cos` in f32 would round to a tenth of that.
-pub fn uniform_cone(u: [f32; 2], one_minus_cos_max: f32) -> Vec3 {
+pub(crate) fn uniform_cone(u: [f32; 2], one_minus_cos_max: f32) -> Vec3 {
     let one_minus_cos = u[0] * one_minus_cos_max;
     let cos_theta = 1.0 - one_minus_cos;
     let sin_theta = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0).sqrt();
@@ -69,14 +69,14 @@ pub fn uniform_cone(u: [f32; 2], one_minus_cos_max: f32) -> Vec3 {
 }
 
 /// Pdf of [`uniform_cone`] per unit solid angle: one over the cone's solid angle.
-pub fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
+pub(crate) fn uniform_cone_pdf(one_minus_cos_max: f32) -> f32 {
     1.0 / (2.0 * PI * one_minus_cos_max)
 }
 
 /// Veach's power heuristic (beta = 2): the MIS weight of a sample drawn `nf` times from
 /// the strategy with pdf `f_pdf`, against `ng` samples of the strategy with pdf `g_pdf`.
 /// Returns 0 when both pdfs vanish instead of NaN, and stays finite when a pdf is huge.
-pub fn power_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
+pub(crate) fn power_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
     let f = nf * f_pdf;
     let g = ng * g_pdf;
     if f.is_infinite() {
@@ -95,7 +95,7 @@ pub fn power_heuristic(nf: f32, f_pdf: f32, ng: f32, g_pdf: f32) -> f32 {
 /// A piecewise-constant density on [0, 1) proportional to a table of non-negative
 /// values, sampled by inverting its CDF.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Distribution1D {
+pub(crate) struct Distribution1D {
     func: Vec<f32>,
     /// `func.len() + 1` entries from 0 to exactly 1.
     cdf: Vec<f32>,

@@ -30,7 +30,7 @@ pub enum Strategy {
     Mis,
     /// Next-event estimation only: emission found by BSDF sampling is ignored, except
     /// what the camera sees directly and lights that next-event estimation never samples
-    /// (see [`Light::needs_light_sampling`]).
+    /// (a uniform environment: see `Light::needs_light_sampling`).
     LightOnly,
     /// BSDF sampling only: no shadow rays.
     BsdfOnly,

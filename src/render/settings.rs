@@ -39,7 +39,7 @@ impl Default for RenderSettings {
 }
 
 /// Largest accepted image side, so that a typo cannot ask for terabytes.
-pub const MAX_SIDE: u32 = 1 << 15;
+pub(crate) const MAX_SIDE: u32 = 1 << 15;
 
 impl RenderSettings {
     pub fn validate(&self) -> Result<()> {

@@ -160,7 +160,7 @@ impl Camera {
     }
 
     /// Whether [`Self::ray`] uses its lens point (a thin lens) or ignores it (a pinhole).
-    pub fn has_lens(&self) -> bool {
+    pub(crate) fn has_lens(&self) -> bool {
         self.lens_radius > 0.0
     }
 

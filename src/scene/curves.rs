@@ -62,7 +62,7 @@ impl StrandSegment {
     }
 
     /// Primitive ids of the strand's segments.
-    pub fn prims(&self) -> Range<u32> {
+    pub(crate) fn prims(&self) -> Range<u32> {
         self.first_prim..self.first_prim + self.segments
     }
 }
@@ -299,7 +299,7 @@ impl Curves {
     }
 
     /// Splits into the Embree buffers and the table that stays with the scene.
-    pub fn into_parts(
+    pub(crate) fn into_parts(
         self,
     ) -> (
         CurveBasis,

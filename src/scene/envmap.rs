@@ -225,12 +225,12 @@ impl Environment {
     }
 
     /// The same radiance from every direction.
-    pub fn is_uniform(&self) -> bool {
+    pub(crate) fn is_uniform(&self) -> bool {
         matches!(self.source, Source::Uniform(_))
     }
 
     /// Luminance of the radiance averaged over all directions.
-    pub fn mean_luminance(&self) -> f32 {
+    pub(crate) fn mean_luminance(&self) -> f32 {
         self.scale
             * match &self.source {
                 Source::Uniform(l) => luminance(*l),

@@ -16,11 +16,11 @@ use rand_pcg::Pcg64Mcg;
 /// Most control points a procedural groom may have: 2^28 points take 4 GiB as points and
 /// radii, as much as a workstation can spare for one groom; more is surely a mistake in
 /// the inputs.
-pub const MAX_GROOM_POINTS: usize = 1 << 28;
+pub(crate) const MAX_GROOM_POINTS: usize = 1 << 28;
 /// Bytes per control point in [`Strands`] without colours (xyz + radius).
 const BYTES_PER_POINT: usize = 16;
 /// Most segments per strand: what a `.hair` file can hold, so every groom can be saved.
-pub const MAX_SEGMENTS: u32 = u16::MAX as u32;
+pub(crate) const MAX_SEGMENTS: u32 = u16::MAX as u32;
 
 /// A sphere covered in fur: roots spread evenly over it, strands growing outward and
 /// bending with gravity, curl, noise and clumping.

@@ -32,7 +32,7 @@ const HAS_TRANSPARENCY: u32 = 1 << 3;
 const HAS_COLORS: u32 = 1 << 4;
 const KNOWN_FLAGS: u32 = HAS_SEGMENTS | HAS_POINTS | HAS_THICKNESS | HAS_TRANSPARENCY | HAS_COLORS;
 /// The segments array holds u16, so a strand has at most this many points.
-pub const MAX_POINTS_PER_STRAND: u32 = u16::MAX as u32 + 1;
+pub(crate) const MAX_POINTS_PER_STRAND: u32 = u16::MAX as u32 + 1;
 
 /// How the file's thickness values are read and written.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

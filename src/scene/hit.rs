@@ -20,7 +20,13 @@ use crate::math::Frame;
 /// Degenerate input never gives NaN: a zero tangent becomes a direction perpendicular
 /// to the ray, and a ray along the tangent gets an arbitrary y perpendicular to x
 /// (every y is then equally valid: the ray sees the fiber end-on).
-pub fn hair_frame(tangent: Vec3, dir: Vec3, org: Vec3, axis: Vec3, radius: f32) -> (Frame, f32) {
+pub(crate) fn hair_frame(
+    tangent: Vec3,
+    dir: Vec3,
+    org: Vec3,
+    axis: Vec3,
+    radius: f32,
+) -> (Frame, f32) {
     let d = dir.as_dvec3();
     let x = tangent.as_dvec3().try_normalize().unwrap_or_else(|| {
         d.try_normalize()

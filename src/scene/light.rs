@@ -151,7 +151,7 @@ impl Light {
     /// ray a path traces anyway estimates it with the BSDF's own importance, and a shadow
     /// ray toward a uniformly drawn direction would double the rays for little gain
     /// (measured: README, "Render efficiency").
-    pub fn needs_light_sampling(&self) -> bool {
+    pub(crate) fn needs_light_sampling(&self) -> bool {
         !matches!(self, Light::Environment(env) if env.is_uniform())
     }
 

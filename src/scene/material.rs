@@ -144,13 +144,18 @@ impl HairMaterial {
 
 impl PreparedHair {
     /// Every hit shares one BSDF: nothing varies per strand, along strands or by colour.
-    pub fn is_uniform(&self) -> bool {
+    pub(crate) fn is_uniform(&self) -> bool {
         self.uniform.is_some()
     }
 
     /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's colour
     /// at the hit when it has one.
-    pub fn params_at(&self, strand: u32, s: f32, vertex_color: Option<[f32; 3]>) -> HairParams {
+    pub(crate) fn params_at(
+        &self,
+        strand: u32,
+        s: f32,
+        vertex_color: Option<[f32; 3]>,
+    ) -> HairParams {
         let m = &self.material;
         let mut p = self.base;
         if let (true, Some(c)) = (
@@ -172,7 +177,7 @@ impl PreparedHair {
     }
 
     /// The BSDF at a hit: shared when the material is uniform.
-    pub fn bsdf_at(
+    pub(crate) fn bsdf_at(
         &self,
         strand: u32,
         s: f32,

@@ -54,7 +54,7 @@ impl Mesh {
     }
 
     /// Every object of an OBJ file, merged into one mesh; polygons are triangulated.
-    pub fn from_obj(path: impl AsRef<Path>) -> Result<Self> {
+    pub(crate) fn from_obj(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let options = tobj::LoadOptions {
             triangulate: true,
@@ -100,7 +100,7 @@ impl Mesh {
     /// The `vertex` (x, y, z and, if all present, nx, ny, nz) and `face` (`vertex_indices`
     /// or `vertex_index`, polygons fanned into triangles) elements of a PLY file, ASCII or
     /// binary.
-    pub fn from_ply(path: impl AsRef<Path>) -> Result<Self> {
+    pub(crate) fn from_ply(path: impl AsRef<Path>) -> Result<Self> {
         let path = path.as_ref();
         let file = File::open(path).map_err(|e| Error::io(path, e))?;
         let ply = Parser::<DefaultElement>::new()

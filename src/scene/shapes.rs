@@ -10,7 +10,7 @@ use crate::error::{Result, invalid_arg};
 
 /// Most subdivisions of [`sphere`]: 7 gives 327,680 triangles, far past the point where
 /// smooth normals hide the facets; more is surely a typo.
-pub const MAX_SPHERE_SUBDIVISIONS: u32 = 7;
+pub(crate) const MAX_SPHERE_SUBDIVISIONS: u32 = 7;
 
 /// The golden ratio: the icosahedron's vertices are the cyclic permutations of
 /// (+-1, +-PHI, 0).

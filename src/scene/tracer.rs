@@ -169,10 +169,6 @@ impl Tracer {
         self.record(ray, &hit)
     }
 
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        self.scene.occluded(ray, None)
-    }
-
     /// The ray that continues a path from `from` along `dir` up to `tfar`, leaving the fiber
     /// the default way ([`Escape::ExitAndFilter`]).
     pub fn spawn(&self, from: &Hit, dir: Vec3, tfar: f32) -> SpawnedRay {
@@ -639,7 +635,10 @@ mod tests {
             ..Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z)
         };
         assert!(t.intersect(&hair_only).is_none());
-        assert!(t.occluded(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z)));
+        assert!(t.occluded_spawned(&SpawnedRay {
+            ray: Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z),
+            exclude: None,
+        }));
         let spawned = t.spawn(&hit, Vec3::Z, f32::INFINITY);
         assert!(t.intersect_spawned(&spawned).is_none());
     }

@@ -3,9 +3,27 @@
 //! The crate is layered one way only (docs/architecture.md; `tests/pipeline/architecture.rs`
 //! checks it): [`math`] and [`bsdf`] know nothing of ray tracing; [`embree`] wraps Embree
 //! and knows nothing of shading; [`image`] reads and writes pictures through OpenImageIO;
-//! [`scene`] is the scene as data plus the tracer; [`render`] makes images of it;
+//! [`scene`] is the scene as data plus the tracer; [`mod@render`] makes images of it;
 //! [`description`] reads scene files and builds the demos; [`capi`] is a thin C shell
 //! over the same Rust API. Conventions (frames, units, signs): docs/conventions.md.
+//!
+//! The items re-exported here are the API a Rust host builds on: the hair BSDF alone
+//! ([`HairBsdf`], [`HairParams`], [`LocalBsdf`]), or a whole render from a scene file or
+//! a description built in code:
+//!
+//! ```no_run
+//! use std::sync::Arc;
+//! use hairtrace::{Aovs, Device, NoProgress, SceneDescription, render, write_image};
+//! # fn main() -> hairtrace::Result<()> {
+//! let built = SceneDescription::from_file("scene.toml".as_ref())?.build(Arc::new(Device::new(None)?))?;
+//! let out = render(&built.world, &built.camera, &built.settings, Aovs::default(), &NoProgress)?;
+//! let (w, h) = (built.settings.width as usize, built.settings.height as usize);
+//! write_image("out.exr".as_ref(), w, h, 3, out.film.rgb(), &Default::default())?;
+//! # Ok(()) }
+//! ```
+//!
+//! The modules stay public for hosts that assemble scenes piece by piece (strands, curves,
+//! a tracer, lights) and for the integration tests, which check those pieces one by one.
 
 /// cbindgen:ignore
 pub mod bsdf;
@@ -25,7 +43,13 @@ pub mod scene;
 mod validate;
 
 pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, LocalBsdf};
+pub use description::{BuiltScene, SceneDescription};
+pub use embree::Device;
 pub use error::{Error, Result};
+pub use image::{read_image, write_image};
+pub use render::renderer::{RenderOutput, render};
+pub use render::settings::RenderSettings;
+pub use render::{Aovs, NoProgress, PixelFilter, Progress};
 
 /// The crate version, as the C ABI reports it.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

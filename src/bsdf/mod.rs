@@ -2,13 +2,13 @@
 //! and azimuthal lobes, absorption from colour) are public so that tests and hosts can
 //! check them one by one.
 
-pub mod absorption;
-pub mod azimuthal;
-pub mod diffuse;
-pub mod hair;
+pub(crate) mod absorption;
+pub(crate) mod azimuthal;
+pub(crate) mod diffuse;
+pub(crate) mod hair;
 mod limits;
-pub mod longitudinal;
-pub mod params;
+pub(crate) mod longitudinal;
+pub(crate) mod params;
 
 pub use absorption::{sigma_a_from_color, sigma_a_from_melanin};
 pub use diffuse::Diffuse;

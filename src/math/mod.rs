@@ -2,9 +2,9 @@
 //! implementation run on scalars and on SIMD vectors, and the special functions.
 
 pub mod bessel;
-pub mod fast;
-pub mod frame;
-pub mod lanes;
+pub(crate) mod fast;
+pub(crate) mod frame;
+pub(crate) mod lanes;
 pub mod sampling;
 
 pub use frame::Frame;

@@ -2,15 +2,17 @@
 //! run in parallel, progress and cancellation. The integrator composes them with the
 //! camera, the lights and the traceable scene.
 
-pub mod film;
+pub(crate) mod film;
 pub mod integrator;
-pub mod progress;
+pub(crate) mod progress;
 pub mod renderer;
-pub mod sampler;
+pub(crate) mod sampler;
 pub mod settings;
-pub mod tiles;
+pub(crate) mod tiles;
 
-pub use film::{Aovs, Film, FirstHit, PixelAccumulator, PixelFilter, Window};
+pub use film::{
+    Aovs, Film, FirstHit, NO_HIT_DEPTH, NO_STRAND, PixelAccumulator, PixelFilter, Window, ndc,
+};
 pub use progress::{NoProgress, Progress};
 pub use sampler::PixelSampler;
 pub use tiles::{RenderStatus, TileOptions, render_tiles, tiles};

@@ -6,15 +6,15 @@
 pub mod camera;
 pub mod curves;
 pub mod envmap;
-pub mod groom;
+pub(crate) mod groom;
 pub mod hair_file;
 pub mod hit;
 pub mod light;
 mod light_sample;
 pub mod material;
-pub mod mesh;
-pub mod shapes;
-pub mod strands;
+pub(crate) mod mesh;
+pub(crate) mod shapes;
+pub(crate) mod strands;
 pub mod tracer;
 
 pub use camera::Camera;

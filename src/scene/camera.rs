@@ -9,6 +9,7 @@ use glam::{Vec2, Vec3};
 use crate::Result;
 use crate::error::invalid_arg;
 use crate::math::sampling::concentric_disk;
+use crate::validate::{non_negative, positive};
 
 /// A perspective camera. Built validated, it generates finite unit rays for any input.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -44,11 +45,7 @@ impl Camera {
                 "camera vertical fov {fov_y_deg} degrees must be in (0, 180)"
             ));
         }
-        if !(aspect.is_finite() && aspect > 0.0) {
-            return Err(invalid_arg!(
-                "camera aspect {aspect} must be finite and > 0"
-            ));
-        }
+        positive("camera aspect", aspect)?;
         let view = target - eye;
         let forward = view.try_normalize().ok_or_else(|| {
             invalid_arg!("camera eye {eye} and target {target} must be distinct points")
@@ -86,16 +83,8 @@ impl Camera {
     /// The same camera with a thin lens of `aperture_radius` (world units, >= 0; 0 is a
     /// pinhole) focused at `focus_distance` (> 0) along the view direction.
     pub fn with_thin_lens(self, aperture_radius: f32, focus_distance: f32) -> Result<Self> {
-        if !(aperture_radius.is_finite() && aperture_radius >= 0.0) {
-            return Err(invalid_arg!(
-                "camera aperture radius {aperture_radius} must be finite and >= 0"
-            ));
-        }
-        if !(focus_distance.is_finite() && focus_distance > 0.0) {
-            return Err(invalid_arg!(
-                "camera focus distance {focus_distance} must be finite and > 0"
-            ));
-        }
+        non_negative("camera aperture radius", aperture_radius)?;
+        positive("camera focus distance", focus_distance)?;
         Ok(Self {
             lens_radius: aperture_radius,
             focus_distance,

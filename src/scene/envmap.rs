@@ -23,6 +23,7 @@ use crate::error::invalid_arg;
 use crate::image::read_image;
 use crate::math::luminance;
 use crate::math::sampling::{Distribution2D, UNIFORM_SPHERE_PDF, uniform_sphere};
+use crate::validate::non_negative;
 
 /// An environment light. Cheap to query from many threads at once (`Send + Sync`, no
 /// interior mutability).
@@ -162,11 +163,7 @@ impl Environment {
 
     /// The same environment with its radiance multiplied by `scale` (finite, >= 0).
     pub fn with_scale(self, scale: f32) -> Result<Self> {
-        if !(scale.is_finite() && scale >= 0.0) {
-            return Err(invalid_arg!(
-                "environment scale {scale} must be finite and >= 0"
-            ));
-        }
+        non_negative("environment scale", scale)?;
         Ok(Self { scale, ..self })
     }
 

@@ -7,6 +7,7 @@ use glam::Vec3;
 
 use super::mesh::Mesh;
 use crate::error::{Result, invalid_arg};
+use crate::validate::positive;
 
 /// Most subdivisions of [`sphere`]: 7 gives 327,680 triangles, far past the point where
 /// smooth normals hide the facets; more is surely a typo.
@@ -64,11 +65,7 @@ pub fn sphere(centre: Vec3, radius: f32, subdivisions: u32) -> Result<Mesh> {
     if !centre.is_finite() {
         return Err(invalid_arg!("sphere centre {centre} is not finite"));
     }
-    if !(radius.is_finite() && radius > 0.0) {
-        return Err(invalid_arg!(
-            "sphere radius {radius}: must be finite and > 0"
-        ));
-    }
+    positive("sphere radius", radius)?;
     if subdivisions > MAX_SPHERE_SUBDIVISIONS {
         return Err(invalid_arg!(
             "sphere subdivisions {subdivisions}: must be at most {MAX_SPHERE_SUBDIVISIONS}"
@@ -111,11 +108,7 @@ pub fn ground(y: f32, half_size: f32) -> Result<Mesh> {
     if !y.is_finite() {
         return Err(invalid_arg!("ground height {y} is not finite"));
     }
-    if !(half_size.is_finite() && half_size > 0.0) {
-        return Err(invalid_arg!(
-            "ground half size {half_size}: must be finite and > 0"
-        ));
-    }
+    positive("ground half size", half_size)?;
     let h = half_size;
     Mesh::new(
         vec![[-h, y, -h], [h, y, -h], [h, y, h], [-h, y, h]],

@@ -32,7 +32,8 @@ int main(void) {
     HtHairParams hair = ht_hair_params_default();
     printf("sigma_a %.9g %.9g %.9g\n", hair.sigma_a[0], hair.sigma_a[1], hair.sigma_a[2]);
 
-    /* Viewer along +z, light from above: the R highlight of docs/conventions.md's worked example. */
+    /* Viewer along +z, light from above: the R highlight of the worked example in
+       docs/conventions.md. */
     const float h = 0.5f;
     const float wo[3] = {0.0f, 0.0f, 1.0f};
     const float wi[3] = {0.0f, 0.8660254f, 0.5f};

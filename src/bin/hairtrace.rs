@@ -333,15 +333,15 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         peak_memory()
     );
     if let Some(path) = &args.stats {
-        let json = format!(
-            "{{\"seconds\": {}, \"build_seconds\": {build_seconds}, \"samples\": {}, \"rays\": {}, \"spp\": {}, \"threads\": {}}}\n",
-            s.seconds,
-            s.samples,
-            s.rays,
-            settings.spp,
-            settings.threads.unwrap_or_else(rayon::current_num_threads),
-        );
-        std::fs::write(path, json).map_err(|e| hairtrace::Error::io(path, e))?;
+        let json = serde_json::json!({
+            "seconds": s.seconds,
+            "build_seconds": build_seconds,
+            "samples": s.samples,
+            "rays": s.rays,
+            "spp": settings.spp,
+            "threads": settings.threads.unwrap_or_else(rayon::current_num_threads),
+        });
+        std::fs::write(path, format!("{json}\n")).map_err(|e| hairtrace::Error::io(path, e))?;
     }
     if out.film.rejected_samples() > 0 {
         eprintln!(
@@ -394,10 +394,13 @@ fn compare(args: &CompareArgs) -> hairtrace::Result<()> {
         &image::read_image(&args.reference)?,
     )?;
     if args.json {
-        println!(
-            "{{\"rmse\": {}, \"max_abs\": {}, \"mean\": {}, \"reference_mean\": {}}}",
-            c.rmse, c.max_abs, c.mean, c.reference_mean
-        );
+        let json = serde_json::json!({
+            "rmse": c.rmse,
+            "max_abs": c.max_abs,
+            "mean": c.mean,
+            "reference_mean": c.reference_mean,
+        });
+        println!("{json}");
     } else {
         println!(
             "RMSE {:.6}, max |difference| {:.6}, mean {:.6} (reference {:.6})",

@@ -22,8 +22,8 @@ pub const SURFACE_MASK: u32 = 2;
 
 /// How a continued ray (reflection, transmission, shadow) leaves a fiber.
 ///
-/// Measured re-hit rates (`tests/pipeline/rehit.rs`: ~2500 round-curve hits x 64 random directions,
-/// every basis, straight and bent strands): `Offset` re-hits ~100% of transmitted and ~50%
+/// Measured re-hit rates (`tests/pipeline/rehit.rs`: ~2500 round-curve hits x 64 random
+/// directions, every basis, straight and bent strands): `Offset` re-hits ~100% of transmitted and ~50%
 /// of shadow rays; the three filtered strategies at most 0.005%. `ExitAndFilter` is the
 /// default because it is the fastest of those on round cubic curves (`benches/groom.rs`:
 /// Embree seldom meets the tube it left, so the filter seldom runs).

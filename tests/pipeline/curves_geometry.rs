@@ -300,8 +300,8 @@ fn h_tangent_and_frame_for_every_basis_and_shape() {
                 if st.max_tangent_err > 1e-4 {
                     failures.push(format!("{tag}: tangent error {:.2e}", st.max_tangent_err));
                 }
-                // The formula of docs/conventions.md on every shape (flat cubic hits are first projected
-                // onto the axis).
+                // The formula of docs/conventions.md on every shape (flat cubic hits are
+                // first projected onto the axis).
                 if st.max_h_err > 1e-3 {
                     failures.push(format!("{tag}: h error {:.2e}", st.max_h_err));
                 }

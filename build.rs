@@ -1,15 +1,19 @@
 //! Build script: finds Embree, generates its FFI bindings from the installed header, and
-//! compiles the C++ shim over OpenImageIO.
+//! compiles the C++ shim over OpenImageIO (all three only with the `render` feature; the
+//! BSDF-only build needs neither library); gives the shared library its soname.
 //!
 //! Embree is looked up the way openssl-sys and libsqlite3-sys look up their libraries:
 //! environment overrides first, then the usual system prefixes. The Embree version comes
 //! from the installed `rtcore_config.h`, so the bindings and the `embree3`/`embree4` cfg
 //! always describe the library that is actually linked, never a bundled copy.
 
+#[cfg(feature = "render")]
 use std::env;
 use std::fs;
+#[cfg(feature = "render")]
 use std::path::{Path, PathBuf};
 
+#[cfg(feature = "render")]
 /// Where Embree's headers and library were found.
 struct Embree {
     /// The directory that holds `rtcore.h`.
@@ -21,12 +25,32 @@ struct Embree {
 }
 
 fn main() {
-    let embree = find_embree();
-    generate_embree_bindings(&embree);
-    link_embree(&embree);
-    build_oiio_shim();
+    set_soname();
+    #[cfg(feature = "render")]
+    {
+        let embree = find_embree();
+        generate_embree_bindings(&embree);
+        link_embree(&embree);
+        build_oiio_shim();
+    }
 }
 
+/// `libhairtrace.so.N` with N = `HT_ABI_VERSION` (src/capi/mod.rs, which the header
+/// publishes): the soname changes exactly when a host built against an older header could
+/// no longer run, and a host records it instead of the unversioned name.
+fn set_soname() {
+    let source = "src/capi/mod.rs";
+    println!("cargo:rerun-if-changed={source}");
+    let text = fs::read_to_string(source).expect("hairtrace: cannot read src/capi/mod.rs");
+    let abi: u32 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("pub const HT_ABI_VERSION: u32 = "))
+        .and_then(|rest| rest.trim_end_matches(';').parse().ok())
+        .expect("hairtrace: no `pub const HT_ABI_VERSION: u32 = N;` in src/capi/mod.rs");
+    println!("cargo:rustc-cdylib-link-arg=-Wl,-soname,libhairtrace.so.{abi}");
+}
+
+#[cfg(feature = "render")]
 fn env_path(name: &str) -> Option<PathBuf> {
     println!("cargo:rerun-if-env-changed={name}");
     env::var_os(name)
@@ -34,6 +58,7 @@ fn env_path(name: &str) -> Option<PathBuf> {
         .map(PathBuf::from)
 }
 
+#[cfg(feature = "render")]
 /// The header directory below an include root: Embree 4 wins when both are installed.
 fn header_dir_under(include_root: &Path) -> Option<PathBuf> {
     ["embree4", "embree3"]
@@ -42,6 +67,7 @@ fn header_dir_under(include_root: &Path) -> Option<PathBuf> {
         .find(|dir| dir.join("rtcore.h").is_file())
 }
 
+#[cfg(feature = "render")]
 fn find_embree() -> Embree {
     let embree_dir = env_path("EMBREE_DIR");
     let include_override = env_path("EMBREE_INCLUDE_DIR");
@@ -89,6 +115,7 @@ fn find_embree() -> Embree {
     }
 }
 
+#[cfg(feature = "render")]
 /// Parses `#define RTC_VERSION_{MAJOR,MINOR,PATCH} n` from Embree's config header.
 fn read_version(config: &Path) -> (u32, String) {
     println!("cargo:rerun-if-changed={}", config.display());
@@ -126,6 +153,7 @@ fn read_version(config: &Path) -> (u32, String) {
     (major, format!("{major}.{minor}.{patch}"))
 }
 
+#[cfg(feature = "render")]
 fn generate_embree_bindings(embree: &Embree) {
     let header = embree.include_dir.join("rtcore.h");
     println!("cargo:rerun-if-changed={}", header.display());
@@ -162,6 +190,7 @@ fn generate_embree_bindings(embree: &Embree) {
         .expect("hairtrace: cannot write embree_sys.rs into OUT_DIR");
 }
 
+#[cfg(feature = "render")]
 fn link_embree(embree: &Embree) {
     println!("cargo:rustc-check-cfg=cfg(embree3)");
     println!("cargo:rustc-check-cfg=cfg(embree4)");
@@ -184,6 +213,7 @@ fn link_embree(embree: &Embree) {
     println!("cargo:rustc-link-lib=dylib=embree{}", embree.major);
 }
 
+#[cfg(feature = "render")]
 fn build_oiio_shim() {
     let shim = "src/image/oiio_shim.cpp";
     println!("cargo:rerun-if-changed={shim}");

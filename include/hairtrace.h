@@ -11,10 +11,32 @@
 #include <stddef.h>
 #include <stdbool.h>
 
+/* HT_BSDF_ONLY: the BSDF-only library (no scenes, rendering or images) is linked. */
+#if !defined(HT_BSDF_ONLY) && !defined(HT_RENDER)
+#define HT_RENDER 1
+#endif
+
 /**
- * Version of the C ABI; bumped on any incompatible change of a signature or struct.
+ * Version of the C ABI; bumped on any incompatible change of a signature or struct. The
+ * shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
  */
 #define HT_ABI_VERSION 3
+
+/**
+ * The major part of the library version, which `ht_version()` returns as a string. The
+ * three parts are Cargo's version: a compile-time check keeps them equal.
+ */
+#define HT_VERSION_MAJOR 0
+
+/**
+ * The minor part of the library version.
+ */
+#define HT_VERSION_MINOR 1
+
+/**
+ * The patch part of the library version.
+ */
+#define HT_VERSION_PATCH 0
 
 /**
  * Result of every C entry point; `HT_OK` is 0.
@@ -51,12 +73,15 @@ typedef enum HtStatus {
     HT_ERR_CANCELLED = 7,
 } HtStatus;
 
+#if defined(HT_RENDER)
 /**
  * An Embree device: its thread pool builds the scenes made on it. Create one per
  * process and share it between scenes. Thread safe.
  */
 typedef struct HtDevice HtDevice;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * A scene under construction and, after the first render, its built form. Not thread
  * safe: call the functions of one scene from one thread at a time (different scenes may
@@ -69,6 +94,7 @@ typedef struct HtDevice HtDevice;
  * and free the scene when done.
  */
 typedef struct HtScene HtScene;
+#endif
 
 /**
  * Parameters of the hair BSDF: sigma_a per unit fibre radius (linear RGB, finite, >= 0),
@@ -99,16 +125,21 @@ typedef struct HtHairParams {
     float alpha;
 } HtHairParams;
 
+#if defined(HT_RENDER)
 /**
  * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
  */
 typedef uint32_t HtCurveBasis;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`.
  */
 typedef uint32_t HtCurveShape;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
  * when the call returns.
@@ -150,7 +181,9 @@ typedef struct HtCurves {
     HtCurveBasis basis;
     HtCurveShape shape;
 } HtCurves;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
  * that hold that layout. `ht_scene_add_curves_xyzr` copies them, and the host may free its
@@ -187,7 +220,9 @@ typedef struct HtCurvesXyzr {
     HtCurveBasis basis;
     HtCurveShape shape;
 } HtCurvesXyzr;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * How a hair material varies over the groom, deterministically from the seed, the
  * strand and the position along it.
@@ -215,12 +250,16 @@ typedef struct HtHairVariation {
      */
     uint64_t seed;
 } HtHairVariation;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * A pixel filter: one of the `HT_FILTER_*` constants.
  */
 typedef uint32_t HtPixelFilter;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
  * call. Return false to cancel: no new pixel starts and `ht_render` returns
@@ -232,7 +271,9 @@ typedef uint32_t HtPixelFilter;
  * behaviour (catch inside and return false instead).
  */
 typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
  * the fields you need.
@@ -292,46 +333,63 @@ typedef struct HtRenderSettings {
      */
     void *progress_user;
 } HtRenderSettings;
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Straight segments between consecutive points.
  */
 #define HT_CURVE_LINEAR 0
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Cubic Bezier.
  */
 #define HT_CURVE_BEZIER 1
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Uniform cubic B-spline.
  */
 #define HT_CURVE_BSPLINE 2
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Catmull-Rom spline.
  */
 #define HT_CURVE_CATMULL_ROM 3
+#endif
 
+#if defined(HT_RENDER)
 /**
  * A true tube: the reference, and what close-ups need.
  */
 #define HT_CURVE_ROUND 0
+#endif
 
+#if defined(HT_RENDER)
 /**
  * A ribbon facing the ray: faster, approximate up close.
  */
 #define HT_CURVE_FLAT 1
+#endif
 
+#if defined(HT_RENDER)
 /**
  * A separable tent of half-width `filter_radius` pixels.
  */
 #define HT_FILTER_TENT 0
+#endif
 
+#if defined(HT_RENDER)
 /**
  * The one-pixel box.
  */
 #define HT_FILTER_BOX 1
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -409,27 +467,36 @@ enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
                                  float *f,
                                  float *pdf);
 
+#if defined(HT_RENDER)
 /**
  * Creates a device with `threads` Embree worker threads (0: one per hardware thread).
  * Free it with `ht_device_free`; scenes keep it alive as long as they need it.
  */
 enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Releases a device handle (NULL: nothing to do). Scenes made on it stay valid.
  */
 enum HtStatus ht_device_free(struct HtDevice *device);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Creates an empty scene on `device`. Free it with `ht_scene_free`.
  */
 enum HtStatus ht_scene_new(const struct HtDevice *device, struct HtScene **out);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Releases a scene and everything it holds (NULL: nothing to do).
  */
 enum HtStatus ht_scene_free(struct HtScene *scene);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Places the pinhole camera at `eye` looking at `target`, `up` giving the image's upward
  * direction (not parallel to the view), with a vertical field of view of `fov_y_deg` in
@@ -441,7 +508,9 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
                                   const float *target,
                                   const float *up,
                                   float fov_y_deg);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
  * units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
@@ -452,7 +521,9 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
 enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
                                      float aperture_radius,
                                      float focus_distance);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
  * `material_id`; writes the geometry id (0, 1, ... over curves and meshes, in the order
@@ -462,7 +533,9 @@ enum HtStatus ht_scene_add_curves(struct HtScene *scene,
                                   const struct HtCurves *desc,
                                   uint32_t material_id,
                                   uint32_t *geom_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds strands of float4 control points laid out for the basis (copied: see
  * `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
@@ -471,7 +544,9 @@ enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
                                        const struct HtCurvesXyzr *desc,
                                        uint32_t material_id,
                                        uint32_t *geom_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * As `ht_scene_add_curves_xyzr`, but `desc->points` is shared, not copied: Embree reads
  * the host's array in place, through every render and every rebuild after later
@@ -487,7 +562,9 @@ enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
                                               const struct HtCurvesXyzr *desc,
                                               uint32_t material_id,
                                               uint32_t *geom_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds the strands of a Cem Yuksel `.hair` file as polylines for `basis`. The file's
  * thickness is a diameter unless `thickness_is_radius`.
@@ -499,7 +576,9 @@ enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
                                      HtCurveShape shape,
                                      uint32_t material_id,
                                      uint32_t *geom_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
  * `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
@@ -514,7 +593,9 @@ enum HtStatus ht_scene_add_mesh(struct HtScene *scene,
                                 const uint32_t *indices,
                                 uint32_t material_id,
                                 uint32_t *geom_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
  * material `material_id`; writes the geometry id.
@@ -523,12 +604,16 @@ enum HtStatus ht_scene_add_mesh_file(struct HtScene *scene,
                                      const char *path,
                                      uint32_t material_id,
                                      uint32_t *geom_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds an environment of the same linear RGB `radiance` (>= 0) from every direction.
  */
 enum HtStatus ht_scene_add_environment(struct HtScene *scene, const float *radiance);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a lat-long environment map read through OpenImageIO (EXR, HDR, ...: linear
  * radiance), turned by `rotation_deg` about +y and its radiance multiplied by `scale`
@@ -538,7 +623,9 @@ enum HtStatus ht_scene_add_environment_map(struct HtScene *scene,
                                            const char *path,
                                            float rotation_deg,
                                            float scale);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a light at infinity: `direction` points toward it (any non-zero length), it
  * delivers linear RGB `irradiance` (>= 0) to a surface facing it, and is seen as a disc of
@@ -548,7 +635,9 @@ enum HtStatus ht_scene_add_distant_light(struct HtScene *scene,
                                          const float *direction,
                                          const float *irradiance,
                                          float angular_radius_deg);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a parallelogram light with corners `corner`, `corner + edge_u`, `corner + edge_v`
  * and `corner + edge_u + edge_v`, emitting linear RGB `radiance` (>= 0) toward
@@ -560,12 +649,16 @@ enum HtStatus ht_scene_add_rect_light(struct HtScene *scene,
                                       const float *edge_v,
                                       const float *radiance,
                                       bool two_sided);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * No variation: every strand has the material's parameters, and seed 0.
  */
 struct HtHairVariation ht_hair_variation_default(void);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a hair material with the same parameters on every strand; writes its id (0, 1, ...
  * in the order materials are added) to `material_id`.
@@ -573,7 +666,9 @@ struct HtHairVariation ht_hair_variation_default(void);
 enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
                                          const struct HtHairParams *params,
                                          uint32_t *material_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a hair material whose parameters vary over the groom as `variation` says.
  */
@@ -581,20 +676,26 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
                                                 const struct HtHairParams *params,
                                                 const struct HtHairVariation *variation,
                                                 uint32_t *material_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1].
  */
 enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
                                             const float *albedo,
                                             uint32_t *material_id);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
  * crop), a tent filter of radius 1, no callback.
  */
 struct HtRenderSettings ht_render_settings_default(void);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
  * `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
@@ -609,7 +710,9 @@ enum HtStatus ht_render(struct HtScene *scene,
                         const struct HtRenderSettings *settings,
                         float *rgb,
                         size_t rgb_len);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
  * and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
@@ -637,7 +740,9 @@ enum HtStatus ht_render_aovs(struct HtScene *scene,
                              float *depth,
                              float *strand_id,
                              size_t pixel_count);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Writes `pixels` (width * height * channels linear floats, interleaved, rows from the
  * top; channels 1 grey, 2 grey + alpha, 3 RGB or 4 RGBA with premultiplied alpha) through
@@ -650,6 +755,7 @@ enum HtStatus ht_image_write(const char *path,
                              uint32_t height,
                              uint32_t channels,
                              const float *pixels);
+#endif
 
 #ifdef __cplusplus
 }  // extern "C"

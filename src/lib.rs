@@ -23,33 +23,51 @@
 //! # Ok(()) }
 //! ```
 //!
+//! Without the default `render` feature the crate is the BSDF alone ([`bsdf`], [`math`] and
+//! the BSDF's C entry points): it builds and links without Embree and OpenImageIO.
+//!
 //! The modules stay public for hosts that assemble scenes piece by piece (strands, curves,
 //! a tracer, lights) and for the integration tests, which check those pieces one by one.
+
+// The BSDF-only build compiles the lower layers without the render code that uses some of
+// their helpers; the default build (every feature) still reports code nothing uses.
+#![cfg_attr(not(feature = "render"), allow(dead_code))]
 
 /// cbindgen:ignore
 pub mod bsdf;
 pub mod capi;
+#[cfg(feature = "render")]
 pub mod description;
 /// cbindgen:ignore
+#[cfg(feature = "render")]
 pub mod embree;
 mod error;
 /// cbindgen:ignore
+#[cfg(feature = "render")]
 pub mod image;
 /// cbindgen:ignore
 pub mod math;
 /// cbindgen:ignore
+#[cfg(feature = "render")]
 pub mod render;
 /// cbindgen:ignore
+#[cfg(feature = "render")]
 pub mod scene;
 mod validate;
 
 pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, LocalBsdf};
+#[cfg(feature = "render")]
 pub use description::{BuiltScene, SceneDescription};
+#[cfg(feature = "render")]
 pub use embree::Device;
 pub use error::{Error, Result};
+#[cfg(feature = "render")]
 pub use image::{read_image, write_image};
+#[cfg(feature = "render")]
 pub use render::renderer::{RenderOutput, render};
+#[cfg(feature = "render")]
 pub use render::settings::RenderSettings;
+#[cfg(feature = "render")]
 pub use render::{Aovs, NoProgress, PixelFilter, Progress};
 
 /// The crate version, as the C ABI reports it.

@@ -6,16 +6,21 @@
 //! module by cbindgen.
 
 pub mod bsdf;
+#[cfg(feature = "render")]
 pub mod scene;
 // Scenes first: the header declares them before the calls that fill them.
+#[cfg(feature = "render")]
 pub mod geometry;
+#[cfg(feature = "render")]
 pub mod lights;
+#[cfg(feature = "render")]
 pub mod materials;
-#[cfg(test)]
+#[cfg(all(test, feature = "render"))]
 mod scene_tests;
 // After `scene`, so that the header declares scenes before the render that takes them.
+#[cfg(feature = "render")]
 pub mod render;
-#[cfg(test)]
+#[cfg(all(test, feature = "render"))]
 mod render_tests;
 
 pub use bsdf::HtHairParams;
@@ -28,8 +33,36 @@ use std::ffi::{CStr, CString, c_char};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::PathBuf;
 
-/// Version of the C ABI; bumped on any incompatible change of a signature or struct.
+/// Version of the C ABI; bumped on any incompatible change of a signature or struct. The
+/// shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
 pub const HT_ABI_VERSION: u32 = 3;
+
+/// The major part of the library version, which `ht_version()` returns as a string. The
+/// three parts are Cargo's version: a compile-time check keeps them equal.
+pub const HT_VERSION_MAJOR: u32 = 0;
+/// The minor part of the library version.
+pub const HT_VERSION_MINOR: u32 = 1;
+/// The patch part of the library version.
+pub const HT_VERSION_PATCH: u32 = 0;
+
+/// cbindgen:ignore
+const _: () = {
+    /// A decimal number at compile time (Cargo's version fields are plain digits).
+    const fn parse(s: &str) -> u32 {
+        let (bytes, mut i, mut n) = (s.as_bytes(), 0, 0);
+        while i < bytes.len() {
+            n = n * 10 + (bytes[i] - b'0') as u32;
+            i += 1;
+        }
+        n
+    }
+    assert!(
+        HT_VERSION_MAJOR == parse(env!("CARGO_PKG_VERSION_MAJOR"))
+            && HT_VERSION_MINOR == parse(env!("CARGO_PKG_VERSION_MINOR"))
+            && HT_VERSION_PATCH == parse(env!("CARGO_PKG_VERSION_PATCH")),
+        "HT_VERSION_MAJOR/MINOR/PATCH in src/capi/mod.rs differ from Cargo.toml's version"
+    );
+};
 
 /// Result of every C entry point; `HT_OK` is 0.
 #[repr(C)]

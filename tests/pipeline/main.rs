@@ -5,7 +5,6 @@
 
 mod architecture;
 mod camera_film;
-mod cli;
 mod curves_geometry;
 mod description;
 mod groom;

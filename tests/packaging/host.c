@@ -1,0 +1,67 @@
+/* A host of the installed library (tests/packaging): compiled as C99 and as C++, linked
+ * through pkg-config or CMake, shared or static, full or BSDF-only. It prints the versions
+ * it was compiled and linked against, one BSDF evaluation, what the process costs after
+ * start-up (threads, resident memory, mapped shared objects) and, with the full library,
+ * that a render device can be made. */
+#include <hairtrace.h>
+#include <stdio.h>
+#include <string.h>
+
+/* Prints the value of a "Key:" line of /proc/self/status. */
+static void print_status(const char *key) {
+    char line[256];
+    FILE *f = fopen("/proc/self/status", "r");
+    size_t n = strlen(key);
+    if (!f) return;
+    while (fgets(line, sizeof line, f))
+        if (strncmp(line, key, n) == 0) printf("%s", line);
+    fclose(f);
+}
+
+/* Counts the distinct shared objects mapped into the process, and those whose path holds
+ * `a` or `b`. */
+static void print_maps(const char *a, const char *b) {
+    char line[4096], last[4096] = "";
+    int objects = 0, found_a = 0, found_b = 0;
+    FILE *f = fopen("/proc/self/maps", "r");
+    if (!f) return;
+    while (fgets(line, sizeof line, f)) {
+        const char *path = strchr(line, '/');
+        if (!path || !strstr(path, ".so") || strcmp(path, last) == 0) continue;
+        strncpy(last, path, sizeof last - 1);
+        objects++;
+        found_a += strstr(path, a) != NULL;
+        found_b += strstr(path, b) != NULL;
+    }
+    fclose(f);
+    printf("maps %d objects, %d %s, %d %s\n", objects, found_a, a, found_b, b);
+}
+
+int main(void) {
+    HtHairParams p = ht_hair_params_default();
+    const float wo[3] = {0.0f, 0.0f, 1.0f}, wi[3] = {0.0f, 0.8660254f, 0.5f};
+    float f[3], pdf;
+    if (ht_hair_eval(&p, 0.5f, wo, wi, f, &pdf) != HT_OK) {
+        fprintf(stderr, "ht_hair_eval: %s\n", ht_last_error());
+        return 1;
+    }
+    printf("header %d.%d.%d abi %d\n", HT_VERSION_MAJOR, HT_VERSION_MINOR, HT_VERSION_PATCH,
+           HT_ABI_VERSION);
+    printf("library %s abi %u\n", ht_version(), ht_abi_version());
+    printf("eval %.9g %.9g %.9g %.9g\n", f[0], f[1], f[2], pdf);
+    print_status("Threads:");
+    print_status("VmRSS:");
+    print_maps("libembree", "libOpenImageIO");
+#ifdef HT_RENDER
+    {
+        HtDevice *device = NULL;
+        if (ht_device_new(1, &device) != HT_OK) {
+            fprintf(stderr, "ht_device_new: %s\n", ht_last_error());
+            return 1;
+        }
+        ht_device_free(device);
+        printf("device ok\n");
+    }
+#endif
+    return 0;
+}

@@ -282,7 +282,7 @@ fn render_stats_compare_and_export() {
     );
 
     let dir = tmp("cli_export");
-    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/bench/scenes/fur_ball.toml");
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/../bench/scenes/fur_ball.toml");
     let o = hairtrace(&["export", scene, "-o", &dir]);
     assert!(o.status.success(), "{o:?}");
     let json = std::fs::read_to_string(format!("{dir}/scene.json")).unwrap();

@@ -1,7 +1,8 @@
 //! Everything between a groom and an image, end to end: grooms and .hair files, curves
 //! in Embree against analytic tubes, leaving fibres, lights, camera and film, scene files,
-//! image files, renders, the command line, and the layering of the sources. One test
-//! binary, so that the crate (with Embree and OpenImageIO) is linked once.
+//! image files, renders, and the layering of the sources (the command line is tested in
+//! its own package, cli/tests). One test binary, so that the crate (with Embree and
+//! OpenImageIO) is linked once.
 
 mod architecture;
 mod camera_film;

@@ -8,6 +8,7 @@ mod camera_film;
 mod cli;
 mod curves_geometry;
 mod description;
+mod farm;
 mod groom;
 mod hair_file;
 mod image_io;

@@ -186,9 +186,10 @@ pub extern "C" fn ht_device_new_pinned(
 ) -> HtStatus {
     boundary(|| {
         let out = non_null_mut(out, "out")?;
-        let isa = match isa.is_null() {
-            true => None,
-            false => Some(Isa::named(&read_path(isa, "isa")?.to_string_lossy())?),
+        let isa = if isa.is_null() {
+            None
+        } else {
+            Some(Isa::named(&read_path(isa, "isa")?.to_string_lossy())?)
         };
         let device = Device::pinned((threads > 0).then_some(threads as usize), isa)?;
         let handle = Box::new(HtDevice {

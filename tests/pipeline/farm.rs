@@ -8,6 +8,7 @@ use hairtrace::description::{self, SceneDescription};
 use hairtrace::embree::{Device, Isa};
 use hairtrace::render::{Aovs, NoProgress, renderer};
 use std::path::Path;
+use std::process::Command;
 use std::sync::Arc;
 
 const W: u32 = 48;
@@ -87,4 +88,18 @@ fn the_scene_file_pins_the_isa_and_refuses_unknown_names() {
         .unwrap_err()
         .to_string();
     assert!(bad.contains("isa = \"avx3\": must be one of sse2, avx, avx2, avx512"), "{bad}");
+}
+
+/// The documented recipe itself (`scripts/farm`): bands rendered by separate processes,
+/// assembled with oiiotool, equal to the full render bit for bit (idiff, zero tolerance).
+#[test]
+fn the_farm_recipe_assembles_the_full_frame() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new(root.join("scripts/farm"))
+        .env("HAIRTRACE", env!("CARGO_BIN_EXE_hairtrace"))
+        .output()
+        .expect("run scripts/farm (oiiotool and idiff come from scripts/setup)");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "scripts/farm failed: {err}");
+    assert!(err.contains("assemble into the full frame bit for bit"), "{err}");
 }

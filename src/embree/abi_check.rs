@@ -43,10 +43,7 @@ fn mismatch(message: String) -> Error {
 fn library_version(device: sys::RTCDevice) -> u32 {
     // SAFETY: live device; a read-only property.
     let v = unsafe {
-        sys::rtcGetDeviceProperty(
-            device,
-            sys::RTCDeviceProperty::RTC_DEVICE_PROPERTY_VERSION,
-        )
+        sys::rtcGetDeviceProperty(device, sys::RTCDeviceProperty::RTC_DEVICE_PROPERTY_VERSION)
     };
     u32::try_from(v).unwrap_or(0)
 }
@@ -93,9 +90,8 @@ unsafe fn probe_layout(device: sys::RTCDevice) -> Result<()> {
     // SAFETY: live device; each new object is checked before use and released at the end.
     let scene = unsafe { sys::rtcNewScene(device) };
     // SAFETY: as above.
-    let geometry = unsafe {
-        sys::rtcNewGeometry(device, sys::RTCGeometryType::RTC_GEOMETRY_TYPE_TRIANGLE)
-    };
+    let geometry =
+        unsafe { sys::rtcNewGeometry(device, sys::RTCGeometryType::RTC_GEOMETRY_TYPE_TRIANGLE) };
     if scene.is_null() || geometry.is_null() {
         // SAFETY: releasing what was created; Embree accepts no null here, so guard.
         unsafe { release(scene, geometry) };
@@ -174,7 +170,11 @@ unsafe fn probe_layout(device: sys::RTCDevice) -> Result<()> {
         hit.v,
         hit.geomID,
         hit.primID,
-        if guard_intact { "intact" } else { "overwritten" }
+        if guard_intact {
+            "intact"
+        } else {
+            "overwritten"
+        }
     )))
 }
 
@@ -204,8 +204,13 @@ mod tests {
         assert_eq!(check_version_against(40400, 40303), Ok(()));
         assert_eq!(check_version_against(31305, 31305), Ok(()));
         for (library, header) in [(31305, 40303), (40303, 31305), (40302, 40303), (0, 31305)] {
-            let e = check_version_against(library, header).unwrap_err().to_string();
-            assert!(e.contains(&dotted(library)) && e.contains(&dotted(header)), "{e}");
+            let e = check_version_against(library, header)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains(&dotted(library)) && e.contains(&dotted(header)),
+                "{e}"
+            );
         }
     }
 

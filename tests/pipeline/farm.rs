@@ -22,7 +22,10 @@ fn scene() -> SceneDescription {
 
 /// Renders rows `y0..y1` on `machine`, with Embree pinned to `pin` when given.
 fn render_rows(machine: Isa, pin: Option<Isa>, y0: u32, y1: u32) -> Vec<u32> {
-    let config = format!("max_isa={machine},{}", Device::config(Some(1), pin).unwrap());
+    let config = format!(
+        "max_isa={machine},{}",
+        Device::config(Some(1), pin).unwrap()
+    );
     let device = Arc::new(Device::with_config(&config).unwrap());
     let mut d = scene();
     d.render.crop = Some([0, y0, W, y1]);
@@ -87,7 +90,10 @@ fn the_scene_file_pins_the_isa_and_refuses_unknown_names() {
         .device()
         .unwrap_err()
         .to_string();
-    assert!(bad.contains("isa = \"avx3\": must be one of sse2, avx, avx2, avx512"), "{bad}");
+    assert!(
+        bad.contains("isa = \"avx3\": must be one of sse2, avx, avx2, avx512"),
+        "{bad}"
+    );
 }
 
 /// The documented recipe itself (`scripts/farm`): bands rendered by separate processes,
@@ -101,5 +107,8 @@ fn the_farm_recipe_assembles_the_full_frame() {
         .expect("run scripts/farm (oiiotool and idiff come from scripts/setup)");
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "scripts/farm failed: {err}");
-    assert!(err.contains("assemble into the full frame bit for bit"), "{err}");
+    assert!(
+        err.contains("assemble into the full frame bit for bit"),
+        "{err}"
+    );
 }

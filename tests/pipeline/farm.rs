@@ -112,3 +112,19 @@ fn the_farm_recipe_assembles_the_full_frame() {
         "{err}"
     );
 }
+
+#[test]
+fn the_command_line_refuses_an_unknown_isa_in_one_line() {
+    let out = Command::new(env!("CARGO_BIN_EXE_hairtrace"))
+        .args([
+            "render", "--demo", "furball", "--isa", "sse4.2", "-o", "x.exr",
+        ])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        err.contains("isa = \"sse4.2\": must be one of sse2, avx, avx2, avx512"),
+        "{err}"
+    );
+}

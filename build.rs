@@ -201,7 +201,7 @@ fn link_embree(embree: &Embree) {
     let search = embree
         .lib_dir
         .as_ref()
-        .map(|d| format!("-L{} ", d.display()))
+        .map(|d| format!("-L{0} -Wl,-rpath,{0} ", d.display()))
         .unwrap_or_default();
     println!(
         "cargo:rustc-env=HT_EMBREE_LINK={search}-lembree{}",
@@ -209,6 +209,9 @@ fn link_embree(embree: &Embree) {
     );
     if let Some(dir) = &embree.lib_dir {
         println!("cargo:rustc-link-search=native={}", dir.display());
+        // A folder the loader does not search (scripts/embree4's): recorded as an rpath so
+        // that the binaries, tests and shared library run without LD_LIBRARY_PATH.
+        println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
     }
     println!("cargo:rustc-link-lib=dylib=embree{}", embree.major);
 }

@@ -477,6 +477,15 @@ enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
 
 #if defined(HT_RENDER)
 /**
+ * As `ht_device_new`, with Embree's kernels pinned to the instruction set named by `isa`
+ * ("sse2", "avx", "avx2" or "avx512"; NULL: not pinned, the widest this CPU runs).
+ * Embree's kernels for different instruction sets round differently, so a frame whose
+ * crop pieces render on different CPUs assembles bit for bit only when every piece pins
+ * the same ISA. HT_ERR_INVALID_ARG for another name or an ISA this CPU cannot run.
+ */
+enum HtStatus ht_device_new_pinned(uint32_t threads, const char *isa, struct HtDevice **out);
+
+/**
  * Releases a device handle (NULL: nothing to do). Scenes made on it stay valid.
  */
 enum HtStatus ht_device_free(struct HtDevice *device);

@@ -8,7 +8,7 @@ use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
 use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{self, BuiltScene, SceneDescription};
-use hairtrace::embree::Device;
+use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::{Thickness, info_report, read_hair_file};
@@ -88,6 +88,11 @@ struct RenderArgs {
     /// Worker threads (default: all cores).
     #[arg(long)]
     threads: Option<usize>,
+    /// Pin Embree's kernels to one instruction set (sse2, avx, avx2, avx512) so that
+    /// crop pieces rendered on different CPUs assemble bit for bit (default: the widest
+    /// this CPU runs).
+    #[arg(long, value_parser = Isa::named)]
+    isa: Option<Isa>,
     /// Longest path, in scattering events.
     #[arg(long)]
     max_depth: Option<u32>,
@@ -263,6 +268,9 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     r.height = args.height.unwrap_or(r.height);
     r.seed = args.seed.unwrap_or(r.seed);
     r.threads = args.threads.or(r.threads);
+    if let Some(isa) = args.isa {
+        r.isa = Some(isa.name().to_owned());
+    }
     r.max_depth = args.max_depth.unwrap_or(r.max_depth);
     r.crop = args.crop.or(r.crop);
     r.rr_depth = args.rr_depth.unwrap_or(r.rr_depth);
@@ -274,7 +282,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     }
     r.filter_radius = args.filter_radius.or(r.filter_radius);
     let build_start = std::time::Instant::now();
-    let device = Arc::new(Device::new(r.threads)?);
+    let device = Arc::new(r.device()?);
     let BuiltScene {
         world,
         camera,

@@ -5,8 +5,8 @@
 //! the Embree scene on the first render, then reuses it: adding geometry rebuilds it on
 //! the next render, adding a light only re-weights the lights.
 
-use super::{Failure, HtStatus, boundary, non_null, non_null_mut, read_vec3};
-use crate::embree::{Device, SceneOptions};
+use super::{Failure, HtStatus, boundary, non_null, non_null_mut, read_path, read_vec3};
+use crate::embree::{Device, Isa, SceneOptions};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
@@ -16,6 +16,7 @@ use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::validate::{non_negative, positive};
+use std::ffi::c_char;
 use std::sync::Arc;
 
 /// An Embree device: its thread pool builds the scenes made on it. Create one per
@@ -169,9 +170,28 @@ fn free_handle<T>(handle: *mut T) {
 /// Free it with `ht_device_free`; scenes keep it alive as long as they need it.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_device_new(threads: u32, out: *mut *mut HtDevice) -> HtStatus {
+    ht_device_new_pinned(threads, std::ptr::null(), out)
+}
+
+/// As `ht_device_new`, with Embree's kernels pinned to the instruction set named by `isa`
+/// ("sse2", "avx", "avx2" or "avx512"; NULL: not pinned, the widest this CPU runs).
+/// Embree's kernels for different instruction sets round differently, so a frame whose
+/// crop pieces render on different CPUs assembles bit for bit only when every piece pins
+/// the same ISA. HT_ERR_INVALID_ARG for another name or an ISA this CPU cannot run.
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_device_new_pinned(
+    threads: u32,
+    isa: *const c_char,
+    out: *mut *mut HtDevice,
+) -> HtStatus {
     boundary(|| {
         let out = non_null_mut(out, "out")?;
-        let device = Device::new((threads > 0).then_some(threads as usize))?;
+        let isa = if isa.is_null() {
+            None
+        } else {
+            Some(Isa::named(&read_path(isa, "isa")?.to_string_lossy())?)
+        };
+        let device = Device::pinned((threads > 0).then_some(threads as usize), isa)?;
         let handle = Box::new(HtDevice {
             device: Arc::new(device),
         });

@@ -626,3 +626,23 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
         shared.1
     );
 }
+
+#[test]
+fn pinned_devices_take_embree_isa_names_only() {
+    for isa in [null(), c"sse2".as_ptr()] {
+        let mut device = null_mut();
+        assert_eq!(ht_device_new_pinned(1, isa, &mut device), HtStatus::HT_OK);
+        assert_eq!(ht_device_free(device), HtStatus::HT_OK);
+    }
+    let mut device = null_mut();
+    assert_eq!(
+        ht_device_new_pinned(1, c"sse4.2".as_ptr(), &mut device),
+        HtStatus::HT_ERR_INVALID_ARG
+    );
+    assert!(device.is_null());
+    assert!(
+        last_error().contains("isa = \"sse4.2\": must be one of sse2, avx, avx2, avx512"),
+        "{}",
+        last_error()
+    );
+}

@@ -12,6 +12,7 @@
 //! spp = 16
 //! seed = 0
 //! threads = 2              # absent: all cores
+//! isa = "avx2"             # pin Embree's kernels (sse2, avx, avx2, avx512); absent: the CPU's widest
 //! max_depth = 256
 //! rr_depth = 2            # Russian roulette after this many events
 //! roulette = "sqrt"        # survival sqrt(throughput), or "throughput"
@@ -102,7 +103,7 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 
-use crate::embree::{CurveBasis, CurveShape};
+use crate::embree::{CurveBasis, CurveShape, Device, Isa};
 use crate::error::Result;
 use crate::render::PixelFilter;
 use crate::render::integrator::{PathSettings, Roulette, World};
@@ -137,6 +138,9 @@ pub struct RenderDesc {
     pub spp: u32,
     pub seed: u64,
     pub threads: Option<usize>,
+    /// Embree's kernels pinned to this instruction set (see [`Isa`]); `None`: the widest
+    /// the CPU runs.
+    pub isa: Option<String>,
     pub max_depth: u32,
     pub rr_depth: u32,
     /// "sqrt" (the default) or "throughput": see [`Roulette`].
@@ -158,6 +162,7 @@ impl Default for RenderDesc {
             spp: s.spp,
             seed: s.seed,
             threads: s.threads,
+            isa: None,
             max_depth: s.path.max_depth,
             rr_depth: s.path.rr_depth,
             roulette: s.path.roulette.name().to_string(),
@@ -170,6 +175,12 @@ impl Default for RenderDesc {
 }
 
 impl RenderDesc {
+    /// The Embree device these settings ask for: their thread count and pinned ISA.
+    pub fn device(&self) -> Result<Device> {
+        let isa = self.isa.as_deref().map(Isa::named).transpose()?;
+        Device::pinned(self.threads, isa)
+    }
+
     /// The validated settings.
     pub fn settings(&self) -> Result<RenderSettings> {
         let settings = RenderSettings {

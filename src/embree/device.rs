@@ -4,7 +4,7 @@ use std::ffi::{CStr, CString, c_char, c_void};
 use std::ptr::NonNull;
 use std::sync::Mutex;
 
-use super::sys;
+use super::{Isa, abi_check, sys};
 use crate::error::invalid_arg;
 use crate::{Error, Result};
 
@@ -42,16 +42,38 @@ unsafe impl Sync for Device {}
 
 impl Device {
     /// Creates a device that uses `threads` worker threads, or every hardware thread when
-    /// `None`.
+    /// `None`, with the kernels Embree picks for this CPU.
     pub fn new(threads: Option<usize>) -> Result<Device> {
+        Self::pinned(threads, None)
+    }
+
+    /// As [`Device::new`], with Embree's kernels pinned to `isa` when given (see [`Isa`]:
+    /// the same kernels, hence the same bits, on every CPU that can run them). An ISA this
+    /// CPU cannot run is refused.
+    pub fn pinned(threads: Option<usize>, isa: Option<Isa>) -> Result<Device> {
+        Self::with_config(&Self::config(threads, isa)?)
+    }
+
+    /// The Embree configuration string of [`Device::pinned`]. Embree reads it left to
+    /// right, so `max_isa=avx2,` in front makes a device behave as on a CPU without
+    /// AVX-512 until the pin (what the farm test uses to stand in for mixed machines).
+    pub fn config(threads: Option<usize>, isa: Option<Isa>) -> Result<String> {
+        let mut config = Vec::new();
         match threads {
             // Embree reads "threads=0" as "all", which would silently ignore the request.
-            Some(0) => Err(invalid_arg!(
-                "Embree thread count must be at least 1 (None uses every hardware thread)"
-            )),
-            Some(n) => Self::with_config(&format!("threads={n}")),
-            None => Self::with_config(""),
+            Some(0) => {
+                return Err(invalid_arg!(
+                    "Embree thread count must be at least 1 (None uses every hardware thread)"
+                ));
+            }
+            Some(n) => config.push(format!("threads={n}")),
+            None => {}
         }
+        if let Some(isa) = isa {
+            isa.check_runs_here()?;
+            config.push(format!("isa={isa}"));
+        }
+        Ok(config.join(","))
     }
 
     /// Creates a device from an Embree configuration string (see `rtcNewDevice` in the
@@ -83,7 +105,9 @@ impl Device {
                 std::ptr::from_ref::<ErrorSlot>(&last_error) as *mut c_void,
             );
         }
-        Ok(Device { raw, last_error })
+        let device = Device { raw, last_error };
+        abi_check::verify_once(device.raw())?;
+        Ok(device)
     }
 
     /// The raw handle, for the scene and geometry layer. It is valid while `self` lives;

@@ -15,9 +15,11 @@
 //! Those differences live in `compat.rs` (under `cfg(embree3)` / `cfg(embree4)`, set by
 //! `build.rs` from the installed header); every other file stays version-agnostic.
 
+mod abi_check;
 mod compat;
 mod device;
 mod geometry;
+mod isa;
 mod memory;
 mod query;
 mod scene;
@@ -28,6 +30,7 @@ pub use geometry::{
     CurveBasis, CurveGeometry, CurvePoint, CurveShape, Geometry, SharedBuffer, TriangleGeometry,
     padding_for,
 };
+pub use isa::Isa;
 pub use memory::MemoryMonitor;
 pub use query::{Exclude, Ray, RayHit};
 pub use scene::{Scene, SceneBuilder, SceneOptions};

@@ -8,6 +8,7 @@ mod architecture;
 mod camera_film;
 mod curves_geometry;
 mod description;
+mod farm;
 mod groom;
 mod hair_file;
 mod image_io;

@@ -484,7 +484,9 @@ enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
  * the same ISA. HT_ERR_INVALID_ARG for another name or an ISA this CPU cannot run.
  */
 enum HtStatus ht_device_new_pinned(uint32_t threads, const char *isa, struct HtDevice **out);
+#endif
 
+#if defined(HT_RENDER)
 /**
  * Releases a device handle (NULL: nothing to do). Scenes made on it stay valid.
  */

@@ -31,7 +31,7 @@ const SUN_DIR: [f32; 3] = [1.0, 1.0, 1.0];
 const SUN: [f32; 3] = [2.0, 2.0, 1.8];
 const SUN_RADIUS_DEG: f32 = 2.0;
 
-fn settings(size: u32) -> HtRenderSettings {
+pub(super) fn settings(size: u32) -> HtRenderSettings {
     HtRenderSettings {
         width: size,
         height: size,
@@ -43,7 +43,7 @@ fn settings(size: u32) -> HtRenderSettings {
 }
 
 /// The small fur ball with hair, sky and sun through the C functions.
-fn fur_scene(camera: bool) -> Handles {
+pub(super) fn fur_scene(camera: bool) -> Handles {
     let h = Handles::new();
     let hair = h.hair_material();
     assert_eq!(
@@ -57,7 +57,8 @@ fn fur_scene(camera: bool) -> Handles {
 }
 
 /// Adds sky and sun, and the camera if asked.
-fn light(h: &Handles, camera: bool) {
+pub(super) fn light(h: &Handles, camera: bool) {
+    unsafe {
     assert_eq!(
         ht_scene_add_environment(h.scene, SKY.as_ptr()),
         HtStatus::HT_OK
@@ -68,16 +69,20 @@ fn light(h: &Handles, camera: bool) {
         let s = ht_scene_set_camera(h.scene, EYE.as_ptr(), [0.0; 3].as_ptr(), UP.as_ptr(), 40.0);
         assert_eq!(s, HtStatus::HT_OK);
     }
+    }
 }
 
-fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
+pub(super) fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
+    unsafe {
     let mut rgb = vec![-1.0f32; (s.width * s.height * 3) as usize];
     let status = ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len());
     (status, rgb)
+    }
 }
 
 /// Renders through `ht_render_aovs` with every AOV: rgb, albedo, depth, strand id.
 fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
+    unsafe {
     let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
     let pixels = ((x1 - x0) * (y1 - y0)) as usize;
     let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
@@ -94,9 +99,10 @@ fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
     );
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
     out
+    }
 }
 
-fn bits(rgb: &[f32]) -> Vec<u32> {
+pub(super) fn bits(rgb: &[f32]) -> Vec<u32> {
     rgb.iter().map(|v| v.to_bits()).collect()
 }
 
@@ -113,7 +119,7 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
     let hair = HairMaterial::default().prepare().unwrap();
     let lights = vec![
         Light::Environment(Environment::uniform(Vec3::from(SKY)).unwrap()),
-        Light::distant(SUN_DIR.into(), SUN.into(), SUN_RADIUS_DEG.to_radians()).unwrap(),
+        Light::distant(SUN_DIR.into(), SUN.into(), SUN_RADIUS_DEG).unwrap(),
     ];
     let world = World::new(
         builder.build().unwrap(),
@@ -152,6 +158,7 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
 
 #[test]
 fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
+    unsafe {
     let strands = small_fur();
     let points = xyzr(&strands);
     let desc = xyzr_desc(&points, &strands.counts);
@@ -194,6 +201,7 @@ fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
     assert_eq!(copied_wall, shared_wall);
     assert_ne!(copied_wall, copied);
     assert_eq!(embree_points(), points.as_ptr());
+    }
 }
 
 #[test]
@@ -228,6 +236,7 @@ fn crops_reassemble_into_the_full_frame_bit_for_bit() {
 
 #[test]
 fn aovs_report_the_first_hits_and_null_ones_are_skipped() {
+    unsafe {
     let h = fur_scene(true);
     let s = settings(32);
     let [rgb, albedo, depth, strand_id] = render_aovs_c(&h, &s);
@@ -269,10 +278,12 @@ fn aovs_report_the_first_hits_and_null_ones_are_skipped() {
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
     assert_eq!(bits(&rgb_only), bits(&rgb));
     assert_eq!(bits(&depth_only), bits(&depth));
+    }
 }
 
 #[test]
 fn a_thin_lens_blurs_whichever_comes_first_lens_or_camera() {
+    unsafe {
     use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL, HT_OK};
     let s = settings(24);
     let h = fur_scene(true);
@@ -301,6 +312,7 @@ fn a_thin_lens_blurs_whichever_comes_first_lens_or_camera() {
     assert_eq!(set(&lens_first, 0.5, 10.0), HT_OK);
     light(&lens_first, true);
     assert_eq!(bits(&render_c(&lens_first, &s).1), bits(&blurred));
+    }
 }
 
 extern "C" fn count_then_cancel(_done: u64, _total: u64, user: *mut c_void) -> bool {
@@ -325,8 +337,8 @@ fn the_callback_reports_progress_and_cancels() {
     };
     let (status, full) = render_c(&h, &s);
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    // 16 x 16 tiles: one call per tile.
-    assert_eq!(calls.load(Ordering::Relaxed), 16);
+    // 16 x 16 tiles: one call per tile, and more if a tile takes over 20 ms.
+    assert!(calls.load(Ordering::Relaxed) >= 16);
 
     calls.store(0, Ordering::Relaxed);
     s.progress = Some(count_then_cancel);
@@ -347,6 +359,7 @@ fn the_callback_reports_progress_and_cancels() {
 
 #[test]
 fn adding_geometry_or_lights_rebuilds_what_changed() {
+    unsafe {
     let h = fur_scene(true);
     let s = settings(24);
     let (status, before) = render_c(&h, &s);
@@ -387,6 +400,7 @@ fn adding_geometry_or_lights_rebuilds_what_changed() {
     add_rect(&fresh);
     assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_rect));
     assert_ne!(bits(&with_rect), bits(&with_wall));
+    }
 }
 
 #[test]
@@ -413,6 +427,7 @@ fn without_a_camera_the_scene_is_framed() {
 
 #[test]
 fn bad_settings_and_incomplete_scenes_are_reported() {
+    unsafe {
     use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
     let h = fur_scene(true);
     let s = settings(8);
@@ -519,42 +534,45 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
     for (v, sky) in rgb.iter().zip(SKY.iter().cycle()) {
         assert!((v - sky).abs() < 1e-6, "{v} {sky}");
     }
+    }
 }
 
 #[test]
 fn images_are_written_through_oiio() {
+    unsafe {
     let dir = std::env::temp_dir().join(format!("ht-capi-render-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let file = dir.join("ramp.exr");
     let path = std::ffi::CString::new(file.to_str().unwrap()).unwrap();
     let pixels: Vec<f32> = (0..4 * 2 * 3).map(|i| i as f32 / 8.0).collect();
-    let s = ht_image_write(path.as_ptr(), 4, 2, 3, pixels.as_ptr());
+    let s = ht_image_write(path.as_ptr(), 4, 2, 3, pixels.as_ptr(), pixels.len());
     assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
     let image = read_image(&file).unwrap();
     assert_eq!((image.width, image.height, image.channels), (4, 2, 3));
     assert_eq!(image.pixels, pixels);
 
     fails(
-        ht_image_write(path.as_ptr(), 4, 2, 3, null()),
+        ht_image_write(path.as_ptr(), 4, 2, 3, null(), 24),
         HtStatus::HT_ERR_NULL_ARG,
         "pixels",
     );
     fails(
-        ht_image_write(null(), 4, 2, 3, pixels.as_ptr()),
+        ht_image_write(null(), 4, 2, 3, pixels.as_ptr(), 24),
         HtStatus::HT_ERR_NULL_ARG,
         "path",
     );
     let bmp = std::ffi::CString::new(dir.join("x.bmp").to_str().unwrap()).unwrap();
-    let s = ht_image_write(bmp.as_ptr(), 4, 2, 3, pixels.as_ptr());
+    let s = ht_image_write(bmp.as_ptr(), 4, 2, 3, pixels.as_ptr(), 24);
     assert_ne!(s, HtStatus::HT_OK);
     assert!(last_error().contains("x.bmp"), "{}", last_error());
     let nan = [f32::NAN; 3];
     fails(
-        ht_image_write(path.as_ptr(), 1, 1, 3, nan.as_ptr()),
+        ht_image_write(path.as_ptr(), 1, 1, 3, nan.as_ptr(), 3),
         HtStatus::HT_ERR_IMAGE,
         "NaN",
     );
     std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
 
 #[test]

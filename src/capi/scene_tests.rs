@@ -39,10 +39,12 @@ pub(crate) struct Handles {
 
 impl Handles {
     pub(crate) fn new() -> Self {
+        unsafe {
         let (mut device, mut scene) = (null_mut(), null_mut());
         assert_eq!(ht_device_new(2, &mut device), HtStatus::HT_OK);
         assert_eq!(ht_scene_new(device, &mut scene), HtStatus::HT_OK);
         Handles { device, scene }
+        }
     }
 
     pub(crate) fn scene(&self) -> &HtScene {
@@ -50,6 +52,7 @@ impl Handles {
     }
 
     pub(crate) fn hair_material(&self) -> u32 {
+        unsafe {
         let mut id = u32::MAX;
         let p = ht_hair_params_default();
         assert_eq!(
@@ -57,34 +60,43 @@ impl Handles {
             HtStatus::HT_OK
         );
         id
+        }
     }
 
     pub(crate) fn diffuse_material(&self, albedo: [f32; 3]) -> u32 {
+        unsafe {
         let mut id = u32::MAX;
         let s = ht_scene_add_diffuse_material(self.scene, albedo.as_ptr(), &mut id);
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
         id
+        }
     }
 
     /// Adds `strands` through `ht_scene_add_curves`.
     pub(crate) fn add_strands(&self, strands: &Strands, material: u32) -> HtStatus {
+        unsafe {
         let desc = curves_desc(strands);
         ht_scene_add_curves(self.scene, &desc, material, &mut 0)
+        }
     }
 
     /// Adds a single triangle in front of the origin.
     pub(crate) fn add_triangle(&self, material: u32) -> HtStatus {
+        unsafe {
         let positions = [-3.0f32, -3.0, -1.5, 3.0, -3.0, -1.5, 0.0, 3.0, -1.5];
         let indices = [0u32, 1, 2];
         let (p, i) = (positions.as_ptr(), indices.as_ptr());
         ht_scene_add_mesh(self.scene, 3, p, null(), 1, i, material, &mut 0)
+        }
     }
 }
 
 impl Drop for Handles {
     fn drop(&mut self) {
+        unsafe {
         assert_eq!(ht_scene_free(self.scene), HtStatus::HT_OK);
         assert_eq!(ht_device_free(self.device), HtStatus::HT_OK);
+        }
     }
 }
 
@@ -138,6 +150,7 @@ pub(crate) fn small_fur() -> Strands {
 
 #[test]
 fn null_handles_and_pointers_are_reported() {
+    unsafe {
     use HtStatus::{HT_ERR_NULL_ARG as NULL, HT_OK};
     assert_eq!(ht_device_free(null_mut()), HT_OK);
     assert_eq!(ht_scene_free(null_mut()), HT_OK);
@@ -277,10 +290,12 @@ fn null_handles_and_pointers_are_reported() {
     );
     assert_eq!(id, 2);
     assert!(h.scene().geometries.is_empty() && h.scene().lights.is_empty());
+    }
 }
 
 #[test]
 fn invalid_values_name_the_argument_and_add_nothing() {
+    unsafe {
     use HtStatus::HT_ERR_INVALID_ARG as INVALID;
     let h = Handles::new();
     let mut id = 0;
@@ -361,7 +376,7 @@ fn invalid_values_name_the_argument_and_add_nothing() {
     broken.points[5][1] = f32::INFINITY;
     fails(add(&curves_desc(&broken), hair), INVALID, "point 5");
     let misaligned = HtCurves {
-        points: unsafe { desc.points.cast::<u8>().add(1).cast() },
+        points: { desc.points.cast::<u8>().add(1).cast() },
         ..desc
     };
     fails(add(&misaligned, hair), INVALID, "aligned");
@@ -448,10 +463,12 @@ fn invalid_values_name_the_argument_and_add_nothing() {
         "distinct",
     );
     assert!(h.scene().camera.is_none());
+    }
 }
 
 #[test]
 fn geometry_from_buffers_and_files_gets_consecutive_ids() {
+    unsafe {
     let h = Handles::new();
     let hair = h.hair_material();
     let diffuse = h.diffuse_material([0.5; 3]);
@@ -518,23 +535,26 @@ fn geometry_from_buffers_and_files_gets_consecutive_ids() {
     std::fs::remove_dir_all(&dir).unwrap();
     assert_eq!(h.add_triangle(diffuse), HtStatus::HT_OK);
     assert_eq!(h.scene().geometries.len(), 5);
+    }
 }
 
 #[test]
 fn shared_xyzr_points_are_checked_then_read_in_place() {
+    unsafe {
     use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
     let h = Handles::new();
     let hair = h.hair_material();
     let strands = small_fur();
     let points = xyzr(&strands);
-    // The host's points start 4 bytes into its array: aligned for floats, not to 16.
-    let mut host = vec![0.0f32; 4 * points.len() + 1];
-    host[1..].copy_from_slice(points.as_flattened());
+    // The host's points in 16-byte aligned memory (u128 is 16-aligned), as Embree needs.
+    let mut host = vec![0u128; points.len()];
+    let floats = std::slice::from_raw_parts_mut(host.as_mut_ptr().cast::<f32>(), 4 * points.len());
+    floats.copy_from_slice(points.as_flattened());
     let desc = HtCurvesXyzr {
-        points: host[1..].as_ptr(),
+        points: host.as_ptr().cast(),
         ..xyzr_desc(&points, &strands.counts)
     };
-    assert_ne!(desc.points as usize % 16, 0);
+    assert_eq!(desc.points as usize % 16, 0);
     let add = |d: &HtCurvesXyzr| ht_scene_add_curves_xyzr_shared(h.scene, d, hair, &mut 0);
     let s = ht_scene_add_curves_xyzr_shared(h.scene, null(), hair, &mut 0);
     fails(s, NULL, "desc is NULL");
@@ -544,7 +564,7 @@ fn shared_xyzr_points_are_checked_then_read_in_place() {
     };
     fails(add(&no_points), NULL, "desc->points is NULL");
     let misaligned = HtCurvesXyzr {
-        points: unsafe { desc.points.cast::<u8>().add(2).cast() },
+        points: { desc.points.cast::<u8>().add(2).cast() },
         ..desc
     };
     fails(add(&misaligned), INVALID, "not aligned to 4 bytes");
@@ -564,6 +584,7 @@ fn shared_xyzr_points_are_checked_then_read_in_place() {
     // Only the index buffer and the strand table are the scene's.
     let indices = (strands.segment_count() + padding_for::<u32>()) * 4;
     assert_eq!(c.heap_bytes(), indices + c.strands().heap_bytes());
+    }
 }
 
 /// Bytes hairtrace holds for a scene of curves: what it keeps to rebuild, and the built
@@ -583,6 +604,7 @@ fn held_bytes(scene: &HtScene) -> usize {
 /// `--nocapture` prints bytes per segment.
 #[test]
 fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
+    unsafe {
     const STRANDS: usize = 10_000;
     let strands = FurBall {
         strands: STRANDS,
@@ -625,4 +647,5 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
         copied.1,
         shared.1
     );
+    }
 }

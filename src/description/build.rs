@@ -274,7 +274,7 @@ impl LightDesc {
             } => Light::distant(
                 v(*direction),
                 v(*irradiance),
-                angular_radius_deg.to_radians(),
+                *angular_radius_deg,
             ),
             LightDesc::Rect {
                 corner,

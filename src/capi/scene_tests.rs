@@ -447,7 +447,7 @@ fn invalid_values_name_the_argument_and_add_nothing() {
     );
     fails(
         ht_scene_add_environment_map(h.scene, c"/nonexistent/sky.exr".as_ptr(), 0.0, 1.0),
-        HtStatus::HT_ERR_IMAGE,
+        HtStatus::HT_ERR_IO,
         "sky.exr",
     );
     assert!(h.scene().lights.is_empty());

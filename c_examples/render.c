@@ -241,6 +241,8 @@ int main(int argc, char **argv) {
     /* Both frees accept NULL. The scene keeps the device alive, so the order is free. */
     ht_scene_free(scene);
     ht_device_free(device);
+    /* Every handle is freed: join the worker threads Embree kept (optional at exit). */
+    if (check(ht_shutdown(), "ht_shutdown")) failed = 1;
     free(b.points);
     free(b.radii);
     free(b.counts);

@@ -858,6 +858,26 @@ enum HtStatus ht_image_write(const char *path,
                              const float *pixels,
                              size_t pixels_len);
 
+extern void *dlsym(void *handle, const char *symbol);
+
+/**
+ * Joins the worker threads the library started, once every device and scene has been
+ * freed: TBB's workers, which Embree used to build scenes and which otherwise run until
+ * the process exits. Render threads need no call: each `ht_render` joins its own before
+ * it returns. After `HT_OK` no thread started by hairtrace is running, and the library
+ * may still be used again (a new device starts new workers).
+ *
+ * Call it from one thread, with no other hairtrace call running. Statuses:
+ * `HT_ERR_INVALID_ARG` when a device or scene is still alive (nothing is joined: free them
+ * first); `HT_ERR_EMBREE` when TBB refuses because something else in the process (the
+ * host, another library) still uses it: its workers then keep running, as they would
+ * without this call.
+ *
+ * # Safety
+ * No other thread is inside a hairtrace call, and none starts one until it returns.
+ */
+enum HtStatus ht_shutdown(void);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

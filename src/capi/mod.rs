@@ -17,6 +17,7 @@ mod scene_tests;
 pub mod render;
 #[cfg(test)]
 mod render_tests;
+pub mod shutdown;
 #[cfg(test)]
 mod soundness_tests;
 

@@ -178,10 +178,9 @@ fn free_handle<T>(handle: *mut T) {
 pub unsafe extern "C" fn ht_device_new(threads: u32, out: *mut *mut HtDevice) -> HtStatus {
     boundary(|| {
         let out = non_null_mut(out, "out")?;
-        let device = Device::new((threads > 0).then_some(threads as usize))?;
-        let handle = Box::new(HtDevice {
-            device: Arc::new(device),
-        });
+        let device = Arc::new(Device::new((threads > 0).then_some(threads as usize))?);
+        super::shutdown::track(&device);
+        let handle = Box::new(HtDevice { device });
         // SAFETY: non-NULL (checked), the host's HtDevice*.
         unsafe { out.write(Box::into_raw(handle)) };
         Ok(())

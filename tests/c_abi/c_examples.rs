@@ -279,3 +279,38 @@ fn abi_checks_as_cpp() {
         &[],
     ));
 }
+
+/// `ht_shutdown` refuses while a scene lives, and afterwards leaves the threads the
+/// process had before the first render (TBB's workers outlived the freed device until
+/// then; OpenImageIO's pool, started when the library is loaded, is not ours to join); the
+/// library works again after it.
+fn check_shutdown(out: &str) {
+    let start = numbers(out, "threads start")[0];
+    assert!(numbers(out, "threads freed")[0] > start, "{out}");
+    assert!(
+        out.contains("refused invalid argument: 1 Embree device(s) still in use"),
+        "{out}"
+    );
+    assert_eq!(numbers(out, "shutdown ok threads"), [start], "{out}");
+    assert_eq!(numbers(out, "again ok threads"), [start], "{out}");
+}
+
+#[test]
+fn shutdown_joins_the_worker_threads_as_c99() {
+    check_shutdown(&build_and_run(
+        "shutdown.c",
+        "gcc",
+        &["-std=c99", "-pedantic", "-D_DEFAULT_SOURCE"],
+        &[],
+    ));
+}
+
+#[test]
+fn shutdown_joins_the_worker_threads_as_cpp() {
+    check_shutdown(&build_and_run(
+        "shutdown.c",
+        "g++",
+        &["-x", "c++", "-std=c++17"],
+        &[],
+    ));
+}

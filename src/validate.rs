@@ -112,7 +112,10 @@ mod tests {
             .to_string();
         assert!(e.contains("point 1 = ") && e.contains("within"), "{e}");
         let d = direction("d", Vec3::new(1e30, 1e30, 0.0)).unwrap();
-        assert!((d - Vec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-6, "{d}");
+        assert!(
+            (d - Vec3::new(1.0, 1.0, 0.0).normalize()).length() < 1e-6,
+            "{d}"
+        );
         let d = direction("d", Vec3::new(1e-30, 0.0, 0.0)).unwrap();
         assert_eq!(d, Vec3::X);
         assert!(direction("d", Vec3::ZERO).is_err());

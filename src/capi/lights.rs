@@ -29,7 +29,10 @@ fn add_light(
 /// `scene` is NULL or a live handle not in use on another thread; every `float[3]` argument
 /// is NULL or points to 3 readable floats.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_scene_add_environment(scene: *mut HtScene, radiance: *const f32) -> HtStatus {
+pub unsafe extern "C" fn ht_scene_add_environment(
+    scene: *mut HtScene,
+    radiance: *const f32,
+) -> HtStatus {
     add_light(scene, || {
         let env = Environment::uniform(read_vec3(radiance, "radiance")?)?;
         Ok(Light::Environment(env))

@@ -158,7 +158,11 @@ fn check_aligned<T>(ptr: *const T, name: &str) -> Result<(), Failure> {
     if ptr.is_aligned() {
         Ok(())
     } else {
-        Err(invalid_arg!("{name} = {ptr:?} is not aligned to {} bytes", align_of::<T>()).into())
+        Err(invalid_arg!(
+            "{name} = {ptr:?} is not aligned to {} bytes",
+            align_of::<T>()
+        )
+        .into())
     }
 }
 
@@ -195,7 +199,9 @@ pub(crate) fn check_disjoint(buffers: &[(&str, *const u8, usize)]) -> Result<(),
             let (a0, b0) = (a.1 as usize, b.1 as usize);
             // The lengths were checked not to wrap the address space.
             if a0 < b0 + b.2 && b0 < a0 + a.2 {
-                return Err(invalid_arg!("{} and {} overlap: give each its own memory", a.0, b.0).into());
+                return Err(
+                    invalid_arg!("{} and {} overlap: give each its own memory", a.0, b.0).into(),
+                );
             }
         }
     }

@@ -171,15 +171,15 @@ pub unsafe extern "C" fn ht_render(
     // SAFETY: the caller's promises; the AOV pointers are NULL.
     unsafe {
         ht_render_aovs(
-        scene,
-        settings,
-        rgb,
-        rgb_len,
-        null_mut(),
-        null_mut(),
-        null_mut(),
-        pixel_count,
-    )
+            scene,
+            settings,
+            rgb,
+            rgb_len,
+            null_mut(),
+            null_mut(),
+            null_mut(),
+            pixel_count,
+        )
     }
 }
 
@@ -249,8 +249,9 @@ pub unsafe extern "C" fn ht_render_aovs(
         let depth = optional_slice(depth, pixels, "depth")?;
         let strand_id = optional_slice(strand_id, pixels, "strand_id")?;
         let bytes = |b: &Option<&mut [f32]>| {
-            b.as_ref()
-                .map_or((std::ptr::null(), 0), |b| (b.as_ptr().cast(), size_of_val(*b)))
+            b.as_ref().map_or((std::ptr::null(), 0), |b| {
+                (b.as_ptr().cast(), size_of_val(*b))
+            })
         };
         let [albedo_b, depth_b, strand_b] = [&albedo, &depth, &strand_id].map(bytes);
         check_disjoint(&[
@@ -258,7 +259,11 @@ pub unsafe extern "C" fn ht_render_aovs(
             ("albedo", albedo_b.0, albedo_b.1),
             ("depth", depth_b.0, depth_b.1),
             ("strand_id", strand_b.0, strand_b.1),
-            ("settings", settings_ptr.cast(), size_of::<HtRenderSettings>()),
+            (
+                "settings",
+                settings_ptr.cast(),
+                size_of::<HtRenderSettings>(),
+            ),
         ])?;
         let aovs = Aovs {
             albedo: albedo.is_some(),

@@ -100,11 +100,23 @@ fn coordinates_embree_cannot_trace_are_refused_when_set() {
         let far = [1e19f32, 0.0, 0.0];
         let (zero, up) = ([0.0f32; 3], [0.0f32, 1.0, 0.0]);
         let s = ht_scene_set_camera(h.scene, far.as_ptr(), zero.as_ptr(), up.as_ptr(), 40.0);
-        fails(s, INVALID, "eye = [10000000000000000000, 0, 0]: every coordinate");
+        fails(
+            s,
+            INVALID,
+            "eye = [10000000000000000000, 0, 0]: every coordinate",
+        );
         let s = ht_scene_set_camera(h.scene, zero.as_ptr(), far.as_ptr(), up.as_ptr(), 40.0);
         fails(s, INVALID, "within +-1e15");
-        fails(ht_scene_set_thin_lens(h.scene, 2e18, 4.0), INVALID, "aperture_radius = 2000000000000000000");
-        fails(ht_scene_set_thin_lens(h.scene, 0.1, 2e18), INVALID, "focus_distance");
+        fails(
+            ht_scene_set_thin_lens(h.scene, 2e18, 4.0),
+            INVALID,
+            "aperture_radius = 2000000000000000000",
+        );
+        fails(
+            ht_scene_set_thin_lens(h.scene, 0.1, 2e18),
+            INVALID,
+            "focus_distance",
+        );
         let hair = h.hair_material();
         let mut points = xyzr(&small_fur());
         points[5][1] = -1e19;
@@ -114,10 +126,26 @@ fn coordinates_embree_cannot_trace_are_refused_when_set() {
         let wall = h.diffuse_material([0.5; 3]);
         let positions = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1e19, 0.0];
         let i = [0u32, 1, 2];
-        let s = ht_scene_add_mesh(h.scene, 3, positions.as_ptr(), null(), 1, i.as_ptr(), wall, &mut 0);
+        let s = ht_scene_add_mesh(
+            h.scene,
+            3,
+            positions.as_ptr(),
+            null(),
+            1,
+            i.as_ptr(),
+            wall,
+            &mut 0,
+        );
         fails(s, INVALID, "vertex 2 = ");
         let (e, one) = ([1.0f32, 0.0, 0.0], [1.0f32; 3]);
-        let s = ht_scene_add_rect_light(h.scene, far.as_ptr(), e.as_ptr(), up.as_ptr(), one.as_ptr(), false);
+        let s = ht_scene_add_rect_light(
+            h.scene,
+            far.as_ptr(),
+            e.as_ptr(),
+            up.as_ptr(),
+            one.as_ptr(),
+            false,
+        );
         fails(s, INVALID, "rect light corner");
         assert_eq!(h.scene().geometries.len(), 1);
         let (status, rgb) = render_c(&h, &settings(16));
@@ -167,7 +195,8 @@ fn a_render_of_billions_of_samples_per_pixel_cancels() {
         let mut rgb = vec![-1.0f32; 48];
         // SAFETY: a live scene used by this thread alone; rgb holds 48 floats.
         let status = unsafe { ht_render(scene.0, &s, rgb.as_mut_ptr(), rgb.len()) };
-        tx.send((status, last_error(), calls.into_inner(), rgb)).unwrap();
+        tx.send((status, last_error(), calls.into_inner(), rgb))
+            .unwrap();
     });
     let (status, message, calls, rgb) = rx
         .recv_timeout(Duration::from_secs(120))
@@ -190,12 +219,33 @@ fn overlapping_render_buffers_are_refused() {
         let call = |albedo: *mut f32, depth: *mut f32, strand: *mut f32| {
             ht_render_aovs(h.scene, &s, p, 48, albedo, depth, strand, 16)
         };
-        fails(call(null_mut(), p, null_mut()), INVALID, "rgb and depth overlap");
-        fails(call(p.add(40), null_mut(), null_mut()), INVALID, "rgb and albedo overlap");
-        fails(call(null_mut(), p.add(48), p.add(50)), INVALID, "depth and strand_id overlap");
+        fails(
+            call(null_mut(), p, null_mut()),
+            INVALID,
+            "rgb and depth overlap",
+        );
+        fails(
+            call(p.add(40), null_mut(), null_mut()),
+            INVALID,
+            "rgb and albedo overlap",
+        );
+        fails(
+            call(null_mut(), p.add(48), p.add(50)),
+            INVALID,
+            "depth and strand_id overlap",
+        );
         let mut settings_in = [s; 1];
         let sp = settings_in.as_mut_ptr();
-        let status = ht_render_aovs(h.scene, sp, sp.cast(), 3 * 16, null_mut(), null_mut(), null_mut(), 16);
+        let status = ht_render_aovs(
+            h.scene,
+            sp,
+            sp.cast(),
+            3 * 16,
+            null_mut(),
+            null_mut(),
+            null_mut(),
+            16,
+        );
         // The settings are not a float buffer's size or alignment, or they overlap.
         assert_eq!(status, INVALID, "{}", last_error());
         assert!(rgb.iter().all(|v| *v == -3.0), "a refused call wrote");
@@ -214,7 +264,11 @@ fn image_writes_check_the_buffer_length() {
         let path = CString::new(std::env::temp_dir().join("ht-len.exr").to_str().unwrap()).unwrap();
         let px = [0.5f32; 12];
         let s = ht_image_write(path.as_ptr(), 100_000, 100_000, 3, px.as_ptr(), px.len());
-        fails(s, INVALID, "pixels_len = 12: must be width * height * channels = 100000 * 100000 * 3 = 30000000000");
+        fails(
+            s,
+            INVALID,
+            "pixels_len = 12: must be width * height * channels = 100000 * 100000 * 3 = 30000000000",
+        );
         let s = ht_image_write(path.as_ptr(), u32::MAX, u32::MAX, u32::MAX, px.as_ptr(), 12);
         fails(s, INVALID, "overflows");
         let s = ht_image_write(path.as_ptr(), 2, 2, 3, px.as_ptr(), usize::MAX);
@@ -242,7 +296,11 @@ fn use_vertex_colors_is_checked_to_be_0_or_1() {
             if ok {
                 assert_eq!(s, HT_OK, "{}", last_error());
             } else {
-                fails(s, INVALID, &format!("use_vertex_colors = {flag}: must be 0 or 1"));
+                fails(
+                    s,
+                    INVALID,
+                    &format!("use_vertex_colors = {flag}: must be 0 or 1"),
+                );
             }
         }
     }
@@ -256,8 +314,16 @@ fn statuses_and_messages_are_consistent() {
         let h = Handles::new();
         let mut p = ht_hair_params_default();
         p.beta_m = 2.0;
-        fails(ht_scene_add_hair_material(h.scene, &p, &mut 0), INVALID, "beta_m = 2");
-        assert!(!last_error().contains("invalid argument"), "{}", last_error());
+        fails(
+            ht_scene_add_hair_material(h.scene, &p, &mut 0),
+            INVALID,
+            "beta_m = 2",
+        );
+        assert!(
+            !last_error().contains("invalid argument"),
+            "{}",
+            last_error()
+        );
 
         let hair = h.hair_material();
         let wall = h.diffuse_material([0.5; 3]);
@@ -282,7 +348,12 @@ fn statuses_and_messages_are_consistent() {
 
         let one = [1.0f32; 3];
         let huge = [1e30f32, 1e30, 0.0];
-        assert_eq!(ht_scene_add_distant_light(h.scene, huge.as_ptr(), one.as_ptr(), 1.0), HT_OK, "{}", last_error());
+        assert_eq!(
+            ht_scene_add_distant_light(h.scene, huge.as_ptr(), one.as_ptr(), 1.0),
+            HT_OK,
+            "{}",
+            last_error()
+        );
         let s = ht_scene_add_distant_light(h.scene, huge.as_ptr(), one.as_ptr(), 95.0);
         fails(s, INVALID, "angular radius 95 degrees must be in [0, 90)");
 
@@ -291,14 +362,22 @@ fn statuses_and_messages_are_consistent() {
         let mut colors = vec![[0.5f32; 3]; strands.points.len()];
         colors[3] = [0.5, 5.0, 0.5];
         strands.colors = Some(colors);
-        fails(h.add_strands(&strands, hair), INVALID, "colour 3 = [0.5, 5.0, 0.5]: each channel must be in [0, 1]");
+        fails(
+            h.add_strands(&strands, hair),
+            INVALID,
+            "colour 3 = [0.5, 5.0, 0.5]: each channel must be in [0, 1]",
+        );
 
         // Out-parameters must be aligned for what is written through them.
         let mut ids = [0u32; 2];
         let odd = ids.as_mut_ptr().cast::<u8>().add(1).cast::<u32>();
         let s = ht_scene_add_diffuse_material(h.scene, one.as_ptr(), odd);
         fails(s, INVALID, "material_id = ");
-        assert!(last_error().contains("not aligned to 4 bytes"), "{}", last_error());
+        assert!(
+            last_error().contains("not aligned to 4 bytes"),
+            "{}",
+            last_error()
+        );
         let s = ht_scene_add_curves(h.scene, null(), hair, odd);
         fails(s, INVALID, "geom_id");
     }

@@ -45,10 +45,7 @@ impl Ray {
     fn is_valid(&self) -> bool {
         const EMBREE_LARGE: f32 = 1.844e18;
         let within = |v: Vec3| v.abs().cmple(Vec3::splat(EMBREE_LARGE)).all();
-        within(self.org)
-            && within(self.dir)
-            && !self.tnear.is_nan()
-            && !self.tfar.is_nan()
+        within(self.org) && within(self.dir) && !self.tnear.is_nan() && !self.tfar.is_nan()
     }
 
     fn to_sys(self) -> sys::RTCRay {

@@ -15,9 +15,9 @@ use super::light_sample::check_radiance;
 pub use super::light_sample::{LightEval, LightSample};
 use crate::Result;
 use crate::error::invalid_arg;
-use crate::validate;
 use crate::math::luminance;
 use crate::math::sampling::{uniform_cone, uniform_cone_pdf};
+use crate::validate;
 
 /// A light source. Built through the validating constructors; `Send + Sync`.
 #[derive(Debug, Clone)]

@@ -205,7 +205,10 @@ fn render(width: u32, height: u32, crop: Option<Window>, threads: usize, tile: u
         tile_size: tile,
         threads,
     };
-    let status = render_tiles(&mut film, &options, &NoProgress, |p, a, _| shade(99, 8)(p, a)).unwrap();
+    let status = render_tiles(&mut film, &options, &NoProgress, |p, a, _| {
+        shade(99, 8)(p, a)
+    })
+    .unwrap();
     assert_eq!(status, RenderStatus::Complete);
     film
 }
@@ -315,9 +318,12 @@ fn aovs_average_albedo_and_keep_the_nearest_hit() {
     acc.add(Vec3::ONE, Some(&far));
     acc.add(Vec3::ONE, Some(&near));
     let mut film = Film::new(1, 1, None, ALL_AOVS).unwrap();
-    let done = render_tiles(&mut film, &TileOptions::default(), &NoProgress, |_, a, _| {
-        *a = acc.clone()
-    })
+    let done = render_tiles(
+        &mut film,
+        &TileOptions::default(),
+        &NoProgress,
+        |_, a, _| *a = acc.clone(),
+    )
     .unwrap();
     assert_eq!(done, RenderStatus::Complete);
     assert_eq!(film.rgb(), &[1.0, 1.0, 1.0]);
@@ -388,10 +394,15 @@ fn cancelling_stops_the_render_promptly() {
             tile_size: 16,
             threads,
         };
-        let status = render_tiles(&mut film, &options, &cancel_after_first_tile, |p, acc, _| {
-            shaded.fetch_add(1, Ordering::Relaxed);
-            shade(1, 4)(p, acc)
-        })
+        let status = render_tiles(
+            &mut film,
+            &options,
+            &cancel_after_first_tile,
+            |p, acc, _| {
+                shaded.fetch_add(1, Ordering::Relaxed);
+                shade(1, 4)(p, acc)
+            },
+        )
         .unwrap();
         assert_eq!(status, RenderStatus::Cancelled);
         let shaded = shaded.into_inner();

@@ -103,6 +103,10 @@ int main(void) {
     ROW(ht_scene_add_curves(scene, NULL, hair, &id), NUL, "desc is NULL");
     ROW(ht_scene_add_curves(scene, &c, hair, NULL), NUL, "geom_id is NULL");
     ROW(ht_scene_add_curves(scene, &c, hair, odd_id), BAD, "geom_id");
+    unsigned char bytes[2 * sizeof(HtCurves)];
+    memcpy(bytes + 1, &c, sizeof c);
+    ROW(ht_scene_add_curves(scene, (const HtCurves *)(const void *)(bytes + 1), hair, &id), BAD,
+        "desc = ");
     bad.points = NULL;
     ROW(ht_scene_add_curves(scene, &bad, hair, &id), NUL, "desc->points is NULL");
     bad = c;
@@ -239,6 +243,10 @@ int main(void) {
     ROW(ht_render(NULL, &s, rgb, 12), NUL, "scene is NULL");
     ROW(ht_render(scene, NULL, rgb, 12), NUL, "settings is NULL");
     ROW(ht_render(scene, &s, NULL, 12), NUL, "rgb is NULL");
+    unsigned char settings_bytes[2 * sizeof(HtRenderSettings)];
+    memcpy(settings_bytes + 1, &s, sizeof s);
+    ROW(ht_render(scene, (const HtRenderSettings *)(const void *)(settings_bytes + 1), rgb, 12),
+        BAD, "settings = ");
     ROW(ht_render(scene, &s, rgb, (size_t)-1), BAD, "rgb_len = ");
     ROW(ht_render(scene, &s, odd_rgb, 12), BAD, "not aligned to 4 bytes");
     ROW(ht_render_aovs(scene, &s, rgb, 12, NULL, rgb, NULL, 4), BAD, "rgb and depth overlap");

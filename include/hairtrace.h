@@ -858,8 +858,6 @@ enum HtStatus ht_image_write(const char *path,
                              const float *pixels,
                              size_t pixels_len);
 
-extern void *dlsym(void *handle, const char *symbol);
-
 /**
  * Joins the worker threads the library started, once every device and scene has been
  * freed: TBB's workers, which Embree used to build scenes and which otherwise run until

@@ -2,7 +2,7 @@
 //! shared in place), `.hair` files, and triangle meshes from arrays or files.
 
 use super::scene::{HtScene, Shape, add_with_id};
-use super::{Failure, HtStatus, host_slice, non_null, read_path};
+use super::{Failure, HtStatus, host_slice, read_host, read_path};
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
@@ -157,8 +157,7 @@ pub unsafe extern "C" fn ht_scene_add_curves(
     geom_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
-        // SAFETY: non-NULL (checked); the host's struct.
-        let d = unsafe { *non_null(desc, "desc")? };
+        let d = read_host(desc, "desc")?;
         scene.check_material(material_id, true)?;
         let (basis, shape) = (curve_basis(d.basis)?, curve_shape(d.shape)?);
         check_strand_count(d.strand_count)?;
@@ -267,8 +266,7 @@ fn add_curves_xyzr(
     vertices: impl FnOnce(&[[f32; 4]]) -> std::result::Result<SharedBuffer<[f32; 4]>, Failure>,
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
-        // SAFETY: non-NULL (checked); the host's struct.
-        let d = unsafe { *non_null(desc, "desc")? };
+        let d = read_host(desc, "desc")?;
         scene.check_material(material_id, true)?;
         let (basis, shape) = (curve_basis(d.basis)?, curve_shape(d.shape)?);
         check_strand_count(d.strand_count)?;

@@ -3,7 +3,7 @@
 
 use super::bsdf::HtHairParams;
 use super::scene::{HtScene, add_with_id};
-use super::{Failure, HtStatus, non_null, read_vec3};
+use super::{Failure, HtStatus, read_host, read_vec3};
 use crate::bsdf::diffuse::Diffuse;
 use crate::error::invalid_arg;
 use crate::scene::material::{HairColor, HairMaterial, Material};
@@ -79,9 +79,8 @@ pub unsafe extern "C" fn ht_scene_add_hair_material_varied(
     material_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, material_id, "material_id", |scene| {
-        // SAFETY: non-NULL (checked); the host's structs.
-        let p = unsafe { *non_null(params, "params")? };
-        let v = unsafe { *non_null(variation, "variation")? };
+        let p = read_host(params, "params")?;
+        let v = read_host(variation, "variation")?;
         let material = HairMaterial {
             color: HairColor::SigmaA(p.sigma_a),
             eta: p.eta,

@@ -146,6 +146,16 @@ pub(crate) fn non_null<T>(ptr: *const T, name: &str) -> Result<*const T, Failure
     }
 }
 
+/// A copy of the host's struct at `ptr`, which must not be NULL and must be aligned for
+/// `T` (reading a misaligned one would be undefined behaviour).
+pub(crate) fn read_host<T: Copy>(ptr: *const T, name: &str) -> Result<T, Failure> {
+    let ptr = non_null(ptr, name)?;
+    check_aligned(ptr, name)?;
+    // SAFETY: non-NULL and aligned (checked); the host promises a readable, initialised
+    // `T` there.
+    Ok(unsafe { ptr.read() })
+}
+
 /// [`non_null`] for out-parameters, which must also be aligned for `T`: the library
 /// writes through them.
 pub(crate) fn non_null_mut<T>(ptr: *mut T, name: &str) -> Result<*mut T, Failure> {

@@ -2,7 +2,7 @@
 
 use super::scene::{HtScene, scene_mut};
 use super::{
-    Failure, HtStatus, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
+    Failure, HtStatus, boundary, check_disjoint, host_slice, host_slice_mut, non_null, read_host,
     non_null_mut, read_path,
 };
 use crate::error::invalid_arg;
@@ -225,8 +225,7 @@ pub unsafe extern "C" fn ht_render_aovs(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        // SAFETY: non-NULL (checked); the host's struct.
-        let s = unsafe { *non_null(settings, "settings")? };
+        let s = read_host(settings, "settings")?;
         let settings_ptr = settings;
         let settings = s.to_rust()?;
         settings.validate()?;

@@ -5,7 +5,7 @@
 //! the Embree scene on the first render, then reuses it: adding geometry rebuilds it on
 //! the next render, adding a light only re-weights the lights.
 
-use super::{Failure, HtStatus, boundary, non_null, non_null_mut, read_vec3};
+use super::{Failure, HtStatus, boundary, non_null_mut, read_vec3};
 use crate::embree::{Device, SceneOptions};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
@@ -213,8 +213,8 @@ pub unsafe extern "C" fn ht_device_free(device: *mut HtDevice) -> HtStatus {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut HtScene) -> HtStatus {
     boundary(|| {
-        // SAFETY: non-NULL (checked), a live handle from ht_device_new.
-        let device = unsafe { &*non_null(device, "device")? };
+        // SAFETY: non-NULL and aligned (checked), a live handle from ht_device_new.
+        let device = unsafe { &*non_null_mut(device.cast_mut(), "device")? };
         let out = non_null_mut(out, "out")?;
         let scene = Box::new(HtScene {
             device: device.device.clone(),

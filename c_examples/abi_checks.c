@@ -273,6 +273,8 @@ int main(void) {
     ROW(ht_image_write(NULL, 2, 2, 3, px, 12), NUL, "path is NULL");
     ROW(ht_image_write("/tmp/x.exr", 2, 2, 3, NULL, 12), NUL, "pixels is NULL");
     ROW(ht_image_write("/tmp/x.exr", 100000, 100000, 3, px, 12), BAD, "pixels_len = 12");
+    const float nan_px[12] = {0.0f, nan, 0.0f};
+    ROW(ht_image_write("/tmp/x.exr", 2, 2, 3, nan_px, 12), BAD, "channel 1 is NaN");
     ROW(ht_image_write("/tmp/x.exr", UINT32_MAX, UINT32_MAX, UINT32_MAX, px, 12), BAD,
         "overflows");
     ROW(ht_image_write("/tmp/x.exr", 2, 2, 3, (const float *)(const void *)((const char *)px + 1),

@@ -843,8 +843,9 @@ enum HtStatus ht_render_aovs(struct HtScene *scene,
  *
  * Statuses: `HT_ERR_NULL_ARG` (`path` or `pixels` NULL); `HT_ERR_INVALID_ARG` (empty or
  * non-UTF-8 path, a size of 0, channels not in 1..=4, `pixels_len` not the size,
- * `pixels` misaligned, NaN or infinite pixels, an unknown extension); `HT_ERR_IO` (the
- * folder does not exist or cannot be written); `HT_ERR_IMAGE` (OpenImageIO failed).
+ * `pixels` misaligned, NaN or infinite pixels); `HT_ERR_IMAGE` (an unknown extension, a
+ * format that cannot hold the channels, or OpenImageIO could not write the file, e.g.
+ * into a folder that does not exist).
  * Any thread; touches no handle.
  *
  * # Safety

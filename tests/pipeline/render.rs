@@ -118,7 +118,7 @@ fn lit_world() -> World {
         Light::distant(
             Vec3::new(1.0, 1.0, 1.0),
             Vec3::new(2.0, 1.8, 1.5),
-            10f32.to_radians(),
+            10.0,
         )
         .unwrap(),
         Light::rect(

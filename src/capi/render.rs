@@ -2,8 +2,8 @@
 
 use super::scene::{HtScene, scene_mut};
 use super::{
-    Failure, HtStatus, boundary, check_disjoint, host_slice, host_slice_mut, non_null, read_host,
-    non_null_mut, read_path,
+    Failure, HtStatus, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
+    non_null_mut, read_host, read_path,
 };
 use crate::error::invalid_arg;
 use crate::image::{WriteOptions, write_image};

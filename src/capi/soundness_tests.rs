@@ -33,13 +33,13 @@ fn aligned_copy(points: &[[f32; 4]]) -> Vec<Aligned> {
 
 /// The same values starting `offset` bytes (a multiple of 4) before `host[1]`.
 fn shifted(host: &mut [Aligned], offset: usize) -> *const f32 {
-    let floats: &mut [f32] = bytemuck_floats(host);
+    let floats: &mut [f32] = as_floats(host);
     let n = floats.len() - 4;
     floats.copy_within(4.., 4 - offset / 4);
     floats[4 - offset / 4..][..n].as_ptr()
 }
 
-fn bytemuck_floats(host: &mut [Aligned]) -> &mut [f32] {
+fn as_floats(host: &mut [Aligned]) -> &mut [f32] {
     // SAFETY: `Aligned` is four floats with no padding.
     unsafe { std::slice::from_raw_parts_mut(host.as_mut_ptr().cast(), 4 * host.len()) }
 }

@@ -98,11 +98,18 @@ static void sphere(float r, int rings, int sectors, float *positions, float *nor
     }
 }
 
-/* Counts its calls; the renderer never runs two at once, so a plain counter is safe. */
+/* What the progress callback saw. The renderer never runs two calls at once, so plain
+ * fields are safe. */
+typedef struct Progress {
+    unsigned calls;
+    uint64_t done, total;
+} Progress;
+
 static bool count_progress(uint64_t done, uint64_t total, void *user) {
-    (void)done;
-    (void)total;
-    *(unsigned *)user += 1;
+    Progress *p = (Progress *)user;
+    p->calls += 1;
+    p->done = done;
+    p->total = total;
     return true;
 }
 
@@ -163,21 +170,22 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     const float up[3] = {0.0f, 1.0f, 0.0f};
     if (check(ht_scene_set_camera(scene, eye, target, up, 35.0f), "camera")) return 1;
 
-    unsigned progress_calls = 0;
+    Progress progress = {0, 0, 0};
     HtRenderSettings settings = ht_render_settings_default();
     settings.width = WIDTH;
     settings.height = HEIGHT;
     settings.spp = 4;
     settings.seed = 1;
     settings.progress = count_progress;
-    settings.progress_user = &progress_calls;
+    settings.progress_user = &progress;
     if (check(ht_render(scene, &settings, b->rgb, WIDTH * HEIGHT * 3), "ht_render")) return 1;
 
     double sum = 0.0;
     for (int i = 0; i < WIDTH * HEIGHT * 3; i++) sum += b->rgb[i];
     printf("image %d %d\n", WIDTH, HEIGHT);
     printf("mean %.6f\n", sum / (WIDTH * HEIGHT * 3));
-    printf("progress %u\n", progress_calls);
+    printf("progress %u calls, done %llu of %llu\n", progress.calls,
+           (unsigned long long)progress.done, (unsigned long long)progress.total);
 
     /* A crop renders exactly the full frame's pixels there, so a farm can split a frame;
      * this one also asks for the depth AOV (the other AOVs are not wanted: NULL). */
@@ -198,7 +206,7 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     }
     for (int i = 0; i < CROP_W * CROP_H; i++) hits += depth[i] > 0.0f;
     printf("crop %d %d same %d hits %d\n", CROP_W, CROP_H, same, hits);
-    if (check(ht_image_write(out, WIDTH, HEIGHT, 3, b->rgb), "ht_image_write")) return 1;
+    if (check(ht_image_write(out, WIDTH, HEIGHT, 3, b->rgb, WIDTH * HEIGHT * 3), "ht_image_write")) return 1;
     printf("wrote %s\n", out);
     return 0;
 }
@@ -233,6 +241,8 @@ int main(int argc, char **argv) {
     /* Both frees accept NULL. The scene keeps the device alive, so the order is free. */
     ht_scene_free(scene);
     ht_device_free(device);
+    /* Every handle is freed: join the worker threads Embree kept (optional at exit). */
+    if (check(ht_shutdown(), "ht_shutdown")) failed = 1;
     free(b.points);
     free(b.radii);
     free(b.counts);

@@ -20,7 +20,7 @@
  * Version of the C ABI; bumped on any incompatible change of a signature or struct. The
  * shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
  */
-#define HT_ABI_VERSION 3
+#define HT_ABI_VERSION 4
 
 /**
  * The major part of the library version, which `ht_version()` returns as a string. The
@@ -37,6 +37,14 @@
  * The patch part of the library version.
  */
 #define HT_VERSION_PATCH 0
+
+/**
+ * The largest magnitude, in world units, of a coordinate or a camera length the library
+ * accepts. Embree refuses rays whose origin or direction has a component beyond about
+ * 1.8e18 (and aborts on them); positions a thousand times below that keep every ray the
+ * renderer forms between them (camera, lens, hits, lights) well inside.
+ */
+#define MAX_COORDINATE 1e15
 
 /**
  * Result of every C entry point; `HT_OK` is 0.
@@ -162,11 +170,13 @@ typedef struct HtCurves {
      */
     size_t point_count;
     /**
-     * x, y, z of every point, strand after strand: `3 * point_count` floats.
+     * x, y, z of every point (world units, finite, within +-1e15), strand after strand:
+     * `3 * point_count` floats.
      */
     const float *points;
     /**
-     * Fiber radius (not diameter) at every point, > 0: `point_count` floats; or NULL.
+     * Fiber radius (not diameter) at every point, finite and > 0: `point_count` floats;
+     * or NULL.
      */
     const float *radii;
     /**
@@ -174,8 +184,9 @@ typedef struct HtCurves {
      */
     float radius;
     /**
-     * Linear RGB at every point (`3 * point_count` floats, >= 0), used by hair materials
-     * with `use_vertex_colors`; or NULL.
+     * Linear RGB reflectance at every point (`3 * point_count` floats, each in [0, 1]; 0
+     * is taken as 1e-4, the darkest colour a finite absorption makes), used by hair
+     * materials with `use_vertex_colors`; or NULL.
      */
     const float *colors;
     HtCurveBasis basis;
@@ -208,13 +219,13 @@ typedef struct HtCurvesXyzr {
      */
     size_t point_count;
     /**
-     * x, y, z, radius (not diameter, >= 0) of every control point: `4 * point_count`
-     * floats.
+     * x, y, z (world units, within +-1e15), radius (not diameter, >= 0) of every control
+     * point, all finite: `4 * point_count` floats.
      */
     const float *points;
     /**
-     * Linear RGB (>= 0) at every segment end, segments + 1 per strand, strand after
-     * strand; or NULL.
+     * Linear RGB reflectance (each in [0, 1], as in `HtCurves`) at every segment end,
+     * segments + 1 per strand, strand after strand; or NULL.
      */
     const float *colors;
     HtCurveBasis basis;
@@ -242,9 +253,11 @@ typedef struct HtHairVariation {
      */
     float tip_absorption;
     /**
-     * Take the absorption from the curves' per-point colours where they have them.
+     * 1: take the absorption from the curves' per-point colours where they have them;
+     * 0: ignore them. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
+     * than a `bool`, so that no byte the host stores here is undefined behaviour.
      */
-    bool use_vertex_colors;
+    uint8_t use_vertex_colors;
     /**
      * Seed of the per-strand random choices.
      */
@@ -261,9 +274,11 @@ typedef uint32_t HtPixelFilter;
 
 #if defined(HT_RENDER)
 /**
- * Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
- * call. Return false to cancel: no new pixel starts and `ht_render` returns
- * `HT_ERR_CANCELLED` (tiles that finish meanwhile may still report).
+ * Told how far a render has got: `done` of `total` pixels, `done` never decreasing from
+ * call to call. It is called when a 16 x 16 tile finishes and, while pixels take long
+ * (many samples), also every 20 ms or so of work with an unchanged `done`, so that it can
+ * cancel any render promptly. Return false to cancel: no new sample starts, unfinished
+ * tiles are dropped, and `ht_render` returns `HT_ERR_CANCELLED`.
  *
  * Called from the render's worker threads (not necessarily the one that called
  * `ht_render`), but never two calls at once, so `user` needs no locking against itself.
@@ -469,8 +484,15 @@ enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
 
 #if defined(HT_RENDER)
 /**
- * Creates a device with `threads` Embree worker threads (0: one per hardware thread).
- * Free it with `ht_device_free`; scenes keep it alive as long as they need it.
+ * Creates a device with `threads` Embree worker threads (0: one per hardware thread),
+ * which build the scenes made on it, and writes the handle to `*out`. Free it with
+ * `ht_device_free`; scenes keep it alive as long as they need it. Thread safe.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`out` NULL); `HT_ERR_INVALID_ARG` (`out` misaligned);
+ * `HT_ERR_EMBREE` (Embree could not start). `*out` is written on `HT_OK` only.
+ *
+ * # Safety
+ * `out` is NULL or points to a writable `HtDevice*`.
  */
 enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
 #endif
@@ -481,38 +503,74 @@ enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
  * ("sse2", "avx", "avx2" or "avx512"; NULL: not pinned, the widest this CPU runs).
  * Embree's kernels for different instruction sets round differently, so a frame whose
  * crop pieces render on different CPUs assembles bit for bit only when every piece pins
- * the same ISA. HT_ERR_INVALID_ARG for another name or an ISA this CPU cannot run.
+ * the same ISA.
+ *
+ * Statuses: those of `ht_device_new`, and `HT_ERR_INVALID_ARG` for another name or an
+ * ISA this CPU cannot run.
+ *
+ * # Safety
+ * `isa` is NULL or a NUL-terminated string; `out` is NULL or points to a writable
+ * `HtDevice*`.
  */
 enum HtStatus ht_device_new_pinned(uint32_t threads, const char *isa, struct HtDevice **out);
 #endif
 
 #if defined(HT_RENDER)
 /**
- * Releases a device handle (NULL: nothing to do). Scenes made on it stay valid.
+ * Releases a device handle (NULL: nothing to do, `HT_OK`). Scenes made on it stay valid
+ * and release the device with the last of them. Always `HT_OK`.
+ *
+ * # Safety
+ * `device` is NULL or a handle from `ht_device_new` not yet freed; it is invalid after
+ * the call.
  */
 enum HtStatus ht_device_free(struct HtDevice *device);
 #endif
 
 #if defined(HT_RENDER)
 /**
- * Creates an empty scene on `device`. Free it with `ht_scene_free`.
+ * Creates an empty scene on `device` and writes the handle to `*out`. Free it with
+ * `ht_scene_free`. The device handle may be freed before the scene.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`device` or `out` NULL); `HT_ERR_INVALID_ARG` (`out`
+ * misaligned). `*out` is written on `HT_OK` only.
+ *
+ * # Safety
+ * `device` is NULL or a live handle from `ht_device_new`; `out` is NULL or points to a
+ * writable `HtScene*`.
  */
 enum HtStatus ht_scene_new(const struct HtDevice *device, struct HtScene **out);
 #endif
 
 #if defined(HT_RENDER)
 /**
- * Releases a scene and everything it holds (NULL: nothing to do).
+ * Releases a scene and everything it holds, the Embree scene included (NULL: nothing to
+ * do). After it returns, the host may free the points it shared with
+ * `ht_scene_add_curves_xyzr_shared`. Always `HT_OK`.
+ *
+ * # Safety
+ * `scene` is NULL or a handle from `ht_scene_new` not yet freed and not in use on another
+ * thread; it is invalid after the call.
  */
 enum HtStatus ht_scene_free(struct HtScene *scene);
 #endif
 
 #if defined(HT_RENDER)
 /**
- * Places the pinhole camera at `eye` looking at `target`, `up` giving the image's upward
- * direction (not parallel to the view), with a vertical field of view of `fov_y_deg` in
- * (0, 180). Replaces any earlier camera. Without one, renders frame the scene's bounds
- * from the front (+z), a little to the right and above.
+ * Places the pinhole camera at `eye` looking at `target` (world units, each `float[3]`,
+ * every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
+ * giving the image's upward direction (finite, not zero, not parallel to the view), with
+ * a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
+ * `(target - eye) x up`. Replaces any earlier camera. Without one, renders frame the
+ * scene's bounds from the front (+z), a little to the right and above.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
+ * `HT_ERR_INVALID_ARG` (a value out of range, `eye == target`, `up` along the view, a
+ * misaligned array). On failure the camera is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `eye`, `target` and
+ * `up` are NULL or point to 3 readable floats.
  */
 enum HtStatus ht_scene_set_camera(struct HtScene *scene,
                                   const float *eye,
@@ -524,10 +582,16 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
 #if defined(HT_RENDER)
 /**
  * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
- * units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
- * view direction, > 0), so that what lies nearer or farther blurs. Holds for the camera
- * of `ht_scene_set_camera`, whether set before or after, and for the camera that frames a
- * scene without one. Replaces any earlier lens.
+ * units, in [0, 1e15]; 0 is the pinhole again) focused at `focus_distance` (world units
+ * along the view direction, in (0, 1e15]), so that what lies nearer or farther blurs.
+ * Holds for the camera of `ht_scene_set_camera`, whether set before or after, and for the
+ * camera that frames a scene without one. Replaces any earlier lens.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` NULL); `HT_ERR_INVALID_ARG` (NaN, infinite or out
+ * of range). On failure the lens is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread.
  */
 enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
                                      float aperture_radius,
@@ -538,7 +602,18 @@ enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
 /**
  * Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
  * `material_id`; writes the geometry id (0, 1, ... over curves and meshes, in the order
- * they are added) to `geom_id`.
+ * they are added) to `geom_id`. `desc->radii` and `desc->colors` may be NULL.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `desc`, `geom_id` or a required array NULL);
+ * `HT_ERR_INVALID_ARG` (no strand, a strand of fewer points than its basis needs, counts
+ * that do not add up, a NaN, infinite or out-of-range value, an unknown basis or shape,
+ * a misaligned or oversized array, a material that is not hair). Nothing is added on
+ * failure, and `*geom_id` is written on `HT_OK` only.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `desc` is NULL or points
+ * to a readable struct whose non-NULL arrays hold the counts it gives; `geom_id` is NULL
+ * or points to a writable `uint32_t`.
  */
 enum HtStatus ht_scene_add_curves(struct HtScene *scene,
                                   const struct HtCurves *desc,
@@ -549,7 +624,19 @@ enum HtStatus ht_scene_add_curves(struct HtScene *scene,
 #if defined(HT_RENDER)
 /**
  * Adds strands of float4 control points laid out for the basis (copied: see
- * `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
+ * `HtCurvesXyzr`, any 4-byte alignment), shaded by the hair material `material_id`;
+ * writes the geometry id. `desc->colors` may be NULL.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `desc`, `geom_id` or a required array NULL);
+ * `HT_ERR_INVALID_ARG` (no strand, a strand of fewer points than its basis needs, counts
+ * that do not add up, a NaN, infinite or out-of-range value, an unknown basis or shape,
+ * a misaligned or oversized array, a material that is not hair). Nothing is added on
+ * failure, and `*geom_id` is written on `HT_OK` only.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `desc` is NULL or points
+ * to a readable struct whose non-NULL arrays hold the counts it gives; `geom_id` is NULL
+ * or points to a writable `uint32_t`.
  */
 enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
                                        const struct HtCurvesXyzr *desc,
@@ -563,11 +650,19 @@ enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
  * the host's array in place, through every render and every rebuild after later
  * additions, and the scene never holds a copy of it. The host keeps those
  * `4 * point_count` floats allocated and unchanged until `ht_scene_free` returns; writing
- * to them or freeing them earlier is undefined behaviour. `points` must be aligned to 4
- * bytes, like any float array (16-byte alignment is not needed, and no padding past the
+ * to them or freeing them earlier is undefined behaviour. `points` must be aligned to 16
+ * bytes, as Embree loads each float4 with one aligned load (`malloc` and `aligned_alloc`
+ * give such memory; a float array at an odd offset does not). No padding is needed past the
  * last point: Embree reads at most the 16 bytes of a float4 from its start). The small
  * per-strand data are still built and kept by the scene: `point_counts` and `colors` are
  * read during the call only, and the index buffer takes 4 bytes per segment.
+ *
+ * Statuses: as `ht_scene_add_curves_xyzr`; `desc->points` not aligned to 16 bytes is
+ * `HT_ERR_INVALID_ARG` (use `ht_scene_add_curves_xyzr`, which copies, for such memory).
+ *
+ * # Safety
+ * As `ht_scene_add_curves_xyzr`, and `desc->points` stays allocated and unchanged until
+ * `ht_scene_free` returns.
  */
 enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
                                               const struct HtCurvesXyzr *desc,
@@ -577,8 +672,18 @@ enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
- * Adds the strands of a Cem Yuksel `.hair` file as polylines for `basis`. The file's
+ * Adds the strands of a Cem Yuksel `.hair` file (read during the call) as polylines for
+ * `basis`, shaded by the hair material `material_id`; writes the geometry id. The file's
  * thickness is a diameter unless `thickness_is_radius`.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `path` or `geom_id` NULL); `HT_ERR_IO` (the file
+ * is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or non-UTF-8 path, a
+ * malformed file, values out of range, an unknown basis or shape, a material that is
+ * not hair).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+ * NUL-terminated string; `geom_id` is NULL or points to a writable `uint32_t`.
  */
 enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
                                      const char *path,
@@ -594,7 +699,18 @@ enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
  * Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
  * `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
  * shading), `indices` 3 vertex indices per triangle, counter-clockwise seen from the
- * front. Writes the geometry id.
+ * front. Positions are world units (finite, within +-1e15), normals finite. Writes the
+ * geometry id.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `positions`, `indices` or `geom_id` NULL);
+ * `HT_ERR_INVALID_ARG` (no vertex or no triangle, an index past the vertices, a NaN,
+ * infinite or out-of-range value, a misaligned or oversized array, a material that is
+ * not diffuse).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `positions` and
+ * `normals` are NULL or hold `3 * vertex_count` readable floats, `indices`
+ * `3 * triangle_count` readable `uint32_t`; `geom_id` is NULL or writable.
  */
 enum HtStatus ht_scene_add_mesh(struct HtScene *scene,
                                 size_t vertex_count,
@@ -609,7 +725,16 @@ enum HtStatus ht_scene_add_mesh(struct HtScene *scene,
 #if defined(HT_RENDER)
 /**
  * Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
- * material `material_id`; writes the geometry id.
+ * material `material_id`; writes the geometry id. The file is read during the call.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `path` or `geom_id` NULL); `HT_ERR_IO` (the file
+ * is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or non-UTF-8 path, another
+ * extension, a malformed file, no triangle, values out of range, a material that is not
+ * diffuse).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+ * NUL-terminated string; `geom_id` is NULL or writable.
  */
 enum HtStatus ht_scene_add_mesh_file(struct HtScene *scene,
                                      const char *path,
@@ -619,7 +744,15 @@ enum HtStatus ht_scene_add_mesh_file(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
- * Adds an environment of the same linear RGB `radiance` (>= 0) from every direction.
+ * Adds an environment of the same linear RGB `radiance` (finite, >= 0) from every
+ * direction.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `radiance` NULL); `HT_ERR_INVALID_ARG` (a NaN,
+ * infinite or negative channel, a misaligned array). Nothing is added on failure.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; every `float[3]` argument
+ * is NULL or points to 3 readable floats.
  */
 enum HtStatus ht_scene_add_environment(struct HtScene *scene, const float *radiance);
 #endif
@@ -628,7 +761,15 @@ enum HtStatus ht_scene_add_environment(struct HtScene *scene, const float *radia
 /**
  * Adds a lat-long environment map read through OpenImageIO (EXR, HDR, ...: linear
  * radiance), turned by `rotation_deg` about +y and its radiance multiplied by `scale`
- * (>= 0). It is importance sampled.
+ * (finite, >= 0). It is importance sampled. The file is read during the call.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `path` NULL); `HT_ERR_IO` (the file is missing
+ * or unreadable); `HT_ERR_IMAGE` (OpenImageIO cannot decode it); `HT_ERR_INVALID_ARG`
+ * (an empty or non-UTF-8 path, NaN or negative pixels, a rotation or scale out of range).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+ * NUL-terminated string.
  */
 enum HtStatus ht_scene_add_environment_map(struct HtScene *scene,
                                            const char *path,
@@ -638,9 +779,18 @@ enum HtStatus ht_scene_add_environment_map(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
- * Adds a light at infinity: `direction` points toward it (any non-zero length), it
- * delivers linear RGB `irradiance` (>= 0) to a surface facing it, and is seen as a disc of
- * `angular_radius_deg` in [0, 90) (0: a point, with hard shadows).
+ * Adds a light at infinity: `direction` (world frame) points toward it (any finite,
+ * non-zero length), it delivers linear RGB `irradiance` (finite, >= 0) to a surface
+ * facing it, and is seen as a disc of `angular_radius_deg` degrees in [0, 90) (0: a
+ * point, with hard shadows).
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `direction` or `irradiance` NULL);
+ * `HT_ERR_INVALID_ARG` (a zero or non-finite direction, a NaN, infinite or negative
+ * value, an angle out of range, a misaligned array). Nothing is added on failure.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; every `float[3]` argument
+ * is NULL or points to 3 readable floats.
  */
 enum HtStatus ht_scene_add_distant_light(struct HtScene *scene,
                                          const float *direction,
@@ -652,7 +802,16 @@ enum HtStatus ht_scene_add_distant_light(struct HtScene *scene,
 /**
  * Adds a parallelogram light with corners `corner`, `corner + edge_u`, `corner + edge_v`
  * and `corner + edge_u + edge_v`, emitting linear RGB `radiance` (>= 0) toward
- * `edge_u x edge_v`, or to both sides if `two_sided`.
+ * `edge_u x edge_v`, or to both sides if `two_sided`. World units; every coordinate
+ * finite and within +-1e15.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or an array NULL); `HT_ERR_INVALID_ARG` (a NaN,
+ * infinite, negative or out-of-range value, edges zero or parallel, a misaligned array).
+ * Nothing is added on failure.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; every `float[3]` argument
+ * is NULL or points to 3 readable floats.
  */
 enum HtStatus ht_scene_add_rect_light(struct HtScene *scene,
                                       const float *corner,
@@ -671,8 +830,17 @@ struct HtHairVariation ht_hair_variation_default(void);
 
 #if defined(HT_RENDER)
 /**
- * Adds a hair material with the same parameters on every strand; writes its id (0, 1, ...
- * in the order materials are added) to `material_id`.
+ * Adds a hair material with the same parameters on every strand (ranges as for
+ * `ht_hair_eval`); writes its id (0, 1, ... in the order materials are added) to
+ * `material_id`.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
+ * `HT_ERR_INVALID_ARG` (a parameter NaN, infinite or out of range, `material_id`
+ * misaligned). Nothing is added on failure.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `params` is NULL or
+ * readable; `material_id` is NULL or points to a writable `uint32_t`.
  */
 enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
                                          const struct HtHairParams *params,
@@ -681,7 +849,14 @@ enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
- * Adds a hair material whose parameters vary over the groom as `variation` says.
+ * Adds a hair material whose parameters vary over the groom as `variation` says (its
+ * ranges on `HtHairVariation`).
+ *
+ * Statuses: as `ht_scene_add_hair_material`, and `HT_ERR_NULL_ARG` for `variation` NULL,
+ * `HT_ERR_INVALID_ARG` for a variation out of range (`use_vertex_colors` not 0 or 1).
+ *
+ * # Safety
+ * As `ht_scene_add_hair_material`; `variation` is NULL or readable.
  */
 enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
                                                 const struct HtHairParams *params,
@@ -691,7 +866,15 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
- * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1].
+ * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;
+ * writes its id.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `albedo` or `material_id` NULL);
+ * `HT_ERR_INVALID_ARG` (a channel NaN or outside [0, 1], a misaligned pointer).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `albedo` is NULL or
+ * points to 3 readable floats; `material_id` is NULL or writable.
  */
 enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
                                             const float *albedo,
@@ -713,9 +896,15 @@ struct HtRenderSettings ht_render_settings_default(void);
  * owned by the host. `ht_render_aovs` without AOVs.
  *
  * The first render builds the Embree scene (its time is part of the call); later ones
- * reuse it until geometry is added. Blocks until the image is done. On
- * `HT_ERR_CANCELLED`, `rgb` holds the pixels finished before the callback said stop and
- * 0 elsewhere; on other errors it is left untouched.
+ * reuse it until geometry is added. Blocks until the image is done, on worker threads of
+ * its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
+ * pixels finished before the callback said stop and 0 elsewhere; on other errors it is
+ * left untouched.
+ *
+ * Statuses: as `ht_render_aovs`.
+ *
+ * # Safety
+ * As `ht_render_aovs`.
  */
 enum HtStatus ht_render(struct HtScene *scene,
                         const struct HtRenderSettings *settings,
@@ -742,6 +931,17 @@ enum HtStatus ht_render(struct HtScene *scene,
  *
  * On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the finished pixels and the values of
  * "nothing hit" elsewhere; on other errors every buffer is left untouched.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
+ * (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer
+ * misaligned, any two buffers (or a buffer and `*settings`) overlapping, a scene with no
+ * light, or no camera and no geometry to frame); `HT_ERR_EMBREE` (the scene build
+ * failed); `HT_ERR_CANCELLED` (the progress callback returned false).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+ * `settings` is NULL or readable; each non-NULL buffer holds the floats its length says,
+ * writable, and nothing else reads or writes it during the call.
  */
 enum HtStatus ht_render_aovs(struct HtScene *scene,
                              const struct HtRenderSettings *settings,
@@ -760,12 +960,47 @@ enum HtStatus ht_render_aovs(struct HtScene *scene,
  * OpenImageIO. The extension picks the format: `.exr` stores 32-bit floats as they are;
  * `.png`, `.jpg`, `.tif` store 8-bit sRGB (clamped to [0, 1]). NaN or infinite pixels are
  * refused rather than written.
+ *
+ * `pixels_len` is the length of `pixels` in floats and must equal
+ * `width * height * channels` (computed without overflow).
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`path` or `pixels` NULL); `HT_ERR_INVALID_ARG` (empty or
+ * non-UTF-8 path, a size of 0, channels not in 1..=4, `pixels_len` not the size,
+ * `pixels` misaligned, NaN or infinite pixels); `HT_ERR_IMAGE` (an unknown extension, a
+ * format that cannot hold the channels, or OpenImageIO could not write the file, e.g.
+ * into a folder that does not exist).
+ * Any thread; touches no handle.
+ *
+ * # Safety
+ * `path` is NULL or a NUL-terminated string; `pixels` is NULL or points to `pixels_len`
+ * readable floats that stay unchanged during the call.
  */
 enum HtStatus ht_image_write(const char *path,
                              uint32_t width,
                              uint32_t height,
                              uint32_t channels,
-                             const float *pixels);
+                             const float *pixels,
+                             size_t pixels_len);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Joins the worker threads the library started, once every device and scene has been
+ * freed: TBB's workers, which Embree used to build scenes and which otherwise run until
+ * the process exits. Render threads need no call: each `ht_render` joins its own before
+ * it returns. After `HT_OK` no thread started by hairtrace is running, and the library
+ * may still be used again (a new device starts new workers).
+ *
+ * Call it from one thread, with no other hairtrace call running. Statuses:
+ * `HT_ERR_INVALID_ARG` when a device or scene is still alive (nothing is joined: free them
+ * first); `HT_ERR_EMBREE` when TBB refuses because something else in the process (the
+ * host, another library) still uses it: its workers then keep running, as they would
+ * without this call.
+ *
+ * # Safety
+ * No other thread is inside a hairtrace call, and none starts one until it returns.
+ */
+enum HtStatus ht_shutdown(void);
 #endif
 
 #ifdef __cplusplus

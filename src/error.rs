@@ -35,6 +35,15 @@ impl Error {
         }
     }
 
+    /// The message without the kind in front, for hosts that get the kind apart (the C
+    /// ABI's status): `Display` gives `"invalid argument: {detail}"`.
+    pub fn detail(&self) -> String {
+        match self {
+            Error::InvalidArg(m) | Error::Io(m) | Error::Image(m) => m.clone(),
+            Error::Embree { code, message } => format!("{message} (Embree error code {code})"),
+        }
+    }
+
     /// An i/o failure on `path`, naming it.
     pub fn io(path: &std::path::Path, e: std::io::Error) -> Error {
         Error::Io(format!("{}: {e}", path.display()))
@@ -72,6 +81,7 @@ mod tests {
             std::path::Path::new("/x.hair"),
             std::io::Error::other("gone"),
         );
+        assert_eq!(e.detail(), "/x.hair: gone");
         assert_eq!(e.context("a").to_string(), "i/o error: a: /x.hair: gone");
     }
 }

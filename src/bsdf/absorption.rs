@@ -27,9 +27,14 @@ pub fn sigma_a_from_color(color: [f32; 3], beta_n: f32) -> Result<[f32; 3]> {
     check_beta("beta_n", beta_n)?;
     for (i, &c) in color.iter().enumerate() {
         if !(c > 0.0 && c <= 1.0) {
-            return Err(invalid_arg!(
-                "color[{i}] = {c}: must be in (0, 1] (0 would need infinite absorption)"
-            ));
+            let why = if c > 1.0 {
+                "a fiber cannot reflect more than it receives"
+            } else if c <= 0.0 {
+                "0 would need infinite absorption"
+            } else {
+                "not a number"
+            };
+            return Err(invalid_arg!("color[{i}] = {c}: must be in (0, 1] ({why})"));
         }
     }
     let d = color_fit(beta_n);

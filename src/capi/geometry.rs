@@ -2,7 +2,7 @@
 //! shared in place), `.hair` files, and triangle meshes from arrays or files.
 
 use super::scene::{HtScene, Shape, add_with_id};
-use super::{Failure, HtStatus, host_slice, non_null, read_path};
+use super::{Failure, HtStatus, host_slice, read_host, read_path};
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
@@ -44,14 +44,17 @@ pub struct HtCurves {
     pub point_counts: *const u32,
     /// Points of all strands.
     pub point_count: usize,
-    /// x, y, z of every point, strand after strand: `3 * point_count` floats.
+    /// x, y, z of every point (world units, finite, within +-1e15), strand after strand:
+    /// `3 * point_count` floats.
     pub points: *const f32,
-    /// Fiber radius (not diameter) at every point, > 0: `point_count` floats; or NULL.
+    /// Fiber radius (not diameter) at every point, finite and > 0: `point_count` floats;
+    /// or NULL.
     pub radii: *const f32,
     /// Fiber radius (not diameter) of every point when `radii` is NULL, > 0.
     pub radius: f32,
-    /// Linear RGB at every point (`3 * point_count` floats, >= 0), used by hair materials
-    /// with `use_vertex_colors`; or NULL.
+    /// Linear RGB reflectance at every point (`3 * point_count` floats, each in [0, 1]; 0
+    /// is taken as 1e-4, the darkest colour a finite absorption makes), used by hair
+    /// materials with `use_vertex_colors`; or NULL.
     pub colors: *const f32,
     pub basis: HtCurveBasis,
     pub shape: HtCurveShape,
@@ -74,15 +77,19 @@ pub struct HtCurvesXyzr {
     pub point_counts: *const u32,
     /// Control points of all strands.
     pub point_count: usize,
-    /// x, y, z, radius (not diameter, >= 0) of every control point: `4 * point_count`
-    /// floats.
+    /// x, y, z (world units, within +-1e15), radius (not diameter, >= 0) of every control
+    /// point, all finite: `4 * point_count` floats.
     pub points: *const f32,
-    /// Linear RGB (>= 0) at every segment end, segments + 1 per strand, strand after
-    /// strand; or NULL.
+    /// Linear RGB reflectance (each in [0, 1], as in `HtCurves`) at every segment end,
+    /// segments + 1 per strand, strand after strand; or NULL.
     pub colors: *const f32,
     pub basis: HtCurveBasis,
     pub shape: HtCurveShape,
 }
+
+/// The alignment of the control points Embree reads in place: it loads each float4 with
+/// one aligned 16-byte load.
+const EMBREE_VERTEX_ALIGN: usize = 16;
 
 fn curve_basis(basis: HtCurveBasis) -> Result<CurveBasis> {
     Ok(match basis {
@@ -130,17 +137,27 @@ fn host_triples<'a>(
 
 /// Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
 /// `material_id`; writes the geometry id (0, 1, ... over curves and meshes, in the order
-/// they are added) to `geom_id`.
+/// they are added) to `geom_id`. `desc->radii` and `desc->colors` may be NULL.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `desc`, `geom_id` or a required array NULL);
+/// `HT_ERR_INVALID_ARG` (no strand, a strand of fewer points than its basis needs, counts
+/// that do not add up, a NaN, infinite or out-of-range value, an unknown basis or shape,
+/// a misaligned or oversized array, a material that is not hair). Nothing is added on
+/// failure, and `*geom_id` is written on `HT_OK` only.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `desc` is NULL or points
+/// to a readable struct whose non-NULL arrays hold the counts it gives; `geom_id` is NULL
+/// or points to a writable `uint32_t`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_curves(
+pub unsafe extern "C" fn ht_scene_add_curves(
     scene: *mut HtScene,
     desc: *const HtCurves,
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
-        // SAFETY: non-NULL (checked); the host's struct.
-        let d = unsafe { *non_null(desc, "desc")? };
+        let d = read_host(desc, "desc")?;
         scene.check_material(material_id, true)?;
         let (basis, shape) = (curve_basis(d.basis)?, curve_shape(d.shape)?);
         check_strand_count(d.strand_count)?;
@@ -173,16 +190,28 @@ pub extern "C" fn ht_scene_add_curves(
 }
 
 /// Adds strands of float4 control points laid out for the basis (copied: see
-/// `HtCurvesXyzr`), shaded by the hair material `material_id`; writes the geometry id.
+/// `HtCurvesXyzr`, any 4-byte alignment), shaded by the hair material `material_id`;
+/// writes the geometry id. `desc->colors` may be NULL.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `desc`, `geom_id` or a required array NULL);
+/// `HT_ERR_INVALID_ARG` (no strand, a strand of fewer points than its basis needs, counts
+/// that do not add up, a NaN, infinite or out-of-range value, an unknown basis or shape,
+/// a misaligned or oversized array, a material that is not hair). Nothing is added on
+/// failure, and `*geom_id` is written on `HT_OK` only.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `desc` is NULL or points
+/// to a readable struct whose non-NULL arrays hold the counts it gives; `geom_id` is NULL
+/// or points to a writable `uint32_t`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_curves_xyzr(
+pub unsafe extern "C" fn ht_scene_add_curves_xyzr(
     scene: *mut HtScene,
     desc: *const HtCurvesXyzr,
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
     add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
-        points.to_vec().into()
+        Ok(points.to_vec().into())
     })
 }
 
@@ -190,23 +219,40 @@ pub extern "C" fn ht_scene_add_curves_xyzr(
 /// the host's array in place, through every render and every rebuild after later
 /// additions, and the scene never holds a copy of it. The host keeps those
 /// `4 * point_count` floats allocated and unchanged until `ht_scene_free` returns; writing
-/// to them or freeing them earlier is undefined behaviour. `points` must be aligned to 4
-/// bytes, like any float array (16-byte alignment is not needed, and no padding past the
+/// to them or freeing them earlier is undefined behaviour. `points` must be aligned to 16
+/// bytes, as Embree loads each float4 with one aligned load (`malloc` and `aligned_alloc`
+/// give such memory; a float array at an odd offset does not). No padding is needed past the
 /// last point: Embree reads at most the 16 bytes of a float4 from its start). The small
 /// per-strand data are still built and kept by the scene: `point_counts` and `colors` are
 /// read during the call only, and the index buffer takes 4 bytes per segment.
+///
+/// Statuses: as `ht_scene_add_curves_xyzr`; `desc->points` not aligned to 16 bytes is
+/// `HT_ERR_INVALID_ARG` (use `ht_scene_add_curves_xyzr`, which copies, for such memory).
+///
+/// # Safety
+/// As `ht_scene_add_curves_xyzr`, and `desc->points` stays allocated and unchanged until
+/// `ht_scene_free` returns.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_curves_xyzr_shared(
+pub unsafe extern "C" fn ht_scene_add_curves_xyzr_shared(
     scene: *mut HtScene,
     desc: *const HtCurvesXyzr,
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
     add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+        if points.as_ptr() as usize % EMBREE_VERTEX_ALIGN != 0 {
+            return Err(invalid_arg!(
+                "desc->points = {:?} is not aligned to {EMBREE_VERTEX_ALIGN} bytes: shared \
+                 points are read by Embree with aligned 16-byte loads (copy them with \
+                 ht_scene_add_curves_xyzr instead)",
+                points.as_ptr()
+            )
+            .into());
+        }
         // SAFETY: `points` is the host's checked array (aligned, in bounds); the host keeps it
         // valid and unchanged until ht_scene_free (the documented contract), and the scene
         // is the last owner of every clone of this buffer.
-        unsafe { SharedBuffer::from_raw_parts(NonNull::from(points).cast(), points.len()) }
+        Ok(unsafe { SharedBuffer::from_raw_parts(NonNull::from(points).cast(), points.len()) })
     })
 }
 
@@ -217,11 +263,10 @@ fn add_curves_xyzr(
     desc: *const HtCurvesXyzr,
     material_id: u32,
     geom_id: *mut u32,
-    vertices: impl FnOnce(&[[f32; 4]]) -> SharedBuffer<[f32; 4]>,
+    vertices: impl FnOnce(&[[f32; 4]]) -> std::result::Result<SharedBuffer<[f32; 4]>, Failure>,
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
-        // SAFETY: non-NULL (checked); the host's struct.
-        let d = unsafe { *non_null(desc, "desc")? };
+        let d = read_host(desc, "desc")?;
         scene.check_material(material_id, true)?;
         let (basis, shape) = (curve_basis(d.basis)?, curve_shape(d.shape)?);
         check_strand_count(d.strand_count)?;
@@ -242,15 +287,25 @@ fn add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
-        let curves = Curves::from_control_points(vertices(points), counts, colors, basis, shape)?;
+        let curves = Curves::from_control_points(vertices(points)?, counts, colors, basis, shape)?;
         Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
     })
 }
 
-/// Adds the strands of a Cem Yuksel `.hair` file as polylines for `basis`. The file's
+/// Adds the strands of a Cem Yuksel `.hair` file (read during the call) as polylines for
+/// `basis`, shaded by the hair material `material_id`; writes the geometry id. The file's
 /// thickness is a diameter unless `thickness_is_radius`.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `path` or `geom_id` NULL); `HT_ERR_IO` (the file
+/// is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or non-UTF-8 path, a
+/// malformed file, values out of range, an unknown basis or shape, a material that is
+/// not hair).
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+/// NUL-terminated string; `geom_id` is NULL or points to a writable `uint32_t`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_hair_file(
+pub unsafe extern "C" fn ht_scene_add_hair_file(
     scene: *mut HtScene,
     path: *const c_char,
     thickness_is_radius: bool,
@@ -277,10 +332,21 @@ pub extern "C" fn ht_scene_add_hair_file(
 /// Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
 /// `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
 /// shading), `indices` 3 vertex indices per triangle, counter-clockwise seen from the
-/// front. Writes the geometry id.
+/// front. Positions are world units (finite, within +-1e15), normals finite. Writes the
+/// geometry id.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `positions`, `indices` or `geom_id` NULL);
+/// `HT_ERR_INVALID_ARG` (no vertex or no triangle, an index past the vertices, a NaN,
+/// infinite or out-of-range value, a misaligned or oversized array, a material that is
+/// not diffuse).
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `positions` and
+/// `normals` are NULL or hold `3 * vertex_count` readable floats, `indices`
+/// `3 * triangle_count` readable `uint32_t`; `geom_id` is NULL or writable.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)] // the C signature: one argument per array
-pub extern "C" fn ht_scene_add_mesh(
+pub unsafe extern "C" fn ht_scene_add_mesh(
     scene: *mut HtScene,
     vertex_count: usize,
     positions: *const f32,
@@ -310,9 +376,18 @@ pub extern "C" fn ht_scene_add_mesh(
 }
 
 /// Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
-/// material `material_id`; writes the geometry id.
+/// material `material_id`; writes the geometry id. The file is read during the call.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `path` or `geom_id` NULL); `HT_ERR_IO` (the file
+/// is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or non-UTF-8 path, another
+/// extension, a malformed file, no triangle, values out of range, a material that is not
+/// diffuse).
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+/// NUL-terminated string; `geom_id` is NULL or writable.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_mesh_file(
+pub unsafe extern "C" fn ht_scene_add_mesh_file(
     scene: *mut HtScene,
     path: *const c_char,
     material_id: u32,

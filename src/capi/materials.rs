@@ -3,7 +3,7 @@
 
 use super::bsdf::HtHairParams;
 use super::scene::{HtScene, add_with_id};
-use super::{Failure, HtStatus, non_null, read_vec3};
+use super::{Failure, HtStatus, read_host, read_vec3};
 use crate::bsdf::diffuse::Diffuse;
 use crate::error::invalid_arg;
 use crate::scene::material::{HairColor, HairMaterial, Material};
@@ -20,8 +20,10 @@ pub struct HtHairVariation {
     pub roughness_variation: f32,
     /// Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
     pub tip_absorption: f32,
-    /// Take the absorption from the curves' per-point colours where they have them.
-    pub use_vertex_colors: bool,
+    /// 1: take the absorption from the curves' per-point colours where they have them;
+    /// 0: ignore them. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
+    /// than a `bool`, so that no byte the host stores here is undefined behaviour.
+    pub use_vertex_colors: u8,
     /// Seed of the per-strand random choices.
     pub seed: u64,
 }
@@ -34,35 +36,51 @@ pub extern "C" fn ht_hair_variation_default() -> HtHairVariation {
         absorption_variation: m.absorption_variation,
         roughness_variation: m.roughness_variation,
         tip_absorption: m.tip_absorption,
-        use_vertex_colors: m.use_vertex_colors,
+        use_vertex_colors: u8::from(m.use_vertex_colors),
         seed: m.seed,
     }
 }
 
-/// Adds a hair material with the same parameters on every strand; writes its id (0, 1, ...
-/// in the order materials are added) to `material_id`.
+/// Adds a hair material with the same parameters on every strand (ranges as for
+/// `ht_hair_eval`); writes its id (0, 1, ... in the order materials are added) to
+/// `material_id`.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
+/// `HT_ERR_INVALID_ARG` (a parameter NaN, infinite or out of range, `material_id`
+/// misaligned). Nothing is added on failure.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `params` is NULL or
+/// readable; `material_id` is NULL or points to a writable `uint32_t`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_hair_material(
+pub unsafe extern "C" fn ht_scene_add_hair_material(
     scene: *mut HtScene,
     params: *const HtHairParams,
     material_id: *mut u32,
 ) -> HtStatus {
     let none = ht_hair_variation_default();
-    ht_scene_add_hair_material_varied(scene, params, &none, material_id)
+    // SAFETY: the caller's promises, and `none` lives across the call.
+    unsafe { ht_scene_add_hair_material_varied(scene, params, &none, material_id) }
 }
 
-/// Adds a hair material whose parameters vary over the groom as `variation` says.
+/// Adds a hair material whose parameters vary over the groom as `variation` says (its
+/// ranges on `HtHairVariation`).
+///
+/// Statuses: as `ht_scene_add_hair_material`, and `HT_ERR_NULL_ARG` for `variation` NULL,
+/// `HT_ERR_INVALID_ARG` for a variation out of range (`use_vertex_colors` not 0 or 1).
+///
+/// # Safety
+/// As `ht_scene_add_hair_material`; `variation` is NULL or readable.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_hair_material_varied(
+pub unsafe extern "C" fn ht_scene_add_hair_material_varied(
     scene: *mut HtScene,
     params: *const HtHairParams,
     variation: *const HtHairVariation,
     material_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, material_id, "material_id", |scene| {
-        // SAFETY: non-NULL (checked); the host's structs.
-        let p = unsafe { *non_null(params, "params")? };
-        let v = unsafe { *non_null(variation, "variation")? };
+        let p = read_host(params, "params")?;
+        let v = read_host(variation, "variation")?;
         let material = HairMaterial {
             color: HairColor::SigmaA(p.sigma_a),
             eta: p.eta,
@@ -72,7 +90,16 @@ pub extern "C" fn ht_scene_add_hair_material_varied(
             absorption_variation: v.absorption_variation,
             roughness_variation: v.roughness_variation,
             tip_absorption: v.tip_absorption,
-            use_vertex_colors: v.use_vertex_colors,
+            use_vertex_colors: match v.use_vertex_colors {
+                0 => false,
+                1 => true,
+                other => {
+                    return Err(invalid_arg!(
+                        "variation->use_vertex_colors = {other}: must be 0 or 1"
+                    )
+                    .into());
+                }
+            },
             seed: v.seed,
         };
         let prepared = material.prepare()?;
@@ -80,9 +107,17 @@ pub extern "C" fn ht_scene_add_hair_material_varied(
     })
 }
 
-/// Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1].
+/// Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;
+/// writes its id.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `albedo` or `material_id` NULL);
+/// `HT_ERR_INVALID_ARG` (a channel NaN or outside [0, 1], a misaligned pointer).
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `albedo` is NULL or
+/// points to 3 readable floats; `material_id` is NULL or writable.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_add_diffuse_material(
+pub unsafe extern "C" fn ht_scene_add_diffuse_material(
     scene: *mut HtScene,
     albedo: *const f32,
     material_id: *mut u32,

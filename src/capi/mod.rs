@@ -22,6 +22,10 @@ mod scene_tests;
 pub mod render;
 #[cfg(all(test, feature = "render"))]
 mod render_tests;
+#[cfg(feature = "render")]
+pub mod shutdown;
+#[cfg(all(test, feature = "render"))]
+mod soundness_tests;
 
 pub use bsdf::HtHairParams;
 
@@ -35,7 +39,7 @@ use std::path::PathBuf;
 
 /// Version of the C ABI; bumped on any incompatible change of a signature or struct. The
 /// shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
-pub const HT_ABI_VERSION: u32 = 3;
+pub const HT_ABI_VERSION: u32 = 4;
 
 /// The major part of the library version, which `ht_version()` returns as a string. The
 /// three parts are Cargo's version: a compile-time check keeps them equal.
@@ -128,7 +132,8 @@ pub(crate) struct Failure(HtStatus, String);
 
 impl From<Error> for Failure {
     fn from(e: Error) -> Self {
-        Failure(HtStatus::from(&e), e.to_string())
+        // The status names the kind: the message says what went wrong, once.
+        Failure(HtStatus::from(&e), e.detail())
     }
 }
 
@@ -175,31 +180,74 @@ pub(crate) fn non_null<T>(ptr: *const T, name: &str) -> Result<*const T, Failure
     }
 }
 
-/// [`non_null`] for out-parameters.
+/// A copy of the host's struct at `ptr`, which must not be NULL and must be aligned for
+/// `T` (reading a misaligned one would be undefined behaviour).
+pub(crate) fn read_host<T: Copy>(ptr: *const T, name: &str) -> Result<T, Failure> {
+    let ptr = non_null(ptr, name)?;
+    check_aligned(ptr, name)?;
+    // SAFETY: non-NULL and aligned (checked); the host promises a readable, initialised
+    // `T` there.
+    Ok(unsafe { ptr.read() })
+}
+
+/// [`non_null`] for out-parameters, which must also be aligned for `T`: the library
+/// writes through them.
 pub(crate) fn non_null_mut<T>(ptr: *mut T, name: &str) -> Result<*mut T, Failure> {
-    non_null(ptr.cast_const(), name).map(|p| p.cast_mut())
+    let ptr = non_null(ptr.cast_const(), name)?;
+    check_aligned(ptr, name)?;
+    Ok(ptr.cast_mut())
+}
+
+fn check_aligned<T>(ptr: *const T, name: &str) -> Result<(), Failure> {
+    if ptr.is_aligned() {
+        Ok(())
+    } else {
+        Err(invalid_arg!(
+            "{name} = {ptr:?} is not aligned to {} bytes",
+            align_of::<T>()
+        )
+        .into())
+    }
 }
 
 /// Checks that a host array of `len` elements can be read as a slice: not NULL (unless
-/// empty), aligned for `T`, and no larger than Rust allows an allocation to be. Whether the
-/// host really holds `len` elements there is its promise, as in any C API.
+/// empty), aligned for `T`, no larger than Rust allows an allocation to be, and not running
+/// past the end of the address space. Whether the host really holds `len` elements there
+/// is its promise, as in any C API.
 fn check_host_array<T>(ptr: *const T, len: usize, name: &str) -> Result<(), Failure> {
     if len == 0 {
         return Ok(());
     }
     non_null(ptr, name)?;
-    if !ptr.is_aligned() {
+    check_aligned(ptr, name)?;
+    let fits = len
+        .checked_mul(size_of::<T>())
+        .filter(|&b| b <= isize::MAX as usize)
+        .is_some_and(|b| (ptr as usize).checked_add(b).is_some());
+    if !fits {
         return Err(invalid_arg!(
-            "{name} = {ptr:?} is not aligned to {} bytes",
-            align_of::<T>()
+            "{name}: {len} elements of {} bytes from {ptr:?} do not fit in memory",
+            size_of::<T>()
         )
         .into());
     }
-    if len
-        .checked_mul(size_of::<T>())
-        .is_none_or(|b| b > isize::MAX as usize)
-    {
-        return Err(invalid_arg!("{name}: {len} elements do not fit in memory").into());
+    Ok(())
+}
+
+/// Refuses two host buffers (`(pointer, bytes)`, NULL or empty ones ignored) that overlap:
+/// the library would read what it writes, or write one result over another.
+pub(crate) fn check_disjoint(buffers: &[(&str, *const u8, usize)]) -> Result<(), Failure> {
+    let live = |(_, p, n): &&(&str, *const u8, usize)| !p.is_null() && *n > 0;
+    for (i, a) in buffers.iter().filter(live).enumerate() {
+        for b in buffers.iter().filter(live).skip(i + 1) {
+            let (a0, b0) = (a.1 as usize, b.1 as usize);
+            // The lengths were checked not to wrap the address space.
+            if a0 < b0 + b.2 && b0 < a0 + a.2 {
+                return Err(
+                    invalid_arg!("{} and {} overlap: give each its own memory", a.0, b.0).into(),
+                );
+            }
+        }
     }
     Ok(())
 }

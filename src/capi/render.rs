@@ -2,7 +2,8 @@
 
 use super::scene::{HtScene, scene_mut};
 use super::{
-    Failure, HtStatus, boundary, host_slice, host_slice_mut, non_null, non_null_mut, read_path,
+    Failure, HtStatus, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
+    non_null_mut, read_host, read_path,
 };
 use crate::error::invalid_arg;
 use crate::image::{WriteOptions, write_image};
@@ -13,9 +14,11 @@ use crate::render::{Aovs, NoProgress, PixelFilter, Progress, RenderStatus};
 use std::ffi::{c_char, c_void};
 use std::ptr::null_mut;
 
-/// Told how far a render has got: `done` of `total` pixels, `done` increasing from call to
-/// call. Return false to cancel: no new pixel starts and `ht_render` returns
-/// `HT_ERR_CANCELLED` (tiles that finish meanwhile may still report).
+/// Told how far a render has got: `done` of `total` pixels, `done` never decreasing from
+/// call to call. It is called when a 16 x 16 tile finishes and, while pixels take long
+/// (many samples), also every 20 ms or so of work with an unchanged `done`, so that it can
+/// cancel any render promptly. Return false to cancel: no new sample starts, unfinished
+/// tiles are dropped, and `ht_render` returns `HT_ERR_CANCELLED`.
 ///
 /// Called from the render's worker threads (not necessarily the one that called
 /// `ht_render`), but never two calls at once, so `user` needs no locking against itself.
@@ -147,11 +150,17 @@ impl Progress for HostProgress {
 /// owned by the host. `ht_render_aovs` without AOVs.
 ///
 /// The first render builds the Embree scene (its time is part of the call); later ones
-/// reuse it until geometry is added. Blocks until the image is done. On
-/// `HT_ERR_CANCELLED`, `rgb` holds the pixels finished before the callback said stop and
-/// 0 elsewhere; on other errors it is left untouched.
+/// reuse it until geometry is added. Blocks until the image is done, on worker threads of
+/// its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
+/// pixels finished before the callback said stop and 0 elsewhere; on other errors it is
+/// left untouched.
+///
+/// Statuses: as `ht_render_aovs`.
+///
+/// # Safety
+/// As `ht_render_aovs`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_render(
+pub unsafe extern "C" fn ht_render(
     scene: *mut HtScene,
     settings: *const HtRenderSettings,
     rgb: *mut f32,
@@ -159,16 +168,19 @@ pub extern "C" fn ht_render(
 ) -> HtStatus {
     // A wrong rgb_len is reported as such before the pixel count derived from it.
     let pixel_count = rgb_len / 3;
-    ht_render_aovs(
-        scene,
-        settings,
-        rgb,
-        rgb_len,
-        null_mut(),
-        null_mut(),
-        null_mut(),
-        pixel_count,
-    )
+    // SAFETY: the caller's promises; the AOV pointers are NULL.
+    unsafe {
+        ht_render_aovs(
+            scene,
+            settings,
+            rgb,
+            rgb_len,
+            null_mut(),
+            null_mut(),
+            null_mut(),
+            pixel_count,
+        )
+    }
 }
 
 /// As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
@@ -188,9 +200,20 @@ pub extern "C" fn ht_render(
 ///
 /// On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the finished pixels and the values of
 /// "nothing hit" elsewhere; on other errors every buffer is left untouched.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
+/// (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer
+/// misaligned, any two buffers (or a buffer and `*settings`) overlapping, a scene with no
+/// light, or no camera and no geometry to frame); `HT_ERR_EMBREE` (the scene build
+/// failed); `HT_ERR_CANCELLED` (the progress callback returned false).
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+/// `settings` is NULL or readable; each non-NULL buffer holds the floats its length says,
+/// writable, and nothing else reads or writes it during the call.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)] // the C signature: one argument per buffer
-pub extern "C" fn ht_render_aovs(
+pub unsafe extern "C" fn ht_render_aovs(
     scene: *mut HtScene,
     settings: *const HtRenderSettings,
     rgb: *mut f32,
@@ -202,8 +225,8 @@ pub extern "C" fn ht_render_aovs(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        // SAFETY: non-NULL (checked); the host's struct.
-        let s = unsafe { *non_null(settings, "settings")? };
+        let s = read_host(settings, "settings")?;
+        let settings_ptr = settings;
         let settings = s.to_rust()?;
         settings.validate()?;
         // The crop window's size (the full frame without one).
@@ -224,6 +247,23 @@ pub extern "C" fn ht_render_aovs(
         let albedo = optional_slice(albedo, 3 * pixels, "albedo")?;
         let depth = optional_slice(depth, pixels, "depth")?;
         let strand_id = optional_slice(strand_id, pixels, "strand_id")?;
+        let bytes = |b: &Option<&mut [f32]>| {
+            b.as_ref().map_or((std::ptr::null(), 0), |b| {
+                (b.as_ptr().cast(), size_of_val(*b))
+            })
+        };
+        let [albedo_b, depth_b, strand_b] = [&albedo, &depth, &strand_id].map(bytes);
+        check_disjoint(&[
+            ("rgb", rgb.as_ptr().cast(), size_of_val(rgb)),
+            ("albedo", albedo_b.0, albedo_b.1),
+            ("depth", depth_b.0, depth_b.1),
+            ("strand_id", strand_b.0, strand_b.1),
+            (
+                "settings",
+                settings_ptr.cast(),
+                size_of::<HtRenderSettings>(),
+            ),
+        ])?;
         let aovs = Aovs {
             albedo: albedo.is_some(),
             depth: depth.is_some(),
@@ -280,24 +320,42 @@ fn optional_slice<'a>(
 /// OpenImageIO. The extension picks the format: `.exr` stores 32-bit floats as they are;
 /// `.png`, `.jpg`, `.tif` store 8-bit sRGB (clamped to [0, 1]). NaN or infinite pixels are
 /// refused rather than written.
+///
+/// `pixels_len` is the length of `pixels` in floats and must equal
+/// `width * height * channels` (computed without overflow).
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`path` or `pixels` NULL); `HT_ERR_INVALID_ARG` (empty or
+/// non-UTF-8 path, a size of 0, channels not in 1..=4, `pixels_len` not the size,
+/// `pixels` misaligned, NaN or infinite pixels); `HT_ERR_IMAGE` (an unknown extension, a
+/// format that cannot hold the channels, or OpenImageIO could not write the file, e.g.
+/// into a folder that does not exist).
+/// Any thread; touches no handle.
+///
+/// # Safety
+/// `path` is NULL or a NUL-terminated string; `pixels` is NULL or points to `pixels_len`
+/// readable floats that stay unchanged during the call.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_image_write(
+pub unsafe extern "C" fn ht_image_write(
     path: *const c_char,
     width: u32,
     height: u32,
     channels: u32,
     pixels: *const f32,
+    pixels_len: usize,
 ) -> HtStatus {
     boundary(|| {
         let path = read_path(path, "path")?;
         let (w, h, c) = (width as usize, height as usize, channels as usize);
-        let len = w
-            .checked_mul(h)
-            .and_then(|n| n.checked_mul(c))
-            .ok_or_else(|| {
-                invalid_arg!("{width} x {height} x {channels} values do not fit in memory")
-            })?;
-        let pixels = host_slice(non_null(pixels, "pixels")?, len, "pixels")?;
+        let want = w.checked_mul(h).and_then(|n| n.checked_mul(c));
+        if want != Some(pixels_len) {
+            return Err(invalid_arg!(
+                "pixels_len = {pixels_len}: must be width * height * channels = {width} * \
+                 {height} * {channels}{}",
+                want.map_or(" (which overflows)".into(), |n| format!(" = {n}"))
+            )
+            .into());
+        }
+        let pixels = host_slice(non_null(pixels, "pixels")?, pixels_len, "pixels")?;
         write_image(&path, w, h, c, pixels, &WriteOptions::default())?;
         Ok(())
     })

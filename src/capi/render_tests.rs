@@ -31,7 +31,7 @@ const SUN_DIR: [f32; 3] = [1.0, 1.0, 1.0];
 const SUN: [f32; 3] = [2.0, 2.0, 1.8];
 const SUN_RADIUS_DEG: f32 = 2.0;
 
-fn settings(size: u32) -> HtRenderSettings {
+pub(super) fn settings(size: u32) -> HtRenderSettings {
     HtRenderSettings {
         width: size,
         height: size,
@@ -43,7 +43,7 @@ fn settings(size: u32) -> HtRenderSettings {
 }
 
 /// The small fur ball with hair, sky and sun through the C functions.
-fn fur_scene(camera: bool) -> Handles {
+pub(super) fn fur_scene(camera: bool) -> Handles {
     let h = Handles::new();
     let hair = h.hair_material();
     assert_eq!(
@@ -57,46 +57,53 @@ fn fur_scene(camera: bool) -> Handles {
 }
 
 /// Adds sky and sun, and the camera if asked.
-fn light(h: &Handles, camera: bool) {
-    assert_eq!(
-        ht_scene_add_environment(h.scene, SKY.as_ptr()),
-        HtStatus::HT_OK
-    );
-    let s = ht_scene_add_distant_light(h.scene, SUN_DIR.as_ptr(), SUN.as_ptr(), SUN_RADIUS_DEG);
-    assert_eq!(s, HtStatus::HT_OK);
-    if camera {
-        let s = ht_scene_set_camera(h.scene, EYE.as_ptr(), [0.0; 3].as_ptr(), UP.as_ptr(), 40.0);
+pub(super) fn light(h: &Handles, camera: bool) {
+    unsafe {
+        assert_eq!(
+            ht_scene_add_environment(h.scene, SKY.as_ptr()),
+            HtStatus::HT_OK
+        );
+        let s = ht_scene_add_distant_light(h.scene, SUN_DIR.as_ptr(), SUN.as_ptr(), SUN_RADIUS_DEG);
         assert_eq!(s, HtStatus::HT_OK);
+        if camera {
+            let s =
+                ht_scene_set_camera(h.scene, EYE.as_ptr(), [0.0; 3].as_ptr(), UP.as_ptr(), 40.0);
+            assert_eq!(s, HtStatus::HT_OK);
+        }
     }
 }
 
-fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
-    let mut rgb = vec![-1.0f32; (s.width * s.height * 3) as usize];
-    let status = ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len());
-    (status, rgb)
+pub(super) fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
+    unsafe {
+        let mut rgb = vec![-1.0f32; (s.width * s.height * 3) as usize];
+        let status = ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len());
+        (status, rgb)
+    }
 }
 
 /// Renders through `ht_render_aovs` with every AOV: rgb, albedo, depth, strand id.
 fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
-    let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
-    let pixels = ((x1 - x0) * (y1 - y0)) as usize;
-    let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
-    let [rgb, albedo, depth, strand_id] = &mut out;
-    let status = ht_render_aovs(
-        h.scene,
-        s,
-        rgb.as_mut_ptr(),
-        rgb.len(),
-        albedo.as_mut_ptr(),
-        depth.as_mut_ptr(),
-        strand_id.as_mut_ptr(),
-        pixels,
-    );
-    assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    out
+    unsafe {
+        let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
+        let pixels = ((x1 - x0) * (y1 - y0)) as usize;
+        let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
+        let [rgb, albedo, depth, strand_id] = &mut out;
+        let status = ht_render_aovs(
+            h.scene,
+            s,
+            rgb.as_mut_ptr(),
+            rgb.len(),
+            albedo.as_mut_ptr(),
+            depth.as_mut_ptr(),
+            strand_id.as_mut_ptr(),
+            pixels,
+        );
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        out
+    }
 }
 
-fn bits(rgb: &[f32]) -> Vec<u32> {
+pub(super) fn bits(rgb: &[f32]) -> Vec<u32> {
     rgb.iter().map(|v| v.to_bits()).collect()
 }
 
@@ -113,7 +120,7 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
     let hair = HairMaterial::default().prepare().unwrap();
     let lights = vec![
         Light::Environment(Environment::uniform(Vec3::from(SKY)).unwrap()),
-        Light::distant(SUN_DIR.into(), SUN.into(), SUN_RADIUS_DEG.to_radians()).unwrap(),
+        Light::distant(SUN_DIR.into(), SUN.into(), SUN_RADIUS_DEG).unwrap(),
     ];
     let world = World::new(
         builder.build().unwrap(),
@@ -152,48 +159,50 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
 
 #[test]
 fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
-    let strands = small_fur();
-    let points = xyzr(&strands);
-    let desc = xyzr_desc(&points, &strands.counts);
-    let scenes = [ht_scene_add_curves_xyzr, ht_scene_add_curves_xyzr_shared].map(|add| {
-        let h = Handles::new();
-        let hair = h.hair_material();
-        let s = add(h.scene, &desc, hair, &mut 0);
-        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        light(&h, true);
-        h
-    });
-    let s = settings(24);
-    let render_both = || {
-        scenes.each_ref().map(|h| {
-            let (status, rgb) = render_c(h, &s);
-            assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-            bits(&rgb)
-        })
-    };
-    // The points Embree reads in the shared scene's current build.
-    let embree_points = || {
-        let scene = scene_mut(scenes[1].scene).ok().unwrap();
-        let (world, _) = scene.prepare(1.0).unwrap();
-        match world.tracer.scene().geometry(0) {
-            Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
-            _ => panic!("curves expected"),
-        }
-    };
-    let [copied, shared] = render_both();
-    assert_eq!(copied, shared);
-    assert!(copied.iter().any(|&v| f32::from_bits(v) > 0.0));
-    assert_eq!(embree_points(), points.as_ptr());
+    unsafe {
+        let strands = small_fur();
+        let points = xyzr(&strands);
+        let desc = xyzr_desc(&points, &strands.counts);
+        let scenes = [ht_scene_add_curves_xyzr, ht_scene_add_curves_xyzr_shared].map(|add| {
+            let h = Handles::new();
+            let hair = h.hair_material();
+            let s = add(h.scene, &desc, hair, &mut 0);
+            assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+            light(&h, true);
+            h
+        });
+        let s = settings(24);
+        let render_both = || {
+            scenes.each_ref().map(|h| {
+                let (status, rgb) = render_c(h, &s);
+                assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+                bits(&rgb)
+            })
+        };
+        // The points Embree reads in the shared scene's current build.
+        let embree_points = || {
+            let scene = scene_mut(scenes[1].scene).ok().unwrap();
+            let (world, _) = scene.prepare(1.0).unwrap();
+            match world.tracer.scene().geometry(0) {
+                Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
+                _ => panic!("curves expected"),
+            }
+        };
+        let [copied, shared] = render_both();
+        assert_eq!(copied, shared);
+        assert!(copied.iter().any(|&v| f32::from_bits(v) > 0.0));
+        assert_eq!(embree_points(), points.as_ptr());
 
-    // A wall added later rebuilds the scene, which still reads the host's points.
-    for h in &scenes {
-        let wall = h.diffuse_material([0.9; 3]);
-        assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
+        // A wall added later rebuilds the scene, which still reads the host's points.
+        for h in &scenes {
+            let wall = h.diffuse_material([0.9; 3]);
+            assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
+        }
+        let [copied_wall, shared_wall] = render_both();
+        assert_eq!(copied_wall, shared_wall);
+        assert_ne!(copied_wall, copied);
+        assert_eq!(embree_points(), points.as_ptr());
     }
-    let [copied_wall, shared_wall] = render_both();
-    assert_eq!(copied_wall, shared_wall);
-    assert_ne!(copied_wall, copied);
-    assert_eq!(embree_points(), points.as_ptr());
 }
 
 #[test]
@@ -228,79 +237,83 @@ fn crops_reassemble_into_the_full_frame_bit_for_bit() {
 
 #[test]
 fn aovs_report_the_first_hits_and_null_ones_are_skipped() {
-    let h = fur_scene(true);
-    let s = settings(32);
-    let [rgb, albedo, depth, strand_id] = render_aovs_c(&h, &s);
-    assert_eq!(
-        bits(&rgb),
-        bits(&render_c(&h, &s).1),
-        "AOVs change no pixel"
-    );
-    assert!(albedo.iter().all(|a| (0.0..=1.0).contains(a)), "{albedo:?}");
-    let strands = small_fur().counts.len() as f32;
-    for (d, id) in depth.iter().zip(&strand_id) {
-        if *id >= 0.0 {
-            assert!(d.is_finite() && *d > 0.0, "depth {d} of strand {id}");
-            assert!(id.fract() == 0.0 && *id < strands, "{id}");
-        } else {
-            assert_eq!(*id, -1.0);
+    unsafe {
+        let h = fur_scene(true);
+        let s = settings(32);
+        let [rgb, albedo, depth, strand_id] = render_aovs_c(&h, &s);
+        assert_eq!(
+            bits(&rgb),
+            bits(&render_c(&h, &s).1),
+            "AOVs change no pixel"
+        );
+        assert!(albedo.iter().all(|a| (0.0..=1.0).contains(a)), "{albedo:?}");
+        let strands = small_fur().counts.len() as f32;
+        for (d, id) in depth.iter().zip(&strand_id) {
+            if *id >= 0.0 {
+                assert!(d.is_finite() && *d > 0.0, "depth {d} of strand {id}");
+                assert!(id.fract() == 0.0 && *id < strands, "{id}");
+            } else {
+                assert_eq!(*id, -1.0);
+            }
         }
-    }
-    let hair = strand_id.iter().filter(|id| **id >= 0.0).count();
-    assert!(hair > 20, "{hair} hair pixels");
-    // Pixels of sky alone hit nothing: depth 0, albedo 0.
-    let sky =
-        (depth.iter().zip(albedo.chunks_exact(3))).filter(|(d, a)| **d == 0.0 && *a == [0.0; 3]);
-    assert!(sky.count() > 20);
+        let hair = strand_id.iter().filter(|id| **id >= 0.0).count();
+        assert!(hair > 20, "{hair} hair pixels");
+        // Pixels of sky alone hit nothing: depth 0, albedo 0.
+        let sky = (depth.iter().zip(albedo.chunks_exact(3)))
+            .filter(|(d, a)| **d == 0.0 && *a == [0.0; 3]);
+        assert!(sky.count() > 20);
 
-    // Only the depth: the other buffers may be NULL, and it is the same depth.
-    let mut rgb_only = vec![0.0f32; rgb.len()];
-    let mut depth_only = vec![0.0f32; depth.len()];
-    let status = ht_render_aovs(
-        h.scene,
-        &s,
-        rgb_only.as_mut_ptr(),
-        rgb_only.len(),
-        null_mut(),
-        depth_only.as_mut_ptr(),
-        null_mut(),
-        depth.len(),
-    );
-    assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    assert_eq!(bits(&rgb_only), bits(&rgb));
-    assert_eq!(bits(&depth_only), bits(&depth));
+        // Only the depth: the other buffers may be NULL, and it is the same depth.
+        let mut rgb_only = vec![0.0f32; rgb.len()];
+        let mut depth_only = vec![0.0f32; depth.len()];
+        let status = ht_render_aovs(
+            h.scene,
+            &s,
+            rgb_only.as_mut_ptr(),
+            rgb_only.len(),
+            null_mut(),
+            depth_only.as_mut_ptr(),
+            null_mut(),
+            depth.len(),
+        );
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert_eq!(bits(&rgb_only), bits(&rgb));
+        assert_eq!(bits(&depth_only), bits(&depth));
+    }
 }
 
 #[test]
 fn a_thin_lens_blurs_whichever_comes_first_lens_or_camera() {
-    use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL, HT_OK};
-    let s = settings(24);
-    let h = fur_scene(true);
-    let (status, pinhole) = render_c(&h, &s);
-    assert_eq!(status, HT_OK, "{}", last_error());
-    let set = |h: &Handles, aperture, focus| ht_scene_set_thin_lens(h.scene, aperture, focus);
-    fails(set(&h, f32::NAN, 4.0), INVALID, "aperture_radius = NaN");
-    fails(set(&h, -0.1, 4.0), INVALID, "aperture_radius = -0.1");
-    fails(set(&h, 0.1, 0.0), INVALID, "focus_distance = 0");
-    fails(set(&h, 0.1, f32::INFINITY), INVALID, "focus_distance = inf");
-    fails(ht_scene_set_thin_lens(null_mut(), 0.1, 4.0), NULL, "scene");
-    // Refused lenses leave the pinhole, and aperture 0 is one.
-    assert_eq!(bits(&render_c(&h, &s).1), bits(&pinhole));
-    assert_eq!(set(&h, 0.0, 4.0), HT_OK);
-    assert_eq!(bits(&render_c(&h, &s).1), bits(&pinhole));
+    unsafe {
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL, HT_OK};
+        let s = settings(24);
+        let h = fur_scene(true);
+        let (status, pinhole) = render_c(&h, &s);
+        assert_eq!(status, HT_OK, "{}", last_error());
+        let set = |h: &Handles, aperture, focus| ht_scene_set_thin_lens(h.scene, aperture, focus);
+        fails(set(&h, f32::NAN, 4.0), INVALID, "aperture_radius = NaN");
+        fails(set(&h, -0.1, 4.0), INVALID, "aperture_radius = -0.1");
+        fails(set(&h, 0.1, 0.0), INVALID, "focus_distance = 0");
+        fails(set(&h, 0.1, f32::INFINITY), INVALID, "focus_distance = inf");
+        fails(ht_scene_set_thin_lens(null_mut(), 0.1, 4.0), NULL, "scene");
+        // Refused lenses leave the pinhole, and aperture 0 is one.
+        assert_eq!(bits(&render_c(&h, &s).1), bits(&pinhole));
+        assert_eq!(set(&h, 0.0, 4.0), HT_OK);
+        assert_eq!(bits(&render_c(&h, &s).1), bits(&pinhole));
 
-    // Focused far behind the fur, which blurs; the lens set before the camera holds too.
-    assert_eq!(set(&h, 0.5, 10.0), HT_OK);
-    let (status, blurred) = render_c(&h, &s);
-    assert_eq!(status, HT_OK, "{}", last_error());
-    assert!(blurred.iter().all(|v| v.is_finite()));
-    assert_ne!(bits(&blurred), bits(&pinhole));
-    let lens_first = Handles::new();
-    let hair = lens_first.hair_material();
-    assert_eq!(lens_first.add_strands(&small_fur(), hair), HT_OK);
-    assert_eq!(set(&lens_first, 0.5, 10.0), HT_OK);
-    light(&lens_first, true);
-    assert_eq!(bits(&render_c(&lens_first, &s).1), bits(&blurred));
+        // Focused far behind the fur, which blurs; the lens set before the camera holds too.
+        assert_eq!(set(&h, 0.5, 10.0), HT_OK);
+        let (status, blurred) = render_c(&h, &s);
+        assert_eq!(status, HT_OK, "{}", last_error());
+        assert!(blurred.iter().all(|v| v.is_finite()));
+        assert_ne!(bits(&blurred), bits(&pinhole));
+        let lens_first = Handles::new();
+        let hair = lens_first.hair_material();
+        assert_eq!(lens_first.add_strands(&small_fur(), hair), HT_OK);
+        assert_eq!(set(&lens_first, 0.5, 10.0), HT_OK);
+        light(&lens_first, true);
+        assert_eq!(bits(&render_c(&lens_first, &s).1), bits(&blurred));
+    }
 }
 
 extern "C" fn count_then_cancel(_done: u64, _total: u64, user: *mut c_void) -> bool {
@@ -325,8 +338,8 @@ fn the_callback_reports_progress_and_cancels() {
     };
     let (status, full) = render_c(&h, &s);
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    // 16 x 16 tiles: one call per tile.
-    assert_eq!(calls.load(Ordering::Relaxed), 16);
+    // 16 x 16 tiles: one call per tile, and more if a tile takes over 20 ms.
+    assert!(calls.load(Ordering::Relaxed) >= 16);
 
     calls.store(0, Ordering::Relaxed);
     s.progress = Some(count_then_cancel);
@@ -347,46 +360,48 @@ fn the_callback_reports_progress_and_cancels() {
 
 #[test]
 fn adding_geometry_or_lights_rebuilds_what_changed() {
-    let h = fur_scene(true);
-    let s = settings(24);
-    let (status, before) = render_c(&h, &s);
-    assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    assert_eq!(
-        render_c(&h, &s).1,
-        before,
-        "a second render reuses the build"
-    );
-
-    // A white wall behind the fur, then a rect light: each render equals a scene
-    // built with everything from the start.
-    let wall = h.diffuse_material([0.9; 3]);
-    assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
-    let (status, with_wall) = render_c(&h, &s);
-    assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    assert_ne!(bits(&with_wall), bits(&before));
-    let add_rect = |h: &Handles| {
-        let (corner, u, v) = ([-1.0f32, 2.0, 2.0], [2.0f32, 0.0, 0.0], [0.0f32, 0.0, -2.0]);
-        let s = ht_scene_add_rect_light(
-            h.scene,
-            corner.as_ptr(),
-            u.as_ptr(),
-            v.as_ptr(),
-            [3.0f32; 3].as_ptr(),
-            false,
+    unsafe {
+        let h = fur_scene(true);
+        let s = settings(24);
+        let (status, before) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert_eq!(
+            render_c(&h, &s).1,
+            before,
+            "a second render reuses the build"
         );
-        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    };
-    add_rect(&h);
-    let (status, with_rect) = render_c(&h, &s);
-    assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
 
-    let fresh = fur_scene(true);
-    let wall = fresh.diffuse_material([0.9; 3]);
-    assert_eq!(fresh.add_triangle(wall), HtStatus::HT_OK);
-    assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_wall));
-    add_rect(&fresh);
-    assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_rect));
-    assert_ne!(bits(&with_rect), bits(&with_wall));
+        // A white wall behind the fur, then a rect light: each render equals a scene
+        // built with everything from the start.
+        let wall = h.diffuse_material([0.9; 3]);
+        assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
+        let (status, with_wall) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        assert_ne!(bits(&with_wall), bits(&before));
+        let add_rect = |h: &Handles| {
+            let (corner, u, v) = ([-1.0f32, 2.0, 2.0], [2.0f32, 0.0, 0.0], [0.0f32, 0.0, -2.0]);
+            let s = ht_scene_add_rect_light(
+                h.scene,
+                corner.as_ptr(),
+                u.as_ptr(),
+                v.as_ptr(),
+                [3.0f32; 3].as_ptr(),
+                false,
+            );
+            assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        };
+        add_rect(&h);
+        let (status, with_rect) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+
+        let fresh = fur_scene(true);
+        let wall = fresh.diffuse_material([0.9; 3]);
+        assert_eq!(fresh.add_triangle(wall), HtStatus::HT_OK);
+        assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_wall));
+        add_rect(&fresh);
+        assert_eq!(bits(&render_c(&fresh, &s).1), bits(&with_rect));
+        assert_ne!(bits(&with_rect), bits(&with_wall));
+    }
 }
 
 #[test]
@@ -413,148 +428,152 @@ fn without_a_camera_the_scene_is_framed() {
 
 #[test]
 fn bad_settings_and_incomplete_scenes_are_reported() {
-    use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
-    let h = fur_scene(true);
-    let s = settings(8);
-    let mut rgb = vec![0.0f32; 8 * 8 * 3];
-    let (ptr, len) = (rgb.as_mut_ptr(), rgb.len());
-    fails(ht_render(null_mut(), &s, ptr, len), NULL, "scene");
-    fails(ht_render(h.scene, null(), ptr, len), NULL, "settings");
-    fails(ht_render(h.scene, &s, null_mut(), len), NULL, "rgb");
-    fails(
-        ht_render(h.scene, &s, ptr, len - 1),
-        INVALID,
-        "rgb_len = 191",
-    );
-    let zero = HtRenderSettings { width: 0, ..s };
-    fails(ht_render(h.scene, &zero, ptr, 0), INVALID, "width = 0");
-    let depth = HtRenderSettings { max_depth: 0, ..s };
-    fails(
-        ht_render(h.scene, &depth, ptr, len),
-        INVALID,
-        "max_depth = 0",
-    );
-    let spp = HtRenderSettings { spp: 0, ..s };
-    fails(ht_render(h.scene, &spp, ptr, len), INVALID, "spp = 0");
-    let filter = HtRenderSettings { filter: 7, ..s };
-    fails(ht_render(h.scene, &filter, ptr, len), INVALID, "filter = 7");
-    let radius = HtRenderSettings {
-        filter_radius: f32::NAN,
-        ..s
-    };
-    fails(ht_render(h.scene, &radius, ptr, len), INVALID, "radius NaN");
-    let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
-        let n = null_mut();
-        ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)
-    };
-    fails(
-        aovs(&s, len, 63),
-        INVALID,
-        "pixel_count = 63: must be 8 * 8 = 64",
-    );
-    // A 4 x 3 window: 12 pixels.
-    let crop = HtRenderSettings {
-        crop_x0: 2,
-        crop_y0: 1,
-        crop_x1: 6,
-        crop_y1: 4,
-        ..s
-    };
-    fails(
-        aovs(&crop, len, 12),
-        INVALID,
-        "rgb_len = 192: must be 3 * 4 * 3 = 36",
-    );
-    fails(
-        aovs(&crop, 36, 64),
-        INVALID,
-        "pixel_count = 64: must be 4 * 3 = 12",
-    );
-    let outside = HtRenderSettings { crop_x1: 9, ..crop };
-    fails(aovs(&outside, 36, 12), INVALID, "crop = [2, 1, 9, 4]");
-    let reversed = HtRenderSettings { crop_x0: 6, ..crop };
-    fails(aovs(&reversed, 36, 12), INVALID, "crop = [6, 1, 6, 4]");
-    // Only all four zero mean the full frame.
-    let partial = HtRenderSettings { crop_x1: 4, ..s };
-    fails(
-        ht_render(h.scene, &partial, ptr, len),
-        INVALID,
-        "crop = [0, 0, 4, 0]",
-    );
-    assert!(
-        rgb.iter().all(|v| *v == 0.0),
-        "failed renders leave the buffer alone"
-    );
+    unsafe {
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
+        let h = fur_scene(true);
+        let s = settings(8);
+        let mut rgb = vec![0.0f32; 8 * 8 * 3];
+        let (ptr, len) = (rgb.as_mut_ptr(), rgb.len());
+        fails(ht_render(null_mut(), &s, ptr, len), NULL, "scene");
+        fails(ht_render(h.scene, null(), ptr, len), NULL, "settings");
+        fails(ht_render(h.scene, &s, null_mut(), len), NULL, "rgb");
+        fails(
+            ht_render(h.scene, &s, ptr, len - 1),
+            INVALID,
+            "rgb_len = 191",
+        );
+        let zero = HtRenderSettings { width: 0, ..s };
+        fails(ht_render(h.scene, &zero, ptr, 0), INVALID, "width = 0");
+        let depth = HtRenderSettings { max_depth: 0, ..s };
+        fails(
+            ht_render(h.scene, &depth, ptr, len),
+            INVALID,
+            "max_depth = 0",
+        );
+        let spp = HtRenderSettings { spp: 0, ..s };
+        fails(ht_render(h.scene, &spp, ptr, len), INVALID, "spp = 0");
+        let filter = HtRenderSettings { filter: 7, ..s };
+        fails(ht_render(h.scene, &filter, ptr, len), INVALID, "filter = 7");
+        let radius = HtRenderSettings {
+            filter_radius: f32::NAN,
+            ..s
+        };
+        fails(ht_render(h.scene, &radius, ptr, len), INVALID, "radius NaN");
+        let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
+            let n = null_mut();
+            ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)
+        };
+        fails(
+            aovs(&s, len, 63),
+            INVALID,
+            "pixel_count = 63: must be 8 * 8 = 64",
+        );
+        // A 4 x 3 window: 12 pixels.
+        let crop = HtRenderSettings {
+            crop_x0: 2,
+            crop_y0: 1,
+            crop_x1: 6,
+            crop_y1: 4,
+            ..s
+        };
+        fails(
+            aovs(&crop, len, 12),
+            INVALID,
+            "rgb_len = 192: must be 3 * 4 * 3 = 36",
+        );
+        fails(
+            aovs(&crop, 36, 64),
+            INVALID,
+            "pixel_count = 64: must be 4 * 3 = 12",
+        );
+        let outside = HtRenderSettings { crop_x1: 9, ..crop };
+        fails(aovs(&outside, 36, 12), INVALID, "crop = [2, 1, 9, 4]");
+        let reversed = HtRenderSettings { crop_x0: 6, ..crop };
+        fails(aovs(&reversed, 36, 12), INVALID, "crop = [6, 1, 6, 4]");
+        // Only all four zero mean the full frame.
+        let partial = HtRenderSettings { crop_x1: 4, ..s };
+        fails(
+            ht_render(h.scene, &partial, ptr, len),
+            INVALID,
+            "crop = [0, 0, 4, 0]",
+        );
+        assert!(
+            rgb.iter().all(|v| *v == 0.0),
+            "failed renders leave the buffer alone"
+        );
 
-    let dark = Handles::new();
-    let hair = dark.hair_material();
-    assert_eq!(dark.add_strands(&small_fur(), hair), HtStatus::HT_OK);
-    fails(ht_render(dark.scene, &s, ptr, len), INVALID, "no light");
-    let empty = Handles::new();
-    assert_eq!(
-        ht_scene_add_environment(empty.scene, SKY.as_ptr()),
-        HtStatus::HT_OK
-    );
-    fails(
-        ht_render(empty.scene, &s, ptr, len),
-        INVALID,
-        "ht_scene_set_camera",
-    );
-    // With a camera, an empty scene shows its environment.
-    let z = [0.0f32, 0.0, -1.0];
-    let set = ht_scene_set_camera(
-        empty.scene,
-        [0.0; 3].as_ptr(),
-        z.as_ptr(),
-        UP.as_ptr(),
-        40.0,
-    );
-    assert_eq!(set, HtStatus::HT_OK);
-    assert_eq!(
-        ht_render(empty.scene, &s, ptr, len),
-        HtStatus::HT_OK,
-        "{}",
-        last_error()
-    );
-    for (v, sky) in rgb.iter().zip(SKY.iter().cycle()) {
-        assert!((v - sky).abs() < 1e-6, "{v} {sky}");
+        let dark = Handles::new();
+        let hair = dark.hair_material();
+        assert_eq!(dark.add_strands(&small_fur(), hair), HtStatus::HT_OK);
+        fails(ht_render(dark.scene, &s, ptr, len), INVALID, "no light");
+        let empty = Handles::new();
+        assert_eq!(
+            ht_scene_add_environment(empty.scene, SKY.as_ptr()),
+            HtStatus::HT_OK
+        );
+        fails(
+            ht_render(empty.scene, &s, ptr, len),
+            INVALID,
+            "ht_scene_set_camera",
+        );
+        // With a camera, an empty scene shows its environment.
+        let z = [0.0f32, 0.0, -1.0];
+        let set = ht_scene_set_camera(
+            empty.scene,
+            [0.0; 3].as_ptr(),
+            z.as_ptr(),
+            UP.as_ptr(),
+            40.0,
+        );
+        assert_eq!(set, HtStatus::HT_OK);
+        assert_eq!(
+            ht_render(empty.scene, &s, ptr, len),
+            HtStatus::HT_OK,
+            "{}",
+            last_error()
+        );
+        for (v, sky) in rgb.iter().zip(SKY.iter().cycle()) {
+            assert!((v - sky).abs() < 1e-6, "{v} {sky}");
+        }
     }
 }
 
 #[test]
 fn images_are_written_through_oiio() {
-    let dir = std::env::temp_dir().join(format!("ht-capi-render-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("ramp.exr");
-    let path = std::ffi::CString::new(file.to_str().unwrap()).unwrap();
-    let pixels: Vec<f32> = (0..4 * 2 * 3).map(|i| i as f32 / 8.0).collect();
-    let s = ht_image_write(path.as_ptr(), 4, 2, 3, pixels.as_ptr());
-    assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    let image = read_image(&file).unwrap();
-    assert_eq!((image.width, image.height, image.channels), (4, 2, 3));
-    assert_eq!(image.pixels, pixels);
+    unsafe {
+        let dir = std::env::temp_dir().join(format!("ht-capi-render-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("ramp.exr");
+        let path = std::ffi::CString::new(file.to_str().unwrap()).unwrap();
+        let pixels: Vec<f32> = (0..4 * 2 * 3).map(|i| i as f32 / 8.0).collect();
+        let s = ht_image_write(path.as_ptr(), 4, 2, 3, pixels.as_ptr(), pixels.len());
+        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        let image = read_image(&file).unwrap();
+        assert_eq!((image.width, image.height, image.channels), (4, 2, 3));
+        assert_eq!(image.pixels, pixels);
 
-    fails(
-        ht_image_write(path.as_ptr(), 4, 2, 3, null()),
-        HtStatus::HT_ERR_NULL_ARG,
-        "pixels",
-    );
-    fails(
-        ht_image_write(null(), 4, 2, 3, pixels.as_ptr()),
-        HtStatus::HT_ERR_NULL_ARG,
-        "path",
-    );
-    let bmp = std::ffi::CString::new(dir.join("x.bmp").to_str().unwrap()).unwrap();
-    let s = ht_image_write(bmp.as_ptr(), 4, 2, 3, pixels.as_ptr());
-    assert_ne!(s, HtStatus::HT_OK);
-    assert!(last_error().contains("x.bmp"), "{}", last_error());
-    let nan = [f32::NAN; 3];
-    fails(
-        ht_image_write(path.as_ptr(), 1, 1, 3, nan.as_ptr()),
-        HtStatus::HT_ERR_IMAGE,
-        "NaN",
-    );
-    std::fs::remove_dir_all(&dir).unwrap();
+        fails(
+            ht_image_write(path.as_ptr(), 4, 2, 3, null(), 24),
+            HtStatus::HT_ERR_NULL_ARG,
+            "pixels",
+        );
+        fails(
+            ht_image_write(null(), 4, 2, 3, pixels.as_ptr(), 24),
+            HtStatus::HT_ERR_NULL_ARG,
+            "path",
+        );
+        let bmp = std::ffi::CString::new(dir.join("x.bmp").to_str().unwrap()).unwrap();
+        let s = ht_image_write(bmp.as_ptr(), 4, 2, 3, pixels.as_ptr(), 24);
+        assert_ne!(s, HtStatus::HT_OK);
+        assert!(last_error().contains("x.bmp"), "{}", last_error());
+        let nan = [f32::NAN; 3];
+        fails(
+            ht_image_write(path.as_ptr(), 1, 1, 3, nan.as_ptr(), 3),
+            HtStatus::HT_ERR_INVALID_ARG,
+            "NaN",
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
 
 #[test]

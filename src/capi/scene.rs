@@ -5,7 +5,7 @@
 //! the Embree scene on the first render, then reuses it: adding geometry rebuilds it on
 //! the next render, adding a light only re-weights the lights.
 
-use super::{Failure, HtStatus, boundary, non_null, non_null_mut, read_path, read_vec3};
+use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
 use crate::embree::{Device, Isa, SceneOptions};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
@@ -15,7 +15,7 @@ use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::tracer::{Tracer, TracerBuilder};
-use crate::validate::{non_negative, positive};
+use crate::validate::{length, non_negative, positive};
 use std::ffi::c_char;
 use std::sync::Arc;
 
@@ -166,20 +166,35 @@ fn free_handle<T>(handle: *mut T) {
     }
 }
 
-/// Creates a device with `threads` Embree worker threads (0: one per hardware thread).
-/// Free it with `ht_device_free`; scenes keep it alive as long as they need it.
+/// Creates a device with `threads` Embree worker threads (0: one per hardware thread),
+/// which build the scenes made on it, and writes the handle to `*out`. Free it with
+/// `ht_device_free`; scenes keep it alive as long as they need it. Thread safe.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`out` NULL); `HT_ERR_INVALID_ARG` (`out` misaligned);
+/// `HT_ERR_EMBREE` (Embree could not start). `*out` is written on `HT_OK` only.
+///
+/// # Safety
+/// `out` is NULL or points to a writable `HtDevice*`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_device_new(threads: u32, out: *mut *mut HtDevice) -> HtStatus {
-    ht_device_new_pinned(threads, std::ptr::null(), out)
+pub unsafe extern "C" fn ht_device_new(threads: u32, out: *mut *mut HtDevice) -> HtStatus {
+    // SAFETY: NULL is a valid `isa`; `out` is passed on under the caller's promise.
+    unsafe { ht_device_new_pinned(threads, std::ptr::null(), out) }
 }
 
 /// As `ht_device_new`, with Embree's kernels pinned to the instruction set named by `isa`
 /// ("sse2", "avx", "avx2" or "avx512"; NULL: not pinned, the widest this CPU runs).
 /// Embree's kernels for different instruction sets round differently, so a frame whose
 /// crop pieces render on different CPUs assembles bit for bit only when every piece pins
-/// the same ISA. HT_ERR_INVALID_ARG for another name or an ISA this CPU cannot run.
+/// the same ISA.
+///
+/// Statuses: those of `ht_device_new`, and `HT_ERR_INVALID_ARG` for another name or an
+/// ISA this CPU cannot run.
+///
+/// # Safety
+/// `isa` is NULL or a NUL-terminated string; `out` is NULL or points to a writable
+/// `HtDevice*`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_device_new_pinned(
+pub unsafe extern "C" fn ht_device_new_pinned(
     threads: u32,
     isa: *const c_char,
     out: *mut *mut HtDevice,
@@ -191,31 +206,44 @@ pub extern "C" fn ht_device_new_pinned(
         } else {
             Some(Isa::named(&read_path(isa, "isa")?.to_string_lossy())?)
         };
-        let device = Device::pinned((threads > 0).then_some(threads as usize), isa)?;
-        let handle = Box::new(HtDevice {
-            device: Arc::new(device),
-        });
+        let threads = (threads > 0).then_some(threads as usize);
+        let device = Arc::new(Device::pinned(threads, isa)?);
+        super::shutdown::track(&device);
+        let handle = Box::new(HtDevice { device });
         // SAFETY: non-NULL (checked), the host's HtDevice*.
         unsafe { out.write(Box::into_raw(handle)) };
         Ok(())
     })
 }
 
-/// Releases a device handle (NULL: nothing to do). Scenes made on it stay valid.
+/// Releases a device handle (NULL: nothing to do, `HT_OK`). Scenes made on it stay valid
+/// and release the device with the last of them. Always `HT_OK`.
+///
+/// # Safety
+/// `device` is NULL or a handle from `ht_device_new` not yet freed; it is invalid after
+/// the call.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_device_free(device: *mut HtDevice) -> HtStatus {
+pub unsafe extern "C" fn ht_device_free(device: *mut HtDevice) -> HtStatus {
     boundary(|| {
         free_handle(device);
         Ok(())
     })
 }
 
-/// Creates an empty scene on `device`. Free it with `ht_scene_free`.
+/// Creates an empty scene on `device` and writes the handle to `*out`. Free it with
+/// `ht_scene_free`. The device handle may be freed before the scene.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`device` or `out` NULL); `HT_ERR_INVALID_ARG` (`out`
+/// misaligned). `*out` is written on `HT_OK` only.
+///
+/// # Safety
+/// `device` is NULL or a live handle from `ht_device_new`; `out` is NULL or points to a
+/// writable `HtScene*`.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut HtScene) -> HtStatus {
+pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut HtScene) -> HtStatus {
     boundary(|| {
-        // SAFETY: non-NULL (checked), a live handle from ht_device_new.
-        let device = unsafe { &*non_null(device, "device")? };
+        // SAFETY: non-NULL and aligned (checked), a live handle from ht_device_new.
+        let device = unsafe { &*non_null_mut(device.cast_mut(), "device")? };
         let out = non_null_mut(out, "out")?;
         let scene = Box::new(HtScene {
             device: device.device.clone(),
@@ -233,21 +261,37 @@ pub extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut HtScene) 
     })
 }
 
-/// Releases a scene and everything it holds (NULL: nothing to do).
+/// Releases a scene and everything it holds, the Embree scene included (NULL: nothing to
+/// do). After it returns, the host may free the points it shared with
+/// `ht_scene_add_curves_xyzr_shared`. Always `HT_OK`.
+///
+/// # Safety
+/// `scene` is NULL or a handle from `ht_scene_new` not yet freed and not in use on another
+/// thread; it is invalid after the call.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_free(scene: *mut HtScene) -> HtStatus {
+pub unsafe extern "C" fn ht_scene_free(scene: *mut HtScene) -> HtStatus {
     boundary(|| {
         free_handle(scene);
         Ok(())
     })
 }
 
-/// Places the pinhole camera at `eye` looking at `target`, `up` giving the image's upward
-/// direction (not parallel to the view), with a vertical field of view of `fov_y_deg` in
-/// (0, 180). Replaces any earlier camera. Without one, renders frame the scene's bounds
-/// from the front (+z), a little to the right and above.
+/// Places the pinhole camera at `eye` looking at `target` (world units, each `float[3]`,
+/// every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
+/// giving the image's upward direction (finite, not zero, not parallel to the view), with
+/// a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
+/// `(target - eye) x up`. Replaces any earlier camera. Without one, renders frame the
+/// scene's bounds from the front (+z), a little to the right and above.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
+/// `HT_ERR_INVALID_ARG` (a value out of range, `eye == target`, `up` along the view, a
+/// misaligned array). On failure the camera is unchanged.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `eye`, `target` and
+/// `up` are NULL or point to 3 readable floats.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_set_camera(
+pub unsafe extern "C" fn ht_scene_set_camera(
     scene: *mut HtScene,
     eye: *const f32,
     target: *const f32,
@@ -269,12 +313,18 @@ pub extern "C" fn ht_scene_set_camera(
 }
 
 /// Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
-/// units, >= 0; 0 is the pinhole again) focused at `focus_distance` (world units along the
-/// view direction, > 0), so that what lies nearer or farther blurs. Holds for the camera
-/// of `ht_scene_set_camera`, whether set before or after, and for the camera that frames a
-/// scene without one. Replaces any earlier lens.
+/// units, in [0, 1e15]; 0 is the pinhole again) focused at `focus_distance` (world units
+/// along the view direction, in (0, 1e15]), so that what lies nearer or farther blurs.
+/// Holds for the camera of `ht_scene_set_camera`, whether set before or after, and for the
+/// camera that frames a scene without one. Replaces any earlier lens.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene` NULL); `HT_ERR_INVALID_ARG` (NaN, infinite or out
+/// of range). On failure the lens is unchanged.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_scene_set_thin_lens(
+pub unsafe extern "C" fn ht_scene_set_thin_lens(
     scene: *mut HtScene,
     aperture_radius: f32,
     focus_distance: f32,
@@ -284,6 +334,8 @@ pub extern "C" fn ht_scene_set_thin_lens(
         // Checked here, with the C names, rather than at the next render.
         non_negative("aperture_radius", aperture_radius)?;
         positive("focus_distance", focus_distance)?;
+        length("aperture_radius", aperture_radius)?;
+        length("focus_distance", focus_distance)?;
         scene.lens = Some((aperture_radius, focus_distance));
         Ok(())
     })

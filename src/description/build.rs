@@ -271,11 +271,7 @@ impl LightDesc {
                 direction,
                 irradiance,
                 angular_radius_deg,
-            } => Light::distant(
-                v(*direction),
-                v(*irradiance),
-                angular_radius_deg.to_radians(),
-            ),
+            } => Light::distant(v(*direction), v(*irradiance), *angular_radius_deg),
             LightDesc::Rect {
                 corner,
                 edge_u,

@@ -38,6 +38,16 @@ impl Ray {
         self.org + t * self.dir
     }
 
+    /// Whether Embree accepts the ray: origin and direction components within its
+    /// `FLT_LARGE` (about 1.8e18) and no NaN bound. Embree asserts on anything else (an abort
+    /// in a release build); the scene's inputs are bounded so that this never fails, and a
+    /// ray that would is treated as a miss.
+    fn is_valid(&self) -> bool {
+        const EMBREE_LARGE: f32 = 1.844e18;
+        let within = |v: Vec3| v.abs().cmple(Vec3::splat(EMBREE_LARGE)).all();
+        within(self.org) && within(self.dir) && !self.tnear.is_nan() && !self.tfar.is_nan()
+    }
+
     fn to_sys(self) -> sys::RTCRay {
         sys::RTCRay {
             org_x: self.org.x,
@@ -143,6 +153,9 @@ unsafe extern "C" fn exclude_filter(args: *const sys::RTCFilterFunctionNArgument
 impl Scene {
     /// The closest hit along `ray`, ignoring what `exclude` names.
     pub fn intersect(&self, ray: &Ray, exclude: Option<&Exclude>) -> Option<RayHit> {
+        if !ray.is_valid() {
+            return None;
+        }
         let mut ctx = QueryContext::new(exclude);
         let mut rayhit = sys::RTCRayHit {
             ray: ray.to_sys(),
@@ -169,6 +182,9 @@ impl Scene {
 
     /// Whether anything (not named by `exclude`) lies along `ray` within [tnear, tfar].
     pub(crate) fn occluded(&self, ray: &Ray, exclude: Option<&Exclude>) -> bool {
+        if !ray.is_valid() {
+            return false;
+        }
         let mut ctx = QueryContext::new(exclude);
         let mut r = ray.to_sys();
         // SAFETY: as in `intersect`.

@@ -166,12 +166,13 @@ pub fn write_image(
         } else {
             "infinite"
         };
-        return Err(Error::Image(format!(
+        // A value the caller gave, like any other NaN argument: not an image failure.
+        return Err(invalid_arg!(
             "pixel ({}, {}) channel {c} is {what}; refusing to write {}",
             pixel % width,
             pixel / width,
             path.display()
-        )));
+        ));
     }
 
     let encoded;

@@ -15,4 +15,4 @@ pub use film::{
 };
 pub use progress::{NoProgress, Progress};
 pub use sampler::PixelSampler;
-pub use tiles::{RenderStatus, TileOptions, render_tiles, tiles};
+pub use tiles::{Pulse, REPORT_INTERVAL, RenderStatus, TileOptions, render_tiles, tiles};

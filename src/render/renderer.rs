@@ -51,9 +51,12 @@ pub fn render(
     };
     let rays = AtomicU64::new(0);
     let start = Instant::now();
-    let status = render_tiles(&mut film, &options, progress, |pixel, acc| {
+    let status = render_tiles(&mut film, &options, progress, |pixel, acc, pulse| {
         let mut pixel_rays = 0u64;
         for index in 0..settings.spp {
+            if !pulse.keep_going() {
+                break;
+            }
             let mut sampler = PixelSampler::new(settings.seed, pixel, index);
             let offset = filter.sample(sampler.next_2d());
             let image_point = ndc(settings.width, settings.height, pixel, offset);

@@ -4,8 +4,10 @@
 //! full-frame coordinates, and stored once: the result cannot depend on the number of
 //! threads, the order tiles finish in, the tile size or the crop.
 
+use std::cell::Cell;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use rayon::prelude::*;
 
@@ -20,7 +22,8 @@ pub struct TileOptions {
     /// Tile edge in pixels: small enough that two threads share a small crop and that
     /// cancellation is prompt, large enough that per-tile costs vanish.
     pub tile_size: u32,
-    /// Worker threads; 0 uses rayon's global pool (all cores unless `RAYON_NUM_THREADS`).
+    /// Worker threads; 0: one per hardware thread (or `RAYON_NUM_THREADS`). They are the
+    /// render's own and are joined before [`render_tiles`] returns.
     pub threads: usize,
 }
 
@@ -61,12 +64,40 @@ pub fn tiles(window: Window, size: u32) -> Vec<Window> {
         .collect()
 }
 
-/// Renders every pixel of `film`'s crop window with `shade(pixel, accumulator)`, which
-/// adds the pixel's samples to the fresh accumulator it is given; `pixel` is in
-/// full-frame coordinates.
+/// How often, at most, the progress sink hears from a render in the middle of a tile, so
+/// that it can cancel even a render whose pixels take seconds each.
+pub const REPORT_INTERVAL: Duration = Duration::from_millis(20);
+
+/// What the per-pixel function checks between samples: whether the render goes on.
+pub struct Pulse<'a> {
+    cancelled: &'a AtomicBool,
+    /// Reports progress if [`REPORT_INTERVAL`] has passed since the last report.
+    heartbeat: &'a (dyn Fn() + Sync),
+    calls: Cell<u32>,
+}
+
+impl Pulse<'_> {
+    /// Call before each sample (a few microseconds of work or more); false once the render
+    /// is cancelled: return at once, the pixel is dropped. Every eighth call also gives
+    /// the progress sink its periodic report.
+    pub fn keep_going(&self) -> bool {
+        let n = self.calls.get().wrapping_add(1);
+        self.calls.set(n);
+        if n % 8 == 0 {
+            (self.heartbeat)();
+        }
+        !self.cancelled.load(Ordering::Relaxed)
+    }
+}
+
+/// Renders every pixel of `film`'s crop window with `shade(pixel, accumulator, pulse)`,
+/// which adds the pixel's samples to the fresh accumulator it is given, asking
+/// `pulse.keep_going()` before each; `pixel` is in full-frame coordinates.
 ///
-/// `progress` hears of each finished tile and may cancel: then no new pixel starts, the
-/// tiles in flight are dropped, and the result is [`RenderStatus::Cancelled`].
+/// `progress` hears of each finished tile, and between those at most every
+/// [`REPORT_INTERVAL`] of work while shading calls `keep_going` (with the same `done`
+/// while no tile finishes). It may cancel: then no new sample starts, the tiles in flight
+/// are dropped, and the result is [`RenderStatus::Cancelled`].
 pub fn render_tiles<F>(
     film: &mut Film,
     options: &TileOptions,
@@ -74,7 +105,7 @@ pub fn render_tiles<F>(
     shade: F,
 ) -> Result<RenderStatus>
 where
-    F: Fn((u32, u32), &mut PixelAccumulator) + Sync,
+    F: Fn((u32, u32), &mut PixelAccumulator, &Pulse) + Sync,
 {
     if options.tile_size == 0 {
         return Err(invalid_arg!("tile size must be at least 1 pixel"));
@@ -84,18 +115,42 @@ where
     let work = tiles(crop, options.tile_size);
     let cancelled = AtomicBool::new(false);
     // The film and the count of finished pixels, under one lock so that progress calls
-    // are serialised and see `done` increase.
+    // are serialised and never see `done` decrease.
     let shared = Mutex::new((film, 0u64));
+    let start = Instant::now();
+    let next_report = AtomicU64::new(REPORT_INTERVAL.as_nanos() as u64);
+    let heartbeat = || {
+        let due = |now: u64| now >= next_report.load(Ordering::Relaxed);
+        let now = start.elapsed().as_nanos() as u64;
+        // A busy lock means a tile is being stored, and reported: skip this one.
+        if let (true, Ok(guard)) = (due(now), shared.try_lock()) {
+            if due(now) {
+                next_report.store(now + REPORT_INTERVAL.as_nanos() as u64, Ordering::Relaxed);
+                if !progress.update(guard.1, total) {
+                    cancelled.store(true, Ordering::Relaxed);
+                }
+            }
+        }
+    };
 
     let render_tile = |tile: &Window| {
+        let pulse = Pulse {
+            cancelled: &cancelled,
+            heartbeat: &heartbeat,
+            calls: Cell::new(0),
+        };
         let mut pixels = Vec::with_capacity(tile.pixel_count() as usize);
         for pixel in tile.pixels() {
             if cancelled.load(Ordering::Relaxed) {
                 return;
             }
             let mut acc = PixelAccumulator::default();
-            shade(pixel, &mut acc);
+            shade(pixel, &mut acc, &pulse);
             pixels.push((pixel, acc));
+        }
+        // A pixel cut short by a cancellation is not stored.
+        if cancelled.load(Ordering::Relaxed) {
+            return;
         }
         // A panic in another tile's `shade` poisons the lock but leaves the film valid.
         let mut guard = shared.lock().unwrap_or_else(|e| e.into_inner());
@@ -108,17 +163,15 @@ where
             cancelled.store(true, Ordering::Relaxed);
         }
     };
-    let run = || work.par_iter().for_each(render_tile);
-
-    if options.threads == 0 {
-        run();
-    } else {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads)
-            .build()
-            .map_err(|e| invalid_arg!("cannot start {} render threads: {e}", options.threads))?
-            .install(run);
-    }
+    // A pool of the render's own, joined when `build_scoped` returns: no thread outlives
+    // the render (a host may unload the library after it).
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(options.threads)
+        .build_scoped(
+            |thread| thread.run(),
+            |pool| pool.install(|| work.par_iter().for_each(render_tile)),
+        )
+        .map_err(|e| invalid_arg!("cannot start {} render threads: {e}", options.threads))?;
     Ok(if cancelled.into_inner() {
         RenderStatus::Cancelled
     } else {

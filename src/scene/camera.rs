@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3};
 use crate::Result;
 use crate::error::invalid_arg;
 use crate::math::sampling::concentric_disk;
-use crate::validate::{non_negative, positive};
+use crate::validate::{self, non_negative, positive};
 
 /// A perspective camera. Built validated, it generates finite unit rays for any input.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,10 +35,10 @@ impl Camera {
     /// `fov_y_deg` the vertical field of view in degrees, in (0, 180), and `aspect` the
     /// image width over its height.
     pub fn new(eye: Vec3, target: Vec3, up: Vec3, fov_y_deg: f32, aspect: f32) -> Result<Self> {
-        for (name, v) in [("eye", eye), ("target", target), ("up", up)] {
-            if !v.is_finite() {
-                return Err(invalid_arg!("camera {name} {v} is not finite"));
-            }
+        validate::position("camera eye", eye)?;
+        validate::position("camera target", target)?;
+        if !up.is_finite() {
+            return Err(invalid_arg!("camera up {up} is not finite"));
         }
         if !(fov_y_deg > 0.0 && fov_y_deg < 180.0) {
             return Err(invalid_arg!(
@@ -85,6 +85,8 @@ impl Camera {
     pub fn with_thin_lens(self, aperture_radius: f32, focus_distance: f32) -> Result<Self> {
         non_negative("camera aperture radius", aperture_radius)?;
         positive("camera focus distance", focus_distance)?;
+        validate::length("camera aperture radius", aperture_radius)?;
+        validate::length("camera focus distance", focus_distance)?;
         Ok(Self {
             lens_radius: aperture_radius,
             focus_distance,

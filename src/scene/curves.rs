@@ -236,9 +236,10 @@ impl Curves {
             ));
         }
         check_vertex_count(points.len())?;
+        validate::positions("control point", points)?;
         if let Some(i) = points
             .iter()
-            .position(|v| !(v.iter().all(|c| c.is_finite()) && v[3] >= 0.0))
+            .position(|v| !(v[3].is_finite() && v[3] >= 0.0))
         {
             return Err(invalid_arg!(
                 "control point {i} = {:?}: must be finite with a radius >= 0",

@@ -143,6 +143,8 @@ impl Environment {
 
     /// A lat-long map read through OpenImageIO (EXR, HDR, TIFF, ...), linear.
     pub fn from_file(path: &Path) -> Result<Self> {
+        // A missing or unreadable file is an i/o error, not an image one.
+        std::fs::File::open(path).map_err(|e| crate::Error::io(path, e))?;
         let image = read_image(path)?;
         Self::from_pixels(image.width, image.height, image.channels, &image.pixels)
             .map_err(|e| e.context(path.display()))

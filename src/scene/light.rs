@@ -17,6 +17,7 @@ use crate::Result;
 use crate::error::invalid_arg;
 use crate::math::luminance;
 use crate::math::sampling::{uniform_cone, uniform_cone_pdf};
+use crate::validate;
 
 /// A light source. Built through the validating constructors; `Send + Sync`.
 #[derive(Debug, Clone)]
@@ -59,23 +60,22 @@ pub struct Rect {
 
 impl Light {
     /// A light at infinity seen in `direction` (pointing toward the light, any non-zero
-    /// length) as a disc of `angular_radius` radians, in [0, pi/2); 0 makes it a delta
+    /// length) as a disc of `angular_radius_deg` degrees, in [0, 90); 0 makes it a delta
     /// light (hard shadows, invisible to BSDF-sampled rays).
     ///
     /// It is specified by the `irradiance` it delivers to a surface facing it rather than
     /// by its radiance, which for a delta light does not exist: so widening the disc
     /// softens shadows without changing the exposure. The radiance within the disc is
     /// `irradiance / (pi sin^2(angular_radius))`.
-    pub fn distant(direction: Vec3, irradiance: Vec3, angular_radius: f32) -> Result<Light> {
-        let dir = direction
-            .try_normalize()
-            .ok_or_else(|| invalid_arg!("distant light direction {direction} has no direction"))?;
+    pub fn distant(direction: Vec3, irradiance: Vec3, angular_radius_deg: f32) -> Result<Light> {
+        let dir = validate::direction("distant light direction", direction)?;
         check_radiance("distant light irradiance", irradiance)?;
-        if !(0.0..PI / 2.0).contains(&angular_radius) {
+        if !(0.0..90.0).contains(&angular_radius_deg) {
             return Err(invalid_arg!(
-                "distant light angular radius {angular_radius} radians must be in [0, pi/2)"
+                "distant light angular radius {angular_radius_deg} degrees must be in [0, 90)"
             ));
         }
+        let angular_radius = angular_radius_deg.to_radians();
         let one_minus_cos = 2.0 * (angular_radius / 2.0).sin().powi(2);
         let sin2 = one_minus_cos * (2.0 - one_minus_cos);
         let radiance = if sin2 > 0.0 {
@@ -86,7 +86,7 @@ impl Light {
         if !radiance.is_finite() {
             return Err(invalid_arg!(
                 "distant light: irradiance {irradiance} over an angular radius of \
-                 {angular_radius} radians gives an infinite radiance"
+                 {angular_radius_deg} degrees gives an infinite radiance"
             ));
         }
         let (tangent, bitangent) = dir.any_orthonormal_pair();
@@ -110,11 +110,9 @@ impl Light {
         radiance: Vec3,
         two_sided: bool,
     ) -> Result<Light> {
-        if !(corner.is_finite() && edge_u.is_finite() && edge_v.is_finite()) {
-            return Err(invalid_arg!(
-                "rect light corner {corner} and edges {edge_u}, {edge_v} must be finite"
-            ));
-        }
+        validate::position("rect light corner", corner)?;
+        validate::position("rect light edge_u", edge_u)?;
+        validate::position("rect light edge_v", edge_v)?;
         check_radiance("rect light radiance", radiance)?;
         let cross = edge_u.cross(edge_v);
         let area = cross.length();

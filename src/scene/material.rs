@@ -162,8 +162,9 @@ impl PreparedHair {
             m.use_vertex_colors,
             vertex_color.filter(|c| c.iter().all(|v| v.is_finite())),
         ) {
-            // Colours come from files: clamp them into the inversion's domain.
-            let c = c.map(|v| v.clamp(1e-4, 1.0));
+            // Colours are validated into [0, 1]; black, which no finite absorption makes,
+            // is taken as 1e-4 (documented with the colours of the C ABI and scene files).
+            let c = c.map(|v| v.max(1e-4));
             p.sigma_a = sigma_a_from_color(c, p.beta_n).unwrap_or(p.sigma_a);
         }
         let [ua, ur] = strand_uniforms(m.seed, strand);

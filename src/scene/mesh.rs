@@ -10,6 +10,7 @@ use ply_rs_bw::ply::{DefaultElement, Property};
 
 use crate::Error;
 use crate::error::{Result, invalid_arg};
+use crate::validate;
 
 /// A triangle mesh with optional per-vertex normals.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -43,9 +44,11 @@ impl Mesh {
             .extension()
             .and_then(|e| e.to_str())
             .map(str::to_ascii_lowercase);
+        let opened = || File::open(path).map_err(|e| Error::io(path, e));
+        // A missing or unreadable file is an i/o error whatever its format.
         match ext.as_deref() {
-            Some("obj") => Self::from_obj(path),
-            Some("ply") => Self::from_ply(path),
+            Some("obj") => opened().and_then(|_| Self::from_obj(path)),
+            Some("ply") => opened().and_then(|_| Self::from_ply(path)),
             _ => Err(invalid_arg!(
                 "{}: unknown mesh format (expected .obj or .ply)",
                 path.display()
@@ -158,18 +161,17 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Checks indices in range, finite positions and normals, and one normal per position.
+    /// Checks at least one triangle, indices in range, positions within
+    /// [`MAX_COORDINATE`](crate::validate::MAX_COORDINATE), finite normals, and one normal
+    /// per position.
     pub fn validate(&self) -> Result<()> {
-        if let Some(i) = self
-            .positions
-            .iter()
-            .position(|p| !p.iter().all(|c| c.is_finite()))
-        {
+        if self.triangles.is_empty() {
             return Err(invalid_arg!(
-                "vertex {i} = {:?} is not finite",
-                self.positions[i]
+                "{} vertices and 0 triangles: a mesh needs at least one triangle",
+                self.positions.len()
             ));
         }
+        validate::positions("vertex", &self.positions)?;
         let n = self.positions.len();
         if let Some(t) = self
             .triangles

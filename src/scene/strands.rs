@@ -78,16 +78,7 @@ impl Strands {
                 self.points.len()
             ));
         }
-        if let Some(i) = self
-            .points
-            .iter()
-            .position(|p| !p.iter().all(|v| v.is_finite()))
-        {
-            return Err(invalid_arg!(
-                "point {i} = {:?} is not finite",
-                self.points[i]
-            ));
-        }
+        validate::positions("point", &self.points)?;
         if let Some(i) = self.radii.iter().position(|r| !(r.is_finite() && *r > 0.0)) {
             return Err(invalid_arg!(
                 "radius {i} = {}: must be finite and > 0",

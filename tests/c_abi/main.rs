@@ -4,3 +4,4 @@
 
 mod c_examples;
 mod header;
+mod memcheck;

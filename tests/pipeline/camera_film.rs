@@ -205,7 +205,10 @@ fn render(width: u32, height: u32, crop: Option<Window>, threads: usize, tile: u
         tile_size: tile,
         threads,
     };
-    let status = render_tiles(&mut film, &options, &NoProgress, shade(99, 8)).unwrap();
+    let status = render_tiles(&mut film, &options, &NoProgress, |p, a, _| {
+        shade(99, 8)(p, a)
+    })
+    .unwrap();
     assert_eq!(status, RenderStatus::Complete);
     film
 }
@@ -315,9 +318,12 @@ fn aovs_average_albedo_and_keep_the_nearest_hit() {
     acc.add(Vec3::ONE, Some(&far));
     acc.add(Vec3::ONE, Some(&near));
     let mut film = Film::new(1, 1, None, ALL_AOVS).unwrap();
-    let done = render_tiles(&mut film, &TileOptions::default(), &NoProgress, |_, a| {
-        *a = acc.clone()
-    })
+    let done = render_tiles(
+        &mut film,
+        &TileOptions::default(),
+        &NoProgress,
+        |_, a, _| *a = acc.clone(),
+    )
     .unwrap();
     assert_eq!(done, RenderStatus::Complete);
     assert_eq!(film.rgb(), &[1.0, 1.0, 1.0]);
@@ -343,7 +349,7 @@ fn non_finite_samples_are_counted_as_black_and_never_poison_a_pixel() {
         &mut film,
         &TileOptions::default(),
         &NoProgress,
-        |(x, y), acc| {
+        |(x, y), acc, _| {
             for s in 0..4u32 {
                 if x == 3 && y == 5 && s < 3 {
                     acc.add(bad[s as usize], None);
@@ -388,10 +394,15 @@ fn cancelling_stops_the_render_promptly() {
             tile_size: 16,
             threads,
         };
-        let status = render_tiles(&mut film, &options, &cancel_after_first_tile, |p, acc| {
-            shaded.fetch_add(1, Ordering::Relaxed);
-            shade(1, 4)(p, acc)
-        })
+        let status = render_tiles(
+            &mut film,
+            &options,
+            &cancel_after_first_tile,
+            |p, acc, _| {
+                shaded.fetch_add(1, Ordering::Relaxed);
+                shade(1, 4)(p, acc)
+            },
+        )
         .unwrap();
         assert_eq!(status, RenderStatus::Cancelled);
         let shaded = shaded.into_inner();
@@ -432,7 +443,7 @@ fn progress_counts_up_to_the_total() {
         threads: 2,
     };
     assert_eq!(
-        render_tiles(&mut film, &options, &record, shade(3, 1)).unwrap(),
+        render_tiles(&mut film, &options, &record, |p, a, _| shade(3, 1)(p, a)).unwrap(),
         RenderStatus::Complete
     );
     let seen = seen.into_inner().unwrap();
@@ -495,7 +506,7 @@ fn invalid_films_and_options_are_errors() {
         tile_size: 0,
         threads: 1,
     };
-    assert!(render_tiles(&mut film, &zero_tiles, &NoProgress, |_, _| {}).is_err());
+    assert!(render_tiles(&mut film, &zero_tiles, &NoProgress, |_, _, _| {}).is_err());
     assert!(PixelFilter::tent(0.0).is_err() && PixelFilter::tent(f32::NAN).is_err());
 }
 
@@ -517,4 +528,39 @@ fn pixel_filters_place_samples_around_the_pixel_centre() {
     assert!(mean.abs() < 1e-4, "{mean}");
     // For the triangle on [-1, 1], P(|x| < 1/2) = 3/4.
     assert!((inner - 0.75).abs() < 1e-3, "{inner}");
+}
+
+/// A pixel that never ends (a stand-in for billions of samples) still hears the progress
+/// sink, which cancels: the render returns. A watchdog fails the test instead of hanging
+/// if it does not (the bound is no timing claim: a minute against a few tens of ms).
+#[test]
+fn cancelling_stops_a_pixel_that_never_ends() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut film = Film::new(4, 4, None, Aovs::default()).unwrap();
+        let calls = AtomicU64::new(0);
+        let cancel = |done: u64, _total: u64| {
+            assert_eq!(done, 0, "no pixel can finish");
+            calls.fetch_add(1, Ordering::Relaxed);
+            false
+        };
+        let options = TileOptions {
+            tile_size: 16,
+            threads: 2,
+        };
+        let status = render_tiles(&mut film, &options, &cancel, |_, acc, pulse| {
+            while pulse.keep_going() {
+                acc.add(Vec3::ONE, None);
+            }
+        });
+        tx.send((status, calls.into_inner(), film.rgb().to_vec()))
+            .unwrap();
+    });
+    let (status, calls, rgb) = rx
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .expect("the render was not cancelled: it would never return");
+    assert_eq!(status.unwrap(), RenderStatus::Cancelled);
+    assert!(calls >= 1);
+    // The unfinished pixels are dropped, not stored half done.
+    assert!(rgb.iter().all(|&v| v == 0.0), "{rgb:?}");
 }

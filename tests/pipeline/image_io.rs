@@ -252,7 +252,7 @@ fn non_finite_pixels_are_refused() {
             let err = write_image(&path, 4, 3, 2, &px, &WriteOptions::default()).unwrap_err();
             let expected = format!("pixel (2, 1) channel 1 is {word}");
             assert!(
-                matches!(&err, Error::Image(m) if m.contains(&expected)),
+                matches!(&err, Error::InvalidArg(m) if m.contains(&expected)),
                 "{err:?}"
             );
             assert!(!path.exists(), "{name} was written");

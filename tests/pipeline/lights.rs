@@ -179,7 +179,7 @@ fn uniform_environment_irradiance_is_pi_l() {
 fn distant_light_with_a_disc_matches_cosine_sampling_and_the_closed_form() {
     let irradiance = Vec3::new(3.0, 2.5, 2.0);
     let dir = Vec3::new(0.3, 1.0, 0.2);
-    let light = Light::distant(dir, irradiance, 0.2).unwrap();
+    let light = Light::distant(dir, irradiance, 0.2f32.to_degrees()).unwrap();
     let (p, n) = (Vec3::ZERO, Vec3::Y);
     // The disc is wholly above the horizon, so E = irradiance * cos(angle to the normal).
     let exact = irradiance * dir.normalize().dot(n);
@@ -194,7 +194,7 @@ fn distant_light_with_a_disc_matches_cosine_sampling_and_the_closed_form() {
     );
 
     // A sun-sized disc (0.27 degrees) keeps its exposure and stays finite.
-    let sun = Light::distant(dir, irradiance, 0.00465).unwrap();
+    let sun = Light::distant(dir, irradiance, 0.00465f32.to_degrees()).unwrap();
     by_light_sampling(&sun, p, n).assert_near(exact, "sun-sized distant light");
     let s = sun.sample_li(p, [0.3, 0.7]).unwrap();
     assert!(s.wi.angle_between(dir.normalize()) <= 0.00466);
@@ -285,7 +285,7 @@ fn sample_li_pdf_equals_pdf_li_for_every_light() {
     let lights = [
         Light::Environment(Environment::uniform(Vec3::ONE).unwrap()),
         Light::Environment(sky().with_rotation(37.0).unwrap()),
-        Light::distant(Vec3::new(1.0, 1.0, 0.0), Vec3::ONE, 0.3).unwrap(),
+        Light::distant(Vec3::new(1.0, 1.0, 0.0), Vec3::ONE, 0.3f32.to_degrees()).unwrap(),
         Light::rect(
             Vec3::new(-1.0, 1.0, -1.0),
             Vec3::X * 2.0,
@@ -455,7 +455,7 @@ fn invalid_lights_are_errors() {
     assert!(Light::distant(Vec3::new(f32::NAN, 1.0, 0.0), one, 0.0).is_err());
     assert!(Light::distant(Vec3::Y, -one, 0.0).is_err());
     assert!(Light::distant(Vec3::Y, Vec3::splat(f32::INFINITY), 0.0).is_err());
-    assert!(Light::distant(Vec3::Y, one, PI / 2.0).is_err());
+    assert!(Light::distant(Vec3::Y, one, 90.0).is_err());
     assert!(Light::distant(Vec3::Y, one, -0.1).is_err());
     assert!(Light::distant(Vec3::Y, one, f32::NAN).is_err());
     assert!(Light::rect(Vec3::ZERO, Vec3::X, Vec3::X * 2.0, one, false).is_err());

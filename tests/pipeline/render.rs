@@ -115,12 +115,7 @@ fn white_fur_ball_of_30k_strands_keeps_the_furnace_within_a_thousandth() {
 fn lit_world() -> World {
     let lights = vec![
         Light::Environment(Environment::uniform(Vec3::splat(0.2)).unwrap()),
-        Light::distant(
-            Vec3::new(1.0, 1.0, 1.0),
-            Vec3::new(2.0, 1.8, 1.5),
-            10f32.to_radians(),
-        )
-        .unwrap(),
+        Light::distant(Vec3::new(1.0, 1.0, 1.0), Vec3::new(2.0, 1.8, 1.5), 10.0).unwrap(),
         Light::rect(
             Vec3::new(-1.0, 2.5, -1.0),
             Vec3::new(2.0, 0.0, 0.0),

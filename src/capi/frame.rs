@@ -1,0 +1,213 @@
+//! The hair shading frame and h for hosts that trace their own rays: built exactly as the
+//! renderer builds them (`math::frame::hair_frame_offset`), with degenerate input refused
+//! by status instead of patched (docs/conventions.md, section 1).
+
+use super::bsdf::{UNIT_TOLERANCE, require, vec3};
+use super::{Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut};
+use crate::error::invalid_arg;
+use crate::math::Frame;
+use crate::math::frame::hair_frame_offset;
+use glam::Vec3;
+
+/// How far past the radius (in radii) a ray may pass the axis and still count as a hit,
+/// its h clamped to +-1: room for the rounding of a host's intersection code.
+pub const HT_HAIR_FRAME_H_TOLERANCE: f32 = 1e-2;
+
+/// The local frame of the hair BSDF at a hit, and the hit's offset h across the fibre.
+///
+/// THE CONVENTION (every BSDF call assumes it; nothing can detect a different one):
+/// - `x` = normalize(tangent): along the fibre, root to tip.
+/// - `y` = normalize(cross(x, d)), d the direction of the ray that hit: across the
+///   fibre, perpendicular to the ray.
+/// - `z` = cross(x, y): perpendicular to both, facing the viewer (dot(z, d) <= 0).
+/// - `h` = dot(ray origin - axis point, y) / radius, in [-1, 1]: the signed offset of the
+///   ray from the fibre's axis, *along +y*, in radii. `axis` is the point of the curve's
+///   axis at the hit's curve parameter, `radius` the fibre radius there.
+/// - `wo` and `wi` are unit vectors in this frame (|length - 1| <= 1e-3), both pointing
+///   away from the fibre: `wo` toward the viewer (-d at a camera hit), `wi` toward the
+///   light. At the hit that defines the frame, wo = -d/|d| has y = 0 and z >= 0.
+/// - Ray along the tangent (cross(x, d) = 0): the fibre is seen end-on, every y
+///   perpendicular to x is equally valid; `ht_hair_frame` picks one and measures h along
+///   it.
+///
+/// DO NOT use pbrt's or Embree's ribbon coordinate (v, or h = -1 + 2 v) for h: it runs
+/// along -y, and the call still returns HT_OK, with every azimuthal lobe mirrored. Example:
+/// a fibre along +x, a ray d = (0, 0, -1) passing the axis at y = +0.5 radius gives
+/// x = (1,0,0), y = (0,1,0), z = (0,0,1), h = +0.5, wo = (0,0,1); with alpha = 0 the R
+/// lobe peaks at wi = (0, 0.866, 0.5) (light from the +y side). With h = -0.5 instead, the
+/// highlight of a thick fibre lands half a radius on the wrong side. `ht_hair_frame`
+/// computes all of this; use it, or check your frame against it once.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HtHairFrame {
+    /// Unit tangent (world space).
+    pub x: [f32; 3],
+    /// Unit vector across the fibre, perpendicular to the ray (world space).
+    pub y: [f32; 3],
+    /// Unit vector toward the viewer, cross(x, y) (world space).
+    pub z: [f32; 3],
+    /// Offset of the ray from the axis along y, in radii, in [-1, 1].
+    pub h: f32,
+}
+
+/// A finite `float[3]` (NULL and alignment already checked).
+fn finite(s: &[f32], name: &str) -> Result<Vec3, Failure> {
+    let v = vec3(s);
+    if !v.is_finite() {
+        return Err(invalid_arg!("{name} = {v}: must be finite").into());
+    }
+    Ok(v)
+}
+
+/// Builds the frame and h of a hit (the convention at `HtHairFrame`) from world-space
+/// inputs and writes them to `*frame`; the frame is computed in double precision.
+///
+/// - `tangent`: the curve's tangent at the hit (any non-zero length, root to tip);
+///   `ray_org`, `ray_dir`: the ray that hit (any non-zero length); `axis`: the axis point
+///   at the hit's curve parameter; `radius`: the fibre radius there, finite and > 0.
+/// - Statuses: a NULL pointer, `HT_ERR_NULL_ARG` (checked first); misaligned pointers
+///   (each 4-byte), `*frame` overlapping an input, a non-finite value, a zero tangent or
+///   ray direction, a radius <= 0: `HT_ERR_INVALID_ARG`; a ray that passes the axis more
+///   than `1 + HT_HAIR_FRAME_H_TOLERANCE` radii away (not a hit on this fibre: a diameter
+///   passed as the radius, or the wrong axis point): `HT_ERR_INVALID_ARG`. Within the
+///   tolerance h is clamped to +-1. `*frame` is untouched on error.
+/// - A ray along the tangent is valid: HT_OK with an arbitrary y perpendicular to x.
+///
+/// Any thread; nothing is kept.
+///
+/// # Safety
+/// Each float pointer is NULL or points to 3 floats; `frame` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_frame(
+    tangent: *const f32,
+    ray_org: *const f32,
+    ray_dir: *const f32,
+    axis: *const f32,
+    radius: f32,
+    frame: *mut HtHairFrame,
+) -> HtStatus {
+    boundary(|| {
+        require(&[
+            (tangent.cast(), "tangent"),
+            (ray_org.cast(), "ray_org"),
+            (ray_dir.cast(), "ray_dir"),
+            (axis.cast(), "axis"),
+            (frame.cast_const().cast(), "frame"),
+        ])?;
+        let inputs = [
+            (tangent, "tangent"),
+            (ray_org, "ray_org"),
+            (ray_dir, "ray_dir"),
+            (axis, "axis"),
+        ];
+        let mut v = [Vec3::ZERO; 4];
+        for (v, &(p, name)) in v.iter_mut().zip(&inputs) {
+            *v = finite(host_slice(p, 3, name)?, name)?;
+        }
+        host_slice(frame.cast_const(), 1, "frame")?;
+        let spans = inputs.map(|(p, name)| Span::of(name, p, 3));
+        check_disjoint(&[Span::of("frame", frame, 1)], &spans)?;
+        let [tangent, org, dir, axis] = v;
+        for (v, name) in [(tangent, "tangent"), (dir, "ray_dir")] {
+            if v.length_squared() == 0.0 {
+                return Err(invalid_arg!("{name} is zero: it must give a direction").into());
+            }
+        }
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(invalid_arg!("radius = {radius}: must be finite and > 0").into());
+        }
+        let (axes, offset) = hair_frame_offset(tangent, dir, org, axis, radius);
+        let limit = 1.0 + f64::from(HT_HAIR_FRAME_H_TOLERANCE);
+        if !(offset.abs() <= limit) {
+            return Err(invalid_arg!(
+                "the ray passes the axis {offset} radii away (radius = {radius}): not a hit \
+                 on this fibre (is the radius a diameter, or axis the wrong point?)"
+            )
+            .into());
+        }
+        host_slice_mut(frame, 1, "frame")?[0] = HtHairFrame {
+            x: axes.x.to_array(),
+            y: axes.y.to_array(),
+            z: axes.z.to_array(),
+            h: offset.clamp(-1.0, 1.0) as f32,
+        };
+        Ok(())
+    })
+}
+
+/// The frame's axes, checked: finite, unit and orthogonal to 1e-3, right-handed.
+fn read_frame(ptr: *const HtHairFrame) -> Result<Frame, Failure> {
+    let f = host_slice(ptr, 1, "frame")?[0];
+    let [x, y, z] = [f.x, f.y, f.z].map(Vec3::from_array);
+    let unit = |v: Vec3| (v.length() - 1.0).abs() <= UNIT_TOLERANCE;
+    let orthogonal = x.dot(y).abs().max(y.dot(z).abs()).max(z.dot(x).abs()) <= UNIT_TOLERANCE;
+    if !(unit(x) && unit(y) && unit(z) && orthogonal && x.cross(y).dot(z) > 0.0) {
+        return Err(invalid_arg!(
+            "frame (x = {x}, y = {y}, z = {z}) is not a right-handed orthonormal frame \
+             (build it with ht_hair_frame)"
+        )
+        .into());
+    }
+    Ok(Frame { x, y, z })
+}
+
+/// Shared body of the two conversions.
+fn convert(
+    frame: *const HtHairFrame,
+    w: *const f32,
+    out: *mut f32,
+    map: fn(&Frame, Vec3) -> Vec3,
+) -> Result<(), Failure> {
+    require(&[
+        (frame.cast(), "frame"),
+        (w.cast(), "w"),
+        (out.cast_const().cast(), "out"),
+    ])?;
+    let w_s = host_slice(w, 3, "w")?;
+    host_slice(out.cast_const(), 3, "out")?;
+    check_disjoint(
+        &[Span::of("out", out, 3)],
+        &[Span::of("w", w, 3), Span::of("frame", frame, 1)],
+    )?;
+    let frame = read_frame(frame)?;
+    let w = finite(w_s, "w")?;
+    host_slice_mut(out, 3, "out")?.copy_from_slice(&map(&frame, w).to_array());
+    Ok(())
+}
+
+/// Writes the world direction `w[3]` in the local frame to `out[3]`: (dot(w, x), dot(w, y),
+/// dot(w, z)). Lengths are kept (give unit vectors to get the BSDF's unit wo and wi);
+/// directions keep their sense (wo must point toward the viewer, i.e. -ray_dir).
+///
+/// - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
+///   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
+/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
+///   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
+///   untouched on error.
+///
+/// Any thread.
+///
+/// # Safety
+/// `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_frame_to_local(
+    frame: *const HtHairFrame,
+    w: *const f32,
+    out: *mut f32,
+) -> HtStatus {
+    boundary(|| convert(frame, w, out, Frame::to_local))
+}
+
+/// Writes the local direction `w[3]` (e.g. a sampled wi) in world space to `out[3]`:
+/// w.x x + w.y y + w.z z. Arguments and statuses as `ht_hair_frame_to_local`.
+///
+/// # Safety
+/// As `ht_hair_frame_to_local`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_frame_to_world(
+    frame: *const HtHairFrame,
+    w: *const f32,
+    out: *mut f32,
+) -> HtStatus {
+    boundary(|| convert(frame, w, out, Frame::to_world))
+}

@@ -1,0 +1,427 @@
+//! The prepared hair BSDF for hosts: a handle holding the per-material constants, and a
+//! per-vertex point in storage the host owns, so that a path vertex costs no allocation
+//! and no re-preparation (docs/c-abi.md).
+//!
+//! The point is an [`OwnedPoint`] (its own copy of the BSDF plus the (h, wo) work) written
+//! into the host's `HtHairPoint` bytes behind a tag; it runs the Rust `HairPoint` code, so
+//! it gives the same bits.
+
+use super::bsdf::{
+    check_dir, check_h, check_sample_outputs, check_u, read_params, require, vec3, write_sample,
+};
+use super::{
+    Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
+};
+use crate::bsdf::{HairBsdf, OwnedPoint};
+use crate::error::invalid_arg;
+use glam::Vec3;
+
+/// Bytes of an `HtHairPoint`.
+pub const HT_HAIR_POINT_SIZE: usize = 320;
+/// Alignment of an `HtHairPoint` in bytes.
+pub const HT_HAIR_POINT_ALIGN: usize = 16;
+
+/// The hair BSDF prepared for one parameter set (the constants that depend on the
+/// parameters only). Create with `ht_hair_prepare`, release with `ht_hair_prepared_free`.
+/// Immutable: any number of threads may use one handle at once.
+pub struct HtHairPrepared {
+    bsdf: HairBsdf,
+}
+
+/// Storage for the BSDF at one shading point (a prepared BSDF at a fixed h and wo), filled
+/// by `ht_hair_point_init` and then evaluated and sampled any number of times.
+///
+/// - The host allocates it (stack, arrays, its own vertex structs): `HT_HAIR_POINT_SIZE`
+///   bytes aligned to `HT_HAIR_POINT_ALIGN` (16); this type has both, so declaring an
+///   `HtHairPoint` (or `malloc`, which aligns to 16 on 64-bit platforms) is enough. A
+///   misaligned point is refused with `HT_ERR_INVALID_ARG`.
+/// - The bytes are opaque. They hold plain numbers and no pointer: a filled point is
+///   self-contained, may be copied with `memcpy` or assignment, stays valid after its
+///   `HtHairPrepared` is freed, and needs no release.
+/// - A point that `ht_hair_point_init` did not fill (zeroed, or overwritten) is refused
+///   with `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised
+///   storage.
+/// - Reading it from several threads at once is safe; filling it while another thread
+///   reads it is a data race (the host's to avoid).
+#[repr(C, align(16))]
+pub struct HtHairPoint {
+    pub opaque: [u8; HT_HAIR_POINT_SIZE],
+}
+
+/// What the host's `HtHairPoint` bytes hold.
+#[repr(C)]
+struct Stored {
+    /// [`TAG`] once filled: catches points that were never filled.
+    tag: u64,
+    point: OwnedPoint,
+}
+
+/// "htpoint" and a layout version.
+const TAG: u64 = 0x6874_706f_696e_7401;
+
+// The host's storage must hold a `Stored` at its alignment: checked at compile time.
+const _: () = assert!(
+    size_of::<Stored>() <= HT_HAIR_POINT_SIZE
+        && align_of::<Stored>() <= HT_HAIR_POINT_ALIGN
+        && size_of::<HtHairPoint>() == HT_HAIR_POINT_SIZE
+        && align_of::<HtHairPoint>() == HT_HAIR_POINT_ALIGN
+);
+
+/// The filled point behind the host's storage (NULL, misaligned or unfilled: an error).
+fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a OwnedPoint, Failure> {
+    let storage = &host_slice(point, 1, name)?[0];
+    // SAFETY: `HtHairPoint` is at least as large and as aligned as `Stored` (asserted
+    // above), and `Stored` is plain numbers, valid for any bytes.
+    let stored = unsafe { &*std::ptr::from_ref(storage).cast::<Stored>() };
+    if stored.tag != TAG {
+        return Err(invalid_arg!(
+            "{name} was not filled by ht_hair_point_init (or was overwritten)"
+        )
+        .into());
+    }
+    Ok(&stored.point)
+}
+
+/// Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
+/// handle to `*out`.
+///
+/// - `params`, `out`: not NULL (`HT_ERR_NULL_ARG`), aligned for their types. A parameter
+///   out of range: `HT_ERR_INVALID_ARG` naming it, and `*out` is left untouched.
+/// - The handle is owned by the host: release it with `ht_hair_prepared_free`. Points
+///   filled from it keep their own copy and outlive it.
+///
+/// Any thread.
+///
+/// # Safety
+/// `params` is NULL or points to an `HtHairParams`; `out` is NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_prepare(
+    params: *const HtHairParams,
+    out: *mut *mut HtHairPrepared,
+) -> HtStatus {
+    boundary(|| {
+        require(&[(params.cast(), "params"), (out.cast_const().cast(), "out")])?;
+        let params = read_params(params)?;
+        let out = host_slice_mut(out, 1, "out")?;
+        let handle = Box::new(HtHairPrepared {
+            bsdf: HairBsdf::new(&params)?,
+        });
+        out[0] = Box::into_raw(handle);
+        Ok(())
+    })
+}
+
+/// Releases a prepared BSDF (NULL: nothing to do; returns HT_OK). Points filled from it
+/// stay valid. Freeing a handle twice, or while another thread uses it, is undefined
+/// behaviour.
+///
+/// # Safety
+/// `prepared` is NULL or a live handle from `ht_hair_prepare`, not used after this call.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_prepared_free(prepared: *mut HtHairPrepared) -> HtStatus {
+    boundary(|| {
+        if !prepared.is_null() {
+            // SAFETY: a live handle from ht_hair_prepare (the caller's promise).
+            drop(unsafe { Box::from_raw(prepared) });
+        }
+        Ok(())
+    })
+}
+
+/// Fills `*point` with the BSDF of `prepared` at offset `h` and outgoing direction `wo`:
+/// the work that depends on (h, wo) (Fresnel, absorption, refraction) is done here once,
+/// and shared by every eval, pdf and sample at that point.
+///
+/// - `h` in [-1, 1], `wo[3]` a unit vector (|length - 1| <= 1e-3) in the local frame
+///   pointing away from the fibre (see `HtHairFrame`); else `HT_ERR_INVALID_ARG`.
+/// - `prepared`, `wo`, `point`: not NULL (`HT_ERR_NULL_ARG`, checked first); `wo` 4-byte
+///   and `point` 16-byte aligned; `wo` must not lie inside `*point`. On error `*point` is
+///   untouched.
+///
+/// Any thread; `prepared` may be shared, `point` must not be read meanwhile.
+///
+/// # Safety
+/// `prepared` is NULL or a live handle; `wo` NULL or 3 floats; `point` NULL or writable
+/// storage of `HT_HAIR_POINT_SIZE` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_init(
+    prepared: *const HtHairPrepared,
+    h: f32,
+    wo: *const f32,
+    point: *mut HtHairPoint,
+) -> HtStatus {
+    boundary(|| {
+        require(&[
+            (prepared.cast(), "prepared"),
+            (wo.cast(), "wo"),
+            (point.cast_const().cast(), "point"),
+        ])?;
+        let wo_s = host_slice(wo, 3, "wo")?;
+        host_slice(point.cast_const(), 1, "point")?;
+        check_disjoint(&[Span::of("point", point, 1)], &[Span::of("wo", wo, 3)])?;
+        let h = check_h(h)?;
+        let wo = check_dir(vec3(wo_s), "wo")?;
+        // SAFETY: non-NULL (checked), a live handle (the caller's promise).
+        let bsdf = unsafe { &(*prepared).bsdf };
+        let stored = Stored {
+            tag: TAG,
+            point: OwnedPoint::new(bsdf, h, wo),
+        };
+        // SAFETY: non-NULL and aligned (checked), `HT_HAIR_POINT_SIZE` writable bytes that
+        // hold a `Stored` (asserted above).
+        unsafe { point.cast::<Stored>().write(stored) };
+        Ok(())
+    })
+}
+
+/// f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward
+/// `wi[3]` at a filled point: the same bits as `ht_hair_eval` with the point's parameters,
+/// h and wo.
+///
+/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame, pointing away;
+///   else `HT_ERR_INVALID_ARG`.
+/// - `point`, `wi`, `f`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+///   filled by `ht_hair_point_init` and 16-byte aligned, the floats 4-byte aligned
+///   (`HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi` or the point
+///   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///
+/// Any thread, concurrently on the same point.
+///
+/// # Safety
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f` NULL or 3 floats,
+/// `pdf` NULL or 1 float; outputs writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_eval(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        require(&[
+            (point.cast(), "point"),
+            (wi.cast(), "wi"),
+            (f.cast_const().cast(), "f"),
+            (pdf.cast_const().cast(), "pdf"),
+        ])?;
+        let p = read_point(point, "point")?;
+        let wi_s = host_slice(wi, 3, "wi")?;
+        host_slice(f.cast_const(), 3, "f")?;
+        host_slice(pdf.cast_const(), 1, "pdf")?;
+        check_disjoint(
+            &[Span::of("f", f, 3), Span::of("pdf", pdf, 1)],
+            &[Span::of("wi", wi, 3), Span::of("point", point, 1)],
+        )?;
+        let e = p.eval(check_dir(vec3(wi_s), "wi")?);
+        host_slice_mut(f, 3, "f")?.copy_from_slice(&e.f.to_array());
+        host_slice_mut(pdf, 1, "pdf")?[0] = e.pdf;
+        Ok(())
+    })
+}
+
+/// The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
+/// `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
+/// Arguments, statuses and thread safety as `ht_hair_point_eval`, without `f`.
+///
+/// # Safety
+/// As `ht_hair_point_eval`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_pdf(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        require(&[
+            (point.cast(), "point"),
+            (wi.cast(), "wi"),
+            (pdf.cast_const().cast(), "pdf"),
+        ])?;
+        let p = read_point(point, "point")?;
+        let wi_s = host_slice(wi, 3, "wi")?;
+        host_slice(pdf.cast_const(), 1, "pdf")?;
+        check_disjoint(
+            &[Span::of("pdf", pdf, 1)],
+            &[Span::of("wi", wi, 3), Span::of("point", point, 1)],
+        )?;
+        host_slice_mut(pdf, 1, "pdf")?[0] = p.eval(check_dir(vec3(wi_s), "wi")?).pdf;
+        Ok(())
+    })
+}
+
+/// Samples an incident direction at a filled point from `u[3]` in [0, 1): writes `wi[3]`
+/// (unit, local frame), `f[3]` and `*pdf`, the same bits as `ht_hair_sample` with the
+/// point's parameters, h and wo. pdf = 0 (wi, f zero) means no direction; still HT_OK.
+///
+/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled and 16-byte
+///   aligned, floats 4-byte aligned; `wi`, `f`, `pdf` must not overlap each other, `u` or
+///   the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///
+/// Any thread, concurrently on the same point.
+///
+/// # Safety
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `f` NULL or 3
+/// floats, `pdf` NULL or 1 float; outputs writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_sample(
+    point: *const HtHairPoint,
+    u: *const f32,
+    wi: *mut f32,
+    f: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        require(&[
+            (point.cast(), "point"),
+            (u.cast(), "u"),
+            (wi.cast_const().cast(), "wi"),
+            (f.cast_const().cast(), "f"),
+            (pdf.cast_const().cast(), "pdf"),
+        ])?;
+        let p = read_point(point, "point")?;
+        let u_s = host_slice(u, 3, "u")?;
+        check_sample_outputs(
+            wi,
+            f,
+            pdf,
+            &[Span::of("u", u, 3), Span::of("point", point, 1)],
+        )?;
+        let u = check_u(vec3(u_s).to_array(), "u")?;
+        write_sample(p.sample(u), wi, f, pdf)
+    })
+}
+
+/// The pointers of a batch over points, checked as one: `points[n]`, an input of `3n`
+/// floats, and the outputs (`3n` floats each, then `pdf[n]`).
+struct Batch<'a> {
+    points: &'a [HtHairPoint],
+    input: &'a [[f32; 3]],
+}
+
+impl<'a> Batch<'a> {
+    /// NULL checks of everything (when n > 0), then sizes, alignment and overlap.
+    fn check(
+        points: *const HtHairPoint,
+        n: usize,
+        input: (*const f32, &str),
+        outputs: &[(*mut f32, &str)],
+        pdf: *mut f32,
+    ) -> Result<Self, Failure> {
+        if n > 0 {
+            let mut all = vec![(points.cast(), "points"), (input.0.cast(), input.1)];
+            all.extend(
+                outputs
+                    .iter()
+                    .map(|&(p, name)| (p.cast_const().cast(), name)),
+            );
+            all.push((pdf.cast_const().cast(), "pdf"));
+            require(&all)?;
+        }
+        let points = host_slice(points, n, "points")?;
+        let input_s = host_slice(input.0.cast::<[f32; 3]>(), n, input.1)?;
+        let mut spans = Vec::with_capacity(outputs.len() + 1);
+        for &(p, name) in outputs {
+            host_slice(p.cast_const().cast::<[f32; 3]>(), n, name)?;
+            spans.push(Span::of(name, p.cast_const().cast::<[f32; 3]>(), n));
+        }
+        host_slice(pdf.cast_const(), n, "pdf")?;
+        spans.push(Span::of("pdf", pdf, n));
+        check_disjoint(
+            &spans,
+            &[
+                Span::of("points", points.as_ptr(), n),
+                Span::of(input.1, input_s.as_ptr(), n),
+            ],
+        )?;
+        Ok(Batch {
+            points,
+            input: input_s,
+        })
+    }
+
+    /// Every point filled and every input valid (`check`), before anything is written;
+    /// the message names the first bad element.
+    fn elements<T>(
+        &self,
+        check: impl Fn([f32; 3]) -> Result<T, Failure>,
+    ) -> Result<Vec<(&'a OwnedPoint, T)>, Failure> {
+        let (points, input) = (self.points, self.input);
+        (0..points.len())
+            .map(|i| {
+                read_point(&points[i], "point")
+                    .and_then(|p| Ok((p, check(input[i])?)))
+                    .map_err(|Failure(s, m)| Failure(s, format!("element {i}: {m}")))
+            })
+            .collect()
+    }
+}
+
+/// `ht_hair_point_eval` over `n` points at once: `points[n]` (each filled, possibly from
+/// different prepared BSDFs), `wi[3n]` in, `f[3n]` and `pdf[n]` out, tightly packed; each
+/// result bit-identical to `ht_hair_point_eval`.
+///
+/// - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
+///   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
+///   "negative" `n`: `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi`
+///   or `points` (`HT_ERR_INVALID_ARG`).
+/// - Every point and every `wi` is checked before anything is written; the message names
+///   the first bad element (`element 7: ...`).
+///
+/// Any thread, concurrently on the same points.
+///
+/// # Safety
+/// Each array is NULL or holds the number of elements given above (outputs writable).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_points_eval(
+    points: *const HtHairPoint,
+    n: usize,
+    wi: *const f32,
+    f: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        let batch = Batch::check(points, n, (wi, "wi"), &[(f, "f")], pdf)?;
+        let elements = batch.elements(|w| check_dir(Vec3::from_array(w), "wi"))?;
+        let f = host_slice_mut(f.cast::<[f32; 3]>(), n, "f")?;
+        let pdf = host_slice_mut(pdf, n, "pdf")?;
+        for (i, (p, wi)) in elements.into_iter().enumerate() {
+            let e = p.eval(wi);
+            f[i] = e.f.to_array();
+            pdf[i] = e.pdf;
+        }
+        Ok(())
+    })
+}
+
+/// `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
+/// `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
+/// `ht_hair_point_sample`. Checks and statuses as `ht_hair_points_eval` (every `u[i]` in
+/// [0, 1)); `wi`, `f` and `pdf` must not overlap each other, `u` or `points`.
+///
+/// # Safety
+/// Each array is NULL or holds the number of elements given above (outputs writable).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_points_sample(
+    points: *const HtHairPoint,
+    n: usize,
+    u: *const f32,
+    wi: *mut f32,
+    f: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        let batch = Batch::check(points, n, (u, "u"), &[(wi, "wi"), (f, "f")], pdf)?;
+        let elements = batch.elements(|u| check_u(u, "u"))?;
+        let wi = host_slice_mut(wi.cast::<[f32; 3]>(), n, "wi")?;
+        let f = host_slice_mut(f.cast::<[f32; 3]>(), n, "f")?;
+        let pdf = host_slice_mut(pdf, n, "pdf")?;
+        for (i, (p, u)) in elements.into_iter().enumerate() {
+            let s = p.sample(u);
+            (wi[i], f[i], pdf[i]) = s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
+                (s.wi.to_array(), s.f.to_array(), s.pdf)
+            });
+        }
+        Ok(())
+    })
+}

@@ -211,3 +211,114 @@ pub unsafe extern "C" fn ht_hair_frame_to_world(
 ) -> HtStatus {
     boundary(|| convert(frame, w, out, Frame::to_world))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::ht_last_error;
+    use super::*;
+    use crate::scene::hit::hair_frame;
+
+    fn last_error() -> String {
+        unsafe { std::ffi::CStr::from_ptr(ht_last_error()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    fn frame(t: Vec3, org: Vec3, d: Vec3, axis: Vec3, r: f32) -> (HtStatus, HtHairFrame) {
+        let mut out = HtHairFrame {
+            x: [0.0; 3],
+            y: [0.0; 3],
+            z: [0.0; 3],
+            h: 9.0,
+        };
+        let s = unsafe {
+            ht_hair_frame(
+                t.as_ref().as_ptr(),
+                org.as_ref().as_ptr(),
+                d.as_ref().as_ptr(),
+                axis.as_ref().as_ptr(),
+                r,
+                &mut out,
+            )
+        };
+        (s, out)
+    }
+
+    #[test]
+    fn the_documented_example_and_the_renderer_agree() {
+        // Fibre along +x, ray down -z passing the axis half a radius to +y.
+        let (s, f) = frame(
+            Vec3::X * 3.0,
+            Vec3::new(0.0, 0.5, 5.0),
+            -Vec3::Z * 2.0,
+            Vec3::ZERO,
+            1.0,
+        );
+        assert_eq!(s, HtStatus::HT_OK);
+        assert_eq!(
+            (f.x, f.y, f.z, f.h),
+            ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], 0.5)
+        );
+        let (t, org, d) = (
+            Vec3::new(0.3, 1.0, -0.2),
+            Vec3::new(0.1, 0.2, 4.0),
+            Vec3::new(0.05, -0.1, -1.0),
+        );
+        let axis = Vec3::new(0.2, 0.25, 0.0);
+        let (s, f) = frame(t, org, d, axis, 0.3);
+        let (want, h) = hair_frame(t, d, org, axis, 0.3);
+        assert_eq!(s, HtStatus::HT_OK);
+        assert_eq!(
+            (f.x, f.y, f.z, f.h),
+            (want.x.to_array(), want.y.to_array(), want.z.to_array(), h)
+        );
+        // Round trip through the local frame; wo = -d has y = 0 and z > 0 there.
+        let wo = (-d).normalize();
+        let (mut local, mut back) = ([0.0f32; 3], [0.0f32; 3]);
+        assert_eq!(
+            unsafe { ht_hair_frame_to_local(&f, wo.as_ref().as_ptr(), local.as_mut_ptr()) },
+            HtStatus::HT_OK
+        );
+        assert!(local[1].abs() < 1e-6 && local[2] > 0.0, "{local:?}");
+        assert_eq!(
+            unsafe { ht_hair_frame_to_world(&f, local.as_ptr(), back.as_mut_ptr()) },
+            HtStatus::HT_OK
+        );
+        assert!((Vec3::from_array(back) - wo).length() < 1e-6);
+    }
+
+    #[test]
+    fn degenerate_inputs_get_a_status() {
+        let (s, _) = frame(Vec3::ZERO, Vec3::Z, -Vec3::Z, Vec3::ZERO, 1.0);
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("tangent is zero"), "{}", last_error());
+        let (s, _) = frame(Vec3::X, Vec3::new(0.0, 1.5, 1.0), -Vec3::Z, Vec3::ZERO, 1.0);
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("1.5 radii away"), "{}", last_error());
+        let (s, f) = frame(
+            Vec3::X,
+            Vec3::new(0.0, 1.005, 1.0),
+            -Vec3::Z,
+            Vec3::ZERO,
+            1.0,
+        );
+        assert_eq!((s, f.h), (HtStatus::HT_OK, 1.0));
+        let (s, _) = frame(Vec3::X, Vec3::Z, -Vec3::Z, Vec3::ZERO, 0.0);
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("radius = 0"), "{}", last_error());
+        // The ray runs along the fibre: any y across it, a valid frame.
+        let (s, f) = frame(Vec3::X, Vec3::new(-5.0, 0.0, 0.0), Vec3::X, Vec3::ZERO, 1.0);
+        assert_eq!(s, HtStatus::HT_OK);
+        let [x, y, z] = [f.x, f.y, f.z].map(Vec3::from_array);
+        assert!(x.dot(y).abs() < 1e-6 && (x.cross(y) - z).length() < 1e-6 && f.h == 0.0);
+        // A mirrored (left-handed) frame is refused by the conversions.
+        let mirrored = HtHairFrame {
+            z: (-z).to_array(),
+            ..f
+        };
+        let mut out = [0.0f32; 3];
+        let s = unsafe { ht_hair_frame_to_local(&mirrored, f.x.as_ptr(), out.as_mut_ptr()) };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("right-handed"), "{}", last_error());
+    }
+}

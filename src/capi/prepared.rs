@@ -16,8 +16,9 @@ use crate::bsdf::{HairBsdf, OwnedPoint};
 use crate::error::invalid_arg;
 use glam::Vec3;
 
-/// Bytes of an `HtHairPoint`.
-pub const HT_HAIR_POINT_SIZE: usize = 320;
+/// Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
+/// grow without changing the ABI.
+pub const HT_HAIR_POINT_SIZE: usize = 384;
 /// Alignment of an `HtHairPoint` in bytes.
 pub const HT_HAIR_POINT_ALIGN: usize = 16;
 
@@ -424,4 +425,194 @@ pub unsafe extern "C" fn ht_hair_points_sample(
         }
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::ht_last_error;
+    use super::*;
+    use crate::bsdf::HairParams;
+    use std::ptr::null_mut;
+
+    fn last_error() -> String {
+        unsafe { std::ffi::CStr::from_ptr(ht_last_error()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    fn point() -> HtHairPoint {
+        HtHairPoint {
+            opaque: [0; HT_HAIR_POINT_SIZE],
+        }
+    }
+
+    fn prepare(p: &HtHairParams) -> *mut HtHairPrepared {
+        let mut handle = null_mut();
+        assert_eq!(unsafe { ht_hair_prepare(p, &mut handle) }, HtStatus::HT_OK);
+        handle
+    }
+
+    #[test]
+    fn points_give_the_rust_bits_and_outlive_their_handle() {
+        let params = HtHairParams {
+            alpha: -3.0,
+            ..HairParams::default().into()
+        };
+        let bsdf = HairBsdf::new(&params.into()).unwrap();
+        let handle = prepare(&params);
+        let (h, wo) = (0.4f32, Vec3::new(0.6, 0.0, 0.8));
+        let mut pt = point();
+        let s = unsafe { ht_hair_point_init(handle, h, wo.as_ref().as_ptr(), &mut pt) };
+        assert_eq!(s, HtStatus::HT_OK);
+        assert_eq!(unsafe { ht_hair_prepared_free(handle) }, HtStatus::HT_OK);
+        // A byte copy is as good as the original, after the handle is gone.
+        let copy = HtHairPoint { opaque: pt.opaque };
+        let rust = bsdf.at(h, wo);
+        for k in 0..64 {
+            let a = 0.1 * k as f32;
+            let wi = Vec3::new(a.sin() * 0.5, a.cos() * 0.7, 0.5).normalize();
+            let (mut f, mut pdf, mut pdf_only) = ([0.0f32; 3], 0.0f32, 0.0f32);
+            let s = unsafe {
+                ht_hair_point_eval(&copy, wi.as_ref().as_ptr(), f.as_mut_ptr(), &mut pdf)
+            };
+            assert_eq!(s, HtStatus::HT_OK);
+            let want = rust.eval(wi);
+            assert_eq!((f, pdf), (want.f.to_array(), want.pdf));
+            let s = unsafe { ht_hair_point_pdf(&copy, wi.as_ref().as_ptr(), &mut pdf_only) };
+            assert_eq!(
+                (s, pdf_only.to_bits()),
+                (HtStatus::HT_OK, want.pdf.to_bits())
+            );
+            let u = [k as f32 / 64.0, 0.37, 0.81];
+            let (mut wi_s, mut f_s, mut pdf_s) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
+            let s = unsafe {
+                ht_hair_point_sample(
+                    &pt,
+                    u.as_ptr(),
+                    wi_s.as_mut_ptr(),
+                    f_s.as_mut_ptr(),
+                    &mut pdf_s,
+                )
+            };
+            assert_eq!(s, HtStatus::HT_OK);
+            let want = rust.sample(u).unwrap();
+            assert_eq!(
+                (wi_s, f_s, pdf_s),
+                (want.wi.to_array(), want.f.to_array(), want.pdf)
+            );
+        }
+    }
+
+    #[test]
+    fn unfilled_misaligned_and_overlapping_points_are_refused() {
+        let wi = [0.0f32, 0.0, 1.0];
+        let (mut f, mut pdf) = ([0.0f32; 3], 0.0f32);
+        let zeroed = point();
+        let s = unsafe { ht_hair_point_eval(&zeroed, wi.as_ptr(), f.as_mut_ptr(), &mut pdf) };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("not filled by ht_hair_point_init"),
+            "{}",
+            last_error()
+        );
+        let handle = prepare(&HairParams::default().into());
+        let mut two = [point(), point()];
+        let odd = unsafe { two.as_mut_ptr().cast::<u8>().add(4) }.cast::<HtHairPoint>();
+        let s = unsafe { ht_hair_point_init(handle, 0.0, wi.as_ptr(), odd) };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("not aligned to 16"),
+            "{}",
+            last_error()
+        );
+        // wo inside the point it fills.
+        let inside = two[0].opaque.as_ptr().cast::<f32>();
+        let s = unsafe { ht_hair_point_init(handle, 0.0, inside, &mut two[0]) };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("point and wo overlap"),
+            "{}",
+            last_error()
+        );
+        unsafe { ht_hair_prepared_free(handle) };
+    }
+
+    #[test]
+    fn batches_match_single_calls_and_check_every_element() {
+        let handle = prepare(&HairParams::default().into());
+        let mut points = [point(), point(), point()];
+        for (k, p) in points.iter_mut().enumerate() {
+            let wo = Vec3::new(0.2 * k as f32, 0.0, 1.0).normalize();
+            unsafe { ht_hair_point_init(handle, 0.3 * k as f32, wo.as_ref().as_ptr(), p) };
+        }
+        let wi = [[0.0f32, 0.6, 0.8], [0.0, -0.6, 0.8], [1.0, 0.0, 0.0]];
+        let (mut f, mut pdf) = ([[0.0f32; 3]; 3], [0.0f32; 3]);
+        let s = unsafe {
+            ht_hair_points_eval(
+                points.as_ptr(),
+                3,
+                wi.as_ptr().cast(),
+                f.as_mut_ptr().cast(),
+                pdf.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_OK);
+        let u = [[0.1f32, 0.2, 0.3], [0.5, 0.5, 0.5], [0.9, 0.1, 0.7]];
+        let (mut wis, mut fs, mut pdfs) = ([[0.0f32; 3]; 3], [[0.0f32; 3]; 3], [0.0f32; 3]);
+        let s = unsafe {
+            ht_hair_points_sample(
+                points.as_ptr(),
+                3,
+                u.as_ptr().cast(),
+                wis.as_mut_ptr().cast(),
+                fs.as_mut_ptr().cast(),
+                pdfs.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_OK);
+        for k in 0..3 {
+            let (mut f1, mut p1) = ([0.0f32; 3], 0.0f32);
+            unsafe { ht_hair_point_eval(&points[k], wi[k].as_ptr(), f1.as_mut_ptr(), &mut p1) };
+            assert_eq!((f[k], pdf[k]), (f1, p1));
+            let (mut w1, mut f1, mut p1) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
+            unsafe {
+                ht_hair_point_sample(
+                    &points[k],
+                    u[k].as_ptr(),
+                    w1.as_mut_ptr(),
+                    f1.as_mut_ptr(),
+                    &mut p1,
+                )
+            };
+            assert_eq!((wis[k], fs[k], pdfs[k]), (w1, f1, p1));
+        }
+        let bad = [[0.0f32, 0.6, 0.8], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
+        let s = unsafe {
+            ht_hair_points_eval(
+                points.as_ptr(),
+                3,
+                bad.as_ptr().cast(),
+                f.as_mut_ptr().cast(),
+                pdf.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().starts_with("element 1: "), "{}", last_error());
+        let s = unsafe {
+            ht_hair_points_eval(
+                points.as_ptr(),
+                usize::MAX / 2,
+                bad.as_ptr().cast(),
+                f.as_mut_ptr().cast(),
+                pdf.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("do not fit in memory"),
+            "{}",
+            last_error()
+        );
+        unsafe { ht_hair_prepared_free(handle) };
+    }
 }

@@ -28,9 +28,10 @@
 #define HT_HAIR_FRAME_H_TOLERANCE 1e-2
 
 /**
- * Bytes of an `HtHairPoint`.
+ * Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
+ * grow without changing the ABI.
  */
-#define HT_HAIR_POINT_SIZE 320
+#define HT_HAIR_POINT_SIZE 384
 
 /**
  * Alignment of an `HtHairPoint` in bytes.

@@ -12,7 +12,7 @@
 use super::{
     Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
 };
-use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
+use crate::bsdf::{BsdfSample, HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
 use crate::error::invalid_arg;
 use glam::Vec3;
 use std::cell::RefCell;
@@ -100,6 +100,7 @@ pub(super) const UNIT_TOLERANCE: f32 = 1e-3;
 
 /// Checks that a direction is a finite unit vector (to [`UNIT_TOLERANCE`]): the model reads
 /// angles from its components.
+#[inline(always)]
 pub(super) fn check_dir(v: Vec3, name: &str) -> Result<Vec3, Failure> {
     // Squared length against the squared bounds: no square root on the hot path.
     let (lo, hi) = (
@@ -107,14 +108,21 @@ pub(super) fn check_dir(v: Vec3, name: &str) -> Result<Vec3, Failure> {
         (1.0 + UNIT_TOLERANCE).powi(2),
     );
     let len2 = v.length_squared();
-    if !(len2 >= lo && len2 <= hi) {
-        return Err(invalid_arg!(
-            "{name} = {v}: must be a finite unit vector (length {}, tolerance {UNIT_TOLERANCE})",
-            len2.sqrt()
-        )
-        .into());
+    if len2 >= lo && len2 <= hi {
+        Ok(v)
+    } else {
+        Err(not_unit(v, name))
     }
-    Ok(v)
+}
+
+#[cold]
+#[inline(never)]
+fn not_unit(v: Vec3, name: &str) -> Failure {
+    invalid_arg!(
+        "{name} = {v}: must be a finite unit vector (length {}, tolerance {UNIT_TOLERANCE})",
+        v.length()
+    )
+    .into()
 }
 
 pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
@@ -309,7 +317,7 @@ pub unsafe extern "C" fn ht_hair_sample(
 }
 
 /// Alignment of a sample's outputs, and their overlap with each other and `inputs`.
-pub(super) fn check_sample_outputs(
+fn check_sample_outputs(
     wi: *mut f32,
     f: *mut f32,
     pdf: *mut f32,
@@ -328,16 +336,22 @@ pub(super) fn check_sample_outputs(
     )
 }
 
+/// A sample's wi, f and pdf, or zeros when there is none (the C ABI's "pdf = 0").
+#[inline(always)]
+pub(super) fn sample_parts(s: Option<BsdfSample>) -> ([f32; 3], [f32; 3], f32) {
+    s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
+        (s.wi.to_array(), s.f.to_array(), s.pdf)
+    })
+}
+
 /// Writes a sample's wi, f and pdf, or zeros when there is none.
-pub(super) fn write_sample(
-    s: Option<crate::bsdf::BsdfSample>,
+fn write_sample(
+    s: Option<BsdfSample>,
     wi: *mut f32,
     f: *mut f32,
     pdf: *mut f32,
 ) -> Result<(), Failure> {
-    let (d, v, p) = s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
-        (s.wi.to_array(), s.f.to_array(), s.pdf)
-    });
+    let (d, v, p) = sample_parts(s);
     host_slice_mut(wi, 3, "wi")?.copy_from_slice(&d);
     host_slice_mut(f, 3, "f")?.copy_from_slice(&v);
     host_slice_mut(pdf, 1, "pdf")?[0] = p;

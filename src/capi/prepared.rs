@@ -6,9 +6,7 @@
 //! into the host's `HtHairPoint` bytes behind a tag; it runs the Rust `HairPoint` code, so
 //! it gives the same bits.
 
-use super::bsdf::{
-    check_dir, check_h, check_sample_outputs, check_u, read_params, require, vec3, write_sample,
-};
+use super::bsdf::{check_dir, check_h, check_u, read_params, require, sample_parts, vec3};
 use super::{
     Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
 };
@@ -70,17 +68,95 @@ const _: () = assert!(
 
 /// The filled point behind the host's storage (NULL, misaligned or unfilled: an error).
 fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a OwnedPoint, Failure> {
-    let storage = &host_slice(point, 1, name)?[0];
-    // SAFETY: `HtHairPoint` is at least as large and as aligned as `Stored` (asserted
-    // above), and `Stored` is plain numbers, valid for any bytes.
-    let stored = unsafe { &*std::ptr::from_ref(storage).cast::<Stored>() };
-    if stored.tag != TAG {
+    host_slice(point, 1, name)?;
+    if !filled(point) {
         return Err(invalid_arg!(
             "{name} was not filled by ht_hair_point_init (or was overwritten)"
         )
         .into());
     }
-    Ok(&stored.point)
+    // SAFETY: non-NULL, aligned and filled (checked); `HtHairPoint` holds a `Stored`.
+    Ok(unsafe { &(*point.cast::<Stored>()).point })
+}
+
+/// The tag of a non-NULL, aligned point.
+#[inline(always)]
+fn filled(point: *const HtHairPoint) -> bool {
+    // SAFETY: the caller checked `point`; `HtHairPoint` is at least as large and as aligned
+    // as `Stored` (asserted above), and `Stored` is plain numbers, valid for any bytes.
+    unsafe { (*point.cast::<Stored>()).tag == TAG }
+}
+
+/// A float array of a per-point call: pointer, name, length.
+type Arg = (*const f32, &'static str, usize);
+
+/// The point of a per-point call, with the call's pointers checked: the common case (all
+/// non-NULL and aligned, outputs clear of the inputs and the point, the point filled)
+/// inline and cheaply, anything else through the full checks that name the problem.
+#[inline(always)]
+fn checked_point<'a>(
+    point: *const HtHairPoint,
+    inputs: &[Arg],
+    outputs: &[Arg],
+) -> Result<&'a OwnedPoint, Failure> {
+    let usable = |p: *const f32| !p.is_null() && p.is_aligned();
+    let bytes = |(p, _, n): Arg| (p as usize, n * size_of::<f32>());
+    let whole = (point as usize, HT_HAIR_POINT_SIZE);
+    let apart = |(a, m): (usize, usize), (b, n): (usize, usize)| a + m <= b || b + n <= a;
+    let clean = !point.is_null()
+        && point.is_aligned()
+        && inputs.iter().chain(outputs).all(|a| usable(a.0))
+        && outputs.iter().enumerate().all(|(k, &o)| {
+            apart(bytes(o), whole)
+                && inputs
+                    .iter()
+                    .chain(&outputs[k + 1..])
+                    .all(|&i| apart(bytes(o), bytes(i)))
+        })
+        && filled(point);
+    if clean {
+        // SAFETY: non-NULL, aligned and filled (checked just above).
+        return Ok(unsafe { &(*point.cast::<Stored>()).point });
+    }
+    let mut all = vec![(point.cast::<()>(), "point")];
+    all.extend(inputs.iter().chain(outputs).map(|a| (a.0.cast(), a.1)));
+    require(&all)?;
+    let p = read_point(point, "point")?;
+    for &(ptr, name, n) in inputs.iter().chain(outputs) {
+        host_slice(ptr, n, name)?;
+    }
+    let mut spans: Vec<_> = inputs
+        .iter()
+        .map(|&(p, name, n)| Span::of(name, p, n))
+        .collect();
+    spans.push(Span::of("point", point, 1));
+    let outs: Vec<_> = outputs
+        .iter()
+        .map(|&(p, name, n)| Span::of(name, p, n))
+        .collect();
+    check_disjoint(&outs, &spans)?;
+    Ok(p)
+}
+
+/// Reads a `float[3]` that [`checked_point`] has checked.
+#[inline(always)]
+fn read3(ptr: *const f32) -> Vec3 {
+    // SAFETY: non-NULL and aligned (checked), 3 floats (the caller's promise).
+    Vec3::from_array(unsafe { ptr.cast::<[f32; 3]>().read() })
+}
+
+/// Writes a `float[3]` that [`checked_point`] has checked.
+#[inline(always)]
+fn write3(ptr: *mut f32, v: [f32; 3]) {
+    // SAFETY: non-NULL, aligned and clear of every input (checked), 3 writable floats.
+    unsafe { ptr.cast::<[f32; 3]>().write(v) }
+}
+
+/// Writes one float that [`checked_point`] has checked.
+#[inline(always)]
+fn write1(ptr: *mut f32, v: f32) {
+    // SAFETY: as `write3`.
+    unsafe { ptr.write(v) }
 }
 
 /// Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
@@ -199,23 +275,10 @@ pub unsafe extern "C" fn ht_hair_point_eval(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        require(&[
-            (point.cast(), "point"),
-            (wi.cast(), "wi"),
-            (f.cast_const().cast(), "f"),
-            (pdf.cast_const().cast(), "pdf"),
-        ])?;
-        let p = read_point(point, "point")?;
-        let wi_s = host_slice(wi, 3, "wi")?;
-        host_slice(f.cast_const(), 3, "f")?;
-        host_slice(pdf.cast_const(), 1, "pdf")?;
-        check_disjoint(
-            &[Span::of("f", f, 3), Span::of("pdf", pdf, 1)],
-            &[Span::of("wi", wi, 3), Span::of("point", point, 1)],
-        )?;
-        let e = p.eval(check_dir(vec3(wi_s), "wi")?);
-        host_slice_mut(f, 3, "f")?.copy_from_slice(&e.f.to_array());
-        host_slice_mut(pdf, 1, "pdf")?[0] = e.pdf;
+        let p = checked_point(point, &[(wi, "wi", 3)], &[(f, "f", 3), (pdf, "pdf", 1)])?;
+        let e = p.eval(check_dir(read3(wi), "wi")?);
+        write3(f, e.f.to_array());
+        write1(pdf, e.pdf);
         Ok(())
     })
 }
@@ -233,19 +296,8 @@ pub unsafe extern "C" fn ht_hair_point_pdf(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        require(&[
-            (point.cast(), "point"),
-            (wi.cast(), "wi"),
-            (pdf.cast_const().cast(), "pdf"),
-        ])?;
-        let p = read_point(point, "point")?;
-        let wi_s = host_slice(wi, 3, "wi")?;
-        host_slice(pdf.cast_const(), 1, "pdf")?;
-        check_disjoint(
-            &[Span::of("pdf", pdf, 1)],
-            &[Span::of("wi", wi, 3), Span::of("point", point, 1)],
-        )?;
-        host_slice_mut(pdf, 1, "pdf")?[0] = p.eval(check_dir(vec3(wi_s), "wi")?).pdf;
+        let p = checked_point(point, &[(wi, "wi", 3)], &[(pdf, "pdf", 1)])?;
+        write1(pdf, p.eval(check_dir(read3(wi), "wi")?).pdf);
         Ok(())
     })
 }
@@ -273,23 +325,18 @@ pub unsafe extern "C" fn ht_hair_point_sample(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        require(&[
-            (point.cast(), "point"),
-            (u.cast(), "u"),
-            (wi.cast_const().cast(), "wi"),
-            (f.cast_const().cast(), "f"),
-            (pdf.cast_const().cast(), "pdf"),
-        ])?;
-        let p = read_point(point, "point")?;
-        let u_s = host_slice(u, 3, "u")?;
-        check_sample_outputs(
-            wi,
-            f,
-            pdf,
-            &[Span::of("u", u, 3), Span::of("point", point, 1)],
-        )?;
-        let u = check_u(vec3(u_s).to_array(), "u")?;
-        write_sample(p.sample(u), wi, f, pdf)
+        let outputs = [
+            (wi.cast_const(), "wi", 3),
+            (f.cast_const(), "f", 3),
+            (pdf.cast_const(), "pdf", 1),
+        ];
+        let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
+        let s = p.sample(check_u(read3(u).to_array(), "u")?);
+        let (d, v, q) = sample_parts(s);
+        write3(wi, d);
+        write3(f, v);
+        write1(pdf, q);
+        Ok(())
     })
 }
 
@@ -298,14 +345,15 @@ pub unsafe extern "C" fn ht_hair_point_sample(
 struct Batch<'a> {
     points: &'a [HtHairPoint],
     input: &'a [[f32; 3]],
+    name: &'static str,
 }
 
-impl<'a> Batch<'a> {
+impl Batch<'_> {
     /// NULL checks of everything (when n > 0), then sizes, alignment and overlap.
     fn check(
         points: *const HtHairPoint,
         n: usize,
-        input: (*const f32, &str),
+        input: (*const f32, &'static str),
         outputs: &[(*mut f32, &str)],
         pdf: *mut f32,
     ) -> Result<Self, Failure> {
@@ -338,23 +386,34 @@ impl<'a> Batch<'a> {
         Ok(Batch {
             points,
             input: input_s,
+            name: input.1,
         })
     }
 
-    /// Every point filled and every input valid (`check`), before anything is written;
-    /// the message names the first bad element.
-    fn elements<T>(
+    /// Checks that every point is filled and every input valid (`check`) before anything
+    /// is written; the message names the first bad element. Then runs `each` on every
+    /// element: its point, its input and its index.
+    fn run<T>(
         &self,
-        check: impl Fn([f32; 3]) -> Result<T, Failure>,
-    ) -> Result<Vec<(&'a OwnedPoint, T)>, Failure> {
+        check: impl Fn([f32; 3], &str) -> Result<T, Failure>,
+        mut each: impl FnMut(usize, &OwnedPoint, T),
+    ) -> Result<(), Failure> {
         let (points, input) = (self.points, self.input);
-        (0..points.len())
-            .map(|i| {
+        for i in 0..points.len() {
+            if !filled(&points[i]) {
                 read_point(&points[i], "point")
-                    .and_then(|p| Ok((p, check(input[i])?)))
-                    .map_err(|Failure(s, m)| Failure(s, format!("element {i}: {m}")))
-            })
-            .collect()
+                    .map_err(|Failure(s, m)| Failure(s, format!("element {i}: {m}")))?;
+            }
+            if let Err(Failure(s, m)) = check(input[i], self.name) {
+                return Err(Failure(s, format!("element {i}: {m}")));
+            }
+        }
+        for (i, (point, &x)) in points.iter().zip(input).enumerate() {
+            // SAFETY: aligned (the slice's type) and filled (checked above).
+            let p = unsafe { &(*std::ptr::from_ref(point).cast::<Stored>()).point };
+            each(i, p, check(x, self.name)?);
+        }
+        Ok(())
     }
 }
 
@@ -383,15 +442,15 @@ pub unsafe extern "C" fn ht_hair_points_eval(
 ) -> HtStatus {
     boundary(|| {
         let batch = Batch::check(points, n, (wi, "wi"), &[(f, "f")], pdf)?;
-        let elements = batch.elements(|w| check_dir(Vec3::from_array(w), "wi"))?;
         let f = host_slice_mut(f.cast::<[f32; 3]>(), n, "f")?;
         let pdf = host_slice_mut(pdf, n, "pdf")?;
-        for (i, (p, wi)) in elements.into_iter().enumerate() {
-            let e = p.eval(wi);
-            f[i] = e.f.to_array();
-            pdf[i] = e.pdf;
-        }
-        Ok(())
+        batch.run(
+            |w, name| check_dir(Vec3::from_array(w), name),
+            |i, p, wi| {
+                let e = p.eval(wi);
+                (f[i], pdf[i]) = (e.f.to_array(), e.pdf);
+            },
+        )
     })
 }
 
@@ -413,17 +472,12 @@ pub unsafe extern "C" fn ht_hair_points_sample(
 ) -> HtStatus {
     boundary(|| {
         let batch = Batch::check(points, n, (u, "u"), &[(wi, "wi"), (f, "f")], pdf)?;
-        let elements = batch.elements(|u| check_u(u, "u"))?;
         let wi = host_slice_mut(wi.cast::<[f32; 3]>(), n, "wi")?;
         let f = host_slice_mut(f.cast::<[f32; 3]>(), n, "f")?;
         let pdf = host_slice_mut(pdf, n, "pdf")?;
-        for (i, (p, u)) in elements.into_iter().enumerate() {
-            let s = p.sample(u);
-            (wi[i], f[i], pdf[i]) = s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
-                (s.wi.to_array(), s.f.to_array(), s.pdf)
-            });
-        }
-        Ok(())
+        batch.run(check_u, |i, p, u| {
+            (wi[i], f[i], pdf[i]) = sample_parts(p.sample(u));
+        })
     })
 }
 

@@ -77,14 +77,25 @@ fn fresh_archive() -> PathBuf {
 /// Compiles `c_examples/<name>` with `compiler` and `flags`, links and runs it with `args`;
 /// returns stdout.
 fn build_and_run(name: &str, compiler: &str, flags: &[&str], args: &[&OsStr]) -> String {
+    build_and_run_file(&Path::new("c_examples").join(name), compiler, flags, args)
+}
+
+/// [`build_and_run`] for the C file at `source`, relative to the repository root.
+pub(crate) fn build_and_run_file(
+    source: &Path,
+    compiler: &str,
+    flags: &[&str],
+    args: &[&OsStr],
+) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let lib = fresh_archive();
+    let name = source.file_name().expect("a file").to_string_lossy();
     let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{compiler}"));
     let out = Command::new(compiler)
         .args(flags)
         .args(["-Wall", "-Wextra", "-Werror", "-O1", "-I"])
         .arg(root.join("include"))
-        .arg(root.join("c_examples").join(name))
+        .arg(root.join(source))
         // Ends a `-x c++` so that the archive is not read as source.
         .args(["-x", "none"])
         .arg(&lib)

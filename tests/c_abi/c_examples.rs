@@ -146,7 +146,7 @@ fn check_bsdf_output(out: &str) {
     let bsdf = HairBsdf::new(&HairParams::default()).unwrap();
     let e = bsdf.eval(0.5, Vec3::Z, Vec3::new(0.0, 0.866_025_4, 0.5));
     let want = [e.f.x, e.f.y, e.f.z, e.pdf];
-    for key in ["eval", "batch"] {
+    for key in ["eval", "batch", "point"] {
         let got = numbers(out, key);
         assert_eq!(got.len(), 4, "{key}: {got:?}");
         for (g, w) in got.iter().zip(want) {
@@ -156,6 +156,8 @@ fn check_bsdf_output(out: &str) {
             );
         }
     }
+    // The frame helper gives the documented h of the worked example (docs/conventions.md).
+    assert_eq!(numbers(out, "frame h"), [0.5], "{out}");
     let furnace = numbers(out, "furnace")[0];
     assert!(
         (furnace - 1.0).abs() < 1e-3,

@@ -118,7 +118,7 @@ pub unsafe extern "C" fn ht_hair_frame(
         }
         let (axes, offset) = hair_frame_offset(tangent, dir, org, axis, radius);
         let limit = 1.0 + f64::from(HT_HAIR_FRAME_H_TOLERANCE);
-        if !(offset.abs() <= limit) {
+        if offset.is_nan() || offset.abs() > limit {
             return Err(invalid_arg!(
                 "the ray passes the axis {offset} radii away (radius = {radius}): not a hit \
                  on this fibre (is the radius a diameter, or axis the wrong point?)"

@@ -2,7 +2,7 @@
 //! per-vertex point in storage the host owns, so that a path vertex costs no allocation
 //! and no re-preparation (docs/c-abi.md).
 //!
-//! The point is an [`OwnedPoint`] (its own copy of the BSDF plus the (h, wo) work) written
+//! The point is an `OwnedPoint` (its own copy of the BSDF plus the (h, wo) work) written
 //! into the host's `HtHairPoint` bytes behind a tag; it runs the Rust `HairPoint` code, so
 //! it gives the same bits.
 

@@ -40,8 +40,11 @@ fn unit(rng: &mut Pcg64) -> [f32; 3] {
     [z, r * phi.cos(), r * phi.sin()]
 }
 
+/// One input of every entry point: parameters, h, wo, wi, u.
+type Case = (HairParams, f32, [f32; 3], [f32; 3], [f32; 3]);
+
 /// Random in-range inputs: parameters over their whole ranges, h, wo, wi, u.
-fn cases(n: usize) -> Vec<(HairParams, f32, [f32; 3], [f32; 3], [f32; 3])> {
+fn cases(n: usize) -> Vec<Case> {
     let mut rng = Pcg64::seed_from_u64(11);
     (0..n)
         .map(|_| {

@@ -422,17 +422,19 @@ pub unsafe extern "C" fn ht_hair_eval_batch(
     })
 }
 
+/// The calling thread's last error message, for the tests of the BSDF entry points.
+#[cfg(test)]
+pub(super) fn last_error() -> String {
+    // SAFETY: ht_last_error returns a valid NUL-terminated string.
+    unsafe { std::ffi::CStr::from_ptr(super::ht_last_error()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
 #[cfg(test)]
 mod tests {
-    use super::super::ht_last_error;
     use super::*;
     use std::ptr::{null, null_mut};
-
-    fn last_error() -> String {
-        unsafe { std::ffi::CStr::from_ptr(ht_last_error()) }
-            .to_string_lossy()
-            .into_owned()
-    }
 
     #[test]
     fn null_pointers_are_reported_before_bad_values() {

@@ -214,15 +214,9 @@ pub unsafe extern "C" fn ht_hair_frame_to_world(
 
 #[cfg(test)]
 mod tests {
-    use super::super::ht_last_error;
+    use super::super::bsdf::last_error;
     use super::*;
     use crate::scene::hit::hair_frame;
-
-    fn last_error() -> String {
-        unsafe { std::ffi::CStr::from_ptr(ht_last_error()) }
-            .to_string_lossy()
-            .into_owned()
-    }
 
     fn frame(t: Vec3, org: Vec3, d: Vec3, axis: Vec3, r: f32) -> (HtStatus, HtHairFrame) {
         let mut out = HtHairFrame {

@@ -483,16 +483,10 @@ pub unsafe extern "C" fn ht_hair_points_sample(
 
 #[cfg(test)]
 mod tests {
-    use super::super::ht_last_error;
+    use super::super::bsdf::last_error;
     use super::*;
     use crate::bsdf::HairParams;
     use std::ptr::null_mut;
-
-    fn last_error() -> String {
-        unsafe { std::ffi::CStr::from_ptr(ht_last_error()) }
-            .to_string_lossy()
-            .into_owned()
-    }
 
     fn point() -> HtHairPoint {
         HtHairPoint {

@@ -149,6 +149,49 @@ pub(super) fn require(ptrs: &[(*const (), &str)]) -> Result<(), Failure> {
     Ok(())
 }
 
+/// A float array of a call: pointer, name, length in floats.
+pub(super) type Arg = (*const f32, &'static str, usize);
+
+/// The common case of a call's float arrays, checked inline and cheaply: every pointer
+/// non-NULL and aligned, every output clear of the inputs, of `extra` (another byte range
+/// the call reads, as (address, bytes)) and of the other outputs. When it is false the
+/// call runs its full checks, which name the problem.
+#[inline(always)]
+pub(super) fn clean_args(inputs: &[Arg], outputs: &[Arg], extra: (usize, usize)) -> bool {
+    let usable = |p: *const f32| !p.is_null() && p.is_aligned();
+    let bytes = |(p, _, n): Arg| (p as usize, n * size_of::<f32>());
+    let apart = |(a, m): (usize, usize), (b, n): (usize, usize)| a + m <= b || b + n <= a;
+    inputs.iter().chain(outputs).all(|a| usable(a.0))
+        && outputs.iter().enumerate().all(|(k, &o)| {
+            apart(bytes(o), extra)
+                && inputs
+                    .iter()
+                    .chain(&outputs[k + 1..])
+                    .all(|&i| apart(bytes(o), bytes(i)))
+        })
+}
+
+/// Reads a `float[3]` that [`clean_args`] or the full checks have passed.
+#[inline(always)]
+pub(super) fn read3(ptr: *const f32) -> Vec3 {
+    // SAFETY: non-NULL and aligned (checked), 3 floats (the caller's promise).
+    Vec3::from_array(unsafe { ptr.cast::<[f32; 3]>().read() })
+}
+
+/// Writes a `float[3]` that [`clean_args`] or the full checks have passed.
+#[inline(always)]
+pub(super) fn write3(ptr: *mut f32, v: [f32; 3]) {
+    // SAFETY: non-NULL, aligned and clear of every input (checked), 3 writable floats.
+    unsafe { ptr.cast::<[f32; 3]>().write(v) }
+}
+
+/// Writes one float that [`clean_args`] or the full checks have passed.
+#[inline(always)]
+pub(super) fn write1(ptr: *mut f32, v: f32) {
+    // SAFETY: as `write3`.
+    unsafe { ptr.write(v) }
+}
+
 /// The host's `float[3]`, already checked for NULL and alignment by [`host_slice`].
 pub(super) fn vec3(s: &[f32]) -> Vec3 {
     Vec3::new(s[0], s[1], s[2])
@@ -249,26 +292,41 @@ pub unsafe extern "C" fn ht_hair_eval(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        require(&[
-            (params.cast(), "params"),
-            (wo.cast(), "wo"),
-            (wi.cast(), "wi"),
-            (f.cast_const().cast(), "f"),
-            (pdf.cast_const().cast(), "pdf"),
-        ])?;
-        let params = read_params(params)?;
-        let (wo_s, wi_s) = (host_slice(wo, 3, "wo")?, host_slice(wi, 3, "wi")?);
-        host_slice(f.cast_const(), 3, "f")?;
-        host_slice(pdf.cast_const(), 1, "pdf")?;
-        check_disjoint(
-            &[Span::of("f", f, 3), Span::of("pdf", pdf, 1)],
-            &[Span::of("wo", wo, 3), Span::of("wi", wi, 3)],
-        )?;
+        let (inputs, outputs) = (
+            [(wo, "wo", 3), (wi, "wi", 3)],
+            [(f.cast_const(), "f", 3), (pdf.cast_const(), "pdf", 1)],
+        );
+        let fast = !params.is_null()
+            && params.is_aligned()
+            && clean_args(
+                &inputs,
+                &outputs,
+                (params as usize, size_of::<HtHairParams>()),
+            );
+        if !fast {
+            require(&[
+                (params.cast(), "params"),
+                (wo.cast(), "wo"),
+                (wi.cast(), "wi"),
+                (f.cast_const().cast(), "f"),
+                (pdf.cast_const().cast(), "pdf"),
+            ])?;
+            read_params(params)?;
+            for (ptr, name, n) in inputs.into_iter().chain(outputs) {
+                host_slice(ptr, n, name)?;
+            }
+            check_disjoint(
+                &[Span::of("f", f, 3), Span::of("pdf", pdf, 1)],
+                &[Span::of("wo", wo, 3), Span::of("wi", wi, 3)],
+            )?;
+        }
+        // SAFETY: non-NULL and aligned (checked above).
+        let params = HairParams::from(unsafe { params.read() });
         let h = check_h(h)?;
-        let (wo, wi) = (check_dir(vec3(wo_s), "wo")?, check_dir(vec3(wi_s), "wi")?);
+        let (wo, wi) = (check_dir(read3(wo), "wo")?, check_dir(read3(wi), "wi")?);
         let e = with_bsdf(params, |b| b.eval(h, wo, wi))?;
-        host_slice_mut(f, 3, "f")?.copy_from_slice(&e.f.to_array());
-        host_slice_mut(pdf, 1, "pdf")?[0] = e.pdf;
+        write3(f, e.f.to_array());
+        write1(pdf, e.pdf);
         Ok(())
     })
 }
@@ -297,22 +355,43 @@ pub unsafe extern "C" fn ht_hair_sample(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        require(&[
-            (params.cast(), "params"),
-            (wo.cast(), "wo"),
-            (u.cast(), "u"),
-            (wi.cast_const().cast(), "wi"),
-            (f.cast_const().cast(), "f"),
-            (pdf.cast_const().cast(), "pdf"),
-        ])?;
-        let params = read_params(params)?;
-        let (wo_s, u_s) = (host_slice(wo, 3, "wo")?, host_slice(u, 3, "u")?);
-        check_sample_outputs(wi, f, pdf, &[Span::of("wo", wo, 3), Span::of("u", u, 3)])?;
+        let inputs = [(wo, "wo", 3), (u, "u", 3)];
+        let outputs = [
+            (wi.cast_const(), "wi", 3),
+            (f.cast_const(), "f", 3),
+            (pdf.cast_const(), "pdf", 1),
+        ];
+        let fast = !params.is_null()
+            && params.is_aligned()
+            && clean_args(
+                &inputs,
+                &outputs,
+                (params as usize, size_of::<HtHairParams>()),
+            );
+        if !fast {
+            require(&[
+                (params.cast(), "params"),
+                (wo.cast(), "wo"),
+                (u.cast(), "u"),
+                (wi.cast_const().cast(), "wi"),
+                (f.cast_const().cast(), "f"),
+                (pdf.cast_const().cast(), "pdf"),
+            ])?;
+            read_params(params)?;
+            host_slice(wo, 3, "wo")?;
+            host_slice(u, 3, "u")?;
+            check_sample_outputs(wi, f, pdf, &[Span::of("wo", wo, 3), Span::of("u", u, 3)])?;
+        }
+        // SAFETY: non-NULL and aligned (checked above).
+        let params = HairParams::from(unsafe { params.read() });
         let h = check_h(h)?;
-        let wo = check_dir(vec3(wo_s), "wo")?;
-        let u = check_u(vec3(u_s).to_array(), "u")?;
-        let s = with_bsdf(params, |b| b.sample(h, wo, u))?;
-        write_sample(s, wi, f, pdf)
+        let wo = check_dir(read3(wo), "wo")?;
+        let u = check_u(read3(u).to_array(), "u")?;
+        let (d, v, p) = sample_parts(with_bsdf(params, |b| b.sample(h, wo, u))?);
+        write3(wi, d);
+        write3(f, v);
+        write1(pdf, p);
+        Ok(())
     })
 }
 
@@ -342,20 +421,6 @@ pub(super) fn sample_parts(s: Option<BsdfSample>) -> ([f32; 3], [f32; 3], f32) {
     s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
         (s.wi.to_array(), s.f.to_array(), s.pdf)
     })
-}
-
-/// Writes a sample's wi, f and pdf, or zeros when there is none.
-fn write_sample(
-    s: Option<BsdfSample>,
-    wi: *mut f32,
-    f: *mut f32,
-    pdf: *mut f32,
-) -> Result<(), Failure> {
-    let (d, v, p) = sample_parts(s);
-    host_slice_mut(wi, 3, "wi")?.copy_from_slice(&d);
-    host_slice_mut(f, 3, "f")?.copy_from_slice(&v);
-    host_slice_mut(pdf, 1, "pdf")?[0] = p;
-    Ok(())
 }
 
 /// `n` evaluations at once (eight per SIMD step), each bit-identical to `ht_hair_eval`:

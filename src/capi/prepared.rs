@@ -6,7 +6,10 @@
 //! into the host's `HtHairPoint` bytes behind a tag; it runs the Rust `HairPoint` code, so
 //! it gives the same bits.
 
-use super::bsdf::{check_dir, check_h, check_u, read_params, require, sample_parts, vec3};
+use super::bsdf::{
+    Arg, check_dir, check_h, check_u, clean_args, read_params, read3, require, sample_parts,
+    write1, write3,
+};
 use super::{
     Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
 };
@@ -87,9 +90,6 @@ fn filled(point: *const HtHairPoint) -> bool {
     unsafe { (*point.cast::<Stored>()).tag == TAG }
 }
 
-/// A float array of a per-point call: pointer, name, length.
-type Arg = (*const f32, &'static str, usize);
-
 /// The point of a per-point call, with the call's pointers checked: the common case (all
 /// non-NULL and aligned, outputs clear of the inputs and the point, the point filled)
 /// inline and cheaply, anything else through the full checks that name the problem.
@@ -99,20 +99,9 @@ fn checked_point<'a>(
     inputs: &[Arg],
     outputs: &[Arg],
 ) -> Result<&'a OwnedPoint, Failure> {
-    let usable = |p: *const f32| !p.is_null() && p.is_aligned();
-    let bytes = |(p, _, n): Arg| (p as usize, n * size_of::<f32>());
-    let whole = (point as usize, HT_HAIR_POINT_SIZE);
-    let apart = |(a, m): (usize, usize), (b, n): (usize, usize)| a + m <= b || b + n <= a;
     let clean = !point.is_null()
         && point.is_aligned()
-        && inputs.iter().chain(outputs).all(|a| usable(a.0))
-        && outputs.iter().enumerate().all(|(k, &o)| {
-            apart(bytes(o), whole)
-                && inputs
-                    .iter()
-                    .chain(&outputs[k + 1..])
-                    .all(|&i| apart(bytes(o), bytes(i)))
-        })
+        && clean_args(inputs, outputs, (point as usize, HT_HAIR_POINT_SIZE))
         && filled(point);
     if clean {
         // SAFETY: non-NULL, aligned and filled (checked just above).
@@ -136,27 +125,6 @@ fn checked_point<'a>(
         .collect();
     check_disjoint(&outs, &spans)?;
     Ok(p)
-}
-
-/// Reads a `float[3]` that [`checked_point`] has checked.
-#[inline(always)]
-fn read3(ptr: *const f32) -> Vec3 {
-    // SAFETY: non-NULL and aligned (checked), 3 floats (the caller's promise).
-    Vec3::from_array(unsafe { ptr.cast::<[f32; 3]>().read() })
-}
-
-/// Writes a `float[3]` that [`checked_point`] has checked.
-#[inline(always)]
-fn write3(ptr: *mut f32, v: [f32; 3]) {
-    // SAFETY: non-NULL, aligned and clear of every input (checked), 3 writable floats.
-    unsafe { ptr.cast::<[f32; 3]>().write(v) }
-}
-
-/// Writes one float that [`checked_point`] has checked.
-#[inline(always)]
-fn write1(ptr: *mut f32, v: f32) {
-    // SAFETY: as `write3`.
-    unsafe { ptr.write(v) }
 }
 
 /// Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
@@ -228,16 +196,24 @@ pub unsafe extern "C" fn ht_hair_point_init(
     point: *mut HtHairPoint,
 ) -> HtStatus {
     boundary(|| {
-        require(&[
-            (prepared.cast(), "prepared"),
-            (wo.cast(), "wo"),
-            (point.cast_const().cast(), "point"),
-        ])?;
-        let wo_s = host_slice(wo, 3, "wo")?;
-        host_slice(point.cast_const(), 1, "point")?;
-        check_disjoint(&[Span::of("point", point, 1)], &[Span::of("wo", wo, 3)])?;
+        let fast = !prepared.is_null()
+            && !point.is_null()
+            && point.is_aligned()
+            && clean_args(&[(wo, "wo", 3)], &[], (0, 0))
+            && (wo as usize + 3 * size_of::<f32>() <= point as usize
+                || point as usize + HT_HAIR_POINT_SIZE <= wo as usize);
+        if !fast {
+            require(&[
+                (prepared.cast(), "prepared"),
+                (wo.cast(), "wo"),
+                (point.cast_const().cast(), "point"),
+            ])?;
+            host_slice(wo, 3, "wo")?;
+            host_slice(point.cast_const(), 1, "point")?;
+            check_disjoint(&[Span::of("point", point, 1)], &[Span::of("wo", wo, 3)])?;
+        }
         let h = check_h(h)?;
-        let wo = check_dir(vec3(wo_s), "wo")?;
+        let wo = check_dir(read3(wo), "wo")?;
         // SAFETY: non-NULL (checked), a live handle (the caller's promise).
         let bsdf = unsafe { &(*prepared).bsdf };
         let stored = Stored {

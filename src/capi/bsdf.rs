@@ -12,7 +12,9 @@
 use super::{
     Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
 };
-use crate::bsdf::{BsdfSample, HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
+use crate::bsdf::{
+    BsdfEval, BsdfSample, HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin,
+};
 use crate::error::invalid_arg;
 use glam::Vec3;
 use std::cell::RefCell;
@@ -171,6 +173,44 @@ pub(super) fn clean_args(inputs: &[Arg], outputs: &[Arg], extra: (usize, usize))
         })
 }
 
+/// The pointers of a call: `head` (the struct it reads first: parameters or a point)
+/// and its float arrays, checked inline by [`clean_args`] in the common case, else in the
+/// documented order with messages: every NULL first, then alignment and sizes, then the
+/// overlap of each output with the other outputs, the inputs and `head`.
+#[inline(always)]
+pub(super) fn check_args<H>(
+    head: (*const H, &'static str),
+    inputs: &[Arg],
+    outputs: &[Arg],
+) -> Result<(), Failure> {
+    let ptr = head.0;
+    let extra = (ptr as usize, size_of::<H>());
+    if !ptr.is_null() && ptr.is_aligned() && clean_args(inputs, outputs, extra) {
+        return Ok(());
+    }
+    full_checks(head, inputs, outputs)
+}
+
+#[cold]
+#[inline(never)]
+fn full_checks<H>(
+    (ptr, name): (*const H, &'static str),
+    inputs: &[Arg],
+    outputs: &[Arg],
+) -> Result<(), Failure> {
+    let mut all = vec![(ptr.cast::<()>(), name)];
+    all.extend(inputs.iter().chain(outputs).map(|a| (a.0.cast(), a.1)));
+    require(&all)?;
+    host_slice(ptr, 1, name)?;
+    for &(p, arg, n) in inputs.iter().chain(outputs) {
+        host_slice(p, n, arg)?;
+    }
+    let span = |&(p, arg, n): &Arg| Span::of(arg, p, n);
+    let mut read: Vec<_> = inputs.iter().map(span).collect();
+    read.push(Span::of(name, ptr, 1));
+    check_disjoint(&outputs.iter().map(span).collect::<Vec<_>>(), &read)
+}
+
 /// Reads a `float[3]` that [`clean_args`] or the full checks have passed.
 #[inline(always)]
 pub(super) fn read3(ptr: *const f32) -> Vec3 {
@@ -296,37 +336,12 @@ pub unsafe extern "C" fn ht_hair_eval(
             [(wo, "wo", 3), (wi, "wi", 3)],
             [(f.cast_const(), "f", 3), (pdf.cast_const(), "pdf", 1)],
         );
-        let fast = !params.is_null()
-            && params.is_aligned()
-            && clean_args(
-                &inputs,
-                &outputs,
-                (params as usize, size_of::<HtHairParams>()),
-            );
-        if !fast {
-            require(&[
-                (params.cast(), "params"),
-                (wo.cast(), "wo"),
-                (wi.cast(), "wi"),
-                (f.cast_const().cast(), "f"),
-                (pdf.cast_const().cast(), "pdf"),
-            ])?;
-            read_params(params)?;
-            for (ptr, name, n) in inputs.into_iter().chain(outputs) {
-                host_slice(ptr, n, name)?;
-            }
-            check_disjoint(
-                &[Span::of("f", f, 3), Span::of("pdf", pdf, 1)],
-                &[Span::of("wo", wo, 3), Span::of("wi", wi, 3)],
-            )?;
-        }
+        check_args((params, "params"), &inputs, &outputs)?;
         // SAFETY: non-NULL and aligned (checked above).
         let params = HairParams::from(unsafe { params.read() });
         let h = check_h(h)?;
         let (wo, wi) = (check_dir(read3(wo), "wo")?, check_dir(read3(wi), "wi")?);
-        let e = with_bsdf(params, |b| b.eval(h, wo, wi))?;
-        write3(f, e.f.to_array());
-        write1(pdf, e.pdf);
+        write_eval(with_bsdf(params, |b| b.eval(h, wo, wi))?, f, pdf);
         Ok(())
     })
 }
@@ -361,58 +376,31 @@ pub unsafe extern "C" fn ht_hair_sample(
             (f.cast_const(), "f", 3),
             (pdf.cast_const(), "pdf", 1),
         ];
-        let fast = !params.is_null()
-            && params.is_aligned()
-            && clean_args(
-                &inputs,
-                &outputs,
-                (params as usize, size_of::<HtHairParams>()),
-            );
-        if !fast {
-            require(&[
-                (params.cast(), "params"),
-                (wo.cast(), "wo"),
-                (u.cast(), "u"),
-                (wi.cast_const().cast(), "wi"),
-                (f.cast_const().cast(), "f"),
-                (pdf.cast_const().cast(), "pdf"),
-            ])?;
-            read_params(params)?;
-            host_slice(wo, 3, "wo")?;
-            host_slice(u, 3, "u")?;
-            check_sample_outputs(wi, f, pdf, &[Span::of("wo", wo, 3), Span::of("u", u, 3)])?;
-        }
+        check_args((params, "params"), &inputs, &outputs)?;
         // SAFETY: non-NULL and aligned (checked above).
         let params = HairParams::from(unsafe { params.read() });
         let h = check_h(h)?;
         let wo = check_dir(read3(wo), "wo")?;
         let u = check_u(read3(u).to_array(), "u")?;
-        let (d, v, p) = sample_parts(with_bsdf(params, |b| b.sample(h, wo, u))?);
-        write3(wi, d);
-        write3(f, v);
-        write1(pdf, p);
+        write_sample(with_bsdf(params, |b| b.sample(h, wo, u))?, wi, f, pdf);
         Ok(())
     })
 }
 
-/// Alignment of a sample's outputs, and their overlap with each other and `inputs`.
-fn check_sample_outputs(
-    wi: *mut f32,
-    f: *mut f32,
-    pdf: *mut f32,
-    inputs: &[Span],
-) -> Result<(), Failure> {
-    host_slice(wi.cast_const(), 3, "wi")?;
-    host_slice(f.cast_const(), 3, "f")?;
-    host_slice(pdf.cast_const(), 1, "pdf")?;
-    check_disjoint(
-        &[
-            Span::of("wi", wi, 3),
-            Span::of("f", f, 3),
-            Span::of("pdf", pdf, 1),
-        ],
-        inputs,
-    )
+/// Writes an evaluation to outputs that [`check_args`] has passed.
+#[inline(always)]
+pub(super) fn write_eval(e: BsdfEval, f: *mut f32, pdf: *mut f32) {
+    write3(f, e.f.to_array());
+    write1(pdf, e.pdf);
+}
+
+/// Writes a sample (zeros when there is none) to outputs that [`check_args`] has passed.
+#[inline(always)]
+pub(super) fn write_sample(s: Option<BsdfSample>, wi: *mut f32, f: *mut f32, pdf: *mut f32) {
+    let (d, v, p) = sample_parts(s);
+    write3(wi, d);
+    write3(f, v);
+    write1(pdf, p);
 }
 
 /// A sample's wi, f and pdf, or zeros when there is none (the C ABI's "pdf = 0").

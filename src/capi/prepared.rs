@@ -7,8 +7,8 @@
 //! it gives the same bits.
 
 use super::bsdf::{
-    Arg, check_dir, check_h, check_u, clean_args, read_params, read3, require, sample_parts,
-    write1, write3,
+    Arg, check_args, check_dir, check_h, check_u, clean_args, read_params, read3, require,
+    sample_parts, write_eval, write_sample, write1,
 };
 use super::{
     Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
@@ -99,32 +99,12 @@ fn checked_point<'a>(
     inputs: &[Arg],
     outputs: &[Arg],
 ) -> Result<&'a OwnedPoint, Failure> {
-    let clean = !point.is_null()
-        && point.is_aligned()
-        && clean_args(inputs, outputs, (point as usize, HT_HAIR_POINT_SIZE))
-        && filled(point);
-    if clean {
-        // SAFETY: non-NULL, aligned and filled (checked just above).
+    check_args((point, "point"), inputs, outputs)?;
+    if filled(point) {
+        // SAFETY: non-NULL, aligned (checked above) and filled.
         return Ok(unsafe { &(*point.cast::<Stored>()).point });
     }
-    let mut all = vec![(point.cast::<()>(), "point")];
-    all.extend(inputs.iter().chain(outputs).map(|a| (a.0.cast(), a.1)));
-    require(&all)?;
-    let p = read_point(point, "point")?;
-    for &(ptr, name, n) in inputs.iter().chain(outputs) {
-        host_slice(ptr, n, name)?;
-    }
-    let mut spans: Vec<_> = inputs
-        .iter()
-        .map(|&(p, name, n)| Span::of(name, p, n))
-        .collect();
-    spans.push(Span::of("point", point, 1));
-    let outs: Vec<_> = outputs
-        .iter()
-        .map(|&(p, name, n)| Span::of(name, p, n))
-        .collect();
-    check_disjoint(&outs, &spans)?;
-    Ok(p)
+    read_point(point, "point")
 }
 
 /// Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
@@ -252,9 +232,7 @@ pub unsafe extern "C" fn ht_hair_point_eval(
 ) -> HtStatus {
     boundary(|| {
         let p = checked_point(point, &[(wi, "wi", 3)], &[(f, "f", 3), (pdf, "pdf", 1)])?;
-        let e = p.eval(check_dir(read3(wi), "wi")?);
-        write3(f, e.f.to_array());
-        write1(pdf, e.pdf);
+        write_eval(p.eval(check_dir(read3(wi), "wi")?), f, pdf);
         Ok(())
     })
 }
@@ -308,10 +286,7 @@ pub unsafe extern "C" fn ht_hair_point_sample(
         ];
         let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
         let s = p.sample(check_u(read3(u).to_array(), "u")?);
-        let (d, v, q) = sample_parts(s);
-        write3(wi, d);
-        write3(f, v);
-        write1(pdf, q);
+        write_sample(s, wi, f, pdf);
         Ok(())
     })
 }

@@ -23,9 +23,10 @@
 
 /**
  * How far past the radius (in radii) a ray may pass the axis and still count as a hit,
- * its h clamped to +-1: room for the rounding of a host's intersection code.
+ * its h clamped to +-1: room for a host's intersection code (Embree's flat curves are
+ * tessellated, and their hits reach 1.012 radii on a bent strand).
  */
-#define HT_HAIR_FRAME_H_TOLERANCE 1e-2
+#define HT_HAIR_FRAME_H_TOLERANCE 5e-2
 
 /**
  * Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to

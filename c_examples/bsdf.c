@@ -50,6 +50,34 @@ int main(void) {
     if (check(ht_hair_eval_batch(&hair, 2, hb, wob, wib, fb, pdfb), "ht_hair_eval_batch")) return 1;
     printf("batch %.9g %.9g %.9g pdf %.9g\n", fb[3], fb[4], fb[5], pdfb[1]);
 
+    /* How a renderer shades a hair hit: the frame and h from its own ray and curve
+     * (never from a ribbon's v coordinate, which runs the other way), the material
+     * prepared once, and a point per path vertex, in the host's own storage, shared by
+     * light evaluation and BSDF sampling. Same fibre and ray as above, in world space. */
+    const float tangent[3] = {2.0f, 0.0f, 0.0f}, org[3] = {0.0f, 0.5f, 5.0f};
+    const float dir[3] = {0.0f, 0.0f, -1.0f}, axis[3] = {0.0f, 0.0f, 0.0f};
+    HtHairFrame frame;
+    if (check(ht_hair_frame(tangent, org, dir, axis, 1.0f, &frame), "ht_hair_frame")) return 1;
+    const float to_viewer[3] = {-dir[0], -dir[1], -dir[2]};
+    const float to_light[3] = {0.0f, 0.8660254f, 0.5f};
+    float wo_local[3], wi_local[3];
+    if (check(ht_hair_frame_to_local(&frame, to_viewer, wo_local), "to_local")) return 1;
+    if (check(ht_hair_frame_to_local(&frame, to_light, wi_local), "to_local")) return 1;
+    printf("frame h %.9g\n", frame.h);
+    HtHairPrepared *brown;
+    if (check(ht_hair_prepare(&hair, &brown), "ht_hair_prepare")) return 1;
+    HtHairPoint point; /* HT_HAIR_POINT_SIZE bytes, 16-byte aligned by its type */
+    HtStatus init = ht_hair_point_init(brown, frame.h, wo_local, &point);
+    ht_hair_prepared_free(brown); /* the point keeps what it needs */
+    if (check(init, "ht_hair_point_init")) return 1;
+    if (check(ht_hair_point_eval(&point, wi_local, f, &pdf), "ht_hair_point_eval")) return 1;
+    printf("point %.9g %.9g %.9g pdf %.9g\n", f[0], f[1], f[2], pdf);
+    const float u0[3] = {0.25f, 0.5f, 0.5f};
+    float ws[3], wworld[3];
+    if (check(ht_hair_point_sample(&point, u0, ws, f, &pdf), "ht_hair_point_sample")) return 1;
+    if (check(ht_hair_frame_to_world(&frame, ws, wworld), "to_world")) return 1;
+    printf("sampled world %.6f %.6f %.6f pdf %.6g\n", wworld[0], wworld[1], wworld[2], pdf);
+
     /* White furnace by importance sampling: with no absorption every sample weight
      * f |wi.z| / pdf is 1, so the mean is 1. */
     HtHairParams white = hair;

@@ -16,6 +16,12 @@
 #define HT_RENDER 1
 #endif
 
+#if defined(_MSC_VER)
+#define HT_ALIGNED(n) __declspec(align(n))
+#else
+#define HT_ALIGNED(n) __attribute__((aligned(n)))
+#endif
+
 /**
  * Version of the C ABI; bumped on any incompatible change of a signature or struct. The
  * shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
@@ -37,6 +43,24 @@
  * The patch part of the library version.
  */
 #define HT_VERSION_PATCH 0
+
+/**
+ * How far past the radius (in radii) a ray may pass the axis and still count as a hit,
+ * its h clamped to +-1: room for a host's intersection code (Embree's flat curves are
+ * tessellated, and their hits reach 1.012 radii on a bent strand).
+ */
+#define HT_HAIR_FRAME_H_TOLERANCE 5e-2
+
+/**
+ * Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
+ * grow without changing the ABI.
+ */
+#define HT_HAIR_POINT_SIZE 384
+
+/**
+ * Alignment of an `HtHairPoint` in bytes.
+ */
+#define HT_HAIR_POINT_ALIGN 16
 
 /**
  * The largest magnitude, in world units, of a coordinate or a camera length the library
@@ -89,6 +113,13 @@ typedef enum HtStatus {
 typedef struct HtDevice HtDevice;
 #endif
 
+/**
+ * The hair BSDF prepared for one parameter set (the constants that depend on the
+ * parameters only). Create with `ht_hair_prepare`, release with `ht_hair_prepared_free`.
+ * Immutable: any number of threads may use one handle at once.
+ */
+typedef struct HtHairPrepared HtHairPrepared;
+
 #if defined(HT_RENDER)
 /**
  * A scene under construction and, after the first render, its built form. Not thread
@@ -105,18 +136,24 @@ typedef struct HtScene HtScene;
 #endif
 
 /**
- * Parameters of the hair BSDF: sigma_a per unit fibre radius (linear RGB, finite, >= 0),
- * eta in (1, 3], beta_m and beta_n in [0.01, 1], alpha (cuticle tilt) in degrees,
- * |alpha| <= 20. The frame: x along the fibre, y across it (h = offset along y over the
- * radius, in [-1, 1]), z toward the viewer; wo and wi unit vectors pointing away.
+ * Parameters of the hair BSDF (Chiang et al. 2016), all checked, never clamped:
+ * - `sigma_a`: absorption per unit fibre *radius* (so independent of the fibre's size),
+ *   linear RGB, each finite and >= 0; from `ht_hair_sigma_a_from_melanin` or
+ *   `ht_hair_sigma_a_from_color`.
+ * - `eta`: index of refraction, in (1, 3] (1.55 for keratin).
+ * - `beta_m`, `beta_n`: longitudinal and azimuthal roughness, each in [0.01, 1].
+ * - `alpha`: cuticle scale tilt in *degrees*, in [-20, 20] (pbrt's sign; Blender's
+ *   "Offset" is -alpha in radians).
+ *
+ * Directions and h live in the local hair frame described at `HtHairFrame`.
  */
 typedef struct HtHairParams {
     /**
-     * Absorption per unit fiber radius, linear RGB.
+     * Absorption per unit fiber radius, linear RGB, finite, >= 0.
      */
     float sigma_a[3];
     /**
-     * Index of refraction of the fiber.
+     * Index of refraction of the fiber, (1, 3].
      */
     float eta;
     /**
@@ -128,10 +165,76 @@ typedef struct HtHairParams {
      */
     float beta_n;
     /**
-     * Cuticle scale tilt, degrees.
+     * Cuticle scale tilt, degrees, [-20, 20].
      */
     float alpha;
 } HtHairParams;
+
+/**
+ * The local frame of the hair BSDF at a hit, and the hit's offset h across the fibre.
+ *
+ * THE CONVENTION (every BSDF call assumes it; nothing can detect a different one):
+ * - `x` = normalize(tangent): along the fibre, root to tip.
+ * - `y` = normalize(cross(x, d)), d the direction of the ray that hit: across the
+ *   fibre, perpendicular to the ray.
+ * - `z` = cross(x, y): perpendicular to both, facing the viewer (dot(z, d) <= 0).
+ * - `h` = dot(ray origin - axis point, y) / radius, in [-1, 1]: the signed offset of the
+ *   ray from the fibre's axis, *along +y*, in radii. `axis` is the point of the curve's
+ *   axis at the hit's curve parameter, `radius` the fibre radius there.
+ * - `wo` and `wi` are unit vectors in this frame (|length - 1| <= 1e-3), both pointing
+ *   away from the fibre: `wo` toward the viewer (-d at a camera hit), `wi` toward the
+ *   light. At the hit that defines the frame, wo = -d/|d| has y = 0 and z >= 0.
+ * - Ray along the tangent (cross(x, d) = 0): the fibre is seen end-on, every y
+ *   perpendicular to x is equally valid; `ht_hair_frame` picks one and measures h along
+ *   it.
+ *
+ * DO NOT use pbrt's or Embree's ribbon coordinate (v, or h = -1 + 2 v) for h: it runs
+ * along -y, and the call still returns HT_OK, with every azimuthal lobe mirrored. Example:
+ * a fibre along +x, a ray d = (0, 0, -1) passing the axis at y = +0.5 radius gives
+ * x = (1,0,0), y = (0,1,0), z = (0,0,1), h = +0.5, wo = (0,0,1); with alpha = 0 the R
+ * lobe peaks at wi = (0, 0.866, 0.5) (light from the +y side). With h = -0.5 instead, the
+ * highlight of a thick fibre lands half a radius on the wrong side. `ht_hair_frame`
+ * computes all of this; use it, or check your frame against it once.
+ */
+typedef struct HtHairFrame {
+    /**
+     * Unit tangent (world space).
+     */
+    float x[3];
+    /**
+     * Unit vector across the fibre, perpendicular to the ray (world space).
+     */
+    float y[3];
+    /**
+     * Unit vector toward the viewer, cross(x, y) (world space).
+     */
+    float z[3];
+    /**
+     * Offset of the ray from the axis along y, in radii, in [-1, 1].
+     */
+    float h;
+} HtHairFrame;
+
+/**
+ * Storage for the BSDF at one shading point (a prepared BSDF at a fixed h and wo), filled
+ * by `ht_hair_point_init` and then evaluated and sampled any number of times.
+ *
+ * - The host allocates it (stack, arrays, its own vertex structs): `HT_HAIR_POINT_SIZE`
+ *   bytes aligned to `HT_HAIR_POINT_ALIGN` (16); this type has both, so declaring an
+ *   `HtHairPoint` (or `malloc`, which aligns to 16 on 64-bit platforms) is enough. A
+ *   misaligned point is refused with `HT_ERR_INVALID_ARG`.
+ * - The bytes are opaque. They hold plain numbers and no pointer: a filled point is
+ *   self-contained, may be copied with `memcpy` or assignment, stays valid after its
+ *   `HtHairPrepared` is freed, and needs no release.
+ * - A point that `ht_hair_point_init` did not fill (zeroed, or overwritten) is refused
+ *   with `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised
+ *   storage.
+ * - Reading it from several threads at once is safe; filling it while another thread
+ *   reads it is a data race (the host's to avoid).
+ */
+typedef struct HT_ALIGNED(16) HtHairPoint {
+    uint8_t opaque[HT_HAIR_POINT_SIZE];
+} HtHairPoint;
 
 #if defined(HT_RENDER)
 /**
@@ -438,18 +541,57 @@ const char *ht_last_error(void);
 struct HtHairParams ht_hair_params_default(void);
 
 /**
- * sigma_a (per unit fiber radius) from melanin concentrations (finite, >= 0).
+ * Writes `sigma_a[3]` (per unit fibre radius) for melanin concentrations: eumelanin about
+ * 0.3 (blonde), 1.3 (brown), 8 (black); pheomelanin adds red.
+ *
+ * - `eumelanin`, `pheomelanin`: finite, >= 0, and small enough that sigma_a stays finite
+ *   (up to about 1e37), else `HT_ERR_INVALID_ARG`.
+ * - `sigma_a`: out, 3 floats, 4-byte aligned; NULL: `HT_ERR_NULL_ARG`. Untouched on error.
+ *
+ * Any thread.
+ *
+ * # Safety
+ * `sigma_a` is NULL or points to 3 writable floats.
  */
 enum HtStatus ht_hair_sigma_a_from_melanin(float eumelanin, float pheomelanin, float *sigma_a);
 
 /**
- * sigma_a that gives the reflectance `color` (each channel in (0, 1]) at roughness beta_n.
+ * Writes `sigma_a[3]` that makes a fibre look like the linear RGB reflectance `color` at
+ * azimuthal roughness `beta_n` (Chiang's inversion: pass the beta_n you render with).
+ *
+ * - `color`: 3 floats, each in (0, 1]; `beta_n` in [0.01, 1]; else `HT_ERR_INVALID_ARG`.
+ * - `sigma_a`: out, 3 floats. Both pointers 4-byte aligned, not NULL (`HT_ERR_NULL_ARG`),
+ *   and not overlapping (`HT_ERR_INVALID_ARG`). Untouched on error.
+ *
+ * Any thread.
+ *
+ * # Safety
+ * Each pointer is NULL or points to 3 floats (`sigma_a` writable).
  */
 enum HtStatus ht_hair_sigma_a_from_color(const float *color, float beta_n, float *sigma_a);
 
 /**
- * f (RGB, pbrt convention: includes 1/|wi.z|) and pdf (solid angle) for unit wo, wi in
- * the local hair frame at offset h in [-1, 1].
+ * Evaluates the BSDF for one (h, wo, wi): writes `f[3]` (linear RGB, per steradian,
+ * pbrt's convention: includes the 1/|wi.z| factor, so `f * |wi.z|` is the scattered
+ * fraction per unit solid angle) and `*pdf` (the density of `ht_hair_sample` at wi, per
+ * unit solid angle).
+ *
+ * - `params`: see `HtHairParams`; a value out of range: `HT_ERR_INVALID_ARG` naming it.
+ * - `h`: offset across the fibre in [-1, 1] (NaN refused); `wo`, `wi`: 3 floats each,
+ *   unit vectors (|length - 1| <= 1e-3) in the local frame, both pointing away from the
+ *   fibre. `HtHairFrame` says how to build the frame and h: a wrong frame or a flipped
+ *   h is *not* detectable here and gives HT_OK with mirrored lobes.
+ * - Pointers: none may be NULL (`HT_ERR_NULL_ARG`, checked before any value); all 4-byte
+ *   aligned; `f` and `pdf` must not overlap each other or an input (`HT_ERR_INVALID_ARG`).
+ *   Outputs are untouched on error. Nothing is kept after the call.
+ *
+ * Any thread, concurrently. Each thread keeps the last parameter set it saw with its
+ * prepared constants; calls alternating between materials prepare them every time:
+ * use `ht_hair_prepare` and `HtHairPoint` for that.
+ *
+ * # Safety
+ * Each pointer is NULL or points to its type (3 floats for `wo`, `wi`, `f`), outputs
+ * writable.
  */
 enum HtStatus ht_hair_eval(const struct HtHairParams *params,
                            float h,
@@ -459,8 +601,19 @@ enum HtStatus ht_hair_eval(const struct HtHairParams *params,
                            float *pdf);
 
 /**
- * Samples wi for wo at h from three uniform numbers u in [0, 1). On success pdf > 0;
- * pdf = 0 (with wi and f zero) means no direction could be sampled.
+ * Samples an incident direction for wo at h from three uniform numbers `u[3]` in [0, 1):
+ * writes `wi[3]` (unit, local frame, pointing away), `f[3]` and `*pdf` exactly as
+ * `ht_hair_eval` gives them at that wi. `f * |wi.z| / pdf` is the path weight. pdf = 0
+ * (with wi and f zero) means no direction could be sampled; the status is still HT_OK.
+ *
+ * Ranges of `params`, `h`, `wo` as in `ht_hair_eval`; `u[i]` outside [0, 1) or NaN:
+ * `HT_ERR_INVALID_ARG`. Pointers: none NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte
+ * aligned; the outputs `wi`, `f`, `pdf` must not overlap each other or an input
+ * (`HT_ERR_INVALID_ARG`). Outputs are untouched on error. Any thread, as `ht_hair_eval`.
+ *
+ * # Safety
+ * Each pointer is NULL or points to its type (3 floats for `wo`, `u`, `wi`, `f`),
+ * outputs writable.
  */
 enum HtStatus ht_hair_sample(const struct HtHairParams *params,
                              float h,
@@ -471,8 +624,21 @@ enum HtStatus ht_hair_sample(const struct HtHairParams *params,
                              float *pdf);
 
 /**
- * n evaluations at once (SIMD inside); `h[n]`, `wo[3n]`, `wi[3n]`, `f[3n]`, `pdf[n]`, tightly
- * packed. Every input is checked before anything is written.
+ * `n` evaluations at once (eight per SIMD step), each bit-identical to `ht_hair_eval`:
+ * reads `h[n]`, `wo[3n]`, `wi[3n]`, writes `f[3n]`, `pdf[n]`, tightly packed.
+ *
+ * - `params` is checked (NULL, ranges) even when `n` = 0.
+ * - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked before any
+ *   value); 4-byte aligned; `3n` floats must fit in memory (a huge or "negative" `n`:
+ *   `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other or an input
+ *   (`HT_ERR_INVALID_ARG`).
+ * - Every element is checked (ranges as in `ht_hair_eval`) before anything is written;
+ *   the message names the first bad element (`element 7: ...`).
+ *
+ * Any thread, as `ht_hair_eval`.
+ *
+ * # Safety
+ * Each array is NULL or holds the number of floats given above (outputs writable).
  */
 enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
                                  size_t n,
@@ -481,6 +647,202 @@ enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
                                  const float *wi,
                                  float *f,
                                  float *pdf);
+
+/**
+ * Builds the frame and h of a hit (the convention at `HtHairFrame`) from world-space
+ * inputs and writes them to `*frame`; the frame is computed in double precision.
+ *
+ * - `tangent`: the curve's tangent at the hit (any non-zero length, root to tip);
+ *   `ray_org`, `ray_dir`: the ray that hit (any non-zero length); `axis`: the axis point
+ *   at the hit's curve parameter; `radius`: the fibre radius there, finite and > 0.
+ * - Statuses: a NULL pointer, `HT_ERR_NULL_ARG` (checked first); misaligned pointers
+ *   (each 4-byte), `*frame` overlapping an input, a non-finite value, a zero tangent or
+ *   ray direction, a radius <= 0: `HT_ERR_INVALID_ARG`; a ray that passes the axis more
+ *   than `1 + HT_HAIR_FRAME_H_TOLERANCE` radii away (not a hit on this fibre: a diameter
+ *   passed as the radius, or the wrong axis point): `HT_ERR_INVALID_ARG`. Within the
+ *   tolerance h is clamped to +-1. `*frame` is untouched on error.
+ * - A ray along the tangent is valid: HT_OK with an arbitrary y perpendicular to x.
+ *
+ * Any thread; nothing is kept.
+ *
+ * # Safety
+ * Each float pointer is NULL or points to 3 floats; `frame` is NULL or writable.
+ */
+enum HtStatus ht_hair_frame(const float *tangent,
+                            const float *ray_org,
+                            const float *ray_dir,
+                            const float *axis,
+                            float radius,
+                            struct HtHairFrame *frame);
+
+/**
+ * Writes the world direction `w[3]` in the local frame to `out[3]`: (dot(w, x), dot(w, y),
+ * dot(w, z)). Lengths are kept (give unit vectors to get the BSDF's unit wo and wi);
+ * directions keep their sense (wo must point toward the viewer, i.e. -ray_dir).
+ *
+ * - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
+ *   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
+ * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
+ *   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
+ *   untouched on error.
+ *
+ * Any thread.
+ *
+ * # Safety
+ * `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
+ */
+enum HtStatus ht_hair_frame_to_local(const struct HtHairFrame *frame, const float *w, float *out);
+
+/**
+ * Writes the local direction `w[3]` (e.g. a sampled wi) in world space to `out[3]`:
+ * w.x x + w.y y + w.z z. Arguments and statuses as `ht_hair_frame_to_local`.
+ *
+ * # Safety
+ * As `ht_hair_frame_to_local`.
+ */
+enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const float *w, float *out);
+
+/**
+ * Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
+ * handle to `*out`.
+ *
+ * - `params`, `out`: not NULL (`HT_ERR_NULL_ARG`), aligned for their types. A parameter
+ *   out of range: `HT_ERR_INVALID_ARG` naming it, and `*out` is left untouched.
+ * - The handle is owned by the host: release it with `ht_hair_prepared_free`. Points
+ *   filled from it keep their own copy and outlive it.
+ *
+ * Any thread.
+ *
+ * # Safety
+ * `params` is NULL or points to an `HtHairParams`; `out` is NULL or writable.
+ */
+enum HtStatus ht_hair_prepare(const struct HtHairParams *params, struct HtHairPrepared **out);
+
+/**
+ * Releases a prepared BSDF (NULL: nothing to do; returns HT_OK). Points filled from it
+ * stay valid. Freeing a handle twice, or while another thread uses it, is undefined
+ * behaviour.
+ *
+ * # Safety
+ * `prepared` is NULL or a live handle from `ht_hair_prepare`, not used after this call.
+ */
+enum HtStatus ht_hair_prepared_free(struct HtHairPrepared *prepared);
+
+/**
+ * Fills `*point` with the BSDF of `prepared` at offset `h` and outgoing direction `wo`:
+ * the work that depends on (h, wo) (Fresnel, absorption, refraction) is done here once,
+ * and shared by every eval, pdf and sample at that point.
+ *
+ * - `h` in [-1, 1], `wo[3]` a unit vector (|length - 1| <= 1e-3) in the local frame
+ *   pointing away from the fibre (see `HtHairFrame`); else `HT_ERR_INVALID_ARG`.
+ * - `prepared`, `wo`, `point`: not NULL (`HT_ERR_NULL_ARG`, checked first); `wo` 4-byte
+ *   and `point` 16-byte aligned; `wo` must not lie inside `*point`. On error `*point` is
+ *   untouched.
+ *
+ * Any thread; `prepared` may be shared, `point` must not be read meanwhile.
+ *
+ * # Safety
+ * `prepared` is NULL or a live handle; `wo` NULL or 3 floats; `point` NULL or writable
+ * storage of `HT_HAIR_POINT_SIZE` bytes.
+ */
+enum HtStatus ht_hair_point_init(const struct HtHairPrepared *prepared,
+                                 float h,
+                                 const float *wo,
+                                 struct HtHairPoint *point);
+
+/**
+ * f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward
+ * `wi[3]` at a filled point: the same bits as `ht_hair_eval` with the point's parameters,
+ * h and wo.
+ *
+ * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame, pointing away;
+ *   else `HT_ERR_INVALID_ARG`.
+ * - `point`, `wi`, `f`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+ *   filled by `ht_hair_point_init` and 16-byte aligned, the floats 4-byte aligned
+ *   (`HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi` or the point
+ *   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *
+ * Any thread, concurrently on the same point.
+ *
+ * # Safety
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f` NULL or 3 floats,
+ * `pdf` NULL or 1 float; outputs writable.
+ */
+enum HtStatus ht_hair_point_eval(const struct HtHairPoint *point,
+                                 const float *wi,
+                                 float *f,
+                                 float *pdf);
+
+/**
+ * The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
+ * `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
+ * Arguments, statuses and thread safety as `ht_hair_point_eval`, without `f`.
+ *
+ * # Safety
+ * As `ht_hair_point_eval`.
+ */
+enum HtStatus ht_hair_point_pdf(const struct HtHairPoint *point, const float *wi, float *pdf);
+
+/**
+ * Samples an incident direction at a filled point from `u[3]` in [0, 1): writes `wi[3]`
+ * (unit, local frame), `f[3]` and `*pdf`, the same bits as `ht_hair_sample` with the
+ * point's parameters, h and wo. pdf = 0 (wi, f zero) means no direction; still HT_OK.
+ *
+ * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+ * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled and 16-byte
+ *   aligned, floats 4-byte aligned; `wi`, `f`, `pdf` must not overlap each other, `u` or
+ *   the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *
+ * Any thread, concurrently on the same point.
+ *
+ * # Safety
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `f` NULL or 3
+ * floats, `pdf` NULL or 1 float; outputs writable.
+ */
+enum HtStatus ht_hair_point_sample(const struct HtHairPoint *point,
+                                   const float *u,
+                                   float *wi,
+                                   float *f,
+                                   float *pdf);
+
+/**
+ * `ht_hair_point_eval` over `n` points at once: `points[n]` (each filled, possibly from
+ * different prepared BSDFs), `wi[3n]` in, `f[3n]` and `pdf[n]` out, tightly packed; each
+ * result bit-identical to `ht_hair_point_eval`.
+ *
+ * - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
+ *   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
+ *   "negative" `n`: `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi`
+ *   or `points` (`HT_ERR_INVALID_ARG`).
+ * - Every point and every `wi` is checked before anything is written; the message names
+ *   the first bad element (`element 7: ...`).
+ *
+ * Any thread, concurrently on the same points.
+ *
+ * # Safety
+ * Each array is NULL or holds the number of elements given above (outputs writable).
+ */
+enum HtStatus ht_hair_points_eval(const struct HtHairPoint *points,
+                                  size_t n,
+                                  const float *wi,
+                                  float *f,
+                                  float *pdf);
+
+/**
+ * `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
+ * `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
+ * `ht_hair_point_sample`. Checks and statuses as `ht_hair_points_eval` (every `u[i]` in
+ * [0, 1)); `wi`, `f` and `pdf` must not overlap each other, `u` or `points`.
+ *
+ * # Safety
+ * Each array is NULL or holds the number of elements given above (outputs writable).
+ */
+enum HtStatus ht_hair_points_sample(const struct HtHairPoint *points,
+                                    size_t n,
+                                    const float *u,
+                                    float *wi,
+                                    float *f,
+                                    float *pdf);
 
 #if defined(HT_RENDER)
 /**

@@ -15,9 +15,18 @@ const PHEOMELANIN_SIGMA_A: [f32; 3] = [0.187, 0.4, 1.05];
 pub fn sigma_a_from_melanin(eumelanin: f32, pheomelanin: f32) -> Result<[f32; 3]> {
     non_negative("eumelanin", eumelanin)?;
     non_negative("pheomelanin", pheomelanin)?;
-    Ok(std::array::from_fn(|i| {
+    let sigma_a: [f32; 3] = std::array::from_fn(|i| {
         eumelanin * EUMELANIN_SIGMA_A[i] + pheomelanin * PHEOMELANIN_SIGMA_A[i]
-    }))
+    });
+    // Finite inputs near f32::MAX overflow to an infinite sigma_a that the BSDF would
+    // refuse later; refuse it here, where the cause is known.
+    if !sigma_a.iter().all(|s| s.is_finite()) {
+        return Err(invalid_arg!(
+            "eumelanin = {eumelanin}, pheomelanin = {pheomelanin}: sigma_a overflows to \
+             infinity (about 8 is jet black)"
+        ));
+    }
+    Ok(sigma_a)
 }
 
 /// sigma_a that makes a fiber look like the reflectance `color` (each channel in (0, 1])
@@ -28,7 +37,7 @@ pub fn sigma_a_from_color(color: [f32; 3], beta_n: f32) -> Result<[f32; 3]> {
     for (i, &c) in color.iter().enumerate() {
         if !(c > 0.0 && c <= 1.0) {
             let why = if c > 1.0 {
-                "a fiber cannot reflect more than it receives"
+                "a fibre cannot reflect more than it receives"
             } else if c <= 0.0 {
                 "0 would need infinite absorption"
             } else {
@@ -73,6 +82,12 @@ mod tests {
         assert!(sigma_a_from_melanin(-1.0, 0.0).is_err());
         let e = sigma_a_from_melanin(0.0, f32::NAN).unwrap_err().to_string();
         assert!(e.contains("pheomelanin"), "{e}");
+        // Finite but overflowing concentrations are refused, not turned into inf.
+        let e = sigma_a_from_melanin(f32::MAX, f32::MAX)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("overflows"), "{e}");
+        assert!(sigma_a_from_melanin(1e37, 0.0).unwrap()[2].is_finite());
     }
 
     #[test]
@@ -82,7 +97,13 @@ mod tests {
         let s = sigma_a_from_color([0.8, 0.5, 0.2], 0.3).unwrap();
         assert!(s[0] < s[1] && s[1] < s[2]);
         assert!(sigma_a_from_color([0.0, 0.5, 0.5], 0.3).is_err());
-        assert!(sigma_a_from_color([0.5, 1.5, 0.5], 0.3).is_err());
+        let e = sigma_a_from_color([0.5, 1.5, 0.5], 0.3)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("color[1] = 1.5") && e.contains("more than"),
+            "{e}"
+        );
         let back = color_from_sigma_a(s, 0.3);
         for (b, c) in back.iter().zip([0.8, 0.5, 0.2]) {
             assert!((b - c).abs() < 1e-5, "{back:?}");

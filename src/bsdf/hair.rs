@@ -29,7 +29,8 @@ const EXPLICIT_LOBES: usize = 3;
 const MIN_COS_WI: f32 = 1e-20;
 
 /// The hair BSDF for one parameter set, with every parameter-only constant precomputed.
-#[derive(Debug, Clone, PartialEq)]
+/// Plain numbers only (`Copy`), so a copy can travel inside a self-contained point.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HairBsdf {
     params: HairParams,
     /// Mp of R, TT, TRT and the residual lobe.
@@ -42,6 +43,7 @@ pub struct HairBsdf {
 }
 
 /// Everything that depends on (h, wo) but not on wi.
+#[derive(Clone, Copy)]
 struct Outgoing<T> {
     sin_to: T,
     cos_to: T,
@@ -79,9 +81,16 @@ impl HairBsdf {
     /// and shared by every `eval`, `pdf` and `sample` at that point (next-event
     /// estimation and BSDF sampling of a path vertex use the same point).
     pub fn at(&self, h: f32, wo: Vec3) -> HairPoint<'_> {
-        let wo = wo.to_array();
         HairPoint {
             bsdf: self,
+            at: self.vertex(h, wo),
+        }
+    }
+
+    /// The (h, wo) part of a point, without the reference back to the BSDF.
+    fn vertex(&self, h: f32, wo: Vec3) -> Vertex {
+        let wo = wo.to_array();
+        Vertex {
             wo,
             o: self.outgoing(h, wo),
         }
@@ -100,7 +109,7 @@ impl HairBsdf {
     /// Energy of each lobe (R, TT, TRT, residual) leaving wo at h: the lobes' Mp and Np
     /// integrate to one, so this is Ap.
     pub fn lobe_energies(&self, h: f32, wo: Vec3) -> [Vec3; 4] {
-        self.at(h, wo).o.ap.map(Vec3::from_array)
+        self.vertex(h, wo).o.ap.map(Vec3::from_array)
     }
 
     /// Samples wi: `u[0]` picks the lobe (proportionally to its mean attenuation) and is
@@ -298,23 +307,70 @@ impl LocalBsdf for HairPoint<'_> {
 /// [`HairBsdf`] at a fixed (h, wo); see [`HairBsdf::at`].
 pub struct HairPoint<'a> {
     bsdf: &'a HairBsdf,
-    wo: [f32; 3],
-    o: Outgoing<f32>,
+    at: Vertex,
 }
 
 impl HairPoint<'_> {
     /// f and pdf for the incident direction wi.
     pub fn eval(&self, wi: Vec3) -> BsdfEval {
-        let (f, pdf) = self.bsdf.eval_lobes_packed(&self.o, self.wo, wi.to_array());
+        self.bsdf.eval_at(&self.at, wi)
+    }
+
+    /// Samples wi; see [`HairBsdf::sample`].
+    pub fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        self.bsdf.sample_at(&self.at, u)
+    }
+}
+
+/// A [`HairPoint`] that holds its own copy of the BSDF instead of a reference: plain
+/// numbers that may be copied byte for byte and outlive the [`HairBsdf`] they came from
+/// (the C ABI keeps it in host memory). It runs the same code, so gives the same bits.
+#[derive(Clone, Copy)]
+pub(crate) struct OwnedPoint {
+    bsdf: HairBsdf,
+    at: Vertex,
+}
+
+impl OwnedPoint {
+    pub(crate) fn new(bsdf: &HairBsdf, h: f32, wo: Vec3) -> Self {
+        Self {
+            bsdf: *bsdf,
+            at: bsdf.vertex(h, wo),
+        }
+    }
+
+    #[inline]
+    pub(crate) fn eval(&self, wi: Vec3) -> BsdfEval {
+        self.bsdf.eval_at(&self.at, wi)
+    }
+
+    pub(crate) fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        self.bsdf.sample_at(&self.at, u)
+    }
+}
+
+/// What a point keeps of (h, wo).
+#[derive(Clone, Copy)]
+struct Vertex {
+    wo: [f32; 3],
+    o: Outgoing<f32>,
+}
+
+impl HairBsdf {
+    /// f and pdf toward wi at a prepared vertex.
+    #[inline(always)]
+    fn eval_at(&self, at: &Vertex, wi: Vec3) -> BsdfEval {
+        let (f, pdf) = self.eval_lobes_packed(&at.o, at.wo, wi.to_array());
         BsdfEval {
             f: Vec3::from_array(f),
             pdf,
         }
     }
 
-    /// Samples wi; see [`HairBsdf::sample`].
-    pub fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
-        let (bsdf, o, wo) = (self.bsdf, &self.o, self.wo);
+    /// Samples wi at a prepared vertex; see [`HairBsdf::sample`].
+    #[inline]
+    fn sample_at(&self, at: &Vertex, u: [f32; 3]) -> Option<BsdfSample> {
+        let (o, wo) = (&at.o, at.wo);
         let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
         // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
         // density underflows, from being sampled with a whole 2^-24 of probability.
@@ -325,9 +381,9 @@ impl HairPoint<'_> {
         } else {
             (o.sin_to, o.cos_to)
         };
-        let (sin_ti, cos_ti) = bsdf.mp[p].sample(sin_to, cos_to, [u_theta, u[2]]);
+        let (sin_ti, cos_ti) = self.mp[p].sample(sin_to, cos_to, [u_theta, u[2]]);
         let dphi = if p < EXPLICIT_LOBES {
-            o.deflection[p] + bsdf.np.sample(u_phi)
+            o.deflection[p] + self.np.sample(u_phi)
         } else {
             TAU * u_phi
         };
@@ -345,7 +401,7 @@ impl HairPoint<'_> {
             cos_ti * (cos_po * cos_d - sin_po * sin_d),
             cos_ti * (sin_po * cos_d + cos_po * sin_d),
         );
-        let e = self.eval(wi);
+        let e = self.eval_at(at, wi);
         (e.pdf > 0.0).then_some(BsdfSample {
             wi,
             f: e.f,

@@ -13,6 +13,7 @@ pub(crate) mod params;
 pub use absorption::{sigma_a_from_color, sigma_a_from_melanin};
 pub use diffuse::Diffuse;
 pub use diffuse::DiffusePoint;
+pub(crate) use hair::OwnedPoint;
 pub use hair::{HairBsdf, HairPoint};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
 pub use params::HairParams;

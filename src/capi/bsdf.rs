@@ -1,32 +1,46 @@
 //! The hair BSDF through the C ABI: the Rust model's eval and sample, with every input
-//! checked (docs/c-abi.md).
+//! checked (docs/c-abi.md). The prepared handle and per-vertex point are in `prepared.rs`,
+//! the frame helpers in `frame.rs`.
 //!
 //! Hosts pass the parameters with every call. Building the per-parameter constants costs
 //! about as much as an evaluation, so each thread keeps the last parameter set it saw and
 //! its prepared BSDF, and reuses them while the parameters stay the same.
+//!
+//! Every entry point checks its pointers (NULL, then alignment, sizes and overlap) before
+//! any value, so a NULL pointer is always `HT_ERR_NULL_ARG` whatever else is wrong.
 
-use super::{Failure, HtStatus, boundary, non_null, non_null_mut, read_vec3};
-use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
+use super::{
+    Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
+};
+use crate::bsdf::{
+    BsdfEval, BsdfSample, HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin,
+};
 use crate::error::invalid_arg;
 use glam::Vec3;
 use std::cell::RefCell;
 
-/// Parameters of the hair BSDF: sigma_a per unit fibre radius (linear RGB, finite, >= 0),
-/// eta in (1, 3], beta_m and beta_n in [0.01, 1], alpha (cuticle tilt) in degrees,
-/// |alpha| <= 20. The frame: x along the fibre, y across it (h = offset along y over the
-/// radius, in [-1, 1]), z toward the viewer; wo and wi unit vectors pointing away.
+/// Parameters of the hair BSDF (Chiang et al. 2016), all checked, never clamped:
+/// - `sigma_a`: absorption per unit fibre *radius* (so independent of the fibre's size),
+///   linear RGB, each finite and >= 0; from `ht_hair_sigma_a_from_melanin` or
+///   `ht_hair_sigma_a_from_color`.
+/// - `eta`: index of refraction, in (1, 3] (1.55 for keratin).
+/// - `beta_m`, `beta_n`: longitudinal and azimuthal roughness, each in [0.01, 1].
+/// - `alpha`: cuticle scale tilt in *degrees*, in [-20, 20] (pbrt's sign; Blender's
+///   "Offset" is -alpha in radians).
+///
+/// Directions and h live in the local hair frame described at `HtHairFrame`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HtHairParams {
-    /// Absorption per unit fiber radius, linear RGB.
+    /// Absorption per unit fiber radius, linear RGB, finite, >= 0.
     pub sigma_a: [f32; 3],
-    /// Index of refraction of the fiber.
+    /// Index of refraction of the fiber, (1, 3].
     pub eta: f32,
     /// Longitudinal roughness, [0.01, 1].
     pub beta_m: f32,
     /// Azimuthal roughness, [0.01, 1].
     pub beta_n: f32,
-    /// Cuticle scale tilt, degrees.
+    /// Cuticle scale tilt, degrees, [-20, 20].
     pub alpha: f32,
 }
 
@@ -58,9 +72,13 @@ thread_local! {
     static PREPARED: RefCell<Option<HairBsdf>> = const { RefCell::new(None) };
 }
 
+/// Copies the host's parameters (NULL: `HT_ERR_NULL_ARG`; misaligned: invalid).
+pub(super) fn read_params(ptr: *const HtHairParams) -> Result<HairParams, Failure> {
+    Ok(host_slice(ptr, 1, "params")?[0].into())
+}
+
 /// Runs `f` with the BSDF for `params`, prepared once per parameter set and thread.
-fn with_bsdf<R>(params: *const HtHairParams, f: impl FnOnce(&HairBsdf) -> R) -> Result<R, Failure> {
-    let params: HairParams = unsafe { *non_null(params, "params")? }.into();
+fn with_bsdf<R>(params: HairParams, f: impl FnOnce(&HairBsdf) -> R) -> Result<R, Failure> {
     PREPARED.with(|cell| {
         let mut slot = cell.borrow_mut();
         // Compare bit patterns so that a NaN parameter is never taken as "unchanged".
@@ -79,33 +97,144 @@ fn bits(p: &HairParams) -> [u32; 7] {
     [s[0], s[1], s[2], p.eta, p.beta_m, p.beta_n, p.alpha].map(f32::to_bits)
 }
 
-/// Reads a float[3] direction and checks that it is a finite unit vector.
-fn read_dir(ptr: *const f32, name: &str) -> Result<Vec3, Failure> {
-    let v = read_vec3(ptr, name)?;
-    check_dir(v, name)?;
-    Ok(v)
-}
+/// Largest accepted |length - 1| of a direction.
+pub(super) const UNIT_TOLERANCE: f32 = 1e-3;
 
-/// Directions must be unit length to 1e-3: the model reads angles from components.
-fn check_dir(v: Vec3, name: &str) -> Result<(), Failure> {
-    let len = v.length();
-    if !(v.is_finite() && (len - 1.0).abs() <= 1e-3) {
-        return Err(
-            invalid_arg!("{name} = {v}: must be a finite unit vector (length {len})").into(),
-        );
+/// Checks that a direction is a finite unit vector (to [`UNIT_TOLERANCE`]): the model reads
+/// angles from its components.
+#[inline(always)]
+pub(super) fn check_dir(v: Vec3, name: &str) -> Result<Vec3, Failure> {
+    // Squared length against the squared bounds: no square root on the hot path.
+    let (lo, hi) = (
+        (1.0 - UNIT_TOLERANCE).powi(2),
+        (1.0 + UNIT_TOLERANCE).powi(2),
+    );
+    let len2 = v.length_squared();
+    if len2 >= lo && len2 <= hi {
+        Ok(v)
+    } else {
+        Err(not_unit(v, name))
     }
-    Ok(())
 }
 
-fn check_h(h: f32) -> Result<(), Failure> {
+#[cold]
+#[inline(never)]
+fn not_unit(v: Vec3, name: &str) -> Failure {
+    invalid_arg!(
+        "{name} = {v}: must be a finite unit vector (length {}, tolerance {UNIT_TOLERANCE})",
+        v.length()
+    )
+    .into()
+}
+
+pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
     if !(-1.0..=1.0).contains(&h) {
         return Err(invalid_arg!("h = {h}: must be in [-1, 1]").into());
     }
+    Ok(h)
+}
+
+/// Checks three uniform numbers in [0, 1).
+pub(super) fn check_u(u: [f32; 3], name: &str) -> Result<[f32; 3], Failure> {
+    if let Some(bad) = u.iter().position(|x| !(0.0..1.0).contains(x)) {
+        return Err(invalid_arg!("{name}[{bad}] = {}: must be in [0, 1)", u[bad]).into());
+    }
+    Ok(u)
+}
+
+/// NULL-checks every pointer of a call before anything else, so that a NULL pointer is
+/// reported as such whatever else is wrong with the call.
+pub(super) fn require(ptrs: &[(*const (), &str)]) -> Result<(), Failure> {
+    for &(p, name) in ptrs {
+        non_null(p, name)?;
+    }
     Ok(())
 }
 
-fn write3(ptr: *mut f32, v: [f32; 3]) {
+/// A float array of a call: pointer, name, length in floats.
+pub(super) type Arg = (*const f32, &'static str, usize);
+
+/// The common case of a call's float arrays, checked inline and cheaply: every pointer
+/// non-NULL and aligned, every output clear of the inputs, of `extra` (another byte range
+/// the call reads, as (address, bytes)) and of the other outputs. When it is false the
+/// call runs its full checks, which name the problem.
+#[inline(always)]
+pub(super) fn clean_args(inputs: &[Arg], outputs: &[Arg], extra: (usize, usize)) -> bool {
+    let usable = |p: *const f32| !p.is_null() && p.is_aligned();
+    let bytes = |(p, _, n): Arg| (p as usize, n * size_of::<f32>());
+    let apart = |(a, m): (usize, usize), (b, n): (usize, usize)| a + m <= b || b + n <= a;
+    inputs.iter().chain(outputs).all(|a| usable(a.0))
+        && outputs.iter().enumerate().all(|(k, &o)| {
+            apart(bytes(o), extra)
+                && inputs
+                    .iter()
+                    .chain(&outputs[k + 1..])
+                    .all(|&i| apart(bytes(o), bytes(i)))
+        })
+}
+
+/// The pointers of a call: `head` (the struct it reads first: parameters or a point)
+/// and its float arrays, checked inline by [`clean_args`] in the common case, else in the
+/// documented order with messages: every NULL first, then alignment and sizes, then the
+/// overlap of each output with the other outputs, the inputs and `head`.
+#[inline(always)]
+pub(super) fn check_args<H>(
+    head: (*const H, &'static str),
+    inputs: &[Arg],
+    outputs: &[Arg],
+) -> Result<(), Failure> {
+    let ptr = head.0;
+    let extra = (ptr as usize, size_of::<H>());
+    if !ptr.is_null() && ptr.is_aligned() && clean_args(inputs, outputs, extra) {
+        return Ok(());
+    }
+    full_checks(head, inputs, outputs)
+}
+
+#[cold]
+#[inline(never)]
+fn full_checks<H>(
+    (ptr, name): (*const H, &'static str),
+    inputs: &[Arg],
+    outputs: &[Arg],
+) -> Result<(), Failure> {
+    let mut all = vec![(ptr.cast::<()>(), name)];
+    all.extend(inputs.iter().chain(outputs).map(|a| (a.0.cast(), a.1)));
+    require(&all)?;
+    host_slice(ptr, 1, name)?;
+    for &(p, arg, n) in inputs.iter().chain(outputs) {
+        host_slice(p, n, arg)?;
+    }
+    let span = |&(p, arg, n): &Arg| Span::of(arg, p, n);
+    let mut read: Vec<_> = inputs.iter().map(span).collect();
+    read.push(Span::of(name, ptr, 1));
+    check_disjoint(&outputs.iter().map(span).collect::<Vec<_>>(), &read)
+}
+
+/// Reads a `float[3]` that [`clean_args`] or the full checks have passed.
+#[inline(always)]
+pub(super) fn read3(ptr: *const f32) -> Vec3 {
+    // SAFETY: non-NULL and aligned (checked), 3 floats (the caller's promise).
+    Vec3::from_array(unsafe { ptr.cast::<[f32; 3]>().read() })
+}
+
+/// Writes a `float[3]` that [`clean_args`] or the full checks have passed.
+#[inline(always)]
+pub(super) fn write3(ptr: *mut f32, v: [f32; 3]) {
+    // SAFETY: non-NULL, aligned and clear of every input (checked), 3 writable floats.
     unsafe { ptr.cast::<[f32; 3]>().write(v) }
+}
+
+/// Writes one float that [`clean_args`] or the full checks have passed.
+#[inline(always)]
+pub(super) fn write1(ptr: *mut f32, v: f32) {
+    // SAFETY: as `write3`.
+    unsafe { ptr.write(v) }
+}
+
+/// The host's `float[3]`, already checked for NULL and alignment by [`host_slice`].
+pub(super) fn vec3(s: &[f32]) -> Vec3 {
+    Vec3::new(s[0], s[1], s[2])
 }
 
 /// Brown hair: sigma_a from eumelanin 1.3, eta 1.55, beta_m = beta_n = 0.3, alpha = 2.
@@ -114,39 +243,87 @@ pub extern "C" fn ht_hair_params_default() -> HtHairParams {
     HairParams::default().into()
 }
 
-/// sigma_a (per unit fiber radius) from melanin concentrations (finite, >= 0).
+/// Writes `sigma_a[3]` (per unit fibre radius) for melanin concentrations: eumelanin about
+/// 0.3 (blonde), 1.3 (brown), 8 (black); pheomelanin adds red.
+///
+/// - `eumelanin`, `pheomelanin`: finite, >= 0, and small enough that sigma_a stays finite
+///   (up to about 1e37), else `HT_ERR_INVALID_ARG`.
+/// - `sigma_a`: out, 3 floats, 4-byte aligned; NULL: `HT_ERR_NULL_ARG`. Untouched on error.
+///
+/// Any thread.
+///
+/// # Safety
+/// `sigma_a` is NULL or points to 3 writable floats.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_hair_sigma_a_from_melanin(
+pub unsafe extern "C" fn ht_hair_sigma_a_from_melanin(
     eumelanin: f32,
     pheomelanin: f32,
     sigma_a: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        let out = non_null_mut(sigma_a, "sigma_a")?;
-        write3(out, sigma_a_from_melanin(eumelanin, pheomelanin)?);
+        let out = host_slice_mut(sigma_a, 3, "sigma_a")?;
+        out.copy_from_slice(&sigma_a_from_melanin(eumelanin, pheomelanin)?);
         Ok(())
     })
 }
 
-/// sigma_a that gives the reflectance `color` (each channel in (0, 1]) at roughness beta_n.
+/// Writes `sigma_a[3]` that makes a fibre look like the linear RGB reflectance `color` at
+/// azimuthal roughness `beta_n` (Chiang's inversion: pass the beta_n you render with).
+///
+/// - `color`: 3 floats, each in (0, 1]; `beta_n` in [0.01, 1]; else `HT_ERR_INVALID_ARG`.
+/// - `sigma_a`: out, 3 floats. Both pointers 4-byte aligned, not NULL (`HT_ERR_NULL_ARG`),
+///   and not overlapping (`HT_ERR_INVALID_ARG`). Untouched on error.
+///
+/// Any thread.
+///
+/// # Safety
+/// Each pointer is NULL or points to 3 floats (`sigma_a` writable).
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_hair_sigma_a_from_color(
+pub unsafe extern "C" fn ht_hair_sigma_a_from_color(
     color: *const f32,
     beta_n: f32,
     sigma_a: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        let color = read_vec3(color, "color")?.to_array();
-        let out = non_null_mut(sigma_a, "sigma_a")?;
-        write3(out, sigma_a_from_color(color, beta_n)?);
+        require(&[
+            (color.cast(), "color"),
+            (sigma_a.cast_const().cast(), "sigma_a"),
+        ])?;
+        let rgb = vec3(host_slice(color, 3, "color")?).to_array();
+        host_slice(sigma_a.cast_const(), 3, "sigma_a")?;
+        check_disjoint(
+            &[Span::of("sigma_a", sigma_a, 3)],
+            &[Span::of("color", color, 3)],
+        )?;
+        let rgb = sigma_a_from_color(rgb, beta_n)?;
+        host_slice_mut(sigma_a, 3, "sigma_a")?.copy_from_slice(&rgb);
         Ok(())
     })
 }
 
-/// f (RGB, pbrt convention: includes 1/|wi.z|) and pdf (solid angle) for unit wo, wi in
-/// the local hair frame at offset h in [-1, 1].
+/// Evaluates the BSDF for one (h, wo, wi): writes `f[3]` (linear RGB, per steradian,
+/// pbrt's convention: includes the 1/|wi.z| factor, so `f * |wi.z|` is the scattered
+/// fraction per unit solid angle) and `*pdf` (the density of `ht_hair_sample` at wi, per
+/// unit solid angle).
+///
+/// - `params`: see `HtHairParams`; a value out of range: `HT_ERR_INVALID_ARG` naming it.
+/// - `h`: offset across the fibre in [-1, 1] (NaN refused); `wo`, `wi`: 3 floats each,
+///   unit vectors (|length - 1| <= 1e-3) in the local frame, both pointing away from the
+///   fibre. `HtHairFrame` says how to build the frame and h: a wrong frame or a flipped
+///   h is *not* detectable here and gives HT_OK with mirrored lobes.
+/// - Pointers: none may be NULL (`HT_ERR_NULL_ARG`, checked before any value); all 4-byte
+///   aligned; `f` and `pdf` must not overlap each other or an input (`HT_ERR_INVALID_ARG`).
+///   Outputs are untouched on error. Nothing is kept after the call.
+///
+/// Any thread, concurrently. Each thread keeps the last parameter set it saw with its
+/// prepared constants; calls alternating between materials prepare them every time:
+/// use `ht_hair_prepare` and `HtHairPoint` for that.
+///
+/// # Safety
+/// Each pointer is NULL or points to its type (3 floats for `wo`, `wi`, `f`), outputs
+/// writable.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_hair_eval(
+pub unsafe extern "C" fn ht_hair_eval(
     params: *const HtHairParams,
     h: f32,
     wo: *const f32,
@@ -155,20 +332,35 @@ pub extern "C" fn ht_hair_eval(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        check_h(h)?;
-        let (wo, wi) = (read_dir(wo, "wo")?, read_dir(wi, "wi")?);
-        let (f_out, pdf_out) = (non_null_mut(f, "f")?, non_null_mut(pdf, "pdf")?);
-        let e = with_bsdf(params, |b| b.eval(h, wo, wi))?;
-        write3(f_out, e.f.to_array());
-        unsafe { pdf_out.write(e.pdf) };
+        let (inputs, outputs) = (
+            [(wo, "wo", 3), (wi, "wi", 3)],
+            [(f.cast_const(), "f", 3), (pdf.cast_const(), "pdf", 1)],
+        );
+        check_args((params, "params"), &inputs, &outputs)?;
+        // SAFETY: non-NULL and aligned (checked above).
+        let params = HairParams::from(unsafe { params.read() });
+        let h = check_h(h)?;
+        let (wo, wi) = (check_dir(read3(wo), "wo")?, check_dir(read3(wi), "wi")?);
+        write_eval(with_bsdf(params, |b| b.eval(h, wo, wi))?, f, pdf);
         Ok(())
     })
 }
 
-/// Samples wi for wo at h from three uniform numbers u in [0, 1). On success pdf > 0;
-/// pdf = 0 (with wi and f zero) means no direction could be sampled.
+/// Samples an incident direction for wo at h from three uniform numbers `u[3]` in [0, 1):
+/// writes `wi[3]` (unit, local frame, pointing away), `f[3]` and `*pdf` exactly as
+/// `ht_hair_eval` gives them at that wi. `f * |wi.z| / pdf` is the path weight. pdf = 0
+/// (with wi and f zero) means no direction could be sampled; the status is still HT_OK.
+///
+/// Ranges of `params`, `h`, `wo` as in `ht_hair_eval`; `u[i]` outside [0, 1) or NaN:
+/// `HT_ERR_INVALID_ARG`. Pointers: none NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte
+/// aligned; the outputs `wi`, `f`, `pdf` must not overlap each other or an input
+/// (`HT_ERR_INVALID_ARG`). Outputs are untouched on error. Any thread, as `ht_hair_eval`.
+///
+/// # Safety
+/// Each pointer is NULL or points to its type (3 floats for `wo`, `u`, `wi`, `f`),
+/// outputs writable.
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_hair_sample(
+pub unsafe extern "C" fn ht_hair_sample(
     params: *const HtHairParams,
     h: f32,
     wo: *const f32,
@@ -178,32 +370,64 @@ pub extern "C" fn ht_hair_sample(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        check_h(h)?;
-        let wo = read_dir(wo, "wo")?;
-        let u = read_vec3(u, "u")?.to_array();
-        if let Some(bad) = u.iter().position(|x| !(0.0..1.0).contains(x)) {
-            return Err(invalid_arg!("u[{bad}] = {}: must be in [0, 1)", u[bad]).into());
-        }
-        let (wi_out, f_out, pdf_out) = (
-            non_null_mut(wi, "wi")?,
-            non_null_mut(f, "f")?,
-            non_null_mut(pdf, "pdf")?,
-        );
-        let s = with_bsdf(params, |b| b.sample(h, wo, u))?;
-        let (d, v, p) = s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
-            (s.wi.to_array(), s.f.to_array(), s.pdf)
-        });
-        write3(wi_out, d);
-        write3(f_out, v);
-        unsafe { pdf_out.write(p) };
+        let inputs = [(wo, "wo", 3), (u, "u", 3)];
+        let outputs = [
+            (wi.cast_const(), "wi", 3),
+            (f.cast_const(), "f", 3),
+            (pdf.cast_const(), "pdf", 1),
+        ];
+        check_args((params, "params"), &inputs, &outputs)?;
+        // SAFETY: non-NULL and aligned (checked above).
+        let params = HairParams::from(unsafe { params.read() });
+        let h = check_h(h)?;
+        let wo = check_dir(read3(wo), "wo")?;
+        let u = check_u(read3(u).to_array(), "u")?;
+        write_sample(with_bsdf(params, |b| b.sample(h, wo, u))?, wi, f, pdf);
         Ok(())
     })
 }
 
-/// n evaluations at once (SIMD inside); `h[n]`, `wo[3n]`, `wi[3n]`, `f[3n]`, `pdf[n]`, tightly
-/// packed. Every input is checked before anything is written.
+/// Writes an evaluation to outputs that [`check_args`] has passed.
+#[inline(always)]
+pub(super) fn write_eval(e: BsdfEval, f: *mut f32, pdf: *mut f32) {
+    write3(f, e.f.to_array());
+    write1(pdf, e.pdf);
+}
+
+/// Writes a sample (zeros when there is none) to outputs that [`check_args`] has passed.
+#[inline(always)]
+pub(super) fn write_sample(s: Option<BsdfSample>, wi: *mut f32, f: *mut f32, pdf: *mut f32) {
+    let (d, v, p) = sample_parts(s);
+    write3(wi, d);
+    write3(f, v);
+    write1(pdf, p);
+}
+
+/// A sample's wi, f and pdf, or zeros when there is none (the C ABI's "pdf = 0").
+#[inline(always)]
+pub(super) fn sample_parts(s: Option<BsdfSample>) -> ([f32; 3], [f32; 3], f32) {
+    s.map_or(([0.0; 3], [0.0; 3], 0.0), |s| {
+        (s.wi.to_array(), s.f.to_array(), s.pdf)
+    })
+}
+
+/// `n` evaluations at once (eight per SIMD step), each bit-identical to `ht_hair_eval`:
+/// reads `h[n]`, `wo[3n]`, `wi[3n]`, writes `f[3n]`, `pdf[n]`, tightly packed.
+///
+/// - `params` is checked (NULL, ranges) even when `n` = 0.
+/// - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked before any
+///   value); 4-byte aligned; `3n` floats must fit in memory (a huge or "negative" `n`:
+///   `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other or an input
+///   (`HT_ERR_INVALID_ARG`).
+/// - Every element is checked (ranges as in `ht_hair_eval`) before anything is written;
+///   the message names the first bad element (`element 7: ...`).
+///
+/// Any thread, as `ht_hair_eval`.
+///
+/// # Safety
+/// Each array is NULL or holds the number of floats given above (outputs writable).
 #[unsafe(no_mangle)]
-pub extern "C" fn ht_hair_eval_batch(
+pub unsafe extern "C" fn ht_hair_eval_batch(
     params: *const HtHairParams,
     n: usize,
     h: *const f32,
@@ -213,29 +437,51 @@ pub extern "C" fn ht_hair_eval_batch(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        if n == 0 {
-            return Ok(());
+        non_null(params, "params")?;
+        if n > 0 {
+            require(&[
+                (h.cast(), "h"),
+                (wo.cast(), "wo"),
+                (wi.cast(), "wi"),
+                (f.cast_const().cast(), "f"),
+                (pdf.cast_const().cast(), "pdf"),
+            ])?;
         }
-        let (h, wo, wi) = (non_null(h, "h")?, non_null(wo, "wo")?, non_null(wi, "wi")?);
-        let (f, pdf) = (non_null_mut(f, "f")?, non_null_mut(pdf, "pdf")?);
-        let (h, wo, wi, f, pdf) = unsafe {
-            (
-                std::slice::from_raw_parts(h, n),
-                std::slice::from_raw_parts(wo.cast::<[f32; 3]>(), n),
-                std::slice::from_raw_parts(wi.cast::<[f32; 3]>(), n),
-                std::slice::from_raw_parts_mut(f.cast::<[f32; 3]>(), n),
-                std::slice::from_raw_parts_mut(pdf, n),
-            )
-        };
-        for i in 0..n {
-            check_h(h[i])
-                .and_then(|_| check_dir(Vec3::from_array(wo[i]), "wo"))
-                .and_then(|_| check_dir(Vec3::from_array(wi[i]), "wi"))
-                .map_err(|Failure(s, m)| Failure(s, format!("element {i}: {m}")))?;
-        }
-        with_bsdf(params, |b| b.eval_batch(h, wo, wi, f, pdf))??;
-        Ok(())
+        let params = read_params(params)?;
+        let h = host_slice(h, n, "h")?;
+        let wo = host_slice(wo.cast::<[f32; 3]>(), n, "wo")?;
+        let wi = host_slice(wi.cast::<[f32; 3]>(), n, "wi")?;
+        let f = f.cast::<[f32; 3]>();
+        host_slice(f.cast_const(), n, "f")?;
+        host_slice(pdf.cast_const(), n, "pdf")?;
+        check_disjoint(
+            &[Span::of("f", f, n), Span::of("pdf", pdf, n)],
+            &[
+                Span::of("h", h.as_ptr(), h.len()),
+                Span::of("wo", wo.as_ptr(), wo.len()),
+                Span::of("wi", wi.as_ptr(), wi.len()),
+            ],
+        )?;
+        with_bsdf(params, |b| -> Result<(), Failure> {
+            for i in 0..n {
+                check_h(h[i])
+                    .and_then(|_| check_dir(Vec3::from_array(wo[i]), "wo"))
+                    .and_then(|_| check_dir(Vec3::from_array(wi[i]), "wi"))
+                    .map_err(|Failure(s, m)| Failure(s, format!("element {i}: {m}")))?;
+            }
+            let (f, pdf) = (host_slice_mut(f, n, "f")?, host_slice_mut(pdf, n, "pdf")?);
+            Ok(b.eval_batch(h, wo, wi, f, pdf)?)
+        })?
     })
+}
+
+/// The calling thread's last error message, for the tests of the BSDF entry points.
+#[cfg(test)]
+pub(super) fn last_error() -> String {
+    // SAFETY: ht_last_error returns a valid NUL-terminated string.
+    unsafe { std::ffi::CStr::from_ptr(super::ht_last_error()) }
+        .to_string_lossy()
+        .into_owned()
 }
 
 #[cfg(test)]
@@ -244,50 +490,119 @@ mod tests {
     use std::ptr::{null, null_mut};
 
     #[test]
-    fn null_and_bad_arguments_are_reported() {
-        let p = ht_hair_params_default();
+    fn null_pointers_are_reported_before_bad_values() {
         let wo = [0.0f32, 0.0, 1.0];
         let (mut f, mut pdf) = ([0.0f32; 3], 0.0f32);
-        let eval = |p: *const HtHairParams, h: f32, wo: *const f32, f: *mut f32| {
-            ht_hair_eval(p, h, wo, wo, f, &mut 0.0)
+        let s = unsafe {
+            ht_hair_eval(
+                null(),
+                f32::NAN,
+                wo.as_ptr(),
+                wo.as_ptr(),
+                f.as_mut_ptr(),
+                &mut pdf,
+            )
         };
-        assert_eq!(
-            eval(null(), 0.0, wo.as_ptr(), f.as_mut_ptr()),
-            HtStatus::HT_ERR_NULL_ARG
-        );
-        assert_eq!(
-            eval(&p, 0.0, null(), f.as_mut_ptr()),
-            HtStatus::HT_ERR_NULL_ARG
-        );
-        assert_eq!(
-            eval(&p, 0.0, wo.as_ptr(), null_mut()),
-            HtStatus::HT_ERR_NULL_ARG
-        );
-        assert_eq!(
-            eval(&p, 1.5, wo.as_ptr(), f.as_mut_ptr()),
-            HtStatus::HT_ERR_INVALID_ARG
-        );
-        assert_eq!(
-            eval(&p, f32::NAN, wo.as_ptr(), f.as_mut_ptr()),
-            HtStatus::HT_ERR_INVALID_ARG
-        );
-        let long = [0.0f32, 0.0, 2.0];
-        assert_eq!(
-            eval(&p, 0.0, long.as_ptr(), f.as_mut_ptr()),
-            HtStatus::HT_ERR_INVALID_ARG
-        );
+        assert_eq!(s, HtStatus::HT_ERR_NULL_ARG);
+        assert_eq!(last_error(), "params is NULL");
+        let p = ht_hair_params_default();
+        let s = unsafe { ht_hair_eval(&p, 2.0, wo.as_ptr(), wo.as_ptr(), null_mut(), &mut pdf) };
+        assert_eq!(s, HtStatus::HT_ERR_NULL_ARG);
+        assert_eq!(last_error(), "f is NULL");
         let bad = HtHairParams { beta_m: 0.0, ..p };
-        assert_eq!(
-            eval(&bad, 0.0, wo.as_ptr(), f.as_mut_ptr()),
-            HtStatus::HT_ERR_INVALID_ARG
+        let s = unsafe {
+            ht_hair_eval(
+                &bad,
+                0.0,
+                wo.as_ptr(),
+                wo.as_ptr(),
+                f.as_mut_ptr(),
+                &mut pdf,
+            )
+        };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("beta_m = 0"), "{}", last_error());
+    }
+
+    #[test]
+    fn batch_checks_sizes_params_and_overlap() {
+        let p = ht_hair_params_default();
+        let buf = [0.0f32; 64];
+        let mut out = [0.0f32; 64];
+        let n = usize::MAX / 2;
+        let s = unsafe {
+            ht_hair_eval_batch(
+                &p,
+                n,
+                buf.as_ptr(),
+                buf.as_ptr(),
+                buf.as_ptr(),
+                out.as_mut_ptr(),
+                out.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("do not fit in memory"),
+            "{}",
+            last_error()
         );
-        let msg = unsafe { std::ffi::CStr::from_ptr(super::super::ht_last_error()) };
-        assert!(msg.to_str().unwrap().contains("beta_m"), "{msg:?}");
-        assert_eq!(
-            ht_hair_eval(&p, 0.3, wo.as_ptr(), wo.as_ptr(), f.as_mut_ptr(), &mut pdf),
-            HtStatus::HT_OK
+        // n = 0 still checks the parameters.
+        let bad = HtHairParams { eta: 0.5, ..p };
+        let s =
+            unsafe { ht_hair_eval_batch(&bad, 0, null(), null(), null(), null_mut(), null_mut()) };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("eta = 0.5"), "{}", last_error());
+        let s = unsafe {
+            ht_hair_eval_batch(null(), 0, null(), null(), null(), null_mut(), null_mut())
+        };
+        assert_eq!(s, HtStatus::HT_ERR_NULL_ARG);
+        // pdf inside f: refused before anything is written.
+        let (h, wo) = ([0.1f32; 2], [[0.0f32, 0.0, 1.0]; 2]);
+        let mut f = [7.0f32; 8];
+        let s = unsafe {
+            ht_hair_eval_batch(
+                &p,
+                2,
+                h.as_ptr(),
+                wo.as_ptr().cast(),
+                wo.as_ptr().cast(),
+                f.as_mut_ptr(),
+                f.as_mut_ptr().add(4),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("f and pdf overlap"),
+            "{}",
+            last_error()
         );
-        assert!(pdf > 0.0 && f.iter().all(|v| v.is_finite() && *v > 0.0));
+        assert_eq!(f, [7.0; 8]);
+        // A misaligned output.
+        let mut raw = [0u8; 64];
+        let odd = unsafe { raw.as_mut_ptr().add(1) }.cast::<f32>();
+        let s = unsafe {
+            ht_hair_eval_batch(
+                &p,
+                2,
+                h.as_ptr(),
+                wo.as_ptr().cast(),
+                wo.as_ptr().cast(),
+                odd,
+                out.as_mut_ptr(),
+            )
+        };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("not aligned"), "{}", last_error());
+    }
+
+    #[test]
+    fn melanin_overflow_is_refused_at_the_source() {
+        let mut sigma = [0.0f32; 3];
+        let s = unsafe { ht_hair_sigma_a_from_melanin(f32::MAX, f32::MAX, sigma.as_mut_ptr()) };
+        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(last_error().contains("overflows"), "{}", last_error());
+        assert_eq!(sigma, [0.0; 3]);
     }
 
     #[test]
@@ -300,60 +615,42 @@ mod tests {
         let wo = Vec3::new(0.3, 0.5, (1.0f32 - 0.09 - 0.25).sqrt());
         let u = [0.3f32, 0.6, 0.8];
         let (mut wi, mut f, mut pdf) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
-        let s = ht_hair_sample(
-            &p,
-            0.2,
-            wo.as_ref().as_ptr(),
-            u.as_ptr(),
-            wi.as_mut_ptr(),
-            f.as_mut_ptr(),
-            &mut pdf,
-        );
+        let s = unsafe {
+            ht_hair_sample(
+                &p,
+                0.2,
+                wo.as_ref().as_ptr(),
+                u.as_ptr(),
+                wi.as_mut_ptr(),
+                f.as_mut_ptr(),
+                &mut pdf,
+            )
+        };
         assert_eq!(s, HtStatus::HT_OK);
         let want = bsdf.sample(0.2, wo, u).unwrap();
         assert_eq!(
             (Vec3::from_array(wi), Vec3::from_array(f), pdf),
             (want.wi, want.f, want.pdf)
         );
-        let bad_u = [1.0f32, 0.5, 0.5];
-        let s = ht_hair_sample(
-            &p,
-            0.2,
-            wo.as_ref().as_ptr(),
-            bad_u.as_ptr(),
-            wi.as_mut_ptr(),
-            f.as_mut_ptr(),
-            &mut pdf,
-        );
-        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-
         let hs = [0.2f32, -0.7];
         let wos = [wo.to_array(), [0.0, 1.0, 0.0]];
         let wis = [want.wi.to_array(), [0.0, 0.0, -1.0]];
         let (mut fb, mut pb) = ([[0.0f32; 3]; 2], [0.0f32; 2]);
-        let s = ht_hair_eval_batch(
-            &p,
-            2,
-            hs.as_ptr(),
-            wos.as_ptr().cast(),
-            wis.as_ptr().cast(),
-            fb.as_mut_ptr().cast(),
-            pb.as_mut_ptr(),
-        );
+        let s = unsafe {
+            ht_hair_eval_batch(
+                &p,
+                2,
+                hs.as_ptr(),
+                wos.as_ptr().cast(),
+                wis.as_ptr().cast(),
+                fb.as_mut_ptr().cast(),
+                pb.as_mut_ptr(),
+            )
+        };
         assert_eq!(s, HtStatus::HT_OK);
         for i in 0..2 {
             let e = bsdf.eval(hs[i], Vec3::from_array(wos[i]), Vec3::from_array(wis[i]));
-            assert!((pb[i] - e.pdf).abs() <= 1e-5 * e.pdf);
+            assert_eq!((fb[i], pb[i]), (e.f.to_array(), e.pdf));
         }
-        let s = ht_hair_eval_batch(
-            &p,
-            2,
-            hs.as_ptr(),
-            null(),
-            wis.as_ptr().cast(),
-            fb.as_mut_ptr().cast(),
-            pb.as_mut_ptr(),
-        );
-        assert_eq!(s, HtStatus::HT_ERR_NULL_ARG);
     }
 }

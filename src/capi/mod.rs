@@ -6,6 +6,8 @@
 //! module by cbindgen.
 
 pub mod bsdf;
+pub mod frame;
+pub mod prepared;
 #[cfg(feature = "render")]
 pub mod scene;
 // Scenes first: the header declares them before the calls that fill them.
@@ -234,24 +236,6 @@ fn check_host_array<T>(ptr: *const T, len: usize, name: &str) -> Result<(), Fail
     Ok(())
 }
 
-/// Refuses two host buffers (`(pointer, bytes)`, NULL or empty ones ignored) that overlap:
-/// the library would read what it writes, or write one result over another.
-pub(crate) fn check_disjoint(buffers: &[(&str, *const u8, usize)]) -> Result<(), Failure> {
-    let live = |(_, p, n): &&(&str, *const u8, usize)| !p.is_null() && *n > 0;
-    for (i, a) in buffers.iter().filter(live).enumerate() {
-        for b in buffers.iter().filter(live).skip(i + 1) {
-            let (a0, b0) = (a.1 as usize, b.1 as usize);
-            // The lengths were checked not to wrap the address space.
-            if a0 < b0 + b.2 && b0 < a0 + a.2 {
-                return Err(
-                    invalid_arg!("{} and {} overlap: give each its own memory", a.0, b.0).into(),
-                );
-            }
-        }
-    }
-    Ok(())
-}
-
 /// The host array `ptr[0..len]` (see [`check_host_array`]); empty when `len` is 0.
 pub(crate) fn host_slice<'a, T>(ptr: *const T, len: usize, name: &str) -> Result<&'a [T], Failure> {
     check_host_array(ptr, len, name)?;
@@ -276,6 +260,53 @@ pub(crate) fn host_slice_mut<'a, T>(
     // SAFETY: non-NULL, aligned and of a valid size (checked); the host promises `len`
     // writable elements that nothing else touches during the call.
     Ok(unsafe { std::slice::from_raw_parts_mut(ptr, len) })
+}
+
+/// The bytes a host buffer covers, for [`check_disjoint`].
+pub(crate) struct Span<'a> {
+    name: &'a str,
+    start: usize,
+    bytes: usize,
+}
+
+impl<'a> Span<'a> {
+    /// `len` elements of `T` from `ptr` (an empty span when `len` is 0 or `ptr` NULL).
+    pub(crate) fn of<T>(name: &'a str, ptr: *const T, len: usize) -> Self {
+        let bytes = if ptr.is_null() {
+            0
+        } else {
+            len.saturating_mul(size_of::<T>())
+        };
+        Span {
+            name,
+            start: ptr as usize,
+            bytes,
+        }
+    }
+
+    fn overlaps(&self, other: &Span) -> bool {
+        self.bytes > 0
+            && other.bytes > 0
+            && self.start < other.start.saturating_add(other.bytes)
+            && other.start < self.start.saturating_add(self.bytes)
+    }
+}
+
+/// Refuses an output buffer that shares a byte with another output or with an input of the
+/// same call: writing one while reading or writing the other is undefined behaviour.
+pub(crate) fn check_disjoint(outputs: &[Span], inputs: &[Span]) -> Result<(), Failure> {
+    for (i, out) in outputs.iter().enumerate() {
+        let others = outputs[i + 1..].iter().chain(inputs);
+        if let Some(other) = others.into_iter().find(|o| out.overlaps(o)) {
+            return Err(invalid_arg!(
+                "{} and {} overlap: an output buffer must not share memory with another buffer",
+                out.name,
+                other.name
+            )
+            .into());
+        }
+    }
+    Ok(())
 }
 
 /// Reads a `float[3]` that must be finite; the message names the argument.

@@ -2,7 +2,7 @@
 
 use super::scene::{HtScene, scene_mut};
 use super::{
-    Failure, HtStatus, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
+    Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
     non_null_mut, read_host, read_path,
 };
 use crate::error::invalid_arg;
@@ -247,23 +247,21 @@ pub unsafe extern "C" fn ht_render_aovs(
         let albedo = optional_slice(albedo, 3 * pixels, "albedo")?;
         let depth = optional_slice(depth, pixels, "depth")?;
         let strand_id = optional_slice(strand_id, pixels, "strand_id")?;
-        let bytes = |b: &Option<&mut [f32]>| {
-            b.as_ref().map_or((std::ptr::null(), 0), |b| {
-                (b.as_ptr().cast(), size_of_val(*b))
-            })
+        let span = |name, b: &Option<&mut [f32]>| {
+            b.as_ref()
+                .map_or(Span::of(name, std::ptr::null::<f32>(), 0), |b| {
+                    Span::of(name, b.as_ptr(), b.len())
+                })
         };
-        let [albedo_b, depth_b, strand_b] = [&albedo, &depth, &strand_id].map(bytes);
-        check_disjoint(&[
-            ("rgb", rgb.as_ptr().cast(), size_of_val(rgb)),
-            ("albedo", albedo_b.0, albedo_b.1),
-            ("depth", depth_b.0, depth_b.1),
-            ("strand_id", strand_b.0, strand_b.1),
-            (
-                "settings",
-                settings_ptr.cast(),
-                size_of::<HtRenderSettings>(),
-            ),
-        ])?;
+        check_disjoint(
+            &[
+                Span::of("rgb", rgb.as_ptr(), rgb.len()),
+                span("albedo", &albedo),
+                span("depth", &depth),
+                span("strand_id", &strand_id),
+            ],
+            &[Span::of("settings", settings_ptr, 1)],
+        )?;
         let aovs = Aovs {
             albedo: albedo.is_some(),
             depth: depth.is_some(),

@@ -6,11 +6,12 @@
 //! length leaks into h. In f64 both errors vanish and what remains is the f32 error of the
 //! inputs themselves.
 
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 use super::curves::StrandSegment;
 use crate::embree::CurveShape;
 use crate::math::Frame;
+use crate::math::frame::hair_frame_offset;
 
 /// The local frame of a hair hit and the ray's offset h across the fibre: x the tangent
 /// (root to tip), y = normalize(cross(x, d)) for the ray direction d, z = cross(x, y),
@@ -27,31 +28,11 @@ pub(crate) fn hair_frame(
     axis: Vec3,
     radius: f32,
 ) -> (Frame, f32) {
-    let d = dir.as_dvec3();
-    let x = tangent.as_dvec3().try_normalize().unwrap_or_else(|| {
-        d.try_normalize()
-            .unwrap_or(DVec3::Z)
-            .any_orthonormal_vector()
-    });
-    let y = x
-        .cross(d)
-        .try_normalize()
-        .unwrap_or_else(|| x.any_orthonormal_vector());
-    let z = x.cross(y);
-    let h = if radius > 0.0 {
-        let offset = (org.as_dvec3() - axis.as_dvec3()).dot(y) / f64::from(radius);
-        if offset.is_finite() {
-            offset.clamp(-1.0, 1.0) as f32
-        } else {
-            0.0
-        }
+    let (frame, offset) = hair_frame_offset(tangent, dir, org, axis, radius);
+    let h = if radius > 0.0 && offset.is_finite() {
+        offset.clamp(-1.0, 1.0) as f32
     } else {
         0.0
-    };
-    let frame = Frame {
-        x: x.as_vec3(),
-        y: y.as_vec3(),
-        z: z.as_vec3(),
     };
     (frame, h)
 }

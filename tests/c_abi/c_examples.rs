@@ -74,17 +74,19 @@ fn fresh_archive() -> PathBuf {
     lib
 }
 
-/// Compiles `c_examples/<name>` with `compiler` and `flags` into `<name>-<tag>` and links
-/// it against the static archive; returns the executable.
-pub(crate) fn build(name: &str, compiler: &str, flags: &[&str], tag: &str) -> PathBuf {
+/// Compiles the C file at `source` (relative to the repository root) with `compiler` and
+/// `flags` into `<file name>-<tag>` and links it against the static archive; returns the
+/// executable.
+pub(crate) fn build(source: &Path, compiler: &str, flags: &[&str], tag: &str) -> PathBuf {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let lib = fresh_archive();
+    let name = source.file_name().expect("a file").to_string_lossy();
     let exe = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{tag}"));
     let out = Command::new(compiler)
         .args(flags)
         .args(["-Wall", "-Wextra", "-Werror", "-O1", "-I"])
         .arg(root.join("include"))
-        .arg(root.join("c_examples").join(name))
+        .arg(root.join(source))
         // Ends a `-x c++` so that the archive is not read as source.
         .args(["-x", "none"])
         .arg(&lib)
@@ -129,6 +131,17 @@ pub(crate) fn run(exe: &Path, wrapper: &[&str], env: &[(&str, &str)], args: &[&O
     String::from_utf8(run.stdout).expect("utf-8 output")
 }
 
+/// Builds the C file at `source` (as [`build`]) and runs it directly with `args`; returns
+/// stdout.
+pub(crate) fn build_and_run_file(
+    source: &Path,
+    compiler: &str,
+    flags: &[&str],
+    args: &[&OsStr],
+) -> String {
+    run(&build(source, compiler, flags, compiler), &[], &[], args)
+}
+
 /// The numbers after `key` on the line that starts with it.
 fn numbers(out: &str, key: &str) -> Vec<f32> {
     let line = out
@@ -152,7 +165,7 @@ fn check_bsdf_output(out: &str) {
     let bsdf = HairBsdf::new(&HairParams::default()).unwrap();
     let e = bsdf.eval(0.5, Vec3::Z, Vec3::new(0.0, 0.866_025_4, 0.5));
     let want = [e.f.x, e.f.y, e.f.z, e.pdf];
-    for key in ["eval", "batch"] {
+    for key in ["eval", "batch", "point"] {
         let got = numbers(out, key);
         assert_eq!(got.len(), 4, "{key}: {got:?}");
         for (g, w) in got.iter().zip(want) {
@@ -162,6 +175,8 @@ fn check_bsdf_output(out: &str) {
             );
         }
     }
+    // The frame helper gives the documented h of the worked example (docs/conventions.md).
+    assert_eq!(numbers(out, "frame h"), [0.5], "{out}");
     let furnace = numbers(out, "furnace")[0];
     assert!(
         (furnace - 1.0).abs() < 1e-3,
@@ -272,7 +287,7 @@ pub(crate) fn build_run_check(
     wrapper: &[&str],
     env: &[(&str, &str)],
 ) {
-    let exe = build(example.name, compiler, flags, tag);
+    let exe = build(&Path::new("c_examples").join(example.name), compiler, flags, tag);
     let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{}-{tag}.exr", example.name));
     let _ = std::fs::remove_file(&file);
     let out = run(&exe, wrapper, env, &[file.as_os_str()]);

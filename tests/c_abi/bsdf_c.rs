@@ -1,0 +1,134 @@
+//! The BSDF entry points from C: every bad argument gets its status and message
+//! (`c/bsdf_args.c`), every entry point gives the Rust API's bits on random inputs
+//! (`c/bsdf_bits.c`), and the benchmark's plain float port agrees with the model
+//! (`bench/c_bsdf`).
+
+use crate::c_examples::build_and_run_file;
+use glam::Vec3;
+use hairtrace::{HairBsdf, HairParams};
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+use std::fmt::Write as _;
+use std::path::Path;
+
+/// Runs the argument table and checks it ran every row and none failed (a failing row
+/// fails the run, and `build_and_run_file` shows its stderr).
+fn check_argument_table(compiler: &str, flags: &[&str]) {
+    let out = build_and_run_file(Path::new("tests/c_abi/c/bsdf_args.c"), compiler, flags, &[]);
+    let last = out.lines().last().unwrap_or_default();
+    let words: Vec<&str> = last.split_whitespace().collect();
+    assert_eq!(words.first(), Some(&"checks"), "{out}");
+    let checks: u32 = words[1].parse().expect("a count");
+    assert!(checks >= 100, "only {checks} rows ran:\n{out}");
+    assert_eq!(words[3], "0", "{out}");
+}
+
+#[test]
+fn bad_arguments_get_their_status_and_message_in_c99() {
+    check_argument_table("gcc", &["-std=c99", "-pedantic"]);
+}
+
+#[test]
+fn bad_arguments_get_their_status_and_message_in_cpp() {
+    check_argument_table("g++", &["-x", "c++", "-std=c++17"]);
+}
+
+fn unit(rng: &mut Pcg64) -> [f32; 3] {
+    let z: f32 = rng.random_range(-1.0..1.0);
+    let phi: f32 = rng.random_range(0.0..std::f32::consts::TAU);
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    [z, r * phi.cos(), r * phi.sin()]
+}
+
+/// One input of every entry point: parameters, h, wo, wi, u.
+type Case = (HairParams, f32, [f32; 3], [f32; 3], [f32; 3]);
+
+/// Random in-range inputs: parameters over their whole ranges, h, wo, wi, u.
+fn cases(n: usize) -> Vec<Case> {
+    let mut rng = Pcg64::seed_from_u64(11);
+    (0..n)
+        .map(|_| {
+            let params = HairParams {
+                sigma_a: [0; 3].map(|_| rng.random_range(0.0..6.0)),
+                eta: rng.random_range(1.01..3.0),
+                beta_m: rng.random_range(0.01..1.0),
+                beta_n: rng.random_range(0.01..1.0),
+                alpha: rng.random_range(-20.0..20.0),
+            };
+            let h = rng.random_range(-1.0..=1.0);
+            let u = [0; 3].map(|_| rng.random::<f32>());
+            (params, h, unit(&mut rng), unit(&mut rng), u)
+        })
+        .collect()
+}
+
+#[test]
+fn every_c_entry_point_gives_the_rust_bits() {
+    let cases = cases(3000);
+    let mut input = String::new();
+    for (p, h, wo, wi, u) in &cases {
+        let s = p.sigma_a;
+        let words = [s[0], s[1], s[2], p.eta, p.beta_m, p.beta_n, p.alpha, *h]
+            .into_iter()
+            .chain(*wo)
+            .chain(*wi)
+            .chain(*u);
+        for w in words {
+            write!(input, "{:08x} ", w.to_bits()).unwrap();
+        }
+        input.push('\n');
+    }
+    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("bsdf_bits_input.txt");
+    std::fs::write(&path, input).unwrap();
+    let out = build_and_run_file(
+        Path::new("tests/c_abi/c/bsdf_bits.c"),
+        "gcc",
+        &["-std=c99", "-pedantic"],
+        &[path.as_os_str()],
+    );
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), cases.len());
+    for (i, ((p, h, wo, wi, u), line)) in cases.iter().zip(lines).enumerate() {
+        let got: Vec<u32> = line
+            .split_whitespace()
+            .map(|w| u32::from_str_radix(w, 16).expect("hex"))
+            .collect();
+        let bsdf = HairBsdf::new(p).unwrap();
+        let point = bsdf.at(*h, Vec3::from_array(*wo));
+        let e = point.eval(Vec3::from_array(*wi));
+        let eval = [e.f.x, e.f.y, e.f.z, e.pdf];
+        let sample = point.sample(*u).map_or([0.0; 7], |s| {
+            [s.wi.x, s.wi.y, s.wi.z, s.f.x, s.f.y, s.f.z, s.pdf]
+        });
+        // point eval, point pdf, point sample, eval, sample, points eval, points sample,
+        // eval batch: each the Rust HairPoint's bits.
+        let want: Vec<u32> = eval
+            .iter()
+            .chain(&[e.pdf])
+            .chain(&sample)
+            .chain(&eval)
+            .chain(&sample)
+            .chain(&eval)
+            .chain(&sample)
+            .chain(&eval)
+            .map(|v| v.to_bits())
+            .collect();
+        assert_eq!(
+            got, want,
+            "case {i}: {p:?} h {h} wo {wo:?} wi {wi:?} u {u:?}"
+        );
+    }
+}
+
+#[test]
+fn the_benchmarks_plain_port_agrees_with_the_model() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let port = root.join("bench/c_bsdf/port.c");
+    let out = build_and_run_file(
+        Path::new("bench/c_bsdf/bench.c"),
+        "gcc",
+        &["-std=c99", port.to_str().expect("UTF-8 path")],
+        &["--check".as_ref()],
+    );
+    assert!(out.starts_with("check "), "{out}");
+}

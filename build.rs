@@ -212,6 +212,8 @@ fn link_embree(embree: &Embree) {
         // A folder the loader does not search (scripts/embree4's): recorded as an rpath so
         // that the binaries, tests and shared library run without LD_LIBRARY_PATH.
         println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
+        // The same for the packages that link this library (the command line).
+        println!("cargo::metadata=rpath={}", dir.display());
     }
     println!("cargo:rustc-link-lib=dylib=embree{}", embree.major);
 }

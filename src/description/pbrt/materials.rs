@@ -41,6 +41,9 @@ pub(super) fn material(kind: &str, p: &Params, warn: &mut Vec<Warning>) -> Resul
             for q in &p.list {
                 p.ignore(&q.name);
             }
+            warn.push(p.warning(format_args!(
+                "material type {kind:?} is not supported: a shape that uses it is refused"
+            )));
             Material::Unsupported(format!(
                 "{}: {}: material type {kind:?} is not supported (only \"hair\" and \"diffuse\")",
                 p.loc, p.what

@@ -8,7 +8,7 @@ use std::sync::Arc;
 use hairtrace::Error;
 use hairtrace::bsdf::sigma_a_from_melanin;
 use hairtrace::description::pbrt::PbrtScene;
-use hairtrace::description::{EnvironmentSource, GroomSource, LightDesc, MaterialDesc};
+use hairtrace::description::{EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource};
 use hairtrace::embree::{CurveBasis, CurveShape, Device};
 use hairtrace::render::renderer::render;
 use hairtrace::render::{Aovs, NO_STRAND, NoProgress};
@@ -464,4 +464,42 @@ fn the_fixture_renders() {
         .filter(|&&s| s != NO_STRAND)
         .count();
     assert!(hair > 10, "only {hair} pixels see a strand");
+}
+
+#[test]
+fn a_plymesh_is_read_and_placed() {
+    let dir = scratch("ply");
+    std::fs::write(
+        dir.join("quad.ply"),
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+         property float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n1 0 1\n0 0 1\n4 0 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("scene.pbrt"),
+        "LookAt 0 1 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+         LightSource \"infinite\"\nTranslate 0 -1 0\nScale 2 2 2\n\
+         Shape \"plymesh\" \"string filename\" \"quad.ply\"\n",
+    )
+    .unwrap();
+    let s = PbrtScene::from_file(&dir.join("scene.pbrt")).unwrap();
+    let MeshSource::Triangles(mesh) = &s.description.meshes[0].source else {
+        panic!("an inline mesh");
+    };
+    assert_eq!(mesh.triangles.len(), 2);
+    // Scaled, moved down, mirrored through x = 0 for pbrt's camera.
+    assert_eq!(
+        mesh.positions,
+        [
+            [0.0, -1.0, 0.0],
+            [-2.0, -1.0, 0.0],
+            [-2.0, -1.0, 2.0],
+            [0.0, -1.0, 2.0]
+        ]
+    );
+    assert_eq!(
+        s.description.meshes[0].material,
+        "(pbrt's default diffuse material)"
+    );
 }

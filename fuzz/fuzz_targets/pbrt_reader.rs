@@ -1,6 +1,7 @@
 //! Any text given to the pbrt-v4 reader either reads into a description whose grooms are
 //! whole curves of their basis, or gives an InvalidArg error (Io for a missing include or
-//! PLY file); no panic, no huge allocation, no other error kind.
+//! PLY file, Image for a missing environment map); no panic, no huge allocation, no other
+//! error kind.
 #![no_main]
 
 use hairtrace::Error;
@@ -26,7 +27,9 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
             }
             assert!(scene.warnings.iter().all(|w| w.starts_with("fuzz.pbrt:")));
         }
-        Err(Error::InvalidArg(message) | Error::Io(message)) => assert!(!message.is_empty()),
+        Err(Error::InvalidArg(message) | Error::Io(message) | Error::Image(message)) => {
+            assert!(!message.is_empty())
+        }
         Err(other) => panic!("unexpected error kind: {other:?}"),
     }
 });

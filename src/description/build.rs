@@ -288,6 +288,9 @@ impl LightDesc {
                 let env = match source {
                     EnvironmentSource::Uniform(radiance) => Environment::uniform(v(*radiance))?,
                     EnvironmentSource::Map(path) => Environment::from_file(path)?,
+                    EnvironmentSource::LatLong { width, height, rgb } => {
+                        Environment::from_pixels(*width, *height, 3, rgb)?
+                    }
                 };
                 Ok(Light::Environment(
                     env.with_rotation(*rotation_deg)?.with_scale(*scale)?,

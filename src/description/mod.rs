@@ -330,6 +330,13 @@ pub enum EnvironmentSource {
     Uniform([f32; 3]),
     /// A lat-long image (see [`crate::scene::envmap::Environment`] for its orientation).
     Map(PathBuf),
+    /// A lat-long image given as linear RGB texels, rows from the top (a pbrt map,
+    /// resampled).
+    LatLong {
+        width: usize,
+        height: usize,
+        rgb: Vec<f32>,
+    },
 }
 
 /// What a render needs, built from a description.

@@ -288,8 +288,12 @@ fn refused_input_names_its_line() {
             "t.pbrt:4: LightSource \"point\": only \"infinite\" and \"distant\"",
         ),
         (
-            "LightSource \"infinite\" \"string filename\" \"sky.exr\"",
-            "t.pbrt:4: LightSource \"infinite\": image environment maps are not supported: pbrt-v4 maps them with an equal-area octahedral projection",
+            "LightSource \"infinite\" \"rgb L\" [1 1 1] \"string filename\" \"sky.exr\"",
+            "t.pbrt:4: LightSource \"infinite\": give either \"L\" or \"filename\"",
+        ),
+        (
+            "LightSource \"infinite\" \"string filename\" \"missing.exr\"",
+            "image error: t.pbrt:4: LightSource \"infinite\": cannot read",
         ),
         (
             "LightSource \"distant\" \"spectrum L\" [400 1 700 1]",
@@ -502,4 +506,62 @@ fn a_plymesh_is_read_and_placed() {
         s.description.meshes[0].material,
         "(pbrt's default diffuse material)"
     );
+}
+
+#[test]
+fn an_equal_area_environment_map_keeps_pbrts_directions() {
+    // A square map whose channels mark, in pbrt's light frame, R: +y (v > 1/2), G: +x
+    // (u > 1/2), B: +z (the inner diamond). pbrt's directions, mirrored for its camera,
+    // must find the same marks in our lat-long texels.
+    let n = 32;
+    let mut pixels = Vec::new();
+    for y in 0..n {
+        for x in 0..n {
+            let (u, v) = ((x as f32 + 0.5) / n as f32, (y as f32 + 0.5) / n as f32);
+            let diamond = (u - 0.5).abs() + (v - 0.5).abs() < 0.5;
+            pixels.extend([v > 0.5, u > 0.5, diamond].map(|b| f32::from(u8::from(b))));
+        }
+    }
+    let dir = scratch("envmap");
+    let options = hairtrace::image::WriteOptions::default();
+    hairtrace::image::write_image(&dir.join("sky.exr"), n, n, 3, &pixels, &options).unwrap();
+    let text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+                LightSource \"infinite\" \"string filename\" \"sky.exr\" \"float scale\" 2\n";
+    let s = PbrtScene::from_text(text, &dir, "t.pbrt").unwrap();
+    let LightDesc::Environment {
+        source: EnvironmentSource::LatLong { width, height, rgb },
+        scale,
+        ..
+    } = &s.description.lights[0]
+    else {
+        panic!("a lat-long environment");
+    };
+    assert_eq!((*width, *height, *scale), (2 * n, n, 2.0));
+    let mut wrong = 0;
+    for row in 0..*height {
+        let theta = std::f32::consts::PI * (row as f32 + 0.5) / *height as f32;
+        for col in 0..*width {
+            let phi = 2.0 * std::f32::consts::PI * (col as f32 + 0.5) / *width as f32;
+            // Our lat-long direction (scene::envmap), then back to pbrt's frame (x mirrored).
+            let d = [
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                theta.sin() * phi.cos(),
+            ];
+            let texel = &rgb[(row * width + col) * 3..][..3];
+            let want = d.map(|c| f32::from(u8::from(c > 0.0)));
+            let (x, y, z) = (want[0], want[1], want[2]);
+            if texel != [y, x, z] {
+                wrong += 1;
+            }
+        }
+    }
+    // Only texels along the boundaries may round to the other side.
+    assert!(
+        wrong * 10 < width * height,
+        "{wrong} of {} texels",
+        width * height
+    );
+    let built = s.description.build(Arc::new(Device::new(Some(1)).unwrap()));
+    assert!(built.is_ok());
 }

@@ -1,26 +1,27 @@
 //! A subset of pbrt-v4's scene format, enough for pbrt's hair scenes, read into a
-//! [`SceneDescription`]. The subset and the warning rule are listed in
-//! `docs/scene-files.md` ("pbrt-v4 scenes"); in short:
+//! [`SceneDescription`]. The subset and the warning rule are listed in `docs/pbrt.md`; in
+//! short:
 //!
 //! - **Read**: Camera "perspective" (fov, lensradius, focaldistance), Film (xresolution,
 //!   yresolution, filename), Sampler's pixelsamples, Integrator's maxdepth, LookAt,
 //!   Transform, ConcatTransform, Translate, Rotate, Scale, Identity, CoordinateSystem,
 //!   CoordSysTransform, AttributeBegin/End, TransformBegin/End, Include/Import, WorldBegin,
-//!   LightSource "infinite" (rgb L) and "distant", Shape "curve", "trianglemesh" and
-//!   "plymesh", Material / MakeNamedMaterial "hair" and "diffuse", NamedMaterial.
+//!   LightSource "infinite" (rgb L, or an equal-area image resampled to lat-long) and
+//!   "distant", Shape "curve", "trianglemesh" and "plymesh", Material / MakeNamedMaterial "hair" and "diffuse", NamedMaterial.
 //! - **Warned and ignored** (each warning names the file and line): statements and
 //!   parameters that hairtrace replaces by its own (PixelFilter, the sampler and
 //!   integrator beyond the two values read) or that do not apply to it, and texture
 //!   references, which get pbrt's default value.
 //! - **Refused** with an error naming the file and line: whatever would leave the image
 //!   wrong or incomplete: other shapes, lights and cameras, a shape whose material is not
-//!   hair (curves) or diffuse (meshes), image environment maps, area lights, instancing,
-//!   non-RGB spectra, and malformed input.
+//!   hair (curves) or diffuse (meshes), area lights, instancing, non-RGB spectra, and
+//!   malformed input.
 //!
 //! Curves are gathered into one groom per (material, shape, basis), whatever the number of
 //! Shape statements. pbrt's camera is left-handed; the scene is mirrored through x = 0
 //! when needed so that the image is pbrt's (see `reader.rs`).
 
+mod envmap;
 mod lexer;
 mod materials;
 mod params;

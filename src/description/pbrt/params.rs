@@ -240,6 +240,11 @@ impl Params {
         crate::Error::InvalidArg(format!("{}: {}: {message}", self.loc, self.what))
     }
 
+    /// `e` placed at this statement, same kind.
+    pub fn context(&self, e: crate::Error) -> crate::Error {
+        e.context(format_args!("{}: {}", self.loc, self.what))
+    }
+
     /// A warning at this statement.
     pub fn warning(&self, message: impl std::fmt::Display) -> Warning {
         (self.loc.clone(), format!("{}: {message}", self.what))

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DMat4, DVec3};
 
+use super::envmap::latlong_from_equal_area;
 use super::lexer::{Lexer, Token};
 use super::materials::{DEFAULT_REFLECTANCE, Material, material};
 use super::params::{Color, Params, Warning, read_params};
@@ -15,6 +16,7 @@ use crate::description::{
     CameraDesc, EnvironmentSource, LightDesc, MaterialDesc, MeshDesc, RenderDesc, SceneDescription,
 };
 use crate::error::{Error, Result, invalid_arg};
+use crate::image::read_image;
 
 /// Includes deeper than this are refused (a cycle is refused at once).
 pub(super) const MAX_INCLUDE_DEPTH: usize = 32;
@@ -295,7 +297,7 @@ impl Reader {
             "LightSource" => {
                 let kind = string_arg(lexer, line, word)?;
                 let p = read_params(lexer, loc, format!("LightSource {kind:?}"))?;
-                let light = self.light(&kind, &p)?;
+                let light = self.light(&kind, &p, dir)?;
                 self.lights.push(light);
                 self.warnings.extend(p.unused());
             }
@@ -434,12 +436,13 @@ impl Reader {
         self.render_from_world.unwrap_or(DMat4::IDENTITY) * self.state.ctm
     }
 
-    fn light(&mut self, kind: &str, p: &Params) -> Result<LightDesc> {
-        let rgb = match p.color("L")? {
-            None => [1.0; 3],
-            Some(Color::Rgb(c)) => c,
+    fn light(&mut self, kind: &str, p: &Params, dir: &Path) -> Result<LightDesc> {
+        let given = match p.color("L")? {
+            None => None,
+            Some(Color::Rgb(c)) => Some(c),
             Some(Color::Texture(_)) => return Err(p.fail("\"L\" must be an rgb colour")),
         };
+        let rgb = given.unwrap_or([1.0; 3]);
         // pbrt scales "L" so that its colour space's white is 1 nit: rgb values render as
         // they are given, times "scale" (and the "illuminance" target, if any).
         let scale = p.float("scale")?.unwrap_or(1.0);
@@ -447,13 +450,22 @@ impl Reader {
         let amount = |k: f64| rgb.map(|c| (c * scale * k) as f32);
         match kind {
             "infinite" => {
-                if p.string("filename")?.is_some() {
-                    return Err(p.fail(
-                        "image environment maps are not supported: pbrt-v4 maps them with \
-                         an equal-area octahedral projection, which hairtrace's lat-long \
-                         environment cannot reproduce; use \"rgb L\", or a TOML scene with \
-                         a lat-long map",
-                    ));
+                if let Some(file) = p.string("filename")? {
+                    if given.is_some() || illuminance.is_some() {
+                        return Err(p.fail(
+                            "give either \"L\" or \"filename\", and no \"illuminance\" with an \
+                             image",
+                        ));
+                    }
+                    let image = read_image(&dir.join(file)).map_err(|e| p.context(e))?;
+                    let light_from_render = DMat3::from_mat4(self.to_render()).inverse();
+                    let (width, height, rgb) = latlong_from_equal_area(&image, light_from_render)
+                        .map_err(|e| p.context(e))?;
+                    return Ok(LightDesc::Environment {
+                        source: EnvironmentSource::LatLong { width, height, rgb },
+                        rotation_deg: 0.0,
+                        scale: scale as f32,
+                    });
                 }
                 if p.nums("portal", &["point3", "point"])?.is_some() {
                     self.warnings

@@ -45,15 +45,10 @@ pub(super) enum Color {
 /// Reads `"type name" value` pairs up to the next directive.
 pub(super) fn read_params(lexer: &mut Lexer, loc: String, what: String) -> Result<Params> {
     let mut list: Vec<Param> = Vec::new();
-    loop {
-        let decl = match lexer.peek()? {
-            Some((Token::Str(_), _)) => match lexer.next_token()? {
-                Some((Token::Str(s), line)) => (s, line),
-                _ => unreachable!("peeked a string"),
-            },
-            _ => break,
+    while let Some((Token::Str(_), _)) = lexer.peek()? {
+        let Some((Token::Str(decl), line)) = lexer.next_token()? else {
+            unreachable!("peeked a string");
         };
-        let (decl, line) = decl;
         let mut words = decl.split_whitespace();
         let (Some(ty), Some(name), None) = (words.next(), words.next(), words.next()) else {
             return Err(lexer.error(
@@ -97,7 +92,7 @@ fn read_values(lexer: &mut Lexer, line: u32, name: &str) -> Result<Values> {
                 }
                 let mixed = || lexer.error(l, format_args!("parameter {name:?}: mixed values"));
                 match (&mut values, t) {
-                    (None, t) => values = Some(single(t).ok_or_else(|| mixed())?),
+                    (None, t) => values = Some(single(t).ok_or_else(mixed)?),
                     (Some(Values::Nums(v)), Token::Num(x)) => v.push(x),
                     (Some(Values::Strs(v)), Token::Str(s)) => v.push(s),
                     (Some(Values::Bools(v)), Token::Word("true")) => v.push(true),

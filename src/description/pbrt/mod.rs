@@ -31,7 +31,7 @@ mod shapes;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use super::{GroomSource, MeshSource, SceneDescription};
+use super::{EnvironmentSource, GroomSource, LightDesc, MeshSource, SceneDescription};
 use crate::error::Result;
 use reader::Reader;
 
@@ -122,7 +122,18 @@ impl PbrtScene {
             }
         }
         for (i, l) in d.lights.iter().enumerate() {
-            let _ = writeln!(s, "light[{i}]: {l:?}");
+            let _ = match l {
+                LightDesc::Environment {
+                    source: EnvironmentSource::LatLong { width, height, .. },
+                    scale,
+                    ..
+                } => writeln!(
+                    s,
+                    "light[{i}]: environment map resampled to {width} x {height} lat-long, \
+                     scale {scale}"
+                ),
+                other => writeln!(s, "light[{i}]: {other:?}"),
+            };
         }
         let c = &d.camera;
         let _ = writeln!(

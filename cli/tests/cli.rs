@@ -172,10 +172,10 @@ fn render_and_describe_a_pbrt_scene() {
     assert!(text.contains("strands.pbrt:6: Shape \"curve\""), "{text}");
 
     let bad = tmp("cli_bad.pbrt");
-    std::fs::write(&bad, "WorldBegin\nShape \"sphere\"\n").unwrap();
+    std::fs::write(&bad, "WorldBegin\nShape \"disk\"\n").unwrap();
     assert_one_line_error(
         &hairtrace(&["info", &bad]),
-        "cli_bad.pbrt:2: Shape \"sphere\"",
+        "cli_bad.pbrt:2: Shape \"disk\"",
     );
 }
 

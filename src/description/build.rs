@@ -28,7 +28,7 @@ use crate::validate::positive;
 
 /// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
 /// from the true sphere by under 0.05% of its radius.
-const SPHERE_SUBDIVISIONS: u32 = 4;
+pub(super) const SPHERE_SUBDIVISIONS: u32 = 4;
 
 impl SceneDescription {
     /// Checks every value, reads the files, builds the grooms and meshes into one Embree

@@ -272,8 +272,8 @@ fn refused_input_names_its_line() {
             "t.pbrt:6: Shape \"sphere\": its material cannot be rendered: t.pbrt:4: Material \"conductor\": material type \"conductor\" is not supported",
         ),
         (
-            "Shape \"sphere\" \"float radius\" 1",
-            "t.pbrt:4: Shape \"sphere\": only \"curve\", \"trianglemesh\" and \"plymesh\"",
+            "Shape \"disk\" \"float radius\" 1",
+            "t.pbrt:4: Shape \"disk\": only \"curve\", \"trianglemesh\", \"plymesh\" and \"sphere\"",
         ),
         (
             "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 3]",
@@ -564,4 +564,56 @@ fn an_equal_area_environment_map_keeps_pbrts_directions() {
     );
     let built = s.description.build(Arc::new(Device::new(Some(1)).unwrap()));
     assert!(built.is_ok());
+}
+
+/// Laid out as the hair scenes of pbrt-v4's scene collection: a camera `Transform`, a Film
+/// `iso`, an equal-area map under rotations, gzipped strands in a subfolder, and a sphere
+/// placed in the camera's frame.
+#[test]
+fn a_scene_laid_out_as_pbrts_hair_scenes() {
+    use std::io::Write;
+    let dir = scratch("collection");
+    std::fs::create_dir_all(dir.join("geometry")).unwrap();
+    let strands = "Shape \"curve\" \"string type\" \"cylinder\" \
+                   \"point3 P\" [0 0 0 0 1 0 0 2 0 0 3 0] \"float width0\" 0.2 \"float width1\" 0.1\n";
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(strands.repeat(3).as_bytes()).unwrap();
+    std::fs::write(dir.join("geometry/strands.pbrt.gz"), gz.finish().unwrap()).unwrap();
+    let options = hairtrace::image::WriteOptions::default();
+    hairtrace::image::write_image(&dir.join("sky.exr"), 4, 4, 3, &[0.5; 48], &options).unwrap();
+    std::fs::write(
+        dir.join("scene.pbrt"),
+        "Integrator \"volpath\" \"integer maxdepth\" [ 32 ]\n\
+         Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  0 -1 10 1 ]\n\
+         Film \"rgb\" \"float iso\" [ 400 ] \"integer xresolution\" 16 \"integer yresolution\" 16\n\
+         Camera \"perspective\" \"float fov\" [ 32 ] \"float shutterclose\" 0.5\n\
+         WorldBegin\n\
+         AttributeBegin\n  Rotate -120 1 0 0\n  Rotate 120 0 0 1\n\
+           LightSource \"infinite\" \"string filename\" \"sky.exr\"\nAttributeEnd\n\
+         Material \"hair\" \"float beta_m\" 0.25 \"float eumelanin\" 2\n\
+         Include \"geometry/strands.pbrt.gz\"\n\
+         AttributeBegin\nCoordSysTransform \"camera\"\n\
+         Material \"diffuse\" \"rgb reflectance\" [.1 .1 .1]\n\
+         Translate 0 2 25\nShape \"sphere\" \"float radius\" 3\nAttributeEnd\n",
+    )
+    .unwrap();
+    let s = PbrtScene::from_file(&dir.join("scene.pbrt")).unwrap();
+    let d = &s.description;
+    assert_eq!(control_points(&s, 0).1, [4, 4, 4]);
+    // Film gain: shutter 0.5 x iso 400 / 100 = 2.
+    assert!(matches!(&d.lights[0], LightDesc::Environment { scale, .. } if *scale == 2.0));
+    // The camera at world (0, 1, -10) (the inverse of its transform), looking down +z.
+    assert_eq!(d.camera.eye, Some([0.0, 1.0, -10.0]));
+    assert_eq!(d.camera.target, Some([0.0, 1.0, -9.0]));
+    // The sphere 25 ahead of the camera and 2 up, in world space.
+    let MeshSource::Triangles(sphere) = &d.meshes[0].source else {
+        panic!("an inline mesh");
+    };
+    let n = sphere.positions.len() as f32;
+    let centre = sphere
+        .positions
+        .iter()
+        .fold([0.0f32; 3], |c, p| std::array::from_fn(|k| c[k] + p[k] / n));
+    assert!(close(&centre, &[0.0, 3.0, 15.0], 1e-3), "{centre:?}");
+    assert!(d.build(Arc::new(Device::new(Some(1)).unwrap())).is_ok());
 }

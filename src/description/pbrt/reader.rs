@@ -3,6 +3,7 @@
 //! and shapes. See the module doc of `pbrt` for what is supported and the warning rule.
 
 use std::collections::{BTreeMap, HashMap, HashSet};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DMat4, DVec3};
@@ -20,6 +21,9 @@ use crate::image::read_image;
 
 /// Includes deeper than this are refused (a cycle is refused at once).
 pub(super) const MAX_INCLUDE_DEPTH: usize = 32;
+/// A gzipped file may not decompress to more than this (a small file could otherwise
+/// claim all memory).
+const MAX_DECOMPRESSED: u64 = 4 << 30;
 /// Nested AttributeBegin / TransformBegin blocks beyond this are refused.
 const MAX_NESTING: usize = 10_000;
 /// The material of shapes before any Material statement, as in pbrt: diffuse, 0.5.
@@ -71,6 +75,10 @@ pub(super) struct Reader {
     pub film_filename: Option<PathBuf>,
     spp: u32,
     max_depth: u32,
+    /// pbrt's film gain is exposure time x ISO / 100 (`PixelSensor`): the Camera's
+    /// shutter interval and the Film's `iso`.
+    exposure_time: f64,
+    iso: f64,
     /// Canonical paths of the files being read, outermost first.
     includes: Vec<PathBuf>,
 }
@@ -102,6 +110,8 @@ impl Reader {
             film_filename: None,
             spp: DEFAULT_SPP,
             max_depth: DEFAULT_MAX_DEPTH,
+            exposure_time: 1.0,
+            iso: 100.0,
             includes: Vec::new(),
         }
     }
@@ -122,7 +132,7 @@ impl Reader {
                 path.display()
             ));
         }
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = read_text_file(path)?;
         self.includes.push(canonical);
         let dir = path.parent().unwrap_or(Path::new(""));
         let result = self.read_text(&text, dir, &path.display().to_string());
@@ -344,6 +354,8 @@ impl Reader {
             focus_distance: p.float("focaldistance")?.unwrap_or(1e6),
             loc,
         });
+        self.exposure_time =
+            p.float("shutterclose")?.unwrap_or(1.0) - p.float("shutteropen")?.unwrap_or(0.0);
         self.warnings.extend(p.unused());
         Ok(())
     }
@@ -365,6 +377,7 @@ impl Reader {
             size("yresolution", DEFAULT_RESOLUTION.1)?,
         );
         self.film_filename = p.string("filename")?.map(PathBuf::from);
+        self.iso = p.float("iso")?.unwrap_or(100.0);
         self.warnings.extend(p.unused());
         Ok(())
     }
@@ -520,13 +533,14 @@ impl Reader {
             "curve" => self
                 .grooms
                 .add_curve(p, &to_render, &id, &mut self.warnings),
-            "trianglemesh" | "plymesh" => {
+            "trianglemesh" | "plymesh" | "sphere" => {
                 self.meshes.push(mesh(kind, p, &to_render, dir, &id)?);
                 Ok(())
             }
-            _ => {
-                Err(p.fail("only \"curve\", \"trianglemesh\" and \"plymesh\" shapes are supported"))
-            }
+            _ => Err(p.fail(
+                "only \"curve\", \"trianglemesh\", \"plymesh\" and \"sphere\" shapes are \
+                 supported",
+            )),
         }
     }
 
@@ -537,6 +551,28 @@ impl Reader {
         }
         let (width, height) = self.resolution;
         let camera = self.camera_desc(width, height)?;
+        // The image is linear in the light: pbrt's film gain scales every light.
+        let gain = self.exposure_time * self.iso / 100.0;
+        if !(gain.is_finite() && gain > 0.0) {
+            return Err(invalid_arg!(
+                "{origin}: the shutter interval ({}) times the Film's iso ({}) must be > 0",
+                self.exposure_time,
+                self.iso
+            ));
+        }
+        let mut lights = self.lights;
+        for light in &mut lights {
+            match light {
+                LightDesc::Environment { scale, .. } => *scale *= gain as f32,
+                LightDesc::Distant { irradiance, .. }
+                | LightDesc::Rect {
+                    radiance: irradiance,
+                    ..
+                } => {
+                    *irradiance = irradiance.map(|v| v * gain as f32);
+                }
+            }
+        }
         let used: Vec<&str> = self
             .grooms
             .list
@@ -565,7 +601,7 @@ impl Reader {
             materials,
             grooms: self.grooms.list,
             meshes: self.meshes,
-            lights: self.lights,
+            lights,
             origin: origin.to_string(),
         })
     }
@@ -615,6 +651,33 @@ impl Reader {
             focus_distance: (lens > 0.0).then_some(focus as f32),
         })
     }
+}
+
+/// Text read from a file; a `.gz` file is decompressed (pbrt's scenes include gzipped
+/// geometry), up to [`MAX_DECOMPRESSED`] bytes.
+fn read_text_file(path: &Path) -> Result<String> {
+    let io = |e| Error::io(path, e);
+    let file = std::fs::File::open(path).map_err(io)?;
+    if !path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("gz"))
+    {
+        return std::io::read_to_string(file).map_err(io);
+    }
+    let mut text = String::new();
+    let decoder = flate2::read::GzDecoder::new(std::io::BufReader::new(file));
+    decoder
+        .take(MAX_DECOMPRESSED + 1)
+        .read_to_string(&mut text)
+        .map_err(io)?;
+    if text.len() as u64 > MAX_DECOMPRESSED {
+        return Err(invalid_arg!(
+            "{}: decompresses to more than {} GiB",
+            path.display(),
+            MAX_DECOMPRESSED >> 30
+        ));
+    }
+    Ok(text)
 }
 
 /// `N` numbers, bare or in brackets.

@@ -12,13 +12,15 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use glam::{DMat3, DMat4, DVec3};
+use glam::{DMat3, DMat4, DVec3, Vec3};
 
 use super::params::{Params, Warning};
+use crate::description::build::SPHERE_SUBDIVISIONS;
 use crate::description::{GroomDesc, GroomSource, MeshDesc, MeshSource};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::Result;
 use crate::scene::mesh::Mesh;
+use crate::scene::shapes;
 
 /// Grooms being gathered, one per (material, shape, basis).
 #[derive(Default)]
@@ -171,8 +173,9 @@ fn uniform_scale(m: &DMat4, p: &Params, warn: &mut Vec<Warning>) -> f64 {
     scale
 }
 
-/// A `trianglemesh` or `plymesh` statement as a mesh in world space; `dir` is the folder
-/// of the file that names it.
+/// A `trianglemesh`, `plymesh` or `sphere` statement as a mesh in world space (a sphere
+/// tessellated as a `[[mesh]] shape = "sphere"` is); `dir` is the folder of the file that
+/// names it.
 pub(super) fn mesh(
     kind: &str,
     p: &Params,
@@ -211,6 +214,17 @@ pub(super) fn mesh(
                 triangles,
                 normals: None,
             }
+        }
+        "sphere" => {
+            let radius = p.float("radius")?.unwrap_or(1.0);
+            let full = [("zmin", -radius), ("zmax", radius), ("phimax", 360.0)];
+            for (name, whole) in full {
+                if p.float(name)?.is_some_and(|v| v != whole) {
+                    return Err(p.fail(format_args!("{name}: only whole spheres are supported")));
+                }
+            }
+            shapes::sphere(Vec3::ZERO, radius as f32, SPHERE_SUBDIVISIONS)
+                .map_err(|e| p.context(e))?
         }
         _ => {
             let file = p

@@ -3,11 +3,13 @@
 //! short:
 //!
 //! - **Read**: Camera "perspective" (fov, lensradius, focaldistance, shutter), Film
-//!   (xresolution, yresolution, filename, iso), Sampler's pixelsamples, Integrator's maxdepth, LookAt,
-//!   Transform, ConcatTransform, Translate, Rotate, Scale, Identity, CoordinateSystem,
-//!   CoordSysTransform, AttributeBegin/End, TransformBegin/End, Include/Import (gzipped too), WorldBegin,
-//!   LightSource "infinite" (rgb L, or an equal-area image resampled to lat-long) and
-//!   "distant", Shape "curve", "trianglemesh", "plymesh" and "sphere", Material / MakeNamedMaterial "hair" and "diffuse", NamedMaterial.
+//!   (xresolution, yresolution, filename, iso), Sampler's pixelsamples, Integrator's
+//!   maxdepth, LookAt, Transform, ConcatTransform, Translate, Rotate, Scale, Identity,
+//!   CoordinateSystem, CoordSysTransform, AttributeBegin/End, TransformBegin/End,
+//!   Include/Import (gzipped too), WorldBegin, LightSource "infinite" (rgb L, or an
+//!   equal-area image resampled to lat-long) and "distant", Shape "curve",
+//!   "trianglemesh", "plymesh" and "sphere", Material / MakeNamedMaterial "hair" and
+//!   "diffuse", NamedMaterial.
 //! - **Warned and ignored** (each warning names the file and line): statements and
 //!   parameters that hairtrace replaces by its own (PixelFilter, the sampler and
 //!   integrator beyond the two values read) or that do not apply to it, and texture

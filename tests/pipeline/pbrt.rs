@@ -617,3 +617,37 @@ fn a_scene_laid_out_as_pbrts_hair_scenes() {
     assert!(close(&centre, &[0.0, 3.0, 15.0], 1e-3), "{centre:?}");
     assert!(d.build(Arc::new(Device::new(Some(1)).unwrap())).is_ok());
 }
+
+#[test]
+fn a_steeply_tapered_bspline_keeps_its_curve_and_widths() {
+    // One segment from width 0.03 to 0.001: the B-spline's outer points would need
+    // negative widths, so the curve comes as its Bezier form.
+    let p = [
+        [0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 2.0, 0.0],
+        [1.0, 3.0, 1.0],
+    ];
+    let flat: Vec<String> = p.iter().flatten().map(|v: &f32| v.to_string()).collect();
+    let body = format!(
+        "Material \"hair\"\nShape \"curve\" \"string basis\" \"bspline\" \"point3 P\" [{}] \
+         \"float width0\" 0.03 \"float width1\" 0.001\n",
+        flat.join(" ")
+    );
+    let s = scene(&body).unwrap();
+    assert_eq!(s.description.grooms[0].basis, CurveBasis::Bezier);
+    let (points, _) = control_points(&s, 0);
+    let original: Vec<[f32; 4]> = p.iter().map(|q| [-q[0], q[1], q[2], 0.0]).collect();
+    for t in [0.0, 0.3, 0.7, 1.0] {
+        let got = bezier(points, t);
+        let want = bspline(&original, t);
+        assert!(
+            close(&got[..3], &want[..3], 1e-6),
+            "t {t}: {got:?} {want:?}"
+        );
+        assert!(
+            (got[3] - (0.03 + (0.001 - 0.03) * t) / 2.0).abs() < 1e-7,
+            "t {t}"
+        );
+    }
+}

@@ -7,7 +7,8 @@
 //! to cubic Bezier segments, which is exact. pbrt's width varies linearly from `width0`
 //! at the root to `width1` at the tip over the curve parameter; radii that are an
 //! arithmetic sequence over the control points give exactly that linear variation in
-//! both bases, so each control point gets half the width at its parameter.
+//! both bases, so each control point gets half the width at its parameter (a B-spline
+//! whose outer points would get a negative width is turned into its Bezier segments).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -72,7 +73,16 @@ impl Grooms {
                 return Err(p.fail(format_args!("{name} = {w}: must be >= 0")));
             }
         }
-        let (basis, control) = layout(&points, basis, degree).map_err(|m| p.fail(m))?;
+        let (mut basis, mut control) = layout(&points, basis, degree).map_err(|m| p.fail(m))?;
+        if basis == CurveBasis::BSpline {
+            // The end points of a B-spline sit a segment beyond its ends, where a steep
+            // taper would give them a negative width: the same curve as Bezier segments
+            // then keeps every width between width0 and width1.
+            let beyond = (width1 - width0) / (control.len() - 3) as f64;
+            if width0 - beyond < 0.0 || width1 + beyond < 0.0 {
+                (basis, control) = (CurveBasis::Bezier, bspline_to_bezier(&control));
+            }
+        }
         let scale = uniform_scale(to_world, p, warn);
         let segments = control.len() as f64 - 1.0;
         let (offset, span) = match basis {
@@ -155,6 +165,20 @@ fn layout(
             "basis {basis:?}: only \"bezier\" and \"bspline\" are supported"
         )),
     }
+}
+
+/// A cubic uniform B-spline as the same curve in cubic Bezier segments.
+fn bspline_to_bezier(points: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    let p: Vec<DVec3> = points.iter().map(|q| DVec3::from_array(*q)).collect();
+    let mut out = vec![(p[0] + 4.0 * p[1] + p[2]) / 6.0];
+    for w in p.windows(4) {
+        out.extend([
+            (2.0 * w[1] + w[2]) / 3.0,
+            (w[1] + 2.0 * w[2]) / 3.0,
+            (w[1] + 4.0 * w[2] + w[3]) / 6.0,
+        ]);
+    }
+    out.iter().map(DVec3::to_array).collect()
 }
 
 /// The factor by which `m` scales lengths: exact for a rotation times a uniform scale;

@@ -6,6 +6,7 @@
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{self, BuiltScene, SceneDescription};
 use hairtrace::embree::Isa;
@@ -38,7 +39,8 @@ enum Command {
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),
-    /// Print a .hair groom's strand, point and segment counts, bounds and radius range.
+    /// Print a .hair groom's strand, point and segment counts, bounds and radius range; for
+    /// a .pbrt scene, the same per groom, its meshes, lights, camera and warnings.
     Info(InfoArgs),
     /// Write a scene (file or demo) for a peer renderer: world-space .hair grooms, OBJ
     /// meshes and scene.json, what bench/peer hands to Blender Cycles.
@@ -71,7 +73,7 @@ struct CompareArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A scene description (.toml) or a groom (.hair).
+    /// A scene description (.toml), a pbrt-v4 scene (.pbrt) or a groom (.hair).
     scene: Option<PathBuf>,
     /// A built-in scene instead of a file: furball (the default), furnace, scalp.
     #[arg(long, conflicts_with = "scene")]
@@ -128,7 +130,7 @@ struct RenderArgs {
 
 #[derive(Args)]
 struct InfoArgs {
-    /// The .hair file.
+    /// The .hair or .pbrt file.
     file: PathBuf,
     /// Read the file's thickness as a radius instead of a diameter (the default).
     #[arg(long)]
@@ -240,13 +242,21 @@ impl Progress for Bar {
 /// the fur ball).
 fn load_scene(scene: Option<&PathBuf>, demo: Option<&str>) -> hairtrace::Result<SceneDescription> {
     match scene {
-        Some(path)
-            if path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("hair")) =>
-        {
-            description::quick_look(path)
+        Some(path) if has_extension(path, "pbrt") => {
+            let pbrt = PbrtScene::from_file(path)?;
+            for w in &pbrt.warnings {
+                eprintln!("hairtrace: warning: {w}");
+            }
+            if let Some(name) = &pbrt.film_filename {
+                eprintln!(
+                    "hairtrace: note: the file's Film filename {} is not used: the image goes \
+                     to -o",
+                    name.display()
+                );
+            }
+            Ok(pbrt.description)
         }
+        Some(path) if has_extension(path, "hair") => description::quick_look(path),
         Some(path) => SceneDescription::from_file(path),
         None => description::demo(demo.unwrap_or("furball")),
     }
@@ -385,7 +395,16 @@ fn peak_memory() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+fn has_extension(path: &std::path::Path, ext: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {
+    if has_extension(&args.file, "pbrt") {
+        print!("{}", PbrtScene::from_file(&args.file)?.info_report());
+        return Ok(());
+    }
     let thickness = if args.thickness_is_radius {
         Thickness::Radius
     } else {

@@ -1,5 +1,5 @@
 //! The command line as a user meets it: the main job prints its table, `info` describes
-//! a groom, and every error is one line on stderr with a non-zero exit.
+//! a groom or a pbrt scene, and every error is one line on stderr with a non-zero exit.
 
 use hairtrace::scene::{FurBall, Thickness, write_hair_file};
 use std::process::{Command, Output};
@@ -134,6 +134,49 @@ fn render_a_bare_hair_file() {
     assert!(o.status.success(), "{o:?}");
     let img = hairtrace::image::read_image(std::path::Path::new(&out)).unwrap();
     assert!(img.pixels.iter().any(|v| *v > 0.0));
+}
+
+fn pbrt_fixture() -> String {
+    concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../tests/fixtures/pbrt/hair.pbrt"
+    )
+    .to_string()
+}
+
+/// A pbrt-v4 scene renders at the Film's size unless told otherwise, its warnings on
+/// stderr with their lines; `info` describes its grooms.
+#[test]
+fn render_and_describe_a_pbrt_scene() {
+    let out = tmp("cli_pbrt.exr");
+    let o = hairtrace(&["render", &pbrt_fixture(), "--spp", "1", "-o", &out]);
+    assert!(o.status.success(), "{o:?}");
+    let img = hairtrace::image::read_image(std::path::Path::new(&out)).unwrap();
+    assert_eq!((img.width, img.height), (64, 48), "the Film's resolution");
+    assert!(img.pixels.iter().all(|v| v.is_finite()));
+    assert!(img.pixels.iter().any(|v| *v > 0.0));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("warning: ") && err.contains("hair.pbrt:10: PixelFilter"),
+        "{err}"
+    );
+    assert!(err.contains("Film filename hair.exr is not used"), "{err}");
+
+    let o = hairtrace(&["info", &pbrt_fixture()]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    assert!(
+        text.contains("groom[0]: material \"brown\", Round Bezier curves: 3 strands, 21 control points, 6 segments"),
+        "{text}"
+    );
+    assert!(text.contains("strands.pbrt:6: Shape \"curve\""), "{text}");
+
+    let bad = tmp("cli_bad.pbrt");
+    std::fs::write(&bad, "WorldBegin\nShape \"disk\"\n").unwrap();
+    assert_one_line_error(
+        &hairtrace(&["info", &bad]),
+        "cli_bad.pbrt:2: Shape \"disk\"",
+    );
 }
 
 #[test]

@@ -28,7 +28,7 @@ use crate::validate::positive;
 
 /// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
 /// from the true sphere by under 0.05% of its radius.
-const SPHERE_SUBDIVISIONS: u32 = 4;
+pub(super) const SPHERE_SUBDIVISIONS: u32 = 4;
 
 impl SceneDescription {
     /// Checks every value, reads the files, builds the grooms and meshes into one Embree
@@ -76,13 +76,11 @@ impl SceneDescription {
         let mut hair_bounds = Bounds::EMPTY;
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
-            let strands = g.strands().map_err(|e| self.error(&at, e))?;
-            for (p, r) in strands.points.iter().zip(&strands.radii) {
-                hair_bounds.add(Vec3::from_array(*p), *r);
+            let curves = g.curves().map_err(|e| self.error(&at, e))?;
+            for p in curves.vertices() {
+                hair_bounds.add(Vec3::new(p[0], p[1], p[2]), p[3]);
             }
-            Curves::from_strands(&strands, g.basis, g.shape)
-                .and_then(|c| tracer.add_curves(c))
-                .map_err(|e| self.error(&at, e))?;
+            tracer.add_curves(curves).map_err(|e| self.error(&at, e))?;
         }
         let mut prop_bounds = Bounds::EMPTY;
         for (i, m) in self.meshes.iter().enumerate() {
@@ -192,6 +190,25 @@ impl GroomDesc {
         }
     }
 
+    /// The curves for Embree: strands converted for the basis, or control points as given
+    /// (transformed like strands).
+    pub(crate) fn curves(&self) -> Result<Curves> {
+        let GroomSource::ControlPoints { points, counts } = &self.source else {
+            return Curves::from_strands(&self.strands()?, self.basis, self.shape);
+        };
+        let linear = self.transform.linear()?;
+        positive("radius_scale", self.radius_scale)?;
+        let radius_factor = self.transform.scale * self.radius_scale;
+        let points = points
+            .iter()
+            .map(|&[x, y, z, r]| {
+                let [x, y, z] = self.transform.point(linear, [x, y, z]);
+                [x, y, z, r * radius_factor]
+            })
+            .collect::<Vec<_>>();
+        Curves::from_control_points(points, counts, None, self.basis, self.shape)
+    }
+
     /// The strands, transformed and with their radii scaled.
     pub(crate) fn strands(&self) -> Result<Strands> {
         let linear = self.transform.linear()?;
@@ -200,6 +217,11 @@ impl GroomDesc {
             GroomSource::File { path, thickness } => read_hair_file(path, *thickness)?,
             GroomSource::FurBall(f) => f.build()?,
             GroomSource::Scalp(s) => s.build()?,
+            GroomSource::ControlPoints { .. } => {
+                return Err(invalid_arg!(
+                    "a groom of control points (from a pbrt file) has no polyline strands"
+                ));
+            }
         };
         if self.transform != Transform::default() {
             for p in &mut strands.points {
@@ -234,6 +256,10 @@ impl MeshDesc {
                 shapes::sphere(Vec3::from_array(*centre), *radius, SPHERE_SUBDIVISIONS)?
             }
             MeshSource::Ground { y, half_size } => shapes::ground(*y, *half_size)?,
+            MeshSource::Triangles(mesh) => {
+                mesh.validate()?;
+                mesh.clone()
+            }
         };
         if self.transform != Transform::default() {
             for p in &mut mesh.positions {
@@ -262,6 +288,9 @@ impl LightDesc {
                 let env = match source {
                     EnvironmentSource::Uniform(radiance) => Environment::uniform(v(*radiance))?,
                     EnvironmentSource::Map(path) => Environment::from_file(path)?,
+                    EnvironmentSource::LatLong { width, height, rgb } => {
+                        Environment::from_pixels(*width, *height, 3, rgb)?
+                    }
                 };
                 Ok(Light::Environment(
                     env.with_rotation(*rotation_deg)?.with_scale(*scale)?,

@@ -96,6 +96,7 @@
 mod build;
 mod demos;
 mod file;
+pub mod pbrt;
 pub mod peer;
 
 use std::collections::BTreeMap;
@@ -112,6 +113,7 @@ use crate::scene::camera::Camera;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::HairMaterial;
+use crate::scene::mesh::Mesh;
 
 pub use demos::{DEMOS, demo, quick_look};
 
@@ -272,9 +274,19 @@ pub struct GroomDesc {
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum GroomSource {
-    File { path: PathBuf, thickness: Thickness },
+    File {
+        path: PathBuf,
+        thickness: Thickness,
+    },
     FurBall(FurBall),
     Scalp(ScalpPatch),
+    /// Control points (x, y, z, radius) already laid out for the groom's basis, `counts[i]`
+    /// of them for strand i, as a pbrt file gives them: handed to Embree as they are, with
+    /// no polyline conversion (and so no `.hair` export).
+    ControlPoints {
+        points: Vec<[f32; 4]>,
+        counts: Vec<u32>,
+    },
 }
 
 /// A `[[mesh]]` entry.
@@ -297,6 +309,8 @@ pub enum MeshSource {
         y: f32,
         half_size: f32,
     },
+    /// A mesh given inline (a pbrt `trianglemesh`, or a `plymesh` already placed).
+    Triangles(Mesh),
 }
 
 /// A `[[light]]` entry; see [`crate::scene::light::Light`] for what each parameter means.
@@ -327,6 +341,13 @@ pub enum EnvironmentSource {
     Uniform([f32; 3]),
     /// A lat-long image (see [`crate::scene::envmap::Environment`] for its orientation).
     Map(PathBuf),
+    /// A lat-long image given as linear RGB texels, rows from the top (a pbrt map,
+    /// resampled).
+    LatLong {
+        width: usize,
+        height: usize,
+        rgb: Vec<f32>,
+    },
 }
 
 /// What a render needs, built from a description.

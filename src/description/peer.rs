@@ -198,6 +198,14 @@ fn peer_light(i: usize, light: &LightDesc) -> Result<PeerLight> {
             scale: *scale,
             rotation_deg: *rotation_deg,
         },
+        LightDesc::Environment {
+            source: EnvironmentSource::LatLong { .. },
+            ..
+        } => {
+            return Err(invalid_arg!(
+                "light[{i}]: an environment given as texels (from a pbrt file) is not exported"
+            ));
+        }
         LightDesc::Distant {
             direction,
             irradiance,

@@ -41,7 +41,7 @@ fn shrink(desc: &mut SceneDescription) {
         match &mut g.source {
             GroomSource::FurBall(f) => f.strands = 300,
             GroomSource::Scalp(s) => s.strands = 300,
-            GroomSource::File { .. } => {}
+            GroomSource::File { .. } | GroomSource::ControlPoints { .. } => {}
         }
     }
 }

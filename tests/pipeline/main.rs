@@ -14,5 +14,6 @@ mod hair_file;
 mod image_io;
 mod large_groom;
 mod lights;
+mod pbrt;
 mod rehit;
 mod render;

@@ -11,7 +11,7 @@ use hairtrace::description::{self, BuiltScene, SceneDescription};
 use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
-use hairtrace::scene::{Thickness, info_report, read_hair_file};
+use hairtrace::scene::{Stage, StageProgress, Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -110,7 +110,8 @@ struct RenderArgs {
     #[arg(long)]
     filter_radius: Option<f32>,
     /// Also write the render's figures (seconds of path tracing, scene build seconds,
-    /// camera samples, rays) to this JSON file: what benchmarks read.
+    /// seconds of each stage: read, curves, bvh, render; camera samples, rays) to this
+    /// JSON file: what benchmarks read.
     #[arg(long, value_name = "FILE.json")]
     stats: Option<PathBuf>,
     /// Render only the pixels x0..x1, y0..y1 (ends exclusive) of the full frame, exactly
@@ -225,7 +226,51 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
-/// A progress bar with an ETA on stderr.
+/// A progress bar on stderr, named `prefix`, with an ETA if `eta`.
+fn stage_bar(prefix: &'static str, eta: bool) -> ProgressBar {
+    let template = if eta {
+        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}"
+    } else {
+        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise}"
+    };
+    ProgressBar::new(STAGE_STEPS)
+        .with_style(ProgressStyle::with_template(template).expect("a valid progress template"))
+        .with_prefix(prefix)
+}
+
+/// Steps of a build stage's bar (its progress is a fraction).
+const STAGE_STEPS: u64 = 1000;
+
+/// One bar per build stage, each left on screen with its time when the next starts.
+#[derive(Default)]
+struct StageBars(std::sync::Mutex<Option<(Stage, ProgressBar)>>);
+
+impl StageProgress for StageBars {
+    fn update(&self, stage: Stage, fraction: f64) -> bool {
+        let mut current = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if current.as_ref().is_none_or(|(s, _)| *s != stage) {
+            if let Some((_, bar)) = current.take() {
+                bar.finish();
+            }
+            *current = Some((stage, stage_bar(stage.name(), false)));
+        }
+        if let Some((_, bar)) = current.as_ref() {
+            bar.set_position((fraction * STAGE_STEPS as f64).round() as u64);
+        }
+        true
+    }
+}
+
+impl StageBars {
+    /// Leaves the last stage's bar on screen.
+    fn finish(&self) {
+        if let Some((_, bar)) = self.0.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            bar.finish();
+        }
+    }
+}
+
+/// The render's progress bar.
 struct Bar(ProgressBar);
 
 impl Progress for Bar {
@@ -283,17 +328,17 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     r.filter_radius = args.filter_radius.or(r.filter_radius);
     let build_start = std::time::Instant::now();
     let device = Arc::new(r.device()?);
+    let bars = StageBars::default();
     let BuiltScene {
         world,
         camera,
         settings,
-    } = description.build(device)?;
+        stages,
+    } = description.build_with(device, &bars)?;
+    bars.finish();
     let build_seconds = build_start.elapsed().as_secs_f64();
 
-    let bar = ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}")
-            .expect("a valid progress template"),
-    );
+    let bar = stage_bar("render", true);
     let wants = |name: &str| args.aov.iter().any(|a| a == name);
     let aovs = Aovs {
         albedo: wants("albedo"),
@@ -344,6 +389,11 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         let json = serde_json::json!({
             "seconds": s.seconds,
             "build_seconds": build_seconds,
+            "stage_seconds": Stage::ALL
+                .iter()
+                .map(|&st| (st.name().to_owned(), stages.get(st).into()))
+                .chain([("render".to_owned(), s.seconds.into())])
+                .collect::<serde_json::Map<_, _>>(),
             "samples": s.samples,
             "rays": s.rays,
             "spp": settings.spp,

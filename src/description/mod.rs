@@ -112,6 +112,7 @@ use crate::scene::camera::Camera;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::HairMaterial;
+use crate::scene::stages::StageTimes;
 
 pub use demos::{DEMOS, demo, quick_look};
 
@@ -334,4 +335,6 @@ pub struct BuiltScene {
     pub world: World,
     pub camera: Camera,
     pub settings: RenderSettings,
+    /// Seconds each build stage took.
+    pub stages: StageTimes,
 }

@@ -260,6 +260,12 @@ fn render_stats_compare_and_export() {
     assert_eq!(s["spp"], 2);
     assert!(s["rays"].as_u64().unwrap() >= 32 * 24 * 2, "{s}");
     assert!(s["seconds"].as_f64().unwrap() > 0.0 && s["build_seconds"].as_f64().is_some());
+    // Every stage's seconds, the render's as above, adding up to no more than the build.
+    let stage = |name: &str| s["stage_seconds"][name].as_f64().unwrap_or(-1.0);
+    assert_eq!(stage("render"), s["seconds"].as_f64().unwrap());
+    let built: f64 = ["read", "curves", "bvh"].map(stage).iter().sum();
+    assert!(["read", "curves", "bvh"].iter().all(|n| stage(n) >= 0.0), "{s}");
+    assert!(built > 0.0 && built <= s["build_seconds"].as_f64().unwrap(), "{s}");
 
     let o = hairtrace(&["compare", &a, &b, "--json"]);
     assert!(o.status.success(), "{o:?}");

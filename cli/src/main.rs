@@ -5,12 +5,13 @@
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
-use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{self, BuiltScene, SceneDescription};
+use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription};
 use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
+use hairtrace::scene::material::HairColor;
 use hairtrace::scene::{Stage, StageProgress, Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -118,6 +119,10 @@ struct RenderArgs {
     /// as the full render has them: a farm can split a frame and reassemble the pieces.
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_list::<u32, 4>)]
     crop: Option<[u32; 4]>,
+    /// The hair's absorption preset, for a bare .hair groom: red_brown, light_brown,
+    /// dark_brown, black, white (default: brown from melanin).
+    #[arg(long, value_parser = parse_preset)]
+    preset: Option<[f32; 3]>,
     /// Output image.
     #[arg(short, long)]
     output: PathBuf,
@@ -147,6 +152,10 @@ struct LobesArgs {
     /// Take sigma_a from a reflectance colour "r,g,b" instead of melanin.
     #[arg(long, value_parser = parse_list::<f32, 3>, conflicts_with_all = ["eumelanin", "pheomelanin"])]
     color: Option<[f32; 3]>,
+    /// Take sigma_a from a named preset instead of melanin: red_brown, light_brown,
+    /// dark_brown, black, white.
+    #[arg(long, value_parser = parse_preset, conflicts_with_all = ["eumelanin", "pheomelanin", "color"])]
+    preset: Option<[f32; 3]>,
     /// Longitudinal roughness, [0.01, 1].
     #[arg(long, default_value_t = 0.3)]
     beta_m: f32,
@@ -175,10 +184,16 @@ where
         .map_err(|_| format!("{s:?}: expected {N} comma-separated numbers"))
 }
 
+/// A named absorption preset's sigma_a.
+fn parse_preset(name: &str) -> Result<[f32; 3], String> {
+    sigma_a_preset(name).map_err(|e| e.detail())
+}
+
 fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
-    let sigma_a = match args.color {
-        Some(c) => sigma_a_from_color(c, args.beta_n)?,
-        None => sigma_a_from_melanin(args.eumelanin, args.pheomelanin)?,
+    let sigma_a = match (args.color, args.preset) {
+        (Some(c), _) => sigma_a_from_color(c, args.beta_n)?,
+        (None, Some(p)) => p,
+        (None, None) => sigma_a_from_melanin(args.eumelanin, args.pheomelanin)?,
     };
     let params = HairParams {
         sigma_a,
@@ -306,6 +321,21 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     // Refuse an output the writer will not take before spending minutes on the render.
     image::check_output_path(&args.output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
+    if let Some(sigma_a) = args.preset {
+        let bare = args.scene.as_ref().and_then(|p| p.extension());
+        if !bare.is_some_and(|e| e.eq_ignore_ascii_case("hair")) {
+            return Err(hairtrace::Error::InvalidArg(
+                "--preset is for a bare .hair groom; a scene file names it in its \
+                 [materials.NAME] (preset = \"...\")"
+                    .into(),
+            ));
+        }
+        for m in description.materials.values_mut() {
+            if let MaterialDesc::Hair(h) = m {
+                h.color = HairColor::SigmaA(sigma_a);
+            }
+        }
+    }
     // Overrides go into the description, so that the camera's aspect follows the size.
     let r = &mut description.render;
     r.spp = args.spp.unwrap_or(r.spp);

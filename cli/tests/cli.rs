@@ -264,8 +264,14 @@ fn render_stats_compare_and_export() {
     let stage = |name: &str| s["stage_seconds"][name].as_f64().unwrap_or(-1.0);
     assert_eq!(stage("render"), s["seconds"].as_f64().unwrap());
     let built: f64 = ["read", "curves", "bvh"].map(stage).iter().sum();
-    assert!(["read", "curves", "bvh"].iter().all(|n| stage(n) >= 0.0), "{s}");
-    assert!(built > 0.0 && built <= s["build_seconds"].as_f64().unwrap(), "{s}");
+    assert!(
+        ["read", "curves", "bvh"].iter().all(|n| stage(n) >= 0.0),
+        "{s}"
+    );
+    assert!(
+        built > 0.0 && built <= s["build_seconds"].as_f64().unwrap(),
+        "{s}"
+    );
 
     let o = hairtrace(&["compare", &a, &b, "--json"]);
     assert!(o.status.success(), "{o:?}");

@@ -56,11 +56,7 @@ fn device() -> Arc<Device> {
 /// and conversion; each groom's conversion follows its read.
 fn check_sequence(calls: &[(Stage, f64)]) {
     for stage in Stage::ALL {
-        let fractions: Vec<f64> = calls
-            .iter()
-            .filter(|c| c.0 == stage)
-            .map(|c| c.1)
-            .collect();
+        let fractions: Vec<f64> = calls.iter().filter(|c| c.0 == stage).map(|c| c.1).collect();
         assert!(!fractions.is_empty(), "{stage:?} never reported: {calls:?}");
         assert!(
             fractions.windows(2).all(|w| w[0] <= w[1]),
@@ -93,7 +89,9 @@ fn stages_come_in_order_and_finish() {
     assert!(calls.contains(&(Stage::Read, 0.5)));
     // Embree reports the BVH build's progress in between.
     assert!(
-        calls.iter().any(|&(s, f)| s == Stage::Bvh && f > 0.0 && f < 1.0),
+        calls
+            .iter()
+            .any(|&(s, f)| s == Stage::Bvh && f > 0.0 && f < 1.0),
         "no progress inside the BVH build: {calls:?}"
     );
     let times = built.stages;
@@ -132,7 +130,10 @@ fn cancelling_stops_the_build() {
         assert!(is_cancelled(&err), "{err}");
         let calls = recorder.calls();
         let last = *calls.last().unwrap();
-        assert!(cancel_at(last.0, last.1), "went on after cancelling: {calls:?}");
+        assert!(
+            cancel_at(last.0, last.1),
+            "went on after cancelling: {calls:?}"
+        );
         assert_eq!(calls.iter().filter(|c| cancel_at(c.0, c.1)).count(), 1);
     }
 }

@@ -35,7 +35,7 @@ enum Command {
     /// Render a scene file (.toml), a bare groom (.hair: automatic camera, default light
     /// and brown hair) or a built-in demo, and write the image (the extension picks the
     /// format: .exr linear float, .png/.jpg/.tif sRGB).
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),

@@ -118,7 +118,7 @@ impl SceneBuilder {
     }
 }
 
-/// What [`SceneBuilder::commit`] reports to: the fraction built, `false` to cancel.
+/// What a commit reports to (`SceneBuilder::commit`): the fraction built, `false` to cancel.
 pub type BuildMonitor<'a> = dyn Fn(f64) -> bool + Sync + 'a;
 
 /// Embree's progress callback: forwards to the [`BuildMonitor`] behind `user`. A panic in

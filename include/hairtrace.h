@@ -556,6 +556,23 @@ struct HtHairParams ht_hair_params_default(void);
 enum HtStatus ht_hair_sigma_a_from_melanin(float eumelanin, float pheomelanin, float *sigma_a);
 
 /**
+ * Writes `sigma_a[3]` (per unit fibre radius) of a named absorption preset: "red_brown"
+ * (0.09, 1.3, 2.6), "light_brown" (0.6, 1.3, 2.0), "dark_brown" (0.9, 1.28, 2.66),
+ * "black" (2.9, 5.1, 10.2) or "white" (0.08, 0.09, 0.18), the names of the scene format.
+ *
+ * - `name`: a NUL-terminated UTF-8 string, NULL: `HT_ERR_NULL_ARG`; any other name:
+ *   `HT_ERR_INVALID_ARG`, whose message lists the valid ones.
+ * - `sigma_a`: out, 3 floats, 4-byte aligned; NULL: `HT_ERR_NULL_ARG`. Untouched on error.
+ *
+ * Any thread.
+ *
+ * # Safety
+ * `name` is NULL or a NUL-terminated string; `sigma_a` is NULL or points to 3 writable
+ * floats.
+ */
+enum HtStatus ht_hair_sigma_a_preset(const char *name, float *sigma_a);
+
+/**
  * Writes `sigma_a[3]` that makes a fibre look like the linear RGB reflectance `color` at
  * azimuthal roughness `beta_n` (Chiang's inversion: pass the beta_n you render with).
  *

@@ -5,14 +5,15 @@
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
-use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{self, BuiltScene, SceneDescription};
+use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription};
 use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
-use hairtrace::scene::{Thickness, info_report, read_hair_file};
+use hairtrace::scene::material::HairColor;
+use hairtrace::scene::{Stage, StageProgress, Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -35,7 +36,7 @@ enum Command {
     /// Render a scene file (.toml), a bare groom (.hair: automatic camera, default light
     /// and brown hair) or a built-in demo, and write the image (the extension picks the
     /// format: .exr linear float, .png/.jpg/.tif sRGB).
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),
@@ -112,13 +113,18 @@ struct RenderArgs {
     #[arg(long)]
     filter_radius: Option<f32>,
     /// Also write the render's figures (seconds of path tracing, scene build seconds,
-    /// camera samples, rays) to this JSON file: what benchmarks read.
+    /// seconds of each stage: read, curves, bvh, render; camera samples, rays) to this
+    /// JSON file: what benchmarks read.
     #[arg(long, value_name = "FILE.json")]
     stats: Option<PathBuf>,
     /// Render only the pixels x0..x1, y0..y1 (ends exclusive) of the full frame, exactly
     /// as the full render has them: a farm can split a frame and reassemble the pieces.
     #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_list::<u32, 4>)]
     crop: Option<[u32; 4]>,
+    /// The hair's absorption preset, for a bare .hair groom: red_brown, light_brown,
+    /// dark_brown, black, white (default: brown from melanin).
+    #[arg(long, value_parser = parse_preset)]
+    preset: Option<[f32; 3]>,
     /// Output image.
     #[arg(short, long)]
     output: PathBuf,
@@ -148,6 +154,10 @@ struct LobesArgs {
     /// Take sigma_a from a reflectance colour "r,g,b" instead of melanin.
     #[arg(long, value_parser = parse_list::<f32, 3>, conflicts_with_all = ["eumelanin", "pheomelanin"])]
     color: Option<[f32; 3]>,
+    /// Take sigma_a from a named preset instead of melanin: red_brown, light_brown,
+    /// dark_brown, black, white.
+    #[arg(long, value_parser = parse_preset, conflicts_with_all = ["eumelanin", "pheomelanin", "color"])]
+    preset: Option<[f32; 3]>,
     /// Longitudinal roughness, [0.01, 1].
     #[arg(long, default_value_t = 0.3)]
     beta_m: f32,
@@ -176,10 +186,16 @@ where
         .map_err(|_| format!("{s:?}: expected {N} comma-separated numbers"))
 }
 
+/// A named absorption preset's sigma_a.
+fn parse_preset(name: &str) -> Result<[f32; 3], String> {
+    sigma_a_preset(name).map_err(|e| e.detail())
+}
+
 fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
-    let sigma_a = match args.color {
-        Some(c) => sigma_a_from_color(c, args.beta_n)?,
-        None => sigma_a_from_melanin(args.eumelanin, args.pheomelanin)?,
+    let sigma_a = match (args.color, args.preset) {
+        (Some(c), _) => sigma_a_from_color(c, args.beta_n)?,
+        (None, Some(p)) => p,
+        (None, None) => sigma_a_from_melanin(args.eumelanin, args.pheomelanin)?,
     };
     let params = HairParams {
         sigma_a,
@@ -227,7 +243,51 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
-/// A progress bar with an ETA on stderr.
+/// A progress bar on stderr, named `prefix`, with an ETA if `eta`.
+fn stage_bar(prefix: &'static str, eta: bool) -> ProgressBar {
+    let template = if eta {
+        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}"
+    } else {
+        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise}"
+    };
+    ProgressBar::new(STAGE_STEPS)
+        .with_style(ProgressStyle::with_template(template).expect("a valid progress template"))
+        .with_prefix(prefix)
+}
+
+/// Steps of a build stage's bar (its progress is a fraction).
+const STAGE_STEPS: u64 = 1000;
+
+/// One bar per build stage, each left on screen with its time when the next starts.
+#[derive(Default)]
+struct StageBars(std::sync::Mutex<Option<(Stage, ProgressBar)>>);
+
+impl StageProgress for StageBars {
+    fn update(&self, stage: Stage, fraction: f64) -> bool {
+        let mut current = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if current.as_ref().is_none_or(|(s, _)| *s != stage) {
+            if let Some((_, bar)) = current.take() {
+                bar.finish();
+            }
+            *current = Some((stage, stage_bar(stage.name(), false)));
+        }
+        if let Some((_, bar)) = current.as_ref() {
+            bar.set_position((fraction * STAGE_STEPS as f64).round() as u64);
+        }
+        true
+    }
+}
+
+impl StageBars {
+    /// Leaves the last stage's bar on screen.
+    fn finish(&self) {
+        if let Some((_, bar)) = self.0.lock().unwrap_or_else(|e| e.into_inner()).take() {
+            bar.finish();
+        }
+    }
+}
+
+/// The render's progress bar.
 struct Bar(ProgressBar);
 
 impl Progress for Bar {
@@ -271,6 +331,21 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     // Refuse an output the writer will not take before spending minutes on the render.
     image::check_output_path(&args.output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
+    if let Some(sigma_a) = args.preset {
+        let bare = args.scene.as_ref().and_then(|p| p.extension());
+        if !bare.is_some_and(|e| e.eq_ignore_ascii_case("hair")) {
+            return Err(hairtrace::Error::InvalidArg(
+                "--preset is for a bare .hair groom; a scene file names it in its \
+                 [materials.NAME] (preset = \"...\")"
+                    .into(),
+            ));
+        }
+        for m in description.materials.values_mut() {
+            if let MaterialDesc::Hair(h) = m {
+                h.color = HairColor::SigmaA(sigma_a);
+            }
+        }
+    }
     // Overrides go into the description, so that the camera's aspect follows the size.
     let r = &mut description.render;
     r.spp = args.spp.unwrap_or(r.spp);
@@ -293,17 +368,17 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     r.filter_radius = args.filter_radius.or(r.filter_radius);
     let build_start = std::time::Instant::now();
     let device = Arc::new(r.device()?);
+    let bars = StageBars::default();
     let BuiltScene {
         world,
         camera,
         settings,
-    } = description.build(device)?;
+        stages,
+    } = description.build_with(device, &bars)?;
+    bars.finish();
     let build_seconds = build_start.elapsed().as_secs_f64();
 
-    let bar = ProgressBar::new(0).with_style(
-        ProgressStyle::with_template("{bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}")
-            .expect("a valid progress template"),
-    );
+    let bar = stage_bar("render", true);
     let wants = |name: &str| args.aov.iter().any(|a| a == name);
     let aovs = Aovs {
         albedo: wants("albedo"),
@@ -354,6 +429,11 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         let json = serde_json::json!({
             "seconds": s.seconds,
             "build_seconds": build_seconds,
+            "stage_seconds": Stage::ALL
+                .iter()
+                .map(|&st| (st.name().to_owned(), stages.get(st).into()))
+                .chain([("render".to_owned(), s.seconds.into())])
+                .collect::<serde_json::Map<_, _>>(),
             "samples": s.samples,
             "rays": s.rays,
             "spp": settings.spp,

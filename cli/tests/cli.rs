@@ -134,6 +134,48 @@ fn render_a_bare_hair_file() {
     assert!(o.status.success(), "{o:?}");
     let img = hairtrace::image::read_image(std::path::Path::new(&out)).unwrap();
     assert!(img.pixels.iter().any(|v| *v > 0.0));
+
+    // A named absorption preset: white hair has a higher albedo than black.
+    let mean = |preset: &str| {
+        let out = tmp(&format!("cli_quick_{preset}.exr"));
+        let o = hairtrace(&[
+            "render", &path, "--width", "32", "--height", "32", "--spp", "2", "--preset", preset,
+            "--aov", "albedo", "-o", &out,
+        ]);
+        assert!(o.status.success(), "{o:?}");
+        let albedo = out.replace(".exr", ".albedo.exr");
+        let img = hairtrace::image::read_image(std::path::Path::new(&albedo)).unwrap();
+        img.pixels.iter().sum::<f32>() / img.pixels.len() as f32
+    };
+    let (white, black) = (mean("white"), mean("black"));
+    assert!(
+        white > 3.0 * black && black > 0.0,
+        "white {white}, black {black}"
+    );
+    // Only a bare groom takes it: a scene file names its own.
+    assert_one_line_error(
+        &hairtrace(&["render", "--demo", "scalp", "--preset", "black", "-o", &out]),
+        "[materials.NAME]",
+    );
+    assert_one_line_error(
+        &hairtrace(&["render", &path, "--preset", "auburn", "-o", &out]),
+        "known: red_brown, light_brown, dark_brown, black, white",
+    );
+}
+
+#[test]
+fn lobes_takes_a_preset() {
+    let o = hairtrace(&["lobes", "--preset", "dark_brown"]);
+    assert!(o.status.success(), "{o:?}");
+    assert!(
+        stdout(&o).starts_with("sigma_a = (0.9000, 1.2800, 2.6600)"),
+        "{}",
+        stdout(&o)
+    );
+    assert_one_line_error(
+        &hairtrace(&["lobes", "--preset", "black", "--color", "1,1,1"]),
+        "--color",
+    );
 }
 
 fn pbrt_fixture() -> String {
@@ -303,6 +345,18 @@ fn render_stats_compare_and_export() {
     assert_eq!(s["spp"], 2);
     assert!(s["rays"].as_u64().unwrap() >= 32 * 24 * 2, "{s}");
     assert!(s["seconds"].as_f64().unwrap() > 0.0 && s["build_seconds"].as_f64().is_some());
+    // Every stage's seconds, the render's as above, adding up to no more than the build.
+    let stage = |name: &str| s["stage_seconds"][name].as_f64().unwrap_or(-1.0);
+    assert_eq!(stage("render"), s["seconds"].as_f64().unwrap());
+    let built: f64 = ["read", "curves", "bvh"].map(stage).iter().sum();
+    assert!(
+        ["read", "curves", "bvh"].iter().all(|n| stage(n) >= 0.0),
+        "{s}"
+    );
+    assert!(
+        built > 0.0 && built <= s["build_seconds"].as_f64().unwrap(),
+        "{s}"
+    );
 
     let o = hairtrace(&["compare", &a, &b, "--json"]);
     assert!(o.status.success(), "{o:?}");

@@ -10,6 +10,32 @@ use crate::validate::non_negative;
 const EUMELANIN_SIGMA_A: [f32; 3] = [0.419, 0.697, 1.37];
 const PHEOMELANIN_SIGMA_A: [f32; 3] = [0.187, 0.4, 1.05];
 
+/// Named absorptions (sigma_a per unit fiber radius, linear RGB) of common hair colours,
+/// the ones the scene format, the CLI and the C ABI take by name.
+pub const SIGMA_A_PRESETS: [(&str, [f32; 3]); 5] = [
+    ("red_brown", [0.09, 1.3, 2.6]),
+    ("light_brown", [0.6, 1.3, 2.0]),
+    ("dark_brown", [0.9, 1.28, 2.66]),
+    ("black", [2.9, 5.1, 10.2]),
+    ("white", [0.08, 0.09, 0.18]),
+];
+
+/// The sigma_a of the preset `name` (see [`SIGMA_A_PRESETS`]); an unknown name is an
+/// error that lists the known ones.
+pub fn sigma_a_preset(name: &str) -> Result<[f32; 3]> {
+    SIGMA_A_PRESETS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|&(_, sigma_a)| sigma_a)
+        .ok_or_else(|| {
+            let names: Vec<&str> = SIGMA_A_PRESETS.iter().map(|(n, _)| *n).collect();
+            invalid_arg!(
+                "preset = {name:?}: no such absorption preset (known: {})",
+                names.join(", ")
+            )
+        })
+}
+
 /// sigma_a from eumelanin and pheomelanin concentrations (finite, >= 0). About 8 is jet
 /// black, 1.3 brown, 0.3 blonde; pheomelanin adds red.
 pub fn sigma_a_from_melanin(eumelanin: f32, pheomelanin: f32) -> Result<[f32; 3]> {

@@ -10,7 +10,7 @@ mod limits;
 pub(crate) mod longitudinal;
 pub(crate) mod params;
 
-pub use absorption::{sigma_a_from_color, sigma_a_from_melanin};
+pub use absorption::{SIGMA_A_PRESETS, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 pub use diffuse::Diffuse;
 pub use diffuse::DiffusePoint;
 pub(crate) use hair::OwnedPoint;

@@ -11,13 +11,16 @@
 
 use super::{
     Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
+    read_path,
 };
 use crate::bsdf::{
     BsdfEval, BsdfSample, HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin,
+    sigma_a_preset,
 };
 use crate::error::invalid_arg;
 use glam::Vec3;
 use std::cell::RefCell;
+use std::ffi::c_char;
 
 /// Parameters of the hair BSDF (Chiang et al. 2016), all checked, never clamped:
 /// - `sigma_a`: absorption per unit fibre *radius* (so independent of the fibre's size),
@@ -263,6 +266,37 @@ pub unsafe extern "C" fn ht_hair_sigma_a_from_melanin(
     boundary(|| {
         let out = host_slice_mut(sigma_a, 3, "sigma_a")?;
         out.copy_from_slice(&sigma_a_from_melanin(eumelanin, pheomelanin)?);
+        Ok(())
+    })
+}
+
+/// Writes `sigma_a[3]` (per unit fibre radius) of a named absorption preset: "red_brown"
+/// (0.09, 1.3, 2.6), "light_brown" (0.6, 1.3, 2.0), "dark_brown" (0.9, 1.28, 2.66),
+/// "black" (2.9, 5.1, 10.2) or "white" (0.08, 0.09, 0.18), the names of the scene format.
+///
+/// - `name`: a NUL-terminated UTF-8 string, NULL: `HT_ERR_NULL_ARG`; any other name:
+///   `HT_ERR_INVALID_ARG`, whose message lists the valid ones.
+/// - `sigma_a`: out, 3 floats, 4-byte aligned; NULL: `HT_ERR_NULL_ARG`. Untouched on error.
+///
+/// Any thread.
+///
+/// # Safety
+/// `name` is NULL or a NUL-terminated string; `sigma_a` is NULL or points to 3 writable
+/// floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_sigma_a_preset(
+    name: *const c_char,
+    sigma_a: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        require(&[
+            (name.cast(), "name"),
+            (sigma_a.cast_const().cast(), "sigma_a"),
+        ])?;
+        let out = host_slice_mut(sigma_a, 3, "sigma_a")?;
+        out.copy_from_slice(&sigma_a_preset(
+            &read_path(name, "name")?.to_string_lossy(),
+        )?);
         Ok(())
     })
 }
@@ -603,6 +637,30 @@ mod tests {
         assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
         assert!(last_error().contains("overflows"), "{}", last_error());
         assert_eq!(sigma, [0.0; 3]);
+    }
+
+    #[test]
+    fn presets_by_name() {
+        for (name, want) in crate::bsdf::SIGMA_A_PRESETS {
+            let c = std::ffi::CString::new(name).unwrap();
+            let mut sigma = [0.0f32; 3];
+            let s = unsafe { ht_hair_sigma_a_preset(c.as_ptr(), sigma.as_mut_ptr()) };
+            assert_eq!((s, sigma), (HtStatus::HT_OK, want), "{name}");
+        }
+        let mut sigma = [0.0f32; 3];
+        let s = unsafe { ht_hair_sigma_a_preset(c"auburn".as_ptr(), sigma.as_mut_ptr()) };
+        assert_eq!((s, sigma), (HtStatus::HT_ERR_INVALID_ARG, [0.0; 3]));
+        assert!(
+            last_error().contains("\"auburn\"") && last_error().contains("dark_brown, black"),
+            "{}",
+            last_error()
+        );
+        // NULL first, whatever the name.
+        let s = unsafe { ht_hair_sigma_a_preset(c"auburn".as_ptr(), std::ptr::null_mut()) };
+        assert_eq!(s, HtStatus::HT_ERR_NULL_ARG);
+        let s = unsafe { ht_hair_sigma_a_preset(std::ptr::null(), sigma.as_mut_ptr()) };
+        assert_eq!(s, HtStatus::HT_ERR_NULL_ARG);
+        assert!(last_error().contains("name"), "{}", last_error());
     }
 
     #[test]

@@ -22,6 +22,7 @@ use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
+use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
 use crate::scene::strands::Strands;
 use crate::scene::tracer::TracerBuilder;
 use crate::validate::positive;
@@ -36,6 +37,16 @@ impl SceneDescription {
     /// assignment, lights) come before any groom is read or built, so that a typo does not
     /// wait for a large groom.
     pub fn build(&self, device: Arc<Device>) -> Result<BuiltScene> {
+        self.build_with(device, &NoStages)
+    }
+
+    /// [`build`](Self::build), reporting each stage's progress to `progress` and timing
+    /// it in [`BuiltScene::stages`].
+    pub fn build_with(
+        &self,
+        device: Arc<Device>,
+        progress: &dyn StageProgress,
+    ) -> Result<BuiltScene> {
         let settings = self
             .render
             .settings()
@@ -72,11 +83,29 @@ impl SceneDescription {
             .map(|(i, l)| l.build().map_err(|e| self.error(&format!("light[{i}]"), e)))
             .collect::<Result<Vec<_>>>()?;
 
+        let mut stages = StageRunner::new(progress);
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
         let mut hair_bounds = Bounds::EMPTY;
+        let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
-            let curves = g.curves().map_err(|e| self.error(&at, e))?;
+            // A groom of control points (a pbrt file's) was read with its file: it has
+            // no polyline strands to read, only curves to make.
+            let strands = match g.source {
+                GroomSource::ControlPoints { .. } => None,
+                _ => Some(
+                    stages
+                        .run(Stage::Read, (i, reads), |_| g.strands())
+                        .map_err(|e| self.error(&at, e))?,
+                ),
+            };
+            let curves = stages
+                .run(Stage::Curves, (i, grooms), |_| match &strands {
+                    Some(strands) => Curves::from_strands(strands, g.basis, g.shape),
+                    None => g.curves(),
+                })
+                .map_err(|e| self.error(&at, e))?;
+            drop(strands);
             for p in curves.vertices() {
                 hair_bounds.add(Vec3::new(p[0], p[1], p[2]), p[3]);
             }
@@ -85,7 +114,9 @@ impl SceneDescription {
         let mut prop_bounds = Bounds::EMPTY;
         for (i, m) in self.meshes.iter().enumerate() {
             let at = format!("mesh[{i}]");
-            let mesh = m.mesh().map_err(|e| self.error(&at, e))?;
+            let mesh = stages
+                .run(Stage::Read, (grooms + i, reads), |_| m.mesh())
+                .map_err(|e| self.error(&at, e))?;
             // A ground quad is the stage, not the subject: framing it would shrink the
             // subject to a speck.
             if !matches!(m.source, MeshSource::Ground { .. }) {
@@ -95,6 +126,9 @@ impl SceneDescription {
             }
             tracer.add_mesh(mesh).map_err(|e| self.error(&at, e))?;
         }
+        // A scene without grooms (or meshes) still goes through every stage.
+        stages.report(Stage::Read, 1.0)?;
+        stages.report(Stage::Curves, 1.0)?;
         let framed = if hair_bounds.is_empty() {
             prop_bounds
         } else {
@@ -105,11 +139,13 @@ impl SceneDescription {
             .camera
             .build(framed, aspect)
             .map_err(|e| self.error("camera", e))?;
-        let world = World::new(tracer.build()?, materials, lights)?;
+        let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
+        let world = World::new(tracer, materials, lights)?;
         Ok(BuiltScene {
             world,
             camera,
             settings,
+            stages: stages.times(),
         })
     }
 

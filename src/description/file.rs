@@ -13,6 +13,7 @@ use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
     MeshSource, RenderDesc, SceneDescription, Transform,
 };
+use crate::bsdf::sigma_a_preset;
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
@@ -91,6 +92,7 @@ struct RawMaterial {
     sigma_a: Option<[f32; 3]>,
     melanin: Option<[f32; 2]>,
     color: Option<[f32; 3]>,
+    preset: Option<String>,
     eta: Option<f32>,
     beta_m: Option<f32>,
     beta_n: Option<f32>,
@@ -380,16 +382,19 @@ impl RawMaterial {
         match self.kind {
             MaterialKind::Hair => {
                 reject("a hair material", &[("albedo", self.albedo.is_some())])?;
-                let color = match (self.sigma_a, self.melanin, self.color) {
-                    (Some(s), None, None) => HairColor::SigmaA(s),
-                    (None, Some([eumelanin, pheomelanin]), None) => HairColor::Melanin {
+                let color = match (self.sigma_a, self.melanin, self.color, &self.preset) {
+                    (Some(s), None, None, None) => HairColor::SigmaA(s),
+                    (None, Some([eumelanin, pheomelanin]), None, None) => HairColor::Melanin {
                         eumelanin,
                         pheomelanin,
                     },
-                    (None, None, Some(c)) => HairColor::Color(c),
+                    (None, None, Some(c), None) => HairColor::Color(c),
+                    (None, None, None, Some(name)) => {
+                        HairColor::SigmaA(sigma_a_preset(name).map_err(|e| e.detail())?)
+                    }
                     _ => {
                         return Err("a hair material needs exactly one of `sigma_a`, `melanin` \
-                             (= [eumelanin, pheomelanin]) or `color`"
+                             (= [eumelanin, pheomelanin]), `color` or `preset`"
                             .to_string()
                             .into());
                     }
@@ -419,6 +424,7 @@ impl RawMaterial {
                     sigma_a,
                     melanin,
                     color,
+                    preset,
                     eta,
                     beta_m,
                     beta_n,
@@ -435,6 +441,7 @@ impl RawMaterial {
                         ("sigma_a", sigma_a.is_some()),
                         ("melanin", melanin.is_some()),
                         ("color", color.is_some()),
+                        ("preset", preset.is_some()),
                         ("eta", eta.is_some()),
                         ("beta_m", beta_m.is_some()),
                         ("beta_n", beta_n.is_some()),

@@ -30,7 +30,8 @@
 //! focus_distance = 5.0     # default: the distance from eye to target
 //!
 //! [materials.brown]
-//! type = "hair"            # exactly one of sigma_a = [r, g, b], melanin = [eu, pheo], color = [r, g, b]
+//! type = "hair"            # exactly one of sigma_a = [r, g, b], melanin = [eu, pheo], color = [r, g, b],
+//!                          # preset = "red_brown", "light_brown", "dark_brown", "black" or "white"
 //! melanin = [1.3, 0.2]     # then, optional: eta, beta_m, beta_n, alpha (degrees),
 //! beta_m = 0.3             # absorption_variation, roughness_variation, tip_absorption,
 //!                          # use_vertex_colors, seed (see HairMaterial)
@@ -114,6 +115,7 @@ use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::HairMaterial;
 use crate::scene::mesh::Mesh;
+use crate::scene::stages::StageTimes;
 
 pub use demos::{DEMOS, demo, quick_look};
 
@@ -355,4 +357,6 @@ pub struct BuiltScene {
     pub world: World,
     pub camera: Camera,
     pub settings: RenderSettings,
+    /// Seconds each build stage took.
+    pub stages: StageTimes,
 }

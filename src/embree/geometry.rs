@@ -733,7 +733,7 @@ mod tests {
                     let last = geometry.interpolate(segments as u32 - 1, 1.0).unwrap();
                     assert!(last.p.iter().all(|v| v.is_finite()), "{basis:?}");
                     scene.attach(geometry).unwrap();
-                    let scene = scene.commit().unwrap();
+                    let scene = scene.commit(&|_| true).unwrap();
                     // Rays across the whole strand, up to its tip: every segment is traced.
                     let (lo, hi) = scene.bounds();
                     let hits = (0..=32)

@@ -33,7 +33,7 @@ pub use geometry::{
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
 pub use query::{Exclude, Ray, RayHit};
-pub use scene::{Scene, SceneBuilder, SceneOptions};
+pub use scene::{BuildMonitor, Scene, SceneBuilder, SceneOptions, cancelled, is_cancelled};
 
 /// The Embree version hairtrace was built against, as `major.minor.patch`, read from the
 /// installed `rtcore_config.h` at build time.

@@ -95,16 +95,50 @@ impl SceneBuilder {
         Ok(id)
     }
 
-    /// Builds the BVH. Embree's build uses the device's worker threads.
-    pub(crate) fn commit(self) -> Result<Scene> {
-        // SAFETY: live scene with committed geometries.
-        unsafe { sys::rtcCommitScene(self.raw.0.as_ptr()) };
+    /// Builds the BVH (Embree's build uses the device's worker threads), telling `progress` how far the build has got (0 to 1). Embree may
+    /// call it from several build threads at once and out of order; `false` cancels the
+    /// build, which then fails with Embree's `RTC_ERROR_CANCELLED` (see [`is_cancelled`]).
+    /// The monitor's signature is the same in Embree 3 and 4.
+    pub(crate) fn commit(self, progress: &BuildMonitor<'_>) -> Result<Scene> {
+        let scene = self.raw.0.as_ptr();
+        let user = (&raw const progress).cast_mut().cast::<std::ffi::c_void>();
+        // SAFETY: live scene; `user` points at `progress`, which outlives the commit, and
+        // the monitor is removed before this function returns.
+        unsafe {
+            sys::rtcSetSceneProgressMonitorFunction(scene, Some(monitor), user);
+            sys::rtcCommitScene(scene);
+            sys::rtcSetSceneProgressMonitorFunction(scene, None, std::ptr::null_mut());
+        }
         self.device.check()?;
         Ok(Scene {
             raw: self.raw,
             geometries: self.geometries,
             device: self.device,
         })
+    }
+}
+
+/// What a commit reports to (`SceneBuilder::commit`): the fraction built, `false` to cancel.
+pub type BuildMonitor<'a> = dyn Fn(f64) -> bool + Sync + 'a;
+
+/// Embree's progress callback: forwards to the [`BuildMonitor`] behind `user`. A panic in
+/// it must not unwind into Embree, so it cancels the build instead.
+unsafe extern "C" fn monitor(user: *mut std::ffi::c_void, fraction: f64) -> bool {
+    // SAFETY: `commit` passes a pointer to a live `&BuildMonitor` for the commit.
+    let progress = unsafe { *user.cast::<&BuildMonitor<'_>>() };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| progress(fraction))).unwrap_or(false)
+}
+
+/// Whether `e` is the error of a build that a [`BuildMonitor`] cancelled.
+pub fn is_cancelled(e: &Error) -> bool {
+    matches!(e, Error::Embree { code, .. } if *code == sys::RTCError::RTC_ERROR_CANCELLED.0)
+}
+
+/// The error a cancelled build stage reports, the same as Embree's own.
+pub fn cancelled() -> Error {
+    Error::Embree {
+        code: sys::RTCError::RTC_ERROR_CANCELLED.0,
+        message: "cancelled".into(),
     }
 }
 

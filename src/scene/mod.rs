@@ -14,6 +14,7 @@ mod light_sample;
 pub mod material;
 pub(crate) mod mesh;
 pub(crate) mod shapes;
+pub mod stages;
 pub(crate) mod strands;
 pub mod tracer;
 
@@ -24,4 +25,5 @@ pub use hair_file::{
     Thickness, encode_hair, info_report, parse_hair, read_hair_file, write_hair_file,
 };
 pub use light::{Light, LightEval, LightSample};
+pub use stages::{NoStages, Stage, StageProgress, StageTimes};
 pub use strands::Strands;

@@ -9,6 +9,7 @@ use glam::Vec3;
 use super::curves::{Curves, StrandIndex, StrandSegment};
 use super::hit::{HairHit, Hit, SurfaceHit, hair_frame};
 use super::mesh::Mesh;
+use super::stages::{NoStages, Stage, StageRunner};
 use crate::Result;
 use crate::embree::{
     CurveBasis, CurveGeometry, CurvePoint, CurveShape, Device, Exclude, Geometry, Ray, RayHit,
@@ -122,8 +123,15 @@ impl TracerBuilder {
 
     /// Builds the BVH.
     pub fn build(self) -> Result<Tracer> {
+        self.build_with(&StageRunner::new(&NoStages))
+    }
+
+    /// Builds the BVH, reporting its progress as [`Stage::Bvh`] to `stages`.
+    pub fn build_with(self, stages: &StageRunner<'_>) -> Result<Tracer> {
         Ok(Tracer {
-            scene: self.scene.commit()?,
+            scene: self
+                .scene
+                .commit(&|fraction| stages.forward(Stage::Bvh, fraction))?,
             tables: self.tables,
         })
     }

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 use hairtrace::Error;
+use hairtrace::bsdf::SIGMA_A_PRESETS;
 use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{
     DEMOS, EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource, SceneDescription,
@@ -257,6 +258,37 @@ fn bad_choices_list_the_valid_ones() {
 
     let e = parse_error(&BASE.replace("type = \"environment\"", "type = \"sun\""));
     assert_contains(&e, &["sun", "environment", "distant", "rect"]);
+}
+
+#[test]
+fn absorption_presets_by_name() {
+    for (name, sigma_a) in SIGMA_A_PRESETS {
+        let text = BASE.replace("melanin = [1.3, 0.2]", &format!("preset = \"{name}\""));
+        let desc = parse(&text).unwrap();
+        let MaterialDesc::Hair(h) = &desc.materials["brown"] else {
+            panic!("a hair material");
+        };
+        assert_eq!(h.color, HairColor::SigmaA(sigma_a), "{name}");
+    }
+    let e = parse_error(&BASE.replace("melanin = [1.3, 0.2]", "preset = \"auburn\""));
+    assert_contains(&e, &["materials.brown", "\"auburn\"", "red_brown", "white"]);
+    // A preset is one more way to give the absorption: never together with another.
+    for other in [
+        "melanin = [1.3, 0.2]",
+        "sigma_a = [1, 1, 1]",
+        "color = [0.5, 0.4, 0.3]",
+    ] {
+        let e = parse_error(&BASE.replace(
+            "melanin = [1.3, 0.2]",
+            &format!("{other}\npreset = \"black\""),
+        ));
+        assert_contains(&e, &["materials.brown", "exactly one of", "`preset`"]);
+    }
+    let e = parse_error(&BASE.replace(
+        "albedo = [0.6, 0.5, 0.4]",
+        "albedo = [0.6, 0.5, 0.4]\npreset = \"black\"",
+    ));
+    assert_contains(&e, &["materials.skin.preset", "diffuse"]);
 }
 
 #[test]

@@ -17,3 +17,4 @@ mod lights;
 mod pbrt;
 mod rehit;
 mod render;
+mod stages;

@@ -76,6 +76,12 @@ int main(void) {
     ROW(BAD, "overflows", ht_hair_sigma_a_from_melanin(FLT_MAX, FLT_MAX, out));
     ROW(BAD, "eumelanin = inf", ht_hair_sigma_a_from_melanin(inf, 0.0f, out));
     ROW(BAD, "not aligned", ht_hair_sigma_a_from_melanin(1.0f, 0.0f, odd));
+    /* sigma_a presets by name: an unknown name lists the known ones. */
+    ROW(BAD, "known: red_brown, light_brown", ht_hair_sigma_a_preset("auburn", out));
+    ROW(BAD, "name is empty", ht_hair_sigma_a_preset("", out));
+    ROW(NUL, "name is NULL", ht_hair_sigma_a_preset(NULL, out));
+    ROW(NUL, "sigma_a is NULL", ht_hair_sigma_a_preset("auburn", NULL));
+    ROW(BAD, "not aligned", ht_hair_sigma_a_preset("black", odd));
     UNTOUCHED(out, 8);
     float grey[3] = {0.5f, 0.5f, 0.5f}, bright[3] = {0.5f, 1.5f, 0.5f}, black[3] = {0.5f, 0.0f, 0.5f};
     ROW(NUL, "color is NULL", ht_hair_sigma_a_from_color(NULL, nan, out));

@@ -26,6 +26,8 @@ use crate::scene::strands::Strands;
 use crate::scene::tracer::TracerBuilder;
 use crate::validate::positive;
 
+use super::usd::{is_usd_path, read_usd_file};
+
 /// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
 /// from the true sphere by under 0.05% of its radius.
 const SPHERE_SUBDIVISIONS: u32 = 4;
@@ -52,13 +54,12 @@ impl SceneDescription {
                 .cloned()
                 .map_err(|e| self.error(&format!("{kind}[{i}].material"), e))
         };
-        let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
-        for (i, g) in self.grooms.iter().enumerate() {
-            materials.push(assign("groom", i, &g.material, true)?);
-        }
-        for (i, m) in self.meshes.iter().enumerate() {
-            materials.push(assign("mesh", i, &m.material, false)?);
-        }
+        let groom_materials = (self.grooms.iter().enumerate())
+            .map(|(i, g)| assign("groom", i, &g.material, true))
+            .collect::<Result<Vec<_>>>()?;
+        let mesh_materials = (self.meshes.iter().enumerate())
+            .map(|(i, m)| assign("mesh", i, &m.material, false))
+            .collect::<Result<Vec<_>>>()?;
         if self.lights.is_empty() {
             return Err(invalid_arg!(
                 "{}: no lights: add a [[light]] (environment, distant or rect)",
@@ -74,16 +75,16 @@ impl SceneDescription {
 
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
         let mut hair_bounds = Bounds::EMPTY;
+        // One material per geometry: a USD groom adds one geometry per BasisCurves prim.
+        let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
-            let strands = g.strands().map_err(|e| self.error(&at, e))?;
-            for (p, r) in strands.points.iter().zip(&strands.radii) {
-                hair_bounds.add(Vec3::from_array(*p), *r);
+            for curves in g.curves(&mut hair_bounds).map_err(|e| self.error(&at, e))? {
+                tracer.add_curves(curves).map_err(|e| self.error(&at, e))?;
+                materials.push(groom_materials[i].clone());
             }
-            Curves::from_strands(&strands, g.basis, g.shape)
-                .and_then(|c| tracer.add_curves(c))
-                .map_err(|e| self.error(&at, e))?;
         }
+        materials.extend(mesh_materials);
         let mut prop_bounds = Bounds::EMPTY;
         for (i, m) in self.meshes.iter().enumerate() {
             let at = format!("mesh[{i}]");
@@ -192,11 +193,50 @@ impl GroomDesc {
         }
     }
 
+    /// The Embree curves of the groom: one geometry, or one per BasisCurves prim of a USD
+    /// file (laid out by the prim's own basis and wrap, placed by the entry's transform).
+    /// Adds the points, widened by their radii, to `framed`.
+    fn curves(&self, framed: &mut Bounds) -> Result<Vec<Curves>> {
+        match &self.source {
+            GroomSource::File { path, .. } if is_usd_path(path) => {
+                let linear = self.transform.linear()?;
+                positive("radius_scale", self.radius_scale)?;
+                let radius_factor = self.transform.scale * self.radius_scale;
+                let place = |p| self.transform.point(linear, p);
+                let grooms = read_usd_file(path)?;
+                for c in &grooms.curves {
+                    let (lo, hi) = c.bounds;
+                    let r = c.radius_range.1 * radius_factor;
+                    for corner in 0..8 {
+                        let p = std::array::from_fn(|k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] });
+                        framed.add(Vec3::from_array(place(p)), r);
+                    }
+                }
+                (grooms.curves.iter())
+                    .map(|c| c.curves(self.shape, radius_factor, place))
+                    .collect()
+            }
+            _ => {
+                let strands = self.strands()?;
+                for (p, r) in strands.points.iter().zip(&strands.radii) {
+                    framed.add(Vec3::from_array(*p), *r);
+                }
+                Ok(vec![Curves::from_strands(&strands, self.basis, self.shape)?])
+            }
+        }
+    }
+
     /// The strands, transformed and with their radii scaled.
     pub(crate) fn strands(&self) -> Result<Strands> {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
         let mut strands = match &self.source {
+            GroomSource::File { path, .. } if is_usd_path(path) => {
+                return Err(invalid_arg!(
+                    "{}: a USD groom keeps its own curve bases: it has no .hair strands",
+                    path.display()
+                ));
+            }
             GroomSource::File { path, thickness } => read_hair_file(path, *thickness)?,
             GroomSource::FurBall(f) => f.build()?,
             GroomSource::Scalp(s) => s.build()?,

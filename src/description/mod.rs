@@ -96,6 +96,7 @@
 mod build;
 mod demos;
 mod file;
+pub mod usd;
 pub mod peer;
 
 use std::collections::BTreeMap;

@@ -16,3 +16,4 @@ mod large_groom;
 mod lights;
 mod rehit;
 mod render;
+mod usd;

@@ -101,11 +101,28 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
     let name = path
         .to_str()
         .ok_or_else(|| at(invalid_arg!("the path is not valid UTF-8")))?;
-    let stage = Stage::open(name).map_err(|e| at(invalid_arg!("not a readable USD stage: {e:#}")))?;
-    if let Some(e) = stage.composition_errors().first() {
-        return Err(at(invalid_arg!("composition failed: {e}")));
+    // openusd 0.6 indexes some tables of a corrupt .usdc without checking them, and panics:
+    // the panic is caught here and becomes this file's error (the stage is dropped with it).
+    let read = std::panic::catch_unwind(|| {
+        let stage =
+            Stage::open(name).map_err(|e| invalid_arg!("not a readable USD stage: {e:#}"))?;
+        let grooms = read_stage(&stage, meta.len())?;
+        // Composition is lazy: its errors (cycles, missing layers) are known once every
+        // prim has been visited.
+        match stage.composition_errors().first() {
+            Some(e) => Err(invalid_arg!("composition failed: {e}")),
+            None => Ok(grooms),
+        }
+    });
+    match read {
+        Ok(result) => result.map_err(at),
+        Err(panic) => {
+            let why = (panic.downcast_ref::<String>().map(String::as_str))
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("no message");
+            Err(at(invalid_arg!("not a readable USD stage (the USD library failed: {why})")))
+        }
     }
-    read_stage(&stage, meta.len()).map_err(at)
 }
 
 /// The grooms of a composed stage. `file_bytes` bounds what any count may ask for.

@@ -7,7 +7,7 @@ use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
 use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{self, BuiltScene, SceneDescription};
+use hairtrace::description::{self, BuiltScene, SceneDescription, usd};
 use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
@@ -38,7 +38,8 @@ enum Command {
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),
-    /// Print a .hair groom's strand, point and segment counts, bounds and radius range.
+    /// Print a .hair groom's strand, point and segment counts, bounds and radius range
+    /// (per BasisCurves prim for USD).
     Info(InfoArgs),
     /// Write a scene (file or demo) for a peer renderer: world-space .hair grooms, OBJ
     /// meshes and scene.json, what bench/peer hands to Blender Cycles.
@@ -71,7 +72,8 @@ struct CompareArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A scene description (.toml) or a groom (.hair).
+    /// A scene description (.toml) or a groom (.hair, or USD BasisCurves: .usd, .usda,
+    /// .usdc, .usdz).
     scene: Option<PathBuf>,
     /// A built-in scene instead of a file: furball (the default), furnace, scalp.
     #[arg(long, conflicts_with = "scene")]
@@ -128,7 +130,7 @@ struct RenderArgs {
 
 #[derive(Args)]
 struct InfoArgs {
-    /// The .hair file.
+    /// The .hair or USD (.usd, .usda, .usdc, .usdz) file.
     file: PathBuf,
     /// Read the file's thickness as a radius instead of a diameter (the default).
     #[arg(long)]
@@ -241,9 +243,10 @@ impl Progress for Bar {
 fn load_scene(scene: Option<&PathBuf>, demo: Option<&str>) -> hairtrace::Result<SceneDescription> {
     match scene {
         Some(path)
-            if path
-                .extension()
-                .is_some_and(|e| e.eq_ignore_ascii_case("hair")) =>
+            if usd::is_usd_path(path)
+                || path
+                    .extension()
+                    .is_some_and(|e| e.eq_ignore_ascii_case("hair")) =>
         {
             description::quick_look(path)
         }
@@ -386,6 +389,10 @@ fn peak_memory() -> String {
 }
 
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {
+    if usd::is_usd_path(&args.file) {
+        print!("{}", usd::info_report(&usd::read_usd_file(&args.file)?));
+        return Ok(());
+    }
     let thickness = if args.thickness_is_radius {
         Thickness::Radius
     } else {

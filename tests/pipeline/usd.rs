@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use hairtrace::Error;
-use hairtrace::description::quick_look;
+use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::description::usd::{UsdGrooms, read_usd_file};
 use hairtrace::embree::Device;
 use hairtrace::render::NO_STRAND;
@@ -169,4 +169,29 @@ fn truncated_and_corrupted_crate_files_are_refused() {
     bad[8..16].fill(0xFF);
     let m = refused(&bad, "bad_toc.usdc");
     assert!(m.contains("not a readable USD stage"), "{m}");
+}
+
+/// `[[groom]] file =` takes a USD stage: its prims render with the entry's material and
+/// placement, and moving the entry moves the framed hair (the automatic camera follows).
+#[test]
+fn scene_files_take_usd_grooms() {
+    let scene = |translate: f32| {
+        format!(
+            "[render]\nwidth = 24\nheight = 16\nspp = 1\n\
+             [materials.h]\ntype = \"hair\"\nmelanin = [0.5, 0.1]\nuse_vertex_colors = true\n\
+             [[groom]]\nfile = \"all_bases.usdc\"\nmaterial = \"h\"\ntranslate = [{translate}, 0, 0]\n\
+             [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n"
+        )
+    };
+    let device = Arc::new(Device::new(Some(1)).unwrap());
+    let mut eyes = Vec::new();
+    for t in [0.0, 5.0] {
+        let desc = SceneDescription::from_toml(&scene(t), &fixtures(), "usd.toml").unwrap();
+        let built = desc.build(device.clone()).unwrap();
+        let out = render(&built.world, &built.camera, &built.settings, Aovs::default(), &NoProgress)
+            .unwrap();
+        assert!(out.film.rgb().iter().all(|v| v.is_finite()));
+        eyes.push(built.camera.eye());
+    }
+    assert!((eyes[1].x - eyes[0].x - 5.0).abs() < 1e-3, "{eyes:?}");
 }

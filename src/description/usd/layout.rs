@@ -214,3 +214,93 @@ pub fn wrap_of(name: &str) -> Result<Wrap> {
         }
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pts(n: usize) -> Vec<[f32; 2]> {
+        (0..n).map(|i| [i as f32, (i * i) as f32]).collect()
+    }
+
+    fn layout(basis: CurveBasis, wrap: Wrap) -> Layout {
+        Layout { basis, wrap }
+    }
+
+    fn extended(l: Layout, v: &[[f32; 2]]) -> Vec<[f32; 2]> {
+        let mut out = Vec::new();
+        l.extend(v, &mut out, |p, _| p);
+        assert_eq!(out.len(), l.embree_count(v.len()));
+        out
+    }
+
+    #[test]
+    fn pinned_adds_the_reflected_phantom_points_of_the_spec() {
+        for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
+            let l = layout(basis, Wrap::Pinned);
+            let v = pts(3);
+            // 2 p0 - p1 = (-1, -1); 2 p2 - p1 = (3, 7).
+            assert_eq!(extended(l, &v), [[-1.0, -1.0], [0.0, 0.0], [1.0, 1.0], [2.0, 4.0], [3.0, 7.0]]);
+            assert_eq!(l.segments(3), Some(2));
+            assert_eq!(basis.segments_for(5), Some(2));
+        }
+        // Pinned means nothing more than nonperiodic for linear and Bezier curves.
+        for basis in [CurveBasis::Linear, CurveBasis::Bezier] {
+            assert_eq!(extended(layout(basis, Wrap::Pinned), &pts(4)), pts(4));
+        }
+    }
+
+    #[test]
+    fn periodic_repeats_the_first_points_to_close_the_curve() {
+        let v = pts(3);
+        let l = layout(CurveBasis::Linear, Wrap::Periodic);
+        assert_eq!(extended(l, &v), [v[0], v[1], v[2], v[0]]);
+        assert_eq!((l.segments(3), CurveBasis::Linear.segments_for(4)), (Some(3), Some(3)));
+        let l = layout(CurveBasis::Bezier, Wrap::Periodic);
+        let v6 = pts(6);
+        assert_eq!(extended(l, &v6)[6], v6[0]);
+        assert_eq!((l.segments(6), CurveBasis::Bezier.segments_for(7)), (Some(2), Some(2)));
+        assert_eq!(l.segments(7), None);
+        for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
+            let l = layout(basis, Wrap::Periodic);
+            assert_eq!(extended(l, &v), [v[0], v[1], v[2], v[0], v[1], v[2]]);
+            assert_eq!((l.segments(3), basis.segments_for(6)), (Some(3), Some(3)));
+        }
+    }
+
+    #[test]
+    fn counts_that_make_no_whole_segment_are_refused() {
+        assert_eq!(layout(CurveBasis::Bezier, Wrap::Nonperiodic).segments(5), None);
+        assert_eq!(layout(CurveBasis::BSpline, Wrap::Nonperiodic).segments(3), None);
+        assert_eq!(layout(CurveBasis::Linear, Wrap::Nonperiodic).segments(1), None);
+        assert_eq!(layout(CurveBasis::CatmullRom, Wrap::Periodic).segments(2), None);
+    }
+
+    /// Varying radii reach the segment ends: each basis evaluated at the ends of the radii
+    /// it was given returns the authored values (linear widths, so B-splines are exact too).
+    #[test]
+    fn varying_widths_are_the_radii_at_the_segment_ends() {
+        for (basis, wrap, n) in [
+            (CurveBasis::Bezier, Wrap::Nonperiodic, 7),
+            (CurveBasis::BSpline, Wrap::Nonperiodic, 6),
+            (CurveBasis::CatmullRom, Wrap::Nonperiodic, 6),
+            (CurveBasis::BSpline, Wrap::Pinned, 4),
+            (CurveBasis::CatmullRom, Wrap::Pinned, 4),
+        ] {
+            let l = layout(basis, wrap);
+            let s = l.segments(n).unwrap();
+            let w: Vec<f32> = (0..l.varying_count(s)).map(|j| 1.0 + 0.25 * j as f32).collect();
+            let r = l.varying_to_points(&w, n);
+            assert_eq!(r.len(), n, "{basis:?} {wrap:?}");
+            let mut ext = Vec::new();
+            l.extend(&r, &mut ext, |x, _| x);
+            let as3: Vec<[f32; 3]> = ext.iter().map(|&[x]| [x / 10.0; 3]).collect();
+            let mut ends = Vec::new();
+            l.segment_ends(&as3, s, &mut ends);
+            let got: Vec<f32> = ends.iter().map(|e| e[0] * 10.0).collect();
+            for (g, want) in got.iter().zip(&w) {
+                assert!((g - want).abs() < 1e-5, "{basis:?} {wrap:?}: {got:?} vs {w:?}");
+            }
+        }
+    }
+}

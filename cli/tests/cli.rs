@@ -330,7 +330,10 @@ fn info_and_render_read_usd() {
     ]);
     assert!(o.status.success(), "{o:?}");
     let bad = tmp("cli_bad.usda");
-    std::fs::write(&bad, "#usda 1.0\ndef BasisCurves \"c\" {\nint[] curveVertexCounts = [3]\n}\n")
-        .unwrap();
+    std::fs::write(
+        &bad,
+        "#usda 1.0\ndef BasisCurves \"c\" {\nint[] curveVertexCounts = [3]\n}\n",
+    )
+    .unwrap();
     assert_one_line_error(&hairtrace(&["info", &bad]), "cli_bad.usda");
 }

@@ -208,7 +208,10 @@ impl GroomDesc {
                     let (lo, hi) = c.bounds;
                     let r = c.radius_range.1 * radius_factor;
                     for corner in 0..8 {
-                        let p = std::array::from_fn(|k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] });
+                        let p =
+                            std::array::from_fn(
+                                |k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] },
+                            );
                         framed.add(Vec3::from_array(place(p)), r);
                     }
                 }
@@ -221,7 +224,9 @@ impl GroomDesc {
                 for (p, r) in strands.points.iter().zip(&strands.radii) {
                     framed.add(Vec3::from_array(*p), *r);
                 }
-                Ok(vec![Curves::from_strands(&strands, self.basis, self.shape)?])
+                Ok(vec![Curves::from_strands(
+                    &strands, self.basis, self.shape,
+                )?])
             }
         }
     }

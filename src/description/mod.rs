@@ -96,8 +96,8 @@
 mod build;
 mod demos;
 mod file;
-pub mod usd;
 pub mod peer;
+pub mod usd;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

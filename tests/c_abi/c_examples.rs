@@ -287,7 +287,12 @@ pub(crate) fn build_run_check(
     wrapper: &[&str],
     env: &[(&str, &str)],
 ) {
-    let exe = build(&Path::new("c_examples").join(example.name), compiler, flags, tag);
+    let exe = build(
+        &Path::new("c_examples").join(example.name),
+        compiler,
+        flags,
+        tag,
+    );
     let file = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("{}-{tag}.exr", example.name));
     let _ = std::fs::remove_file(&file);
     let out = run(&exe, wrapper, env, &[file.as_os_str()]);

@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use hairtrace::Error;
-use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::description::usd::{UsdGrooms, read_usd_file};
+use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::embree::Device;
 use hairtrace::render::NO_STRAND;
 use hairtrace::{Aovs, NoProgress, render};
@@ -32,22 +32,50 @@ fn close(a: f64, b: f64, what: &str) {
 
 fn check_against_usd_core(name: &str, grooms: &UsdGrooms, want: &Value) {
     assert_eq!(grooms.up_axis, want["upAxis"].as_str().unwrap(), "{name}");
-    close(grooms.meters_per_unit, want["metersPerUnit"].as_f64().unwrap(), name);
+    close(
+        grooms.meters_per_unit,
+        want["metersPerUnit"].as_f64().unwrap(),
+        name,
+    );
     let prims = want["prims"].as_object().unwrap();
-    assert_eq!(grooms.curves.len(), prims.len(), "{name}: BasisCurves prims");
+    assert_eq!(
+        grooms.curves.len(),
+        prims.len(),
+        "{name}: BasisCurves prims"
+    );
     for c in &grooms.curves {
         let w = &prims[&c.path];
         let at = format!("{name} {}", c.path);
-        assert_eq!(c.authored_counts.len() as u64, w["curves"].as_u64().unwrap(), "{at}");
+        assert_eq!(
+            c.authored_counts.len() as u64,
+            w["curves"].as_u64().unwrap(),
+            "{at}"
+        );
         let points: u64 = c.authored_counts.iter().map(|&n| u64::from(n)).sum();
         assert_eq!(points, w["points"].as_u64().unwrap(), "{at}");
         assert_eq!(c.segments as u64, w["segments"].as_u64().unwrap(), "{at}");
         for k in 0..3 {
-            close(c.bounds.0[k].into(), w["bounds"][0][k].as_f64().unwrap(), &at);
-            close(c.bounds.1[k].into(), w["bounds"][1][k].as_f64().unwrap(), &at);
+            close(
+                c.bounds.0[k].into(),
+                w["bounds"][0][k].as_f64().unwrap(),
+                &at,
+            );
+            close(
+                c.bounds.1[k].into(),
+                w["bounds"][1][k].as_f64().unwrap(),
+                &at,
+            );
         }
-        close(c.radius_range.0.into(), w["radius"][0].as_f64().unwrap(), &at);
-        close(c.radius_range.1.into(), w["radius"][1].as_f64().unwrap(), &at);
+        close(
+            c.radius_range.0.into(),
+            w["radius"][0].as_f64().unwrap(),
+            &at,
+        );
+        close(
+            c.radius_range.1.into(),
+            w["radius"][1].as_f64().unwrap(),
+            &at,
+        );
     }
     let ignored: &[&str] = if name.starts_with("all_bases") {
         &["/groom/head (Sphere)"]
@@ -88,12 +116,22 @@ fn every_fixture_renders_a_visible_image() {
             strand_id: true,
             ..Aovs::default()
         };
-        let out = render(&built.world, &built.camera, &built.settings, aovs, &NoProgress).unwrap();
+        let out = render(
+            &built.world,
+            &built.camera,
+            &built.settings,
+            aovs,
+            &NoProgress,
+        )
+        .unwrap();
         let ids = out.film.strand_id().unwrap();
         let hair = ids.iter().filter(|&&s| s != NO_STRAND).count();
         assert!(hair >= 3, "{name}: {hair} of {} pixels see hair", ids.len());
         let rgb = out.film.rgb();
-        assert!(rgb.iter().all(|v| v.is_finite()) && rgb.iter().any(|&v| v > 0.0), "{name}");
+        assert!(
+            rgb.iter().all(|v| v.is_finite()) && rgb.iter().any(|&v| v > 0.0),
+            "{name}"
+        );
     }
 }
 
@@ -125,22 +163,79 @@ fn bad_files_are_refused_with_a_message() {
 
     let cases: &[(&str, String, &str)] = &[
         ("empty", String::new(), "not a readable USD stage"),
-        ("garbage", "\u{0}\u{1}PXR-USDC garbage".to_string(), "not a readable USD stage"),
-        ("truncated", curves_prim(ok)[..60].to_string(), "not a readable USD stage"),
-        ("counts_sum", curves_prim(&ok.replace("[4]", "[5]")), "add up to 5 points"),
-        ("huge_count", curves_prim(&ok.replace("[4]", "[2147483647]")), "add up to 2147483647"),
-        ("negative", curves_prim(&ok.replace("[4]", "[-4]")), "negative"),
-        ("wrong_type", curves_prim(&ok.replace("float[] widths = [0.1]", "string widths = \"x\"")), "widths: expected float[]"),
-        ("no_widths", curves_prim(&ok.replace("float[] widths = [0.1] (interpolation = \"constant\")", "")), "no widths"),
-        ("widths_len", curves_prim(&ok.replace("[0.1] (interpolation = \"constant\")", "[0.1, 0.2]")), "2 widths for Vertex"),
-        ("zero_width", curves_prim(&ok.replace("[0.1]", "[0]")), "widths[0] = 0"),
-        ("nan_point", curves_prim(&ok.replace("(0,3,0)", "(0,nan,0)")), "not finite"),
-        ("bezier_count", curves_prim(&ok.replace("\"linear\"", "\"cubic\"").replace("[4]", "[4]\nuniform token basis = \"bezier\"\nuniform token wrap = \"periodic\"")), "not a whole number"),
-        ("basis", curves_prim(&ok.replace("\"linear\"", "\"cubic\"\nuniform token basis = \"hermite\"")), "basis \"hermite\""),
-        ("wrap", curves_prim(&format!("{ok}\nuniform token wrap = \"closed\"")), "wrap \"closed\""),
+        (
+            "garbage",
+            "\u{0}\u{1}PXR-USDC garbage".to_string(),
+            "not a readable USD stage",
+        ),
+        (
+            "truncated",
+            curves_prim(ok)[..60].to_string(),
+            "not a readable USD stage",
+        ),
+        (
+            "counts_sum",
+            curves_prim(&ok.replace("[4]", "[5]")),
+            "add up to 5 points",
+        ),
+        (
+            "huge_count",
+            curves_prim(&ok.replace("[4]", "[2147483647]")),
+            "add up to 2147483647",
+        ),
+        (
+            "negative",
+            curves_prim(&ok.replace("[4]", "[-4]")),
+            "negative",
+        ),
+        (
+            "wrong_type",
+            curves_prim(&ok.replace("float[] widths = [0.1]", "string widths = \"x\"")),
+            "widths: expected float[]",
+        ),
+        (
+            "no_widths",
+            curves_prim(&ok.replace("float[] widths = [0.1] (interpolation = \"constant\")", "")),
+            "no widths",
+        ),
+        (
+            "widths_len",
+            curves_prim(&ok.replace("[0.1] (interpolation = \"constant\")", "[0.1, 0.2]")),
+            "2 widths for Vertex",
+        ),
+        (
+            "zero_width",
+            curves_prim(&ok.replace("[0.1]", "[0]")),
+            "widths[0] = 0",
+        ),
+        (
+            "nan_point",
+            curves_prim(&ok.replace("(0,3,0)", "(0,nan,0)")),
+            "not finite",
+        ),
+        (
+            "bezier_count",
+            curves_prim(&ok.replace("\"linear\"", "\"cubic\"").replace(
+                "[4]",
+                "[4]\nuniform token basis = \"bezier\"\nuniform token wrap = \"periodic\"",
+            )),
+            "not a whole number",
+        ),
+        (
+            "basis",
+            curves_prim(&ok.replace("\"linear\"", "\"cubic\"\nuniform token basis = \"hermite\"")),
+            "basis \"hermite\"",
+        ),
+        (
+            "wrap",
+            curves_prim(&format!("{ok}\nuniform token wrap = \"closed\"")),
+            "wrap \"closed\"",
+        ),
         (
             "nonuniform",
-            format!("{HEADER}def Xform \"x\"\n{{\nfloat3 xformOp:scale = (1, 2, 1)\nuniform token[] xformOpOrder = [\"xformOp:scale\"]\ndef BasisCurves \"c\"\n{{\n{ok}\n}}\n}}\n"),
+            format!(
+                "{HEADER}def Xform \"x\"\n{{\nfloat3 xformOp:scale = (1, 2, 1)\nuniform token[] xformOpOrder = [\"xformOp:scale\"]\ndef BasisCurves \"c\"\n{{\n{ok}\n}}\n}}\n"
+            ),
             "uniform scale only",
         ),
         (
@@ -152,7 +247,10 @@ fn bad_files_are_refused_with_a_message() {
     for (name, text, want) in cases {
         let m = refused(text, &format!("{name}.usda"));
         assert!(m.contains(want), "{name}: {m}");
-        assert!(m.contains(&format!("{name}.usda")), "{name}: the message names the file: {m}");
+        assert!(
+            m.contains(&format!("{name}.usda")),
+            "{name}: the message names the file: {m}"
+        );
     }
 }
 
@@ -188,8 +286,14 @@ fn scene_files_take_usd_grooms() {
     for t in [0.0, 5.0] {
         let desc = SceneDescription::from_toml(&scene(t), &fixtures(), "usd.toml").unwrap();
         let built = desc.build(device.clone()).unwrap();
-        let out = render(&built.world, &built.camera, &built.settings, Aovs::default(), &NoProgress)
-            .unwrap();
+        let out = render(
+            &built.world,
+            &built.camera,
+            &built.settings,
+            Aovs::default(),
+            &NoProgress,
+        )
+        .unwrap();
         assert!(out.film.rgb().iter().all(|v| v.is_finite()));
         eyes.push(built.camera.eye());
     }

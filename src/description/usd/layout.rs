@@ -71,7 +71,7 @@ impl Layout {
         let s = match (self.basis, self.effective_wrap()) {
             (CurveBasis::Linear, Wrap::Periodic) => (n >= 2).then_some(n),
             (CurveBasis::Linear, _) => (n >= 2).then(|| n - 1),
-            (CurveBasis::Bezier, Wrap::Periodic) => (n >= 3 && n % 3 == 0).then(|| n / 3),
+            (CurveBasis::Bezier, Wrap::Periodic) => (n >= 3 && n % 3 == 0).then_some(n / 3),
             (CurveBasis::Bezier, _) => (n >= 4 && (n - 1) % 3 == 0).then(|| (n - 1) / 3),
             (_, Wrap::Periodic) => (n >= 3).then_some(n),
             (_, Wrap::Pinned) => (n >= 2).then(|| n - 1),
@@ -140,7 +140,11 @@ impl Layout {
                 .map(|i| {
                     let (j, k) = (i / 3, i % 3);
                     let a = w[j];
-                    let b = if wrap == Wrap::Periodic { w[(j + 1) % w.len()] } else { w[(j + 1).min(w.len() - 1)] };
+                    let b = if wrap == Wrap::Periodic {
+                        w[(j + 1) % w.len()]
+                    } else {
+                        w[(j + 1).min(w.len() - 1)]
+                    };
                     [a + (b - a) * k as f32 / 3.0]
                 })
                 .collect(),
@@ -240,7 +244,10 @@ mod tests {
             let l = layout(basis, Wrap::Pinned);
             let v = pts(3);
             // 2 p0 - p1 = (-1, -1); 2 p2 - p1 = (3, 7).
-            assert_eq!(extended(l, &v), [[-1.0, -1.0], [0.0, 0.0], [1.0, 1.0], [2.0, 4.0], [3.0, 7.0]]);
+            assert_eq!(
+                extended(l, &v),
+                [[-1.0, -1.0], [0.0, 0.0], [1.0, 1.0], [2.0, 4.0], [3.0, 7.0]]
+            );
             assert_eq!(l.segments(3), Some(2));
             assert_eq!(basis.segments_for(5), Some(2));
         }
@@ -255,11 +262,17 @@ mod tests {
         let v = pts(3);
         let l = layout(CurveBasis::Linear, Wrap::Periodic);
         assert_eq!(extended(l, &v), [v[0], v[1], v[2], v[0]]);
-        assert_eq!((l.segments(3), CurveBasis::Linear.segments_for(4)), (Some(3), Some(3)));
+        assert_eq!(
+            (l.segments(3), CurveBasis::Linear.segments_for(4)),
+            (Some(3), Some(3))
+        );
         let l = layout(CurveBasis::Bezier, Wrap::Periodic);
         let v6 = pts(6);
         assert_eq!(extended(l, &v6)[6], v6[0]);
-        assert_eq!((l.segments(6), CurveBasis::Bezier.segments_for(7)), (Some(2), Some(2)));
+        assert_eq!(
+            (l.segments(6), CurveBasis::Bezier.segments_for(7)),
+            (Some(2), Some(2))
+        );
         assert_eq!(l.segments(7), None);
         for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
             let l = layout(basis, Wrap::Periodic);
@@ -270,10 +283,22 @@ mod tests {
 
     #[test]
     fn counts_that_make_no_whole_segment_are_refused() {
-        assert_eq!(layout(CurveBasis::Bezier, Wrap::Nonperiodic).segments(5), None);
-        assert_eq!(layout(CurveBasis::BSpline, Wrap::Nonperiodic).segments(3), None);
-        assert_eq!(layout(CurveBasis::Linear, Wrap::Nonperiodic).segments(1), None);
-        assert_eq!(layout(CurveBasis::CatmullRom, Wrap::Periodic).segments(2), None);
+        assert_eq!(
+            layout(CurveBasis::Bezier, Wrap::Nonperiodic).segments(5),
+            None
+        );
+        assert_eq!(
+            layout(CurveBasis::BSpline, Wrap::Nonperiodic).segments(3),
+            None
+        );
+        assert_eq!(
+            layout(CurveBasis::Linear, Wrap::Nonperiodic).segments(1),
+            None
+        );
+        assert_eq!(
+            layout(CurveBasis::CatmullRom, Wrap::Periodic).segments(2),
+            None
+        );
     }
 
     /// Varying radii reach the segment ends: each basis evaluated at the ends of the radii
@@ -289,7 +314,9 @@ mod tests {
         ] {
             let l = layout(basis, wrap);
             let s = l.segments(n).unwrap();
-            let w: Vec<f32> = (0..l.varying_count(s)).map(|j| 1.0 + 0.25 * j as f32).collect();
+            let w: Vec<f32> = (0..l.varying_count(s))
+                .map(|j| 1.0 + 0.25 * j as f32)
+                .collect();
             let r = l.varying_to_points(&w, n);
             assert_eq!(r.len(), n, "{basis:?} {wrap:?}");
             let mut ext = Vec::new();
@@ -299,7 +326,10 @@ mod tests {
             l.segment_ends(&as3, s, &mut ends);
             let got: Vec<f32> = ends.iter().map(|e| e[0] * 10.0).collect();
             for (g, want) in got.iter().zip(&w) {
-                assert!((g - want).abs() < 1e-5, "{basis:?} {wrap:?}: {got:?} vs {w:?}");
+                assert!(
+                    (g - want).abs() < 1e-5,
+                    "{basis:?} {wrap:?}: {got:?} vs {w:?}"
+                );
             }
         }
     }

@@ -1,6 +1,6 @@
 //! USD grooms: every `BasisCurves` prim of a composed stage (.usda, .usdc or .usdz, read by
 //! the pure-Rust `openusd` crate), each as its own curve geometry in world space, laid out
-//! for Embree (see [`layout`] for the basis and wrap conversions). See docs/formats.md for
+//! for Embree (see [`Layout`] for the basis and wrap conversions). See docs/formats.md for
 //! what is read, the primvar names and what is refused.
 
 mod layout;
@@ -120,7 +120,9 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
             let why = (panic.downcast_ref::<String>().map(String::as_str))
                 .or_else(|| panic.downcast_ref::<&str>().copied())
                 .unwrap_or("no message");
-            Err(at(invalid_arg!("not a readable USD stage (the USD library failed: {why})")))
+            Err(at(invalid_arg!(
+                "not a readable USD stage (the USD library failed: {why})"
+            )))
         }
     }
 }
@@ -149,8 +151,7 @@ fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
             .unwrap_or_default();
         match kind.as_str() {
             "BasisCurves" => curves.push(
-                prim::read_basis_curves(stage, p, file_bytes)
-                    .map_err(|e| e.context(p.as_str()))?,
+                prim::read_basis_curves(stage, p, file_bytes).map_err(|e| e.context(p.as_str()))?,
             ),
             "" | "Xform" | "Scope" => {}
             other => ignored.push(format!("{} ({other})", p.as_str())),
@@ -182,7 +183,11 @@ pub fn info_report(grooms: &UsdGrooms) -> String {
     );
     for c in &grooms.curves {
         let (lo, hi) = c.bounds;
-        let _ = writeln!(s, "prim {} ({:?}, {:?})", c.path, c.layout.basis, c.layout.wrap);
+        let _ = writeln!(
+            s,
+            "prim {} ({:?}, {:?})",
+            c.path, c.layout.basis, c.layout.wrap
+        );
         let _ = writeln!(s, "  strands:  {}", c.authored_counts.len());
         let points: u64 = c.authored_counts.iter().map(|&n| u64::from(n)).sum();
         let _ = writeln!(s, "  points:   {points}");
@@ -192,7 +197,11 @@ pub fn info_report(grooms: &UsdGrooms) -> String {
             "  bounds:   min ({}, {}, {}), max ({}, {}, {})",
             lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
         );
-        let _ = writeln!(s, "  radius:   min {}, max {}", c.radius_range.0, c.radius_range.1);
+        let _ = writeln!(
+            s,
+            "  radius:   min {}, max {}",
+            c.radius_range.0, c.radius_range.1
+        );
         let _ = writeln!(
             s,
             "  colours:  {}",

@@ -179,7 +179,11 @@ fn per_curve<T: Copy>(
 
 /// Reads the BasisCurves prim at `path`. `file_bytes` bounds the counts: no curve table may
 /// ask for more points than the file could hold.
-pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64) -> Result<UsdCurves> {
+pub(super) fn read_basis_curves(
+    stage: &Stage,
+    path: &sdf::Path,
+    file_bytes: u64,
+) -> Result<UsdCurves> {
     let curves = BasisCurves::get(stage, path.clone())
         .map_err(|e| invalid_arg!("{e:#}"))?
         .ok_or_else(|| invalid_arg!("not a BasisCurves prim"))?;
@@ -198,12 +202,16 @@ pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64
         None => return Err(invalid_arg!("no curveVertexCounts")),
     };
     if raw_counts.len() as u64 > file_bytes {
-        return Err(invalid_arg!("{} curves: more than the file could hold", raw_counts.len()));
+        return Err(invalid_arg!(
+            "{} curves: more than the file could hold",
+            raw_counts.len()
+        ));
     }
     let mut counts = Vec::with_capacity(raw_counts.len());
     let mut segs = Vec::with_capacity(raw_counts.len());
     for (i, &c) in raw_counts.iter().enumerate() {
-        let n = usize::try_from(c).map_err(|_| invalid_arg!("curveVertexCounts[{i}] = {c}: negative"))?;
+        let n = usize::try_from(c)
+            .map_err(|_| invalid_arg!("curveVertexCounts[{i}] = {c}: negative"))?;
         let s = layout.segments(n).ok_or_else(|| {
             invalid_arg!(
                 "curve {i} has {n} points, which is not a whole number of {:?} {:?} segments",
@@ -237,12 +245,19 @@ pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64
         ));
     }
     if let Some(i) = widths.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
-        return Err(invalid_arg!("widths[{i}] = {}: must be finite and > 0", widths[i]));
+        return Err(invalid_arg!(
+            "widths[{i}] = {}: must be finite and > 0",
+            widths[i]
+        ));
     }
 
     let color_attr = attr("primvars:displayColor");
     let colors = vec3s(&color_attr, "primvars:displayColor")?;
-    let color_interp = interpolation(&color_attr, "primvars:displayColor", Interpolation::Constant)?;
+    let color_interp = interpolation(
+        &color_attr,
+        "primvars:displayColor",
+        Interpolation::Constant,
+    )?;
     if let Some(c) = &colors {
         let want = expected_len(color_interp, layout, &counts, &segs);
         if c.len() != want {
@@ -251,8 +266,14 @@ pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64
                 c.len()
             ));
         }
-        if let Some(i) = c.iter().position(|v| !v.iter().all(|x| (0.0..=1.0).contains(x))) {
-            return Err(invalid_arg!("displayColor[{i}] = {:?}: must be in [0, 1]", c[i]));
+        if let Some(i) = c
+            .iter()
+            .position(|v| !v.iter().all(|x| (0.0..=1.0).contains(x)))
+        {
+            return Err(invalid_arg!(
+                "displayColor[{i}] = {:?}: must be in [0, 1]",
+                c[i]
+            ));
         }
     }
 
@@ -262,13 +283,18 @@ pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64
     let radius_of = |w: f32| (f64::from(w) * 0.5 * scale) as f32;
     let (lo, hi) = widths
         .iter()
-        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &w| (lo.min(radius_of(w)), hi.max(radius_of(w))));
-    let bounds = world.iter().fold(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]), |(lo, hi), p| {
-        (
-            std::array::from_fn(|k| lo[k].min(p[k])),
-            std::array::from_fn(|k| hi[k].max(p[k])),
-        )
-    });
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &w| {
+            (lo.min(radius_of(w)), hi.max(radius_of(w)))
+        });
+    let bounds = world.iter().fold(
+        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            )
+        },
+    );
 
     let control_total: usize = counts.iter().map(|&n| layout.embree_count(n)).sum();
     let mut control = Vec::with_capacity(control_total);
@@ -279,7 +305,15 @@ pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64
     let mut radii = Vec::new();
     for (i, (&n, &s)) in counts.iter().zip(&segs).enumerate() {
         let varying_n = layout.varying_count(s);
-        let w = per_curve(&widths, widths_interp, i, vertex_start, varying_start, n, varying_n);
+        let w = per_curve(
+            &widths,
+            widths_interp,
+            i,
+            vertex_start,
+            varying_start,
+            n,
+            varying_n,
+        );
         let r: Vec<[f32; 1]> = match widths_interp {
             Interpolation::Varying => layout.varying_to_points(&w, n),
             _ => w.iter().map(|&x| [x]).collect(),
@@ -295,7 +329,15 @@ pub(super) fn read_basis_curves(stage: &Stage, path: &sdf::Path, file_bytes: u64
         );
         control_counts.push(pos.len() as u32);
         if let (Some(c), Some(out)) = (&colors, &mut out_colors) {
-            let v = per_curve(c, color_interp, i, vertex_start, varying_start, n, varying_n);
+            let v = per_curve(
+                c,
+                color_interp,
+                i,
+                vertex_start,
+                varying_start,
+                n,
+                varying_n,
+            );
             match color_interp {
                 Interpolation::Varying => {
                     out.extend_from_slice(&v);

@@ -25,7 +25,7 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     match read_usd_file(&path) {
         Ok(grooms) => {
             for c in &grooms.curves {
-                c.curves(CurveShape::Round, 1.0, |p| p)
+                c.curves(CurveShape::Round, 1.0, |p| p, 0.3)
                     .expect("read curves are valid Embree curves");
             }
         }

@@ -19,7 +19,7 @@ use crate::scene::curves::Curves;
 use crate::scene::envmap::Environment;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
-use crate::scene::material::Material;
+use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 use crate::scene::strands::Strands;
@@ -79,7 +79,11 @@ impl SceneDescription {
         let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
-            for curves in g.curves(&mut hair_bounds).map_err(|e| self.error(&at, e))? {
+            let beta_n = match self.materials.get(&g.material) {
+                Some(MaterialDesc::Hair(h)) => h.beta_n,
+                _ => HairMaterial::default().beta_n,
+            };
+            for curves in (g.curves(&mut hair_bounds, beta_n)).map_err(|e| self.error(&at, e))? {
                 tracer.add_curves(curves).map_err(|e| self.error(&at, e))?;
                 materials.push(groom_materials[i].clone());
             }
@@ -196,7 +200,8 @@ impl GroomDesc {
     /// The Embree curves of the groom: one geometry, or one per BasisCurves prim of a USD
     /// file (laid out by the prim's own basis and wrap, placed by the entry's transform).
     /// Adds the points, widened by their radii, to `framed`.
-    fn curves(&self, framed: &mut Bounds) -> Result<Vec<Curves>> {
+    /// `beta_n` is the material's (melanin primvars become colours for it).
+    fn curves(&self, framed: &mut Bounds, beta_n: f32) -> Result<Vec<Curves>> {
         match &self.source {
             GroomSource::File { path, .. } if is_usd_path(path) => {
                 let linear = self.transform.linear()?;
@@ -216,7 +221,7 @@ impl GroomDesc {
                     }
                 }
                 (grooms.curves.iter())
-                    .map(|c| c.curves(self.shape, radius_factor, place))
+                    .map(|c| c.curves(self.shape, radius_factor, place, beta_n))
                     .collect()
             }
             _ => {

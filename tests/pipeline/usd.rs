@@ -7,9 +7,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use hairtrace::Error;
+use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
 use hairtrace::description::usd::{UsdGrooms, read_usd_file};
 use hairtrace::description::{SceneDescription, quick_look};
-use hairtrace::embree::Device;
+use hairtrace::embree::{CurveShape, Device};
 use hairtrace::render::NO_STRAND;
 use hairtrace::{Aovs, NoProgress, render};
 use serde_json::Value;
@@ -298,4 +299,54 @@ fn scene_files_take_usd_grooms() {
         eyes.push(built.camera.eye());
     }
     assert!((eyes[1].x - eyes[0].x - 5.0).abs() < 1e-3, "{eyes:?}");
+}
+
+/// `primvars:melanin` (eumelanin per curve) becomes a strand colour that the renderer's
+/// colour-to-absorption fit, at the material's beta_n, turns back into the melanin's sigma_a.
+#[test]
+fn melanin_primvar_gives_each_strand_its_absorption() {
+    let grooms = read_usd_file(&fixtures().join("all_bases.usdc")).unwrap();
+    let c = grooms.curves.iter().find(|c| c.melanin.is_some()).unwrap();
+    assert_eq!(c.melanin.as_deref(), Some(&[0.3f32, 1.5][..]));
+    for beta_n in [0.3f32, 0.8] {
+        let curves = c.curves(CurveShape::Round, 1.0, |p| p, beta_n).unwrap();
+        let idx = curves.strands();
+        // Segment 0 is in strand 0 (4 points: 1 segment), the last in strand 1.
+        let last = curves.indices().len() as u32 - 1;
+        for (prim, melanin) in [(0, 0.3f32), (last, 1.5)] {
+            let color = idx.color(&idx.locate(prim).unwrap(), 0.5).unwrap();
+            let got = sigma_a_from_color(color, beta_n).unwrap();
+            let want = sigma_a_from_melanin(melanin, 0.0).unwrap();
+            for k in 0..3 {
+                assert!(
+                    (got[k] - want[k]).abs() < 1e-4 * (1.0 + want[k]),
+                    "{got:?} {want:?}"
+                );
+            }
+        }
+    }
+    let ok = "int[] curveVertexCounts = [2, 2]\npoint3f[] points = [(0,0,0),(0,1,0),(1,0,0),(1,1,0)]\nfloat[] widths = [0.1] (interpolation = \"constant\")\nuniform token type = \"linear\"";
+    for (name, primvar, want) in [
+        (
+            "mel_negative",
+            "float[] primvars:melanin = [-1]",
+            "must be finite and >= 0",
+        ),
+        (
+            "mel_count",
+            "float[] primvars:melanin = [1, 2, 3] (interpolation = \"uniform\")",
+            "3 values for Uniform",
+        ),
+        (
+            "mel_and_color",
+            "float[] primvars:melanin = [1]\ncolor3f[] primvars:displayColor = [(1, 0, 0)]",
+            "give one",
+        ),
+    ] {
+        let m = refused(
+            curves_prim(&format!("{ok}\n{primvar}")),
+            &format!("{name}.usda"),
+        );
+        assert!(m.contains(want), "{name}: {m}");
+    }
 }

@@ -277,6 +277,13 @@ pub(super) fn read_basis_curves(
         }
     }
 
+    let melanin = read_melanin(&attr("primvars:melanin"), counts.len())?;
+    if melanin.is_some() && colors.is_some() {
+        return Err(invalid_arg!(
+            "both primvars:displayColor and primvars:melanin are authored: give one"
+        ));
+    }
+
     let m = world_transform(stage, path, &curves)?;
     let scale = uniform_scale(&m)?;
     let world: Vec<[f32; 3]> = points.iter().map(|&p| transform_point(&m, p)).collect();
@@ -365,5 +372,32 @@ pub(super) fn read_basis_curves(
         control,
         control_counts,
         colors: out_colors,
+        melanin,
     })
+}
+
+/// `primvars:melanin`, eumelanin per curve (constant or uniform), if authored.
+fn read_melanin(attr: &Attribute, curves: usize) -> Result<Option<Vec<f32>>> {
+    const WHAT: &str = "primvars:melanin";
+    let Some(values) = floats(attr, WHAT)? else {
+        return Ok(None);
+    };
+    let per_curve = match interpolation(attr, WHAT, Interpolation::Constant)? {
+        Interpolation::Constant if values.len() == 1 => vec![values[0]; curves],
+        Interpolation::Uniform if values.len() == curves => values,
+        interp => {
+            return Err(invalid_arg!(
+                "{WHAT}: {} values for {interp:?} interpolation: one (constant) or one per \
+                 curve (uniform) expected",
+                values.len()
+            ));
+        }
+    };
+    if let Some(i) = per_curve.iter().position(|m| !(m.is_finite() && *m >= 0.0)) {
+        return Err(invalid_arg!(
+            "{WHAT}[{i}] = {}: must be finite and >= 0",
+            per_curve[i]
+        ));
+    }
+    Ok(Some(per_curve))
 }

@@ -188,6 +188,11 @@ int main(void) {
     ROW(ht_scene_add_hair_file(scene, "", false, 0, 0, hair, &id), BAD, "path is empty");
     ROW(ht_scene_add_hair_file(scene, "/nonexistent/a.hair", false, 0, 0, hair, &id), HT_ERR_IO,
         "/nonexistent/a.hair");
+    uint32_t count = 0;
+    ROW(ht_scene_add_usd_file(scene, NULL, 0, hair, &id, &count), NUL, "path is NULL");
+    ROW(ht_scene_add_usd_file(scene, "a.usda", 0, hair, &id, NULL), NUL, "geom_count is NULL");
+    ROW(ht_scene_add_usd_file(scene, "/nonexistent/a.usda", 0, hair, &id, &count), HT_ERR_IO,
+        "/nonexistent/a.usda");
 
     /* Meshes. */
     const float tri[9] = {0.0f, 0.0f, -1.0f, 1.0f, 0.0f, -1.0f, 0.0f, 1.0f, -1.0f};

@@ -1075,6 +1075,32 @@ enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
+ * Adds every BasisCurves prim of a USD stage (.usd, .usda, .usdc or .usdz, read and
+ * composed during the call; see docs/formats.md) as its own curve geometry, laid out by the
+ * prim's `type`, `basis` and `wrap`, in world space, shaded by the hair material
+ * `material_id`. Writes the first geometry id to `first_geom_id` (the others follow it)
+ * and the number of geometries added (0 for a stage without BasisCurves) to `geom_count`.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `path`, `first_geom_id` or `geom_count` NULL);
+ * `HT_ERR_IO` (the file is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or
+ * non-UTF-8 path, a file that is not a USD stage or fails to compose, a prim the reader
+ * refuses, an unknown shape, a material that is not hair). Nothing is added on error.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+ * NUL-terminated string; `first_geom_id` and `geom_count` are NULL or point to writable
+ * `uint32_t`s.
+ */
+enum HtStatus ht_scene_add_usd_file(struct HtScene *scene,
+                                    const char *path,
+                                    HtCurveShape shape,
+                                    uint32_t material_id,
+                                    uint32_t *first_geom_id,
+                                    uint32_t *geom_count);
+#endif
+
+#if defined(HT_RENDER)
+/**
  * Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
  * `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
  * shading), `indices` 3 vertex indices per triangle, counter-clockwise seen from the

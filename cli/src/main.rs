@@ -8,7 +8,7 @@ use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription};
+use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, usd};
 use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
@@ -40,8 +40,9 @@ enum Command {
     /// Print the energy of the R, TT, TRT and residual lobes (averaged over the fiber's
     /// width) for a range of outgoing angles.
     Lobes(LobesArgs),
-    /// Print a .hair groom's strand, point and segment counts, bounds and radius range; for
-    /// a .pbrt scene, the same per groom, its meshes, lights, camera and warnings.
+    /// Print a .hair groom's strand, point and segment counts, bounds and radius range
+    /// (per BasisCurves prim for USD); for a .pbrt scene, the same per groom, its meshes,
+    /// lights, camera and warnings.
     Info(InfoArgs),
     /// Write a scene (file or demo) for a peer renderer: world-space .hair grooms, OBJ
     /// meshes and scene.json, what bench/peer hands to Blender Cycles.
@@ -74,7 +75,8 @@ struct CompareArgs {
 
 #[derive(Args)]
 struct RenderArgs {
-    /// A scene description (.toml), a pbrt-v4 scene (.pbrt) or a groom (.hair).
+    /// A scene description (.toml), a pbrt-v4 scene (.pbrt) or a groom (.hair, or USD
+    /// BasisCurves: .usd, .usda, .usdc, .usdz).
     scene: Option<PathBuf>,
     /// A built-in scene instead of a file: furball (the default), furnace, scalp.
     #[arg(long, conflicts_with = "scene")]
@@ -136,7 +138,7 @@ struct RenderArgs {
 
 #[derive(Args)]
 struct InfoArgs {
-    /// The .hair or .pbrt file.
+    /// The .hair, USD (.usd, .usda, .usdc, .usdz) or .pbrt file.
     file: PathBuf,
     /// Read the file's thickness as a radius instead of a diameter (the default).
     #[arg(long)]
@@ -316,6 +318,7 @@ fn load_scene(scene: Option<&PathBuf>, demo: Option<&str>) -> hairtrace::Result<
             }
             Ok(pbrt.description)
         }
+        Some(path) if usd::is_usd_path(path) => description::quick_look(path),
         Some(path) if has_extension(path, "hair") => description::quick_look(path),
         Some(path) => SceneDescription::from_file(path),
         None => description::demo(demo.unwrap_or("furball")),
@@ -483,6 +486,10 @@ fn has_extension(path: &std::path::Path, ext: &str) -> bool {
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     if has_extension(&args.file, "pbrt") {
         print!("{}", PbrtScene::from_file(&args.file)?.info_report());
+        return Ok(());
+    }
+    if usd::is_usd_path(&args.file) {
+        print!("{}", usd::info_report(&usd::read_usd_file(&args.file)?));
         return Ok(());
     }
     let thickness = if args.thickness_is_radius {

@@ -387,3 +387,50 @@ fn render_stats_compare_and_export() {
     // The demo's camera is automatic: not exportable, and said so.
     assert_one_line_error(&hairtrace(&["export", "-o", &dir]), "eye and target");
 }
+
+fn usd_fixture(name: &str) -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/fixtures/usd")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// `info` on a USD stage describes each BasisCurves prim and names what it ignored; a bare
+/// USD groom renders like a bare .hair; a bad one is a one-line error.
+#[test]
+fn info_and_render_read_usd() {
+    let o = hairtrace(&["info", &usd_fixture("all_bases.usdc")]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    assert_eq!(text.matches("\nprim /groom/inner/").count(), 10, "{text}");
+    for needle in [
+        "upAxis Y, metersPerUnit 0.01",
+        "(CatmullRom, Pinned)",
+        "  strands:  2\n  points:   11\n  segments: 3\n",
+        "ignored:  /groom/head (Sphere)",
+    ] {
+        assert!(text.contains(needle), "{needle:?} in {text}");
+    }
+    let out = tmp("cli_usd.exr");
+    let o = hairtrace(&[
+        "render",
+        &usd_fixture("case4.usda"),
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--spp",
+        "2",
+        "-o",
+        &out,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let bad = tmp("cli_bad.usda");
+    std::fs::write(
+        &bad,
+        "#usda 1.0\ndef BasisCurves \"c\" {\nint[] curveVertexCounts = [3]\n}\n",
+    )
+    .unwrap();
+    assert_one_line_error(&hairtrace(&["info", &bad]), "cli_bad.usda");
+}

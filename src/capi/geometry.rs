@@ -2,7 +2,8 @@
 //! shared in place), `.hair` files, and triangle meshes from arrays or files.
 
 use super::scene::{HtScene, Shape, add_with_id};
-use super::{Failure, HtStatus, host_slice, read_host, read_path};
+use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
+use crate::description::usd::read_usd_file;
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
@@ -326,6 +327,52 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
         let strands = read_hair_file(&path, thickness)?;
         let curves = Curves::from_strands(&strands, basis, shape)?;
         Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+    })
+}
+
+/// Adds every BasisCurves prim of a USD stage (.usd, .usda, .usdc or .usdz, read and
+/// composed during the call; see docs/formats.md) as its own curve geometry, laid out by the
+/// prim's `type`, `basis` and `wrap`, in world space, shaded by the hair material
+/// `material_id`. Writes the first geometry id to `first_geom_id` (the others follow it)
+/// and the number of geometries added (0 for a stage without BasisCurves) to `geom_count`.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `path`, `first_geom_id` or `geom_count` NULL);
+/// `HT_ERR_IO` (the file is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or
+/// non-UTF-8 path, a file that is not a USD stage or fails to compose, a prim the reader
+/// refuses, an unknown shape, a material that is not hair). Nothing is added on error.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
+/// NUL-terminated string; `first_geom_id` and `geom_count` are NULL or point to writable
+/// `uint32_t`s.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_add_usd_file(
+    scene: *mut HtScene,
+    path: *const c_char,
+    shape: HtCurveShape,
+    material_id: u32,
+    first_geom_id: *mut u32,
+    geom_count: *mut u32,
+) -> HtStatus {
+    add_with_id(scene, first_geom_id, "first_geom_id", |scene| {
+        let count_out = non_null_mut(geom_count, "geom_count")?;
+        let path = read_path(path, "path")?;
+        scene.check_material(material_id, true)?;
+        let shape = curve_shape(shape)?;
+        let beta_n = scene.hair_beta_n(material_id);
+        let grooms = read_usd_file(&path)?;
+        let curves = (grooms.curves.iter())
+            .map(|c| c.curves(shape, 1.0, |p| p, beta_n))
+            .collect::<Result<Vec<_>>>()?;
+        let first = u32::try_from(scene.geometries.len())
+            .map_err(|_| invalid_arg!("too many geometries"))?;
+        let count = u32::try_from(curves.len()).map_err(|_| invalid_arg!("too many prims"))?;
+        for c in curves {
+            scene.add_geometry(Shape::Curves(c), material_id)?;
+        }
+        // SAFETY: non-NULL (checked), the host's uint32_t.
+        unsafe { count_out.write(count) };
+        Ok(first)
     })
 }
 

@@ -674,3 +674,31 @@ fn pinned_devices_take_embree_isa_names_only() {
         last_error()
     );
 }
+
+/// A USD stage adds one geometry per BasisCurves prim, with consecutive ids and the prim's
+/// own basis; bad arguments and files are refused with their status and add nothing.
+#[test]
+fn usd_file_adds_one_geometry_per_basis_curves_prim() {
+    let h = Handles::new();
+    unsafe {
+        let hair = h.hair_material();
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/usd/");
+        let path = std::ffi::CString::new(format!("{dir}all_bases.usdc")).unwrap();
+        let (mut first, mut count) = (u32::MAX, u32::MAX);
+        fails(
+            ht_scene_add_usd_file(h.scene, path.as_ptr(), 0, hair, &mut first, null_mut()),
+            HtStatus::HT_ERR_NULL_ARG,
+            "geom_count",
+        );
+        let missing = c"/nonexistent/groom.usda";
+        let s = ht_scene_add_usd_file(h.scene, missing.as_ptr(), 0, hair, &mut first, &mut count);
+        fails(s, HtStatus::HT_ERR_IO, "/nonexistent/groom.usda");
+        assert!(h.scene().geometries.is_empty());
+        let s = ht_scene_add_usd_file(h.scene, path.as_ptr(), 0, hair, &mut first, &mut count);
+        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        assert_eq!((first, count), (0, 10));
+        assert_eq!(h.scene().geometries.len(), 10);
+        let s = ht_scene_add_usd_file(h.scene, path.as_ptr(), 0, hair, &mut first, &mut count);
+        assert_eq!((s, first, count), (HtStatus::HT_OK, 10, 10));
+    }
+}

@@ -19,13 +19,15 @@ use crate::scene::curves::Curves;
 use crate::scene::envmap::Environment;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
-use crate::scene::material::Material;
+use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
 use crate::scene::strands::Strands;
 use crate::scene::tracer::TracerBuilder;
 use crate::validate::positive;
+
+use super::usd::{is_usd_path, read_usd_file};
 
 /// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
 /// from the true sphere by under 0.05% of its radius.
@@ -63,13 +65,12 @@ impl SceneDescription {
                 .cloned()
                 .map_err(|e| self.error(&format!("{kind}[{i}].material"), e))
         };
-        let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
-        for (i, g) in self.grooms.iter().enumerate() {
-            materials.push(assign("groom", i, &g.material, true)?);
-        }
-        for (i, m) in self.meshes.iter().enumerate() {
-            materials.push(assign("mesh", i, &m.material, false)?);
-        }
+        let groom_materials = (self.grooms.iter().enumerate())
+            .map(|(i, g)| assign("groom", i, &g.material, true))
+            .collect::<Result<Vec<_>>>()?;
+        let mesh_materials = (self.meshes.iter().enumerate())
+            .map(|(i, m)| assign("mesh", i, &m.material, false))
+            .collect::<Result<Vec<_>>>()?;
         if self.lights.is_empty() {
             return Err(invalid_arg!(
                 "{}: no lights: add a [[light]] (environment, distant or rect)",
@@ -87,30 +88,23 @@ impl SceneDescription {
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
         let mut hair_bounds = Bounds::EMPTY;
         let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
+        // One material per geometry: a USD groom adds one geometry per BasisCurves prim.
+        let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
-            // A groom of control points (a pbrt file's) was read with its file: it has
-            // no polyline strands to read, only curves to make.
-            let strands = match g.source {
-                GroomSource::ControlPoints { .. } => None,
-                _ => Some(
-                    stages
-                        .run(Stage::Read, (i, reads), |_| g.strands())
-                        .map_err(|e| self.error(&at, e))?,
-                ),
+            let beta_n = match self.materials.get(&g.material) {
+                Some(MaterialDesc::Hair(h)) => h.beta_n,
+                _ => HairMaterial::default().beta_n,
             };
-            let curves = stages
-                .run(Stage::Curves, (i, grooms), |_| match &strands {
-                    Some(strands) => Curves::from_strands(strands, g.basis, g.shape),
-                    None => g.curves(),
-                })
+            let curves = g
+                .curves(&mut stages, (i, grooms, reads), &mut hair_bounds, beta_n)
                 .map_err(|e| self.error(&at, e))?;
-            drop(strands);
-            for p in curves.vertices() {
-                hair_bounds.add(Vec3::new(p[0], p[1], p[2]), p[3]);
+            for curves in curves {
+                tracer.add_curves(curves).map_err(|e| self.error(&at, e))?;
+                materials.push(groom_materials[i].clone());
             }
-            tracer.add_curves(curves).map_err(|e| self.error(&at, e))?;
         }
+        materials.extend(mesh_materials);
         let mut prop_bounds = Bounds::EMPTY;
         for (i, m) in self.meshes.iter().enumerate() {
             let at = format!("mesh[{i}]");
@@ -226,23 +220,73 @@ impl GroomDesc {
         }
     }
 
-    /// The curves for Embree: strands converted for the basis, or control points as given
-    /// (transformed like strands).
-    pub(crate) fn curves(&self) -> Result<Curves> {
-        let GroomSource::ControlPoints { points, counts } = &self.source else {
-            return Curves::from_strands(&self.strands()?, self.basis, self.shape);
-        };
+    /// The Embree curves of the groom, `part` = (index, grooms, files to read) of the
+    /// build's stages: one geometry, or one per BasisCurves prim of a USD file (laid out by
+    /// the prim's own basis and wrap, placed by the entry's transform). Adds the points,
+    /// widened by their radii, to `framed`. `beta_n` is the material's (melanin primvars
+    /// become colours for it).
+    fn curves(
+        &self,
+        stages: &mut StageRunner,
+        (i, grooms, reads): (usize, usize, usize),
+        framed: &mut Bounds,
+        beta_n: f32,
+    ) -> Result<Vec<Curves>> {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
         let radius_factor = self.transform.scale * self.radius_scale;
-        let points = points
-            .iter()
-            .map(|&[x, y, z, r]| {
-                let [x, y, z] = self.transform.point(linear, [x, y, z]);
-                [x, y, z, r * radius_factor]
-            })
-            .collect::<Vec<_>>();
-        Curves::from_control_points(points, counts, None, self.basis, self.shape)
+        let place = |p| self.transform.point(linear, p);
+        match &self.source {
+            GroomSource::File { path, .. } if is_usd_path(path) => {
+                let file = stages.run(Stage::Read, (i, reads), |_| read_usd_file(path))?;
+                for c in &file.curves {
+                    let (lo, hi) = c.bounds;
+                    let r = c.radius_range.1 * radius_factor;
+                    for corner in 0..8 {
+                        let p =
+                            std::array::from_fn(
+                                |k| {
+                                    if corner >> k & 1 == 1 { hi[k] } else { lo[k] }
+                                },
+                            );
+                        framed.add(Vec3::from_array(place(p)), r);
+                    }
+                }
+                stages.run(Stage::Curves, (i, grooms), |_| {
+                    (file.curves.iter())
+                        .map(|c| c.curves(self.shape, radius_factor, place, beta_n))
+                        .collect()
+                })
+            }
+            // Control points (a pbrt file's) were read with their file: there is only the
+            // conversion to do.
+            GroomSource::ControlPoints { points, counts } => {
+                let curves = stages.run(Stage::Curves, (i, grooms), |_| {
+                    let points = points
+                        .iter()
+                        .map(|&[x, y, z, r]| {
+                            let [x, y, z] = place([x, y, z]);
+                            [x, y, z, r * radius_factor]
+                        })
+                        .collect::<Vec<_>>();
+                    Curves::from_control_points(points, counts, None, self.basis, self.shape)
+                })?;
+                for p in curves.vertices() {
+                    framed.add(Vec3::new(p[0], p[1], p[2]), p[3]);
+                }
+                Ok(vec![curves])
+            }
+            _ => {
+                let strands = stages.run(Stage::Read, (i, reads), |_| self.strands())?;
+                for (p, r) in strands.points.iter().zip(&strands.radii) {
+                    framed.add(Vec3::from_array(*p), *r);
+                }
+                let curves = stages.run(Stage::Curves, (i, grooms), |_| {
+                    Curves::from_strands(&strands, self.basis, self.shape)
+                })?;
+                Ok(vec![curves])
+            }
+        }
     }
 
     /// The strands, transformed and with their radii scaled.
@@ -250,6 +294,12 @@ impl GroomDesc {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
         let mut strands = match &self.source {
+            GroomSource::File { path, .. } if is_usd_path(path) => {
+                return Err(invalid_arg!(
+                    "{}: a USD groom keeps its own curve bases: it has no .hair strands",
+                    path.display()
+                ));
+            }
             GroomSource::File { path, thickness } => read_hair_file(path, *thickness)?,
             GroomSource::FurBall(f) => f.build()?,
             GroomSource::Scalp(s) => s.build()?,

@@ -99,6 +99,7 @@ mod demos;
 mod file;
 pub mod pbrt;
 pub mod peer;
+pub mod usd;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

@@ -143,6 +143,11 @@ impl HairMaterial {
 }
 
 impl PreparedHair {
+    /// The material it was prepared from.
+    pub(crate) fn material(&self) -> &HairMaterial {
+        &self.material
+    }
+
     /// Every hit shares one BSDF: nothing varies per strand, along strands or by colour.
     pub(crate) fn is_uniform(&self) -> bool {
         self.uniform.is_some()

@@ -18,3 +18,4 @@ mod pbrt;
 mod rehit;
 mod render;
 mod stages;
+mod usd;

@@ -1,0 +1,336 @@
+//! UsdGeomBasisCurves' layouts turned into the control points Embree takes.
+//!
+//! USD describes each curve by `type`, `basis` and `wrap`; Embree knows only open curves of
+//! one basis. The conversions, exact for positions:
+//! - nonperiodic: the points as authored;
+//! - pinned (B-spline, Catmull-Rom): one phantom point at each end, the end point reflected
+//!   through its neighbour (`2 p0 - p1`), as the UsdGeom spec defines them, so that the curve
+//!   starts at the first point and ends at the last; for linear and Bezier curves, pinned is
+//!   the same as nonperiodic (the spec gives it meaning for B-spline and Catmull-Rom only);
+//! - periodic: the first points repeated after the last, so that the closing segments exist
+//!   (linear and Bezier: the first point; B-spline and Catmull-Rom: the first three).
+//!
+//! `widths` and `displayColor` with `varying` interpolation hold one value per segment end;
+//! radii are mapped to control points so that the basis reproduces those values at the
+//! segment ends (exactly for linear, Bezier and Catmull-Rom, and for B-splines wherever the
+//! widths change linearly), colours are taken as they are, since the renderer interpolates
+//! colours between segment ends.
+
+use crate::embree::CurveBasis;
+use crate::error::{Result, invalid_arg};
+
+/// UsdGeomBasisCurves' `wrap`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Wrap {
+    Nonperiodic,
+    Pinned,
+    Periodic,
+}
+
+/// How a primvar's values map onto the curves (`interpolation` metadata).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Interpolation {
+    Constant,
+    Uniform,
+    Varying,
+    Vertex,
+}
+
+impl Interpolation {
+    pub fn named(name: &str) -> Option<Self> {
+        Some(match name {
+            "constant" => Interpolation::Constant,
+            "uniform" => Interpolation::Uniform,
+            "varying" => Interpolation::Varying,
+            "vertex" | "faceVarying" => Interpolation::Vertex,
+            _ => return None,
+        })
+    }
+}
+
+/// One prim's curve layout: the basis Embree uses and the USD wrap.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Layout {
+    pub basis: CurveBasis,
+    pub wrap: Wrap,
+}
+
+impl Layout {
+    /// The wrap that changes anything for this basis (pinned means something for B-spline
+    /// and Catmull-Rom only).
+    fn effective_wrap(self) -> Wrap {
+        match (self.basis, self.wrap) {
+            (CurveBasis::Linear | CurveBasis::Bezier, Wrap::Pinned) => Wrap::Nonperiodic,
+            (_, w) => w,
+        }
+    }
+
+    /// Segments of a curve of `n` authored points, or None when `n` does not make whole
+    /// segments of this layout.
+    pub fn segments(self, n: usize) -> Option<usize> {
+        let s = match (self.basis, self.effective_wrap()) {
+            (CurveBasis::Linear, Wrap::Periodic) => (n >= 2).then_some(n),
+            (CurveBasis::Linear, _) => (n >= 2).then(|| n - 1),
+            (CurveBasis::Bezier, Wrap::Periodic) => (n >= 3 && n % 3 == 0).then_some(n / 3),
+            (CurveBasis::Bezier, _) => (n >= 4 && (n - 1) % 3 == 0).then(|| (n - 1) / 3),
+            (_, Wrap::Periodic) => (n >= 3).then_some(n),
+            (_, Wrap::Pinned) => (n >= 2).then(|| n - 1),
+            (_, Wrap::Nonperiodic) => (n >= 4).then(|| n - 3),
+        };
+        s.filter(|&s| s > 0)
+    }
+
+    /// Values a `varying` primvar holds for a curve of `segments` segments.
+    pub fn varying_count(self, segments: usize) -> usize {
+        match self.effective_wrap() {
+            Wrap::Periodic => segments,
+            _ => segments + 1,
+        }
+    }
+
+    /// Control points Embree reads for a curve of `n` authored points.
+    pub fn embree_count(self, n: usize) -> usize {
+        match (self.basis, self.effective_wrap()) {
+            (_, Wrap::Nonperiodic) => n,
+            (_, Wrap::Pinned) => n + 2,
+            (CurveBasis::Linear | CurveBasis::Bezier, Wrap::Periodic) => n + 1,
+            (_, Wrap::Periodic) => n + 3,
+        }
+    }
+
+    /// Appends to `out` the control points Embree reads for one curve whose per-point values
+    /// are `v` (positions, radii, ...). `phantom` turns a reflected end value into a usable
+    /// one (radii must stay > 0).
+    pub fn extend<const N: usize>(
+        self,
+        v: &[[f32; N]],
+        out: &mut Vec<[f32; N]>,
+        phantom: impl Fn([f32; N], [f32; N]) -> [f32; N],
+    ) {
+        let n = v.len();
+        let reflect = |end: usize, next: usize| {
+            let r = std::array::from_fn(|c| 2.0 * v[end][c] - v[next][c]);
+            phantom(r, v[end])
+        };
+        match (self.basis, self.effective_wrap()) {
+            (_, Wrap::Nonperiodic) => out.extend_from_slice(v),
+            (_, Wrap::Pinned) => {
+                out.push(reflect(0, 1));
+                out.extend_from_slice(v);
+                out.push(reflect(n - 1, n - 2));
+            }
+            (CurveBasis::Linear | CurveBasis::Bezier, Wrap::Periodic) => {
+                out.extend_from_slice(v);
+                out.push(v[0]);
+            }
+            (_, Wrap::Periodic) => {
+                out.extend_from_slice(v);
+                out.extend((0..3).map(|i| v[i % n]));
+            }
+        }
+    }
+
+    /// Per-point radii of one curve of `n` points from its `varying` radii `w` (one per
+    /// segment end; see the module notes).
+    pub fn varying_to_points(self, w: &[f32], n: usize) -> Vec<[f32; 1]> {
+        let positive = |r: f32, fallback: f32| if r > 0.0 { r } else { fallback };
+        match (self.basis, self.effective_wrap()) {
+            (CurveBasis::Linear, _) | (_, Wrap::Pinned) => w.iter().map(|&r| [r]).collect(),
+            (CurveBasis::Bezier, wrap) => (0..n)
+                .map(|i| {
+                    let (j, k) = (i / 3, i % 3);
+                    let a = w[j];
+                    let b = if wrap == Wrap::Periodic {
+                        w[(j + 1) % w.len()]
+                    } else {
+                        w[(j + 1).min(w.len() - 1)]
+                    };
+                    [a + (b - a) * k as f32 / 3.0]
+                })
+                .collect(),
+            // A segment runs from the point after its first control point, which is where a
+            // B-spline or Catmull-Rom curve with linearly changing control values has them.
+            (_, Wrap::Periodic) => {
+                let mut r = vec![[0.0]; n];
+                for (k, &x) in w.iter().enumerate() {
+                    r[(k + 1) % n] = [x];
+                }
+                r
+            }
+            (_, Wrap::Nonperiodic) => {
+                let m = w.len();
+                let mut r = Vec::with_capacity(n);
+                r.push([positive(2.0 * w[0] - w[1], w[0])]);
+                r.extend(w.iter().map(|&x| [x]));
+                r.push([positive(2.0 * w[m - 1] - w[m - 2], w[m - 1])]);
+                r
+            }
+        }
+    }
+
+    /// The value at each segment end (segments + 1 per curve) of a curve whose Embree control
+    /// values are `c`: the basis evaluated at the segment's start, and at the last one's end.
+    pub fn segment_ends(self, c: &[[f32; 3]], segments: usize, out: &mut Vec<[f32; 3]>) {
+        let stride = self.basis.segment_stride();
+        let at = |first: usize| -> [f32; 3] {
+            match self.basis {
+                CurveBasis::Linear | CurveBasis::Bezier => c[first],
+                CurveBasis::CatmullRom => c[first + 1],
+                CurveBasis::BSpline => std::array::from_fn(|k| {
+                    ((c[first][k] + 4.0 * c[first + 1][k] + c[first + 2][k]) / 6.0).clamp(0.0, 1.0)
+                }),
+            }
+        };
+        out.extend((0..=segments).map(|s| at(s * stride)));
+    }
+}
+
+/// The Embree basis of a USD `type` and `basis`.
+pub fn basis_of(kind: &str, basis: &str) -> Result<CurveBasis> {
+    Ok(match (kind, basis) {
+        ("linear", _) => CurveBasis::Linear,
+        ("cubic", "bezier") => CurveBasis::Bezier,
+        ("cubic", "bspline") => CurveBasis::BSpline,
+        ("cubic", "catmullRom") => CurveBasis::CatmullRom,
+        ("cubic", other) => {
+            return Err(invalid_arg!(
+                "basis \"{other}\" is not supported (bezier, bspline and catmullRom are)"
+            ));
+        }
+        (other, _) => {
+            return Err(invalid_arg!(
+                "type \"{other}\" is not a BasisCurves type (linear or cubic)"
+            ));
+        }
+    })
+}
+
+/// The `wrap` token.
+pub fn wrap_of(name: &str) -> Result<Wrap> {
+    Ok(match name {
+        "nonperiodic" => Wrap::Nonperiodic,
+        "pinned" => Wrap::Pinned,
+        "periodic" => Wrap::Periodic,
+        other => {
+            return Err(invalid_arg!(
+                "wrap \"{other}\" is not nonperiodic, pinned or periodic"
+            ));
+        }
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pts(n: usize) -> Vec<[f32; 2]> {
+        (0..n).map(|i| [i as f32, (i * i) as f32]).collect()
+    }
+
+    fn layout(basis: CurveBasis, wrap: Wrap) -> Layout {
+        Layout { basis, wrap }
+    }
+
+    fn extended(l: Layout, v: &[[f32; 2]]) -> Vec<[f32; 2]> {
+        let mut out = Vec::new();
+        l.extend(v, &mut out, |p, _| p);
+        assert_eq!(out.len(), l.embree_count(v.len()));
+        out
+    }
+
+    #[test]
+    fn pinned_adds_the_reflected_phantom_points_of_the_spec() {
+        for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
+            let l = layout(basis, Wrap::Pinned);
+            let v = pts(3);
+            // 2 p0 - p1 = (-1, -1); 2 p2 - p1 = (3, 7).
+            assert_eq!(
+                extended(l, &v),
+                [[-1.0, -1.0], [0.0, 0.0], [1.0, 1.0], [2.0, 4.0], [3.0, 7.0]]
+            );
+            assert_eq!(l.segments(3), Some(2));
+            assert_eq!(basis.segments_for(5), Some(2));
+        }
+        // Pinned means nothing more than nonperiodic for linear and Bezier curves.
+        for basis in [CurveBasis::Linear, CurveBasis::Bezier] {
+            assert_eq!(extended(layout(basis, Wrap::Pinned), &pts(4)), pts(4));
+        }
+    }
+
+    #[test]
+    fn periodic_repeats_the_first_points_to_close_the_curve() {
+        let v = pts(3);
+        let l = layout(CurveBasis::Linear, Wrap::Periodic);
+        assert_eq!(extended(l, &v), [v[0], v[1], v[2], v[0]]);
+        assert_eq!(
+            (l.segments(3), CurveBasis::Linear.segments_for(4)),
+            (Some(3), Some(3))
+        );
+        let l = layout(CurveBasis::Bezier, Wrap::Periodic);
+        let v6 = pts(6);
+        assert_eq!(extended(l, &v6)[6], v6[0]);
+        assert_eq!(
+            (l.segments(6), CurveBasis::Bezier.segments_for(7)),
+            (Some(2), Some(2))
+        );
+        assert_eq!(l.segments(7), None);
+        for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
+            let l = layout(basis, Wrap::Periodic);
+            assert_eq!(extended(l, &v), [v[0], v[1], v[2], v[0], v[1], v[2]]);
+            assert_eq!((l.segments(3), basis.segments_for(6)), (Some(3), Some(3)));
+        }
+    }
+
+    #[test]
+    fn counts_that_make_no_whole_segment_are_refused() {
+        assert_eq!(
+            layout(CurveBasis::Bezier, Wrap::Nonperiodic).segments(5),
+            None
+        );
+        assert_eq!(
+            layout(CurveBasis::BSpline, Wrap::Nonperiodic).segments(3),
+            None
+        );
+        assert_eq!(
+            layout(CurveBasis::Linear, Wrap::Nonperiodic).segments(1),
+            None
+        );
+        assert_eq!(
+            layout(CurveBasis::CatmullRom, Wrap::Periodic).segments(2),
+            None
+        );
+    }
+
+    /// Varying radii reach the segment ends: each basis evaluated at the ends of the radii
+    /// it was given returns the authored values (linear widths, so B-splines are exact too).
+    #[test]
+    fn varying_widths_are_the_radii_at_the_segment_ends() {
+        for (basis, wrap, n) in [
+            (CurveBasis::Bezier, Wrap::Nonperiodic, 7),
+            (CurveBasis::BSpline, Wrap::Nonperiodic, 6),
+            (CurveBasis::CatmullRom, Wrap::Nonperiodic, 6),
+            (CurveBasis::BSpline, Wrap::Pinned, 4),
+            (CurveBasis::CatmullRom, Wrap::Pinned, 4),
+        ] {
+            let l = layout(basis, wrap);
+            let s = l.segments(n).unwrap();
+            let w: Vec<f32> = (0..l.varying_count(s))
+                .map(|j| 1.0 + 0.25 * j as f32)
+                .collect();
+            let r = l.varying_to_points(&w, n);
+            assert_eq!(r.len(), n, "{basis:?} {wrap:?}");
+            let mut ext = Vec::new();
+            l.extend(&r, &mut ext, |x, _| x);
+            let as3: Vec<[f32; 3]> = ext.iter().map(|&[x]| [x / 10.0; 3]).collect();
+            let mut ends = Vec::new();
+            l.segment_ends(&as3, s, &mut ends);
+            let got: Vec<f32> = ends.iter().map(|e| e[0] * 10.0).collect();
+            for (g, want) in got.iter().zip(&w) {
+                assert!(
+                    (g - want).abs() < 1e-5,
+                    "{basis:?} {wrap:?}: {got:?} vs {w:?}"
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,243 @@
+//! USD grooms: every `BasisCurves` prim of a composed stage (.usda, .usdc or .usdz, read by
+//! the pure-Rust `openusd` crate), each as its own curve geometry in world space, laid out
+//! for Embree (see [`Layout`] for the basis and wrap conversions). See docs/formats.md for
+//! what is read, the primvar names and what is refused.
+
+mod layout;
+mod prim;
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use openusd::usd::{PrimPredicate, Stage};
+
+use crate::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
+use crate::embree::{CurveBasis, CurveShape};
+use crate::error::{Error, Result, invalid_arg};
+use crate::scene::curves::Curves;
+
+pub use layout::{Interpolation, Layout, Wrap};
+
+/// Bytes a USD file may have: the reader keeps the whole stage in memory.
+const MAX_FILE_BYTES: u64 = 1 << 32;
+
+/// A stage's grooms and what the reader made of the rest.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UsdGrooms {
+    /// The stage's `upAxis` ("Y" when not authored). Reported, not applied: points are used
+    /// as authored (see docs/formats.md).
+    pub up_axis: String,
+    /// The stage's `metersPerUnit` (0.01 when not authored). Reported, not applied.
+    pub meters_per_unit: f64,
+    pub curves: Vec<UsdCurves>,
+    /// Paths and types of the prims that are not BasisCurves (nor plain Xforms or Scopes).
+    pub ignored: Vec<String>,
+}
+
+/// One BasisCurves prim, in world space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UsdCurves {
+    pub path: String,
+    pub layout: Layout,
+    /// `curveVertexCounts` as authored.
+    pub authored_counts: Vec<u32>,
+    /// Segments of all curves.
+    pub segments: usize,
+    /// Bounds of the authored points in world space.
+    pub bounds: ([f32; 3], [f32; 3]),
+    /// Smallest and largest world-space radius the widths give (widths / 2 times the
+    /// transform's scale).
+    pub radius_range: (f32, f32),
+    /// Control points (x, y, z, radius) for Embree, curve after curve.
+    pub control: Vec<[f32; 4]>,
+    /// Control points of each curve in `control`.
+    pub control_counts: Vec<u32>,
+    /// `primvars:displayColor` at every segment end (segments + 1 per curve), if authored.
+    pub colors: Option<Vec<[f32; 3]>>,
+    /// `primvars:melanin`: the eumelanin concentration of each curve, if authored.
+    pub melanin: Option<Vec<f32>>,
+}
+
+impl UsdCurves {
+    /// The Embree curves of this prim, radii multiplied by `radius_scale` and every point
+    /// mapped by `point` (a scene's placement of the groom). `beta_n` is the material's
+    /// azimuthal roughness: melanin becomes the strand colour that the renderer's
+    /// colour-to-absorption fit at that roughness turns back into the melanin's absorption.
+    pub fn curves(
+        &self,
+        shape: CurveShape,
+        radius_scale: f32,
+        point: impl Fn([f32; 3]) -> [f32; 3],
+        beta_n: f32,
+    ) -> Result<Curves> {
+        let colors = match &self.melanin {
+            Some(m) => Some(self.melanin_colors(m, beta_n)?),
+            None => self.colors.clone(),
+        };
+        let control = self
+            .control
+            .iter()
+            .map(|&[x, y, z, r]| {
+                let [x, y, z] = point([x, y, z]);
+                [x, y, z, r * radius_scale]
+            })
+            .collect::<Vec<_>>();
+        Curves::from_control_points(
+            control,
+            &self.control_counts,
+            colors,
+            self.layout.basis,
+            shape,
+        )
+        .map_err(|e| e.context(&self.path))
+    }
+
+    pub fn basis(&self) -> CurveBasis {
+        self.layout.basis
+    }
+
+    /// One colour per segment end from each curve's eumelanin: the inverse of
+    /// [`sigma_a_from_color`] at `beta_n` applied to [`sigma_a_from_melanin`].
+    fn melanin_colors(&self, melanin: &[f32], beta_n: f32) -> Result<Vec<[f32; 3]>> {
+        // sigma_a_from_color(c) = (ln c / d)^2, so d follows from c = 1/e: sigma_a = 1/d^2.
+        let d = 1.0 / f64::from(sigma_a_from_color([(-1.0f32).exp(); 3], beta_n)?[0]).sqrt();
+        let mut out = Vec::new();
+        for (&m, &n) in melanin.iter().zip(&self.control_counts) {
+            let sigma_a = sigma_a_from_melanin(m, 0.0)?;
+            let c = sigma_a.map(|s| (-f64::from(s).sqrt() * d).exp() as f32);
+            let segments = self.layout.basis.segments_for(n as usize).unwrap_or(0);
+            out.extend(std::iter::repeat_n(c, segments + 1));
+        }
+        Ok(out)
+    }
+}
+
+/// Reads and composes the stage at `path` and converts each BasisCurves prim. Errors name
+/// the file (and the prim when one is at fault).
+pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
+    let at = |e: Error| e.context(path.display());
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(at(invalid_arg!(
+            "{} bytes: larger than the {MAX_FILE_BYTES} this reader accepts",
+            meta.len()
+        )));
+    }
+    let name = path
+        .to_str()
+        .ok_or_else(|| at(invalid_arg!("the path is not valid UTF-8")))?;
+    // openusd 0.6 indexes some tables of a corrupt .usdc without checking them, and panics:
+    // the panic is caught here and becomes this file's error (the stage is dropped with it).
+    let read = std::panic::catch_unwind(|| {
+        let stage =
+            Stage::open(name).map_err(|e| invalid_arg!("not a readable USD stage: {e:#}"))?;
+        let grooms = read_stage(&stage, meta.len())?;
+        // Composition is lazy: its errors (cycles, missing layers) are known once every
+        // prim has been visited.
+        match stage.composition_errors().first() {
+            Some(e) => Err(invalid_arg!("composition failed: {e}")),
+            None => Ok(grooms),
+        }
+    });
+    match read {
+        Ok(result) => result.map_err(at),
+        Err(panic) => {
+            let why = (panic.downcast_ref::<String>().map(String::as_str))
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("no message");
+            Err(at(invalid_arg!(
+                "not a readable USD stage (the USD library failed: {why})"
+            )))
+        }
+    }
+}
+
+/// The grooms of a composed stage. `file_bytes` bounds what any count may ask for.
+fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
+    let meta = |key: &str| stage.stage_metadata(key).ok().flatten();
+    let up_axis = meta("upAxis")
+        .and_then(|v| v.try_as_token().map(|t| t.as_str().to_string()))
+        .unwrap_or_else(|| "Y".to_string());
+    let meters_per_unit = meta("metersPerUnit")
+        .and_then(|v| v.try_as_double())
+        .unwrap_or(0.01);
+    let mut paths = Vec::new();
+    stage
+        .traverse(PrimPredicate::DEFAULT, |p| paths.push(p.clone()))
+        .map_err(|e| invalid_arg!("traversal failed: {e:#}"))?;
+    let mut curves = Vec::new();
+    let mut ignored = Vec::new();
+    for p in &paths {
+        let prim = stage.prim(p.clone());
+        let kind = prim
+            .type_name()
+            .map_err(|e| invalid_arg!("{}: {e:#}", p.as_str()))?
+            .map(|t| t.as_str().to_string())
+            .unwrap_or_default();
+        match kind.as_str() {
+            "BasisCurves" => curves.push(
+                prim::read_basis_curves(stage, p, file_bytes).map_err(|e| e.context(p.as_str()))?,
+            ),
+            "" | "Xform" | "Scope" => {}
+            other => ignored.push(format!("{} ({other})", p.as_str())),
+        }
+    }
+    Ok(UsdGrooms {
+        up_axis,
+        meters_per_unit,
+        curves,
+        ignored,
+    })
+}
+
+/// Whether `path` names a USD file by its extension (.usd, .usda, .usdc, .usdz).
+pub fn is_usd_path(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| ["usd", "usda", "usdc", "usdz"].contains(&e.to_ascii_lowercase().as_str()))
+}
+
+/// `hairtrace info` for a USD stage: per prim, curve, point and segment counts, world bounds
+/// and radius range; then the stage's units and the prims that were ignored.
+pub fn info_report(grooms: &UsdGrooms) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "stage:    upAxis {}, metersPerUnit {} (reported, not applied)",
+        grooms.up_axis, grooms.meters_per_unit
+    );
+    for c in &grooms.curves {
+        let (lo, hi) = c.bounds;
+        let _ = writeln!(
+            s,
+            "prim {} ({:?}, {:?})",
+            c.path, c.layout.basis, c.layout.wrap
+        );
+        let _ = writeln!(s, "  strands:  {}", c.authored_counts.len());
+        let points: u64 = c.authored_counts.iter().map(|&n| u64::from(n)).sum();
+        let _ = writeln!(s, "  points:   {points}");
+        let _ = writeln!(s, "  segments: {}", c.segments);
+        let _ = writeln!(
+            s,
+            "  bounds:   min ({}, {}, {}), max ({}, {}, {})",
+            lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
+        );
+        let _ = writeln!(
+            s,
+            "  radius:   min {}, max {}",
+            c.radius_range.0, c.radius_range.1
+        );
+        let _ = writeln!(
+            s,
+            "  colours:  {}",
+            if c.colors.is_some() { "yes" } else { "no" }
+        );
+    }
+    if grooms.curves.is_empty() {
+        let _ = writeln!(s, "no BasisCurves prims");
+    }
+    if !grooms.ignored.is_empty() {
+        let _ = writeln!(s, "ignored:  {}", grooms.ignored.join(", "));
+    }
+    s
+}

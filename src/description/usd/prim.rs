@@ -1,0 +1,403 @@
+//! One BasisCurves prim: its attributes read and checked, its composed world transform
+//! applied, its curves laid out for Embree.
+
+use openusd::gf::Matrix4d;
+use openusd::schemas::geom::{BasisCurves, Xform, Xformable};
+use openusd::sdf::{self, Value};
+use openusd::usd::{Attribute, Stage, TimeCode};
+
+use super::UsdCurves;
+use super::layout::{Interpolation, Layout, basis_of, wrap_of};
+use crate::error::{Result, invalid_arg};
+
+/// Relative difference between the scales of the three axes above which a transform is
+/// refused: radii can follow a uniform scale only.
+const UNIFORM_SCALE_TOLERANCE: f64 = 1e-4;
+
+/// The attribute's default value, or its earliest time sample when only samples are
+/// authored (the reader renders one frame: the first).
+fn value(attr: &Attribute) -> Result<Option<Value>> {
+    let err = |e| failed(attr.path(), e);
+    if let Some(v) = attr.get::<Value>().map_err(err)? {
+        return Ok(Some(v));
+    }
+    let times = attr.time_sample_times().map_err(err)?;
+    match times.first() {
+        Some(&t) => attr.get_at::<Value>(TimeCode::new(t)).map_err(err),
+        None => Ok(None),
+    }
+}
+
+/// An error of the USD library about `path`, its causes included.
+fn failed(path: &sdf::Path, e: impl std::fmt::Display) -> crate::Error {
+    invalid_arg!("{}: {e:#}", path.as_str())
+}
+
+fn wrong_type(what: &str, expected: &str, v: &Value) -> crate::Error {
+    let actual: &'static str = v.into();
+    invalid_arg!("{what}: expected {expected}, found {actual}")
+}
+
+fn token(attr: &Attribute, what: &str, fallback: &str) -> Result<String> {
+    match value(attr)? {
+        None => Ok(fallback.to_string()),
+        Some(Value::Token(t)) => Ok(t.as_str().to_string()),
+        Some(Value::String(s)) => Ok(s),
+        Some(v) => Err(wrong_type(what, "a token", &v)),
+    }
+}
+
+fn floats(attr: &Attribute, what: &str) -> Result<Option<Vec<f32>>> {
+    match value(attr)? {
+        None => Ok(None),
+        Some(Value::FloatVec(v)) => Ok(Some(v)),
+        Some(Value::DoubleVec(v)) => Ok(Some(v.into_iter().map(|x| x as f32).collect())),
+        Some(v) => Err(wrong_type(what, "float[]", &v)),
+    }
+}
+
+fn vec3s(attr: &Attribute, what: &str) -> Result<Option<Vec<[f32; 3]>>> {
+    match value(attr)? {
+        None => Ok(None),
+        Some(Value::Vec3fVec(v)) => Ok(Some(v.into_iter().map(Into::into).collect())),
+        Some(Value::Vec3dVec(v)) => Ok(Some(
+            v.into_iter()
+                .map(|p| {
+                    let p: [f64; 3] = p.into();
+                    p.map(|x| x as f32)
+                })
+                .collect(),
+        )),
+        Some(v) => Err(wrong_type(what, "point3f[] or color3f[]", &v)),
+    }
+}
+
+/// The `interpolation` metadata of a primvar (or `widths`), `fallback` when not authored.
+fn interpolation(attr: &Attribute, what: &str, fallback: Interpolation) -> Result<Interpolation> {
+    let v = attr
+        .get_metadata::<Value>("interpolation")
+        .map_err(|e| invalid_arg!("{what}: {e:#}"))?;
+    match v {
+        None => Ok(fallback),
+        Some(Value::Token(t)) => Interpolation::named(t.as_str())
+            .ok_or_else(|| invalid_arg!("{what}: unknown interpolation \"{}\"", t.as_str())),
+        Some(v) => Err(wrong_type(what, "an interpolation token", &v)),
+    }
+}
+
+/// The prim's local-to-world matrix (row vectors, as USD writes them): its own xformOps
+/// and every ancestor's, stopping at a `!resetXformStack!`.
+fn world_transform(stage: &Stage, path: &sdf::Path, curves: &BasisCurves) -> Result<Matrix4d> {
+    let err = failed;
+    let mut m = curves
+        .local_to_parent_transform(TimeCode::EARLIEST)
+        .map_err(|e| err(path, e))?;
+    let mut reset = curves.resets_xform_stack().map_err(|e| err(path, e))?;
+    let mut at = path.parent();
+    while let Some(p) = at.filter(|p| *p != sdf::Path::abs_root() && !reset) {
+        let ancestor = stage.prim(p.clone());
+        let order = ancestor.attribute("xformOpOrder");
+        match Xform::get(stage, p.clone()).map_err(|e| err(&p, e))? {
+            Some(x) => {
+                m = m * x
+                    .local_to_parent_transform(TimeCode::EARLIEST)
+                    .map_err(|e| err(&p, e))?;
+                reset = x.resets_xform_stack().map_err(|e| err(&p, e))?;
+            }
+            None if value(&order)?.is_some() => {
+                return Err(invalid_arg!(
+                    "ancestor {} has xformOps but is not an Xform: this reader follows the \
+                     transforms of Xform ancestors only",
+                    p.as_str()
+                ));
+            }
+            None => {}
+        }
+        at = p.parent();
+    }
+    Ok(m)
+}
+
+/// The uniform scale of a transform's linear part, or an error when it scales the axes
+/// differently (round fibres cannot follow).
+fn uniform_scale(m: &Matrix4d) -> Result<f64> {
+    let row = |i: usize| [m.0[4 * i], m.0[4 * i + 1], m.0[4 * i + 2]];
+    let len = |r: [f64; 3]| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let (a, b, c) = (row(0), row(1), row(2));
+    let s = [len(a), len(b), len(c)];
+    let mean = (s[0] + s[1] + s[2]) / 3.0;
+    let tol = UNIFORM_SCALE_TOLERANCE * mean;
+    let skew = [dot(a, b), dot(b, c), dot(a, c)].map(f64::abs);
+    if !(mean.is_finite() && mean > 0.0)
+        || s.iter().any(|x| (x - mean).abs() > tol)
+        || skew.iter().any(|&d| d > tol * mean)
+    {
+        return Err(invalid_arg!(
+            "the world transform scales the axes by {:?} (or shears them): radii can follow a \
+             uniform scale only",
+            s
+        ));
+    }
+    Ok(mean)
+}
+
+fn transform_point(m: &Matrix4d, p: [f32; 3]) -> [f32; 3] {
+    let p = p.map(f64::from);
+    std::array::from_fn(|j| {
+        (p[0] * m.0[j] + p[1] * m.0[4 + j] + p[2] * m.0[8 + j] + m.0[12 + j]) as f32
+    })
+}
+
+/// Values per curve a primvar of `interp` has: how many for each curve of `counts`.
+fn expected_len(interp: Interpolation, layout: Layout, counts: &[usize], segs: &[usize]) -> usize {
+    match interp {
+        Interpolation::Constant => 1,
+        Interpolation::Uniform => counts.len(),
+        Interpolation::Vertex => counts.iter().sum(),
+        Interpolation::Varying => segs.iter().map(|&s| layout.varying_count(s)).sum(),
+    }
+}
+
+/// Splits `values` of `interp` into the values of curve `i` (start offsets precomputed).
+fn per_curve<T: Copy>(
+    values: &[T],
+    interp: Interpolation,
+    i: usize,
+    vertex_start: usize,
+    varying_start: usize,
+    n: usize,
+    varying_n: usize,
+) -> Vec<T> {
+    match interp {
+        Interpolation::Constant => vec![values[0]; n],
+        Interpolation::Uniform => vec![values[i]; n],
+        Interpolation::Vertex => values[vertex_start..vertex_start + n].to_vec(),
+        Interpolation::Varying => values[varying_start..varying_start + varying_n].to_vec(),
+    }
+}
+
+/// Reads the BasisCurves prim at `path`. `file_bytes` bounds the counts: no curve table may
+/// ask for more points than the file could hold.
+pub(super) fn read_basis_curves(
+    stage: &Stage,
+    path: &sdf::Path,
+    file_bytes: u64,
+) -> Result<UsdCurves> {
+    let curves = BasisCurves::get(stage, path.clone())
+        .map_err(|e| invalid_arg!("{e:#}"))?
+        .ok_or_else(|| invalid_arg!("not a BasisCurves prim"))?;
+    let prim = stage.prim(path.clone());
+    let attr = |name: &str| prim.attribute(name);
+    let kind = token(&attr("type"), "type", "cubic")?;
+    let basis = token(&attr("basis"), "basis", "bezier")?;
+    let layout = Layout {
+        basis: basis_of(&kind, &basis)?,
+        wrap: wrap_of(&token(&attr("wrap"), "wrap", "nonperiodic")?)?,
+    };
+    let points = vec3s(&attr("points"), "points")?.ok_or_else(|| invalid_arg!("no points"))?;
+    let raw_counts = match value(&attr("curveVertexCounts"))? {
+        Some(Value::IntVec(v)) => v,
+        Some(v) => return Err(wrong_type("curveVertexCounts", "int[]", &v)),
+        None => return Err(invalid_arg!("no curveVertexCounts")),
+    };
+    if raw_counts.len() as u64 > file_bytes {
+        return Err(invalid_arg!(
+            "{} curves: more than the file could hold",
+            raw_counts.len()
+        ));
+    }
+    let mut counts = Vec::with_capacity(raw_counts.len());
+    let mut segs = Vec::with_capacity(raw_counts.len());
+    for (i, &c) in raw_counts.iter().enumerate() {
+        let n = usize::try_from(c)
+            .map_err(|_| invalid_arg!("curveVertexCounts[{i}] = {c}: negative"))?;
+        let s = layout.segments(n).ok_or_else(|| {
+            invalid_arg!(
+                "curve {i} has {n} points, which is not a whole number of {:?} {:?} segments",
+                layout.basis,
+                layout.wrap
+            )
+        })?;
+        counts.push(n);
+        segs.push(s);
+    }
+    let total: u64 = counts.iter().map(|&n| n as u64).sum();
+    if total != points.len() as u64 {
+        return Err(invalid_arg!(
+            "curveVertexCounts add up to {total} points but {} points are given",
+            points.len()
+        ));
+    }
+    if let Some(i) = points.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
+        return Err(invalid_arg!("point {i} = {:?}: not finite", points[i]));
+    }
+
+    let widths_attr = attr("widths");
+    let widths = floats(&widths_attr, "widths")?
+        .ok_or_else(|| invalid_arg!("no widths: the fibres' diameters must be authored"))?;
+    let widths_interp = interpolation(&widths_attr, "widths", Interpolation::Vertex)?;
+    let want = expected_len(widths_interp, layout, &counts, &segs);
+    if widths.len() != want {
+        return Err(invalid_arg!(
+            "{} widths for {widths_interp:?} interpolation: {want} expected",
+            widths.len()
+        ));
+    }
+    if let Some(i) = widths.iter().position(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(invalid_arg!(
+            "widths[{i}] = {}: must be finite and > 0",
+            widths[i]
+        ));
+    }
+
+    let color_attr = attr("primvars:displayColor");
+    let colors = vec3s(&color_attr, "primvars:displayColor")?;
+    let color_interp = interpolation(
+        &color_attr,
+        "primvars:displayColor",
+        Interpolation::Constant,
+    )?;
+    if let Some(c) = &colors {
+        let want = expected_len(color_interp, layout, &counts, &segs);
+        if c.len() != want {
+            return Err(invalid_arg!(
+                "{} displayColor values for {color_interp:?} interpolation: {want} expected",
+                c.len()
+            ));
+        }
+        if let Some(i) = c
+            .iter()
+            .position(|v| !v.iter().all(|x| (0.0..=1.0).contains(x)))
+        {
+            return Err(invalid_arg!(
+                "displayColor[{i}] = {:?}: must be in [0, 1]",
+                c[i]
+            ));
+        }
+    }
+
+    let melanin = read_melanin(&attr("primvars:melanin"), counts.len())?;
+    if melanin.is_some() && colors.is_some() {
+        return Err(invalid_arg!(
+            "both primvars:displayColor and primvars:melanin are authored: give one"
+        ));
+    }
+
+    let m = world_transform(stage, path, &curves)?;
+    let scale = uniform_scale(&m)?;
+    let world: Vec<[f32; 3]> = points.iter().map(|&p| transform_point(&m, p)).collect();
+    let radius_of = |w: f32| (f64::from(w) * 0.5 * scale) as f32;
+    let (lo, hi) = widths
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &w| {
+            (lo.min(radius_of(w)), hi.max(radius_of(w)))
+        });
+    let bounds = world.iter().fold(
+        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            )
+        },
+    );
+
+    let control_total: usize = counts.iter().map(|&n| layout.embree_count(n)).sum();
+    let mut control = Vec::with_capacity(control_total);
+    let mut control_counts = Vec::with_capacity(counts.len());
+    let mut out_colors = colors.as_ref().map(|_| Vec::new());
+    let (mut vertex_start, mut varying_start) = (0, 0);
+    let mut pos = Vec::new();
+    let mut radii = Vec::new();
+    for (i, (&n, &s)) in counts.iter().zip(&segs).enumerate() {
+        let varying_n = layout.varying_count(s);
+        let w = per_curve(
+            &widths,
+            widths_interp,
+            i,
+            vertex_start,
+            varying_start,
+            n,
+            varying_n,
+        );
+        let r: Vec<[f32; 1]> = match widths_interp {
+            Interpolation::Varying => layout.varying_to_points(&w, n),
+            _ => w.iter().map(|&x| [x]).collect(),
+        };
+        pos.clear();
+        layout.extend(&world[vertex_start..vertex_start + n], &mut pos, |p, _| p);
+        radii.clear();
+        layout.extend(&r, &mut radii, |r, end| if r[0] > 0.0 { r } else { end });
+        control.extend(
+            pos.iter()
+                .zip(&radii)
+                .map(|(p, r)| [p[0], p[1], p[2], radius_of(r[0])]),
+        );
+        control_counts.push(pos.len() as u32);
+        if let (Some(c), Some(out)) = (&colors, &mut out_colors) {
+            let v = per_curve(
+                c,
+                color_interp,
+                i,
+                vertex_start,
+                varying_start,
+                n,
+                varying_n,
+            );
+            match color_interp {
+                Interpolation::Varying => {
+                    out.extend_from_slice(&v);
+                    if v.len() == s {
+                        out.push(v[0]);
+                    }
+                }
+                _ => {
+                    let mut ext = Vec::new();
+                    layout.extend(&v, &mut ext, |c, _| c.map(|x| x.clamp(0.0, 1.0)));
+                    layout.segment_ends(&ext, s, out);
+                }
+            }
+        }
+        vertex_start += n;
+        varying_start += varying_n;
+    }
+    Ok(UsdCurves {
+        path: path.as_str().to_string(),
+        layout,
+        authored_counts: counts.iter().map(|&n| n as u32).collect(),
+        segments: segs.iter().sum(),
+        bounds,
+        radius_range: (lo, hi),
+        control,
+        control_counts,
+        colors: out_colors,
+        melanin,
+    })
+}
+
+/// `primvars:melanin`, eumelanin per curve (constant or uniform), if authored.
+fn read_melanin(attr: &Attribute, curves: usize) -> Result<Option<Vec<f32>>> {
+    const WHAT: &str = "primvars:melanin";
+    let Some(values) = floats(attr, WHAT)? else {
+        return Ok(None);
+    };
+    let per_curve = match interpolation(attr, WHAT, Interpolation::Constant)? {
+        Interpolation::Constant if values.len() == 1 => vec![values[0]; curves],
+        Interpolation::Uniform if values.len() == curves => values,
+        interp => {
+            return Err(invalid_arg!(
+                "{WHAT}: {} values for {interp:?} interpolation: one (constant) or one per \
+                 curve (uniform) expected",
+                values.len()
+            ));
+        }
+    };
+    if let Some(i) = per_curve.iter().position(|m| !(m.is_finite() && *m >= 0.0)) {
+        return Err(invalid_arg!(
+            "{WHAT}[{i}] = {}: must be finite and >= 0",
+            per_curve[i]
+        ));
+    }
+    Ok(Some(per_curve))
+}

@@ -108,9 +108,10 @@ use serde::Deserialize;
 
 use crate::embree::{CurveBasis, CurveShape, Device, Isa};
 use crate::error::Result;
-use crate::render::PixelFilter;
 use crate::render::integrator::{PathSettings, Roulette, World};
+use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
+use crate::render::{Aovs, PixelFilter, Progress};
 use crate::scene::camera::Camera;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;
@@ -360,4 +361,11 @@ pub struct BuiltScene {
     pub settings: RenderSettings,
     /// Seconds each build stage took.
     pub stages: StageTimes,
+}
+
+impl BuiltScene {
+    /// Renders the scene as built, its film and AOVs as `aovs` asks.
+    pub fn render(&self, aovs: Aovs, progress: &dyn Progress) -> Result<RenderOutput> {
+        renderer::render(&self.world, &self.camera, &self.settings, aovs, progress)
+    }
 }

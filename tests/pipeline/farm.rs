@@ -6,7 +6,7 @@
 
 use hairtrace::description::{self, SceneDescription};
 use hairtrace::embree::{Device, Isa};
-use hairtrace::render::{Aovs, NoProgress, renderer};
+use hairtrace::render::{Aovs, NoProgress};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -29,14 +29,7 @@ fn render_rows(machine: Isa, pin: Option<Isa>, y0: u32, y1: u32) -> Vec<u32> {
     let mut d = scene();
     d.render.crop = Some([0, y0, W, y1]);
     let built = d.build(device).unwrap();
-    let out = renderer::render(
-        &built.world,
-        &built.camera,
-        &built.settings,
-        Aovs::default(),
-        &NoProgress,
-    )
-    .unwrap();
+    let out = built.render(Aovs::default(), &NoProgress).unwrap();
     out.film.rgb().iter().map(|v| v.to_bits()).collect()
 }
 

@@ -10,7 +10,6 @@ use hairtrace::bsdf::sigma_a_from_melanin;
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::{EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource};
 use hairtrace::embree::{CurveBasis, CurveShape, Device};
-use hairtrace::render::renderer::render;
 use hairtrace::render::{Aovs, NO_STRAND, NoProgress};
 use hairtrace::scene::material::{HairColor, HairMaterial};
 
@@ -448,14 +447,7 @@ fn the_fixture_renders() {
         strand_id: true,
         ..Aovs::default()
     };
-    let out = render(
-        &built.world,
-        &built.camera,
-        &built.settings,
-        aovs,
-        &NoProgress,
-    )
-    .unwrap();
+    let out = built.render(aovs, &NoProgress).unwrap();
     let rgb = out.film.rgb();
     assert!(rgb.iter().all(|v| v.is_finite() && *v >= 0.0));
     let mean = rgb.iter().sum::<f32>() / rgb.len() as f32;

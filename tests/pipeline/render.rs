@@ -289,14 +289,7 @@ fn furnace_demo_renders_to_one() {
     d.render.spp = 8;
     let device = Arc::new(Device::new(Some(2)).unwrap());
     let built = d.build(device).unwrap();
-    let out = render(
-        &built.world,
-        &built.camera,
-        &built.settings,
-        Aovs::default(),
-        &NoProgress,
-    )
-    .unwrap();
+    let out = built.render(Aovs::default(), &NoProgress).unwrap();
     let rgb = out.film.rgb();
     assert!(rgb.iter().all(|v| v.is_finite()));
     let m = mean(rgb);

@@ -12,7 +12,7 @@ use hairtrace::description::usd::{UsdGrooms, read_usd_file};
 use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::embree::{CurveShape, Device};
 use hairtrace::render::NO_STRAND;
-use hairtrace::{Aovs, NoProgress, render};
+use hairtrace::{Aovs, NoProgress};
 use serde_json::Value;
 
 fn fixtures() -> PathBuf {
@@ -117,14 +117,7 @@ fn every_fixture_renders_a_visible_image() {
             strand_id: true,
             ..Aovs::default()
         };
-        let out = render(
-            &built.world,
-            &built.camera,
-            &built.settings,
-            aovs,
-            &NoProgress,
-        )
-        .unwrap();
+        let out = built.render(aovs, &NoProgress).unwrap();
         let ids = out.film.strand_id().unwrap();
         let hair = ids.iter().filter(|&&s| s != NO_STRAND).count();
         assert!(hair >= 3, "{name}: {hair} of {} pixels see hair", ids.len());
@@ -287,14 +280,7 @@ fn scene_files_take_usd_grooms() {
     for t in [0.0, 5.0] {
         let desc = SceneDescription::from_toml(&scene(t), &fixtures(), "usd.toml").unwrap();
         let built = desc.build(device.clone()).unwrap();
-        let out = render(
-            &built.world,
-            &built.camera,
-            &built.settings,
-            Aovs::default(),
-            &NoProgress,
-        )
-        .unwrap();
+        let out = built.render(Aovs::default(), &NoProgress).unwrap();
         assert!(out.film.rgb().iter().all(|v| v.is_finite()));
         eyes.push(built.camera.eye());
     }

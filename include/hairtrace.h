@@ -1086,6 +1086,11 @@ enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
  * non-UTF-8 path, a file that is not a USD stage or fails to compose, a prim the reader
  * refuses, an unknown shape, a material that is not hair). Nothing is added on error.
  *
+ * Untrusted files: a corrupt binary crate file (.usdc, or inside .usdz) can make the USD
+ * crate (openusd 0.6) try to allocate without bound, which aborts the process; text
+ * (.usda) is checked and fuzzed. Read .usdc only from sources you trust
+ * (docs/formats.md, "Limits").
+ *
  * # Safety
  * `scene` is NULL or a live handle not in use on another thread; `path` is NULL or a
  * NUL-terminated string; `first_geom_id` and `geom_count` are NULL or point to writable

@@ -335,8 +335,11 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     image::check_output_path(&args.output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
     if let Some(sigma_a) = args.preset {
-        let bare = args.scene.as_ref().and_then(|p| p.extension());
-        if !bare.is_some_and(|e| e.eq_ignore_ascii_case("hair")) {
+        if !args
+            .scene
+            .as_ref()
+            .is_some_and(|p| has_extension(p, "hair"))
+        {
             return Err(hairtrace::Error::InvalidArg(
                 "--preset is for a bare .hair groom; a scene file names it in its \
                  [materials.NAME] (preset = \"...\")"

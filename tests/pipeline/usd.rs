@@ -205,7 +205,29 @@ fn bad_files_are_refused_with_a_message() {
         (
             "nan_point",
             curves_prim(&ok.replace("(0,3,0)", "(0,nan,0)")),
-            "not finite",
+            "point 3 = [0, NaN, 0]: every coordinate must be finite",
+        ),
+        (
+            // Finite, but past what Embree's rays can reach (CI's fuzzing found this one).
+            "huge_point",
+            curves_prim(&ok.replace("(0,3,0)", "(0,3e29,0)")),
+            "point 3 = [0, 3000000000000000000000000000",
+        ),
+        (
+            "scaled_past_the_limit",
+            format!(
+                "{HEADER}def Xform \"x\"\n{{\nfloat3 xformOp:scale = (1e15, 1e15, 1e15)\nuniform token[] xformOpOrder = [\"xformOp:scale\"]\ndef BasisCurves \"c\"\n{{\n{ok}\n}}\n}}\n"
+            ),
+            "point (in world space) 2",
+        ),
+        (
+            // Every authored point is inside the limit; the reflected end point 2 p3 - p2 is not.
+            "phantom_past_the_limit",
+            curves_prim(&ok.replace("(0,3,0)", "(0,9e14,0)").replace(
+                "\"linear\"",
+                "\"cubic\"\nuniform token basis = \"catmullRom\"\nuniform token wrap = \"pinned\"",
+            )),
+            "control point (the wrap's end points included) 5",
         ),
         (
             "bezier_count",

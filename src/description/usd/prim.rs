@@ -9,6 +9,7 @@ use openusd::usd::{Attribute, Stage, TimeCode};
 use super::UsdCurves;
 use super::layout::{Interpolation, Layout, basis_of, wrap_of};
 use crate::error::{Result, invalid_arg};
+use crate::validate;
 
 /// Relative difference between the scales of the three axes above which a transform is
 /// refused: radii can follow a uniform scale only.
@@ -229,9 +230,7 @@ pub(super) fn read_basis_curves(
             points.len()
         ));
     }
-    if let Some(i) = points.iter().position(|p| !p.iter().all(|x| x.is_finite())) {
-        return Err(invalid_arg!("point {i} = {:?}: not finite", points[i]));
-    }
+    validate::positions("point", &points)?;
 
     let widths_attr = attr("widths");
     let widths = floats(&widths_attr, "widths")?
@@ -287,6 +286,7 @@ pub(super) fn read_basis_curves(
     let m = world_transform(stage, path, &curves)?;
     let scale = uniform_scale(&m)?;
     let world: Vec<[f32; 3]> = points.iter().map(|&p| transform_point(&m, p)).collect();
+    validate::positions("point (in world space)", &world)?;
     let radius_of = |w: f32| (f64::from(w) * 0.5 * scale) as f32;
     let (lo, hi) = widths
         .iter()
@@ -361,6 +361,15 @@ pub(super) fn read_basis_curves(
         }
         vertex_start += n;
         varying_start += varying_n;
+    }
+    // A pinned wrap's phantom end points lie beyond the authored ones, and a transform's
+    // scale can push radii past f32: what Embree gets is checked here, where the file is named.
+    validate::positions("control point (the wrap's end points included)", &control)?;
+    if let Some(i) = control.iter().position(|p| !p[3].is_finite()) {
+        return Err(invalid_arg!(
+            "control point {i}: radius {} in world space is not finite",
+            control[i][3]
+        ));
     }
     Ok(UsdCurves {
         path: path.as_str().to_string(),

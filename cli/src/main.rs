@@ -13,7 +13,7 @@ use hairtrace::embree::Isa;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::material::HairColor;
-use hairtrace::scene::{Stage, StageProgress, Thickness, info_report, read_hair_file};
+use hairtrace::scene::{GroomShape, Stage, StageProgress, Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::PathBuf;
@@ -108,6 +108,10 @@ struct RenderArgs {
     /// throughput.
     #[arg(long, value_parser = ["sqrt", "throughput"])]
     roulette: Option<String>,
+    /// Curve shape of every groom, over the scene's: auto (the default: a ribbon facing the
+    /// ray where a strand is at most a pixel wide, a tube elsewhere), round or flat.
+    #[arg(long, value_parser = ["auto", "round", "flat"])]
+    shape: Option<String>,
     /// Pixel filter: tent (the default) or box (one pixel).
     #[arg(long, value_parser = ["tent", "box"])]
     filter: Option<String>,
@@ -350,6 +354,16 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
             if let MaterialDesc::Hair(h) = m {
                 h.color = HairColor::SigmaA(sigma_a);
             }
+        }
+    }
+    if let Some(shape) = &args.shape {
+        let shape = match shape.as_str() {
+            "round" => GroomShape::Round,
+            "flat" => GroomShape::Flat,
+            _ => GroomShape::Auto,
+        };
+        for g in &mut description.grooms {
+            g.shape = shape;
         }
     }
     // Overrides go into the description, so that the camera's aspect follows the size.

@@ -4,7 +4,8 @@
 use super::scene::{HtScene, Shape, add_with_id};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
 use crate::description::usd::read_usd_file;
-use crate::embree::{CurveBasis, CurveShape, SharedBuffer};
+use crate::embree::{CurveBasis, SharedBuffer};
+use crate::scene::GroomShape;
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
 use crate::scene::mesh::Mesh;
@@ -23,12 +24,18 @@ pub const HT_CURVE_BSPLINE: HtCurveBasis = 2;
 /// Catmull-Rom spline.
 pub const HT_CURVE_CATMULL_ROM: HtCurveBasis = 3;
 
-/// The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`.
+/// The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`,
+/// `HT_CURVE_AUTO`.
 pub type HtCurveShape = u32;
 /// A true tube: the reference, and what close-ups need.
 pub const HT_CURVE_ROUND: HtCurveShape = 0;
 /// A ribbon facing the ray: faster, approximate up close.
 pub const HT_CURVE_FLAT: HtCurveShape = 1;
+/// Per strand, at each render: a ribbon where the strand is at most one pixel wide from
+/// the camera, a tube elsewhere. Its images agree with round ones within noise on the
+/// bench scenes, at 1.2-1.3x the speed (README, "Fidelity knobs"). A render with another
+/// camera or image height than the last one builds the scene's BVH again.
+pub const HT_CURVE_AUTO: HtCurveShape = 2;
 
 /// Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
 /// when the call returns.
@@ -106,13 +113,14 @@ fn curve_basis(basis: HtCurveBasis) -> Result<CurveBasis> {
     })
 }
 
-fn curve_shape(shape: HtCurveShape) -> Result<CurveShape> {
+fn curve_shape(shape: HtCurveShape) -> Result<GroomShape> {
     Ok(match shape {
-        HT_CURVE_ROUND => CurveShape::Round,
-        HT_CURVE_FLAT => CurveShape::Flat,
+        HT_CURVE_ROUND => GroomShape::Round,
+        HT_CURVE_FLAT => GroomShape::Flat,
+        HT_CURVE_AUTO => GroomShape::Auto,
         _ => {
             return Err(invalid_arg!(
-                "shape = {shape}: not HT_CURVE_ROUND (0) or HT_CURVE_FLAT (1)"
+                "shape = {shape}: not HT_CURVE_ROUND (0), HT_CURVE_FLAT (1) or HT_CURVE_AUTO (2)"
             ));
         }
     })
@@ -185,8 +193,8 @@ pub unsafe extern "C" fn ht_scene_add_curves(
             counts: counts.to_vec(),
             colors,
         };
-        let curves = Curves::from_strands(&strands, basis, shape)?;
-        Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+        let curves = Curves::from_strands(&strands, basis, shape.built())?;
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
     })
 }
 
@@ -288,8 +296,8 @@ fn add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
-        let curves = Curves::from_control_points(vertices(points)?, counts, colors, basis, shape)?;
-        Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+        let curves = Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
     })
 }
 
@@ -325,8 +333,8 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
             Thickness::Diameter
         };
         let strands = read_hair_file(&path, thickness)?;
-        let curves = Curves::from_strands(&strands, basis, shape)?;
-        Ok(scene.add_geometry(Shape::Curves(curves), material_id)?)
+        let curves = Curves::from_strands(&strands, basis, shape.built())?;
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
     })
 }
 
@@ -367,13 +375,13 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let beta_n = scene.hair_beta_n(material_id);
         let grooms = read_usd_file(&path)?;
         let curves = (grooms.curves.iter())
-            .map(|c| c.curves(shape, 1.0, |p| p, beta_n))
+            .map(|c| c.curves(shape.built(), 1.0, |p| p, beta_n))
             .collect::<Result<Vec<_>>>()?;
         let first = u32::try_from(scene.geometries.len())
             .map_err(|_| invalid_arg!("too many geometries"))?;
         let count = u32::try_from(curves.len()).map_err(|_| invalid_arg!("too many prims"))?;
         for c in curves {
-            scene.add_geometry(Shape::Curves(c), material_id)?;
+            scene.add_geometry(Shape::curves(c, shape), material_id)?;
         }
         // SAFETY: non-NULL (checked), the host's uint32_t.
         unsafe { count_out.write(count) };

@@ -267,7 +267,7 @@ pub unsafe extern "C" fn ht_render_aovs(
             depth: depth.is_some(),
             strand_id: strand_id.is_some(),
         };
-        let (world, camera) = scene.prepare(s.width as f32 / s.height as f32)?;
+        let (world, camera) = scene.prepare(s.width, s.height)?;
         let host;
         let progress: &dyn Progress = match s.progress {
             Some(callback) => {

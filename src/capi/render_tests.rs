@@ -182,7 +182,7 @@ fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
         // The points Embree reads in the shared scene's current build.
         let embree_points = || {
             let scene = scene_mut(scenes[1].scene).ok().unwrap();
-            let (world, _) = scene.prepare(1.0).unwrap();
+            let (world, _) = scene.prepare(1, 1).unwrap();
             match world.tracer.scene().geometry(0) {
                 Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
                 _ => panic!("curves expected"),

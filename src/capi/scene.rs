@@ -11,6 +11,7 @@ use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
+use crate::scene::ribbons::{self, GroomShape};
 use crate::scene::light::Light;
 use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
@@ -45,19 +46,40 @@ pub struct HtScene {
     pub(super) lens: Option<(f32, f32)>,
     /// The last build; None until the first render and after geometry is added.
     pub(super) world: Option<World>,
-    /// Lights were added since `world` was built.
-    pub(super) lights_changed: bool,
+    /// The view the `auto` curves of `world` were shared out for.
+    pub(super) built_for: Option<View>,
+    /// The bounds of the geometry as added (`auto` curves round), which frame a scene
+    /// with `auto` curves and no camera.
+    pub(super) added_bounds: Option<Bounds>,
 }
 
 pub(super) enum Shape {
     Curves(Curves),
+    /// Curves of the `auto` shape, kept round: each build shares them out between round and
+    /// flat for the render's camera and image height (`ribbons::share_out`).
+    AutoCurves(Curves),
     Mesh(Mesh),
+}
+
+impl Shape {
+    /// Curves given with `shape`.
+    pub(super) fn curves(curves: Curves, shape: GroomShape) -> Shape {
+        match shape {
+            GroomShape::Auto => Shape::AutoCurves(curves),
+            _ => Shape::Curves(curves),
+        }
+    }
 }
 
 pub(super) struct Geometry {
     pub(super) shape: Shape,
     pub(super) material: u32,
 }
+
+/// What an `auto` groom's shapes were chosen for: the camera and the image height.
+type View = (Camera, u32);
+/// Lower and upper corners of a box.
+type Bounds = ([f32; 3], [f32; 3]);
 
 impl HtScene {
     /// The material `id` for a geometry; hair goes on curves, diffuse on meshes.
@@ -83,62 +105,102 @@ impl HtScene {
         let id = u32::try_from(self.geometries.len())
             .map_err(|_| invalid_arg!("too many geometries"))?;
         self.geometries.push(Geometry { shape, material });
-        self.world = None;
+        (self.world, self.built_for, self.added_bounds) = (None, None, None);
         Ok(id)
     }
 
-    fn build_tracer(&self) -> Result<Tracer> {
+    fn has_auto_curves(&self) -> bool {
+        (self.geometries.iter()).any(|g| matches!(g.shape, Shape::AutoCurves(_)))
+    }
+
+    /// The Embree scene and one material per Embree geometry; `auto` curves are shared out
+    /// for `view`, or stay round without one.
+    fn build_tracer(&self, view: Option<&View>) -> Result<(Tracer, Vec<Material>)> {
         let mut builder = TracerBuilder::new(self.device.clone(), SceneOptions::default())?;
+        let mut materials = Vec::with_capacity(self.geometries.len());
         for g in &self.geometries {
-            match &g.shape {
-                Shape::Curves(c) => builder.add_curves(c.clone())?,
-                Shape::Mesh(m) => builder.add_mesh(m.clone())?,
+            let parts = match (&g.shape, view) {
+                (Shape::AutoCurves(c), Some((camera, height))) => {
+                    ribbons::share_out(c.clone(), camera, *height)?
+                }
+                (Shape::Curves(c) | Shape::AutoCurves(c), _) => vec![c.clone()],
+                (Shape::Mesh(m), _) => {
+                    builder.add_mesh(m.clone())?;
+                    Vec::new()
+                }
             };
+            let added = parts.len().max(1);
+            for part in parts {
+                builder.add_curves(part)?;
+            }
+            let material = &self.materials[g.material as usize];
+            materials.extend(std::iter::repeat_n(material.clone(), added));
         }
-        builder.build()
+        Ok((builder.build()?, materials))
+    }
+
+    /// The host's camera, or one framing `bounds` (the geometry's; needed only without a
+    /// camera), for an image of `aspect` (width over height), with the host's lens.
+    fn camera(&self, aspect: f32, bounds: Option<Bounds>) -> Result<Camera> {
+        let camera = match (self.camera, bounds) {
+            (Some(c), _) => c.with_aspect(aspect)?,
+            (None, Some((lo, hi))) if !self.geometries.is_empty() => {
+                Camera::frame_bounds(lo.into(), hi.into(), aspect, Camera::DEFAULT_FOV_Y_DEG)?
+            }
+            (None, _) => {
+                return Err(invalid_arg!(
+                    "the scene has no geometry to frame: set a camera with ht_scene_set_camera"
+                ));
+            }
+        };
+        match self.lens {
+            Some((aperture_radius, focus_distance)) => {
+                camera.with_thin_lens(aperture_radius, focus_distance)
+            }
+            None => Ok(camera),
+        }
     }
 
     /// The world to render, built or updated as needed, and the camera for an image of
-    /// `aspect` (width over height).
-    pub(crate) fn prepare(&mut self, aspect: f32) -> Result<(&World, Camera)> {
+    /// `width` x `height` pixels. `auto` curves make the build depend on the camera and
+    /// the height: a render with another view builds again.
+    pub(crate) fn prepare(&mut self, width: u32, height: u32) -> Result<(&World, Camera)> {
         if self.lights.is_empty() {
             return Err(invalid_arg!(
                 "the scene has no light: add an environment, distant or rect light"
             ));
         }
-        if self.world.is_none() || self.lights_changed {
-            let tracer = match self.world.take() {
-                Some(world) => world.tracer,
-                None => self.build_tracer()?,
+        let aspect = width as f32 / height as f32;
+        let world = self.world.take();
+        let (camera, geometry) = if self.has_auto_curves() {
+            // Framed on the curves as added (round), so that the view never depends on
+            // the shapes it picks.
+            let bounds = match (self.camera, self.added_bounds) {
+                (Some(_), _) => None,
+                (None, Some(b)) => Some(b),
+                (None, None) => Some(
+                    *(self.added_bounds).insert(self.build_tracer(None)?.0.scene().bounds()),
+                ),
             };
-            let materials = self
-                .geometries
-                .iter()
-                .map(|g| self.materials[g.material as usize].clone())
-                .collect();
-            self.world = Some(World::new(tracer, materials, self.lights.clone())?);
-            self.lights_changed = false;
-        }
-        let world = self.world.as_ref().expect("built above");
-        let camera = match self.camera {
-            Some(c) => c.with_aspect(aspect)?,
-            None if self.geometries.is_empty() => {
-                return Err(invalid_arg!(
-                    "the scene has no geometry to frame: set a camera with ht_scene_set_camera"
-                ));
-            }
-            None => {
-                let (lo, hi) = world.tracer.scene().bounds();
-                Camera::frame_bounds(lo.into(), hi.into(), aspect, Camera::DEFAULT_FOV_Y_DEG)?
-            }
+            let camera = self.camera(aspect, bounds)?;
+            let view = (camera, height);
+            let geometry = match world {
+                Some(w) if self.built_for == Some(view) => w.into_geometry(),
+                _ => {
+                    self.built_for = Some(view);
+                    self.build_tracer(Some(&view))?
+                }
+            };
+            (camera, geometry)
+        } else {
+            let geometry = match world {
+                Some(w) => w.into_geometry(),
+                None => self.build_tracer(None)?,
+            };
+            (self.camera(aspect, Some(geometry.0.scene().bounds()))?, geometry)
         };
-        let camera = match self.lens {
-            Some((aperture_radius, focus_distance)) => {
-                camera.with_thin_lens(aperture_radius, focus_distance)?
-            }
-            None => camera,
-        };
-        Ok((world, camera))
+        let world = World::new(geometry.0, geometry.1, self.lights.clone())?;
+        Ok((self.world.insert(world), camera))
     }
 }
 
@@ -261,7 +323,8 @@ pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut Ht
             camera: None,
             lens: None,
             world: None,
-            lights_changed: false,
+            built_for: None,
+            added_bounds: None,
         });
         // SAFETY: non-NULL (checked), the host's HtScene*.
         unsafe { out.write(Box::into_raw(scene)) };

@@ -593,7 +593,7 @@ fn shared_xyzr_points_are_checked_then_read_in_place() {
 fn held_bytes(scene: &HtScene) -> usize {
     let kept: usize = (scene.geometries.iter())
         .map(|g| match &g.shape {
-            Shape::Curves(c) => c.heap_bytes(),
+            Shape::Curves(c) | Shape::AutoCurves(c) => c.heap_bytes(),
             Shape::Mesh(_) => unreachable!("curves only"),
         })
         .sum();
@@ -627,7 +627,7 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
                     ht_scene_add_environment(h.scene, sky.as_ptr()),
                     HtStatus::HT_OK
                 );
-                scene_mut(h.scene).ok().unwrap().prepare(1.0).unwrap();
+                scene_mut(h.scene).ok().unwrap().prepare(1, 1).unwrap();
                 (held_bytes(h.scene()), monitor.current() as usize)
             });
         let segments = strands.segment_count() as f64;

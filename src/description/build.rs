@@ -10,8 +10,9 @@ use super::{
     BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
     MeshDesc, MeshSource, SceneDescription, Transform,
 };
+use crate::scene::{GroomShape, ribbons};
 use crate::bsdf::diffuse::Diffuse;
-use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
+use crate::embree::{CurveBasis, Device, SceneOptions};
 use crate::error::{Error, Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
@@ -90,6 +91,8 @@ impl SceneDescription {
         let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
         // One material per geometry: a USD groom adds one geometry per BasisCurves prim.
         let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
+        // Curves wait for the camera: an `auto` groom's shapes depend on it.
+        let mut built = Vec::new();
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
             let beta_n = match self.materials.get(&g.material) {
@@ -99,13 +102,10 @@ impl SceneDescription {
             let curves = g
                 .curves(&mut stages, (i, grooms, reads), &mut hair_bounds, beta_n)
                 .map_err(|e| self.error(&at, e))?;
-            for curves in curves {
-                tracer.add_curves(curves).map_err(|e| self.error(&at, e))?;
-                materials.push(groom_materials[i].clone());
-            }
+            built.extend(curves.into_iter().map(|c| (i, c)));
         }
-        materials.extend(mesh_materials);
         let mut prop_bounds = Bounds::EMPTY;
+        let mut meshes = Vec::with_capacity(self.meshes.len());
         for (i, m) in self.meshes.iter().enumerate() {
             let at = format!("mesh[{i}]");
             let mesh = stages
@@ -118,7 +118,7 @@ impl SceneDescription {
                     prop_bounds.add(Vec3::from_array(*p), 0.0);
                 }
             }
-            tracer.add_mesh(mesh).map_err(|e| self.error(&at, e))?;
+            meshes.push(mesh);
         }
         // A scene without grooms (or meshes) still goes through every stage.
         stages.report(Stage::Read, 1.0)?;
@@ -133,6 +133,25 @@ impl SceneDescription {
             .camera
             .build(framed, aspect)
             .map_err(|e| self.error("camera", e))?;
+        for (i, curves) in built {
+            let at = format!("groom[{i}]");
+            let parts = match self.grooms[i].shape {
+                GroomShape::Auto => ribbons::share_out(curves, &camera, settings.height)
+                    .map_err(|e| self.error(&at, e))?,
+                _ => vec![curves],
+            };
+            for part in parts {
+                tracer.add_curves(part).map_err(|e| self.error(&at, e))?;
+                materials.push(groom_materials[i].clone());
+            }
+        }
+        // Geometry ids follow `materials`: the grooms' geometries, then the meshes.
+        for (i, mesh) in meshes.into_iter().enumerate() {
+            tracer
+                .add_mesh(mesh)
+                .map_err(|e| self.error(&format!("mesh[{i}]"), e))?;
+        }
+        materials.extend(mesh_materials);
         let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
         let world = World::new(tracer, materials, lights)?;
         Ok(BuiltScene {
@@ -213,7 +232,7 @@ impl GroomDesc {
         GroomDesc {
             source,
             basis: CurveBasis::BSpline,
-            shape: CurveShape::Round,
+            shape: GroomShape::default(),
             radius_scale: 1.0,
             transform: Transform::default(),
             material: material.to_string(),
@@ -254,7 +273,7 @@ impl GroomDesc {
                 }
                 stages.run(Stage::Curves, (i, grooms), |_| {
                     (file.curves.iter())
-                        .map(|c| c.curves(self.shape, radius_factor, place, beta_n))
+                        .map(|c| c.curves(self.shape.built(), radius_factor, place, beta_n))
                         .collect()
                 })
             }
@@ -269,7 +288,7 @@ impl GroomDesc {
                             [x, y, z, r * radius_factor]
                         })
                         .collect::<Vec<_>>();
-                    Curves::from_control_points(points, counts, None, self.basis, self.shape)
+                    Curves::from_control_points(points, counts, None, self.basis, self.shape.built())
                 })?;
                 for p in curves.vertices() {
                     framed.add(Vec3::new(p[0], p[1], p[2]), p[3]);
@@ -282,7 +301,7 @@ impl GroomDesc {
                     framed.add(Vec3::from_array(*p), *r);
                 }
                 let curves = stages.run(Stage::Curves, (i, grooms), |_| {
-                    Curves::from_strands(&strands, self.basis, self.shape)
+                    Curves::from_strands(&strands, self.basis, self.shape.built())
                 })?;
                 Ok(vec![curves])
             }

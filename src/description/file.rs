@@ -13,8 +13,9 @@ use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
     MeshSource, RenderDesc, SceneDescription, Transform,
 };
+use crate::scene::GroomShape;
 use crate::bsdf::sigma_a_preset;
-use crate::embree::{CurveBasis, CurveShape};
+use crate::embree::{CurveBasis};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
 use crate::scene::hair_file::Thickness;
@@ -205,6 +206,7 @@ enum BasisKey {
 enum ShapeKey {
     Round,
     Flat,
+    Auto,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -235,11 +237,12 @@ impl From<BasisKey> for CurveBasis {
     }
 }
 
-impl From<ShapeKey> for CurveShape {
+impl From<ShapeKey> for GroomShape {
     fn from(k: ShapeKey) -> Self {
         match k {
-            ShapeKey::Round => CurveShape::Round,
-            ShapeKey::Flat => CurveShape::Flat,
+            ShapeKey::Round => GroomShape::Round,
+            ShapeKey::Flat => GroomShape::Flat,
+            ShapeKey::Auto => GroomShape::Auto,
         }
     }
 }
@@ -506,7 +509,7 @@ impl RawGroom {
         };
         let mut groom = GroomDesc::new(source, &self.material);
         groom.basis = self.basis.map_or(groom.basis, CurveBasis::from);
-        groom.shape = self.shape.map_or(groom.shape, CurveShape::from);
+        groom.shape = self.shape.map_or(groom.shape, GroomShape::from);
         groom.radius_scale = self.radius_scale.unwrap_or(groom.radius_scale);
         groom.transform = transform(self.translate, self.scale, self.rotate_y_deg);
         Ok(groom)

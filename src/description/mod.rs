@@ -43,7 +43,7 @@
 //! file = "curly.hair"      # relative to the scene file's folder
 //! thickness = "diameter"   # how the file's thickness is read: "diameter" (default) or "radius"
 //! basis = "bspline"        # "linear", "bezier", "bspline" (default) or "catmull_rom"
-//! shape = "round"          # "round" (default) or "flat"
+//! shape = "auto"           # "auto" (default: flat where thinner than a pixel), "round" or "flat"
 //! radius_scale = 1.0       # multiplies every fibre radius
 //! translate = [0, 0, 0]    # the transform: points scaled, turned about +y, then moved;
 //! scale = 1.0              # radii scaled too
@@ -106,7 +106,8 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 
-use crate::embree::{CurveBasis, CurveShape, Device, Isa};
+use crate::scene::GroomShape;
+use crate::embree::{CurveBasis, Device, Isa};
 use crate::error::Result;
 use crate::render::integrator::{PathSettings, Roulette, World};
 use crate::render::renderer::{self, RenderOutput};
@@ -268,7 +269,7 @@ impl Default for Transform {
 pub struct GroomDesc {
     pub source: GroomSource,
     pub basis: CurveBasis,
-    pub shape: CurveShape,
+    pub shape: GroomShape,
     /// Multiplies every fibre radius, on top of the transform's scale: thins or thickens a
     /// groom without editing its file.
     pub radius_scale: f32,

@@ -15,7 +15,8 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
-use crate::embree::{CurveBasis, CurveShape};
+use crate::scene::GroomShape;
+use crate::embree::{CurveBasis};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::hair_file::{Thickness, write_hair_file};
 use crate::scene::mesh::Mesh;
@@ -113,7 +114,8 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
                 ));
             }
         };
-        if g.shape != CurveShape::Round {
+        // `auto` is an approximation of round tubes, which the peer traces exactly.
+        if g.shape == GroomShape::Flat {
             return Err(invalid_arg!("groom[{i}]: only round curves are exported"));
         }
         let MaterialDesc::Hair(hair) = material(&g.material)? else {

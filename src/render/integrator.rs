@@ -140,6 +140,11 @@ pub struct World {
 }
 
 impl World {
+    /// The tracer and the materials, to build another world on them (other lights).
+    pub(crate) fn into_geometry(self) -> (Tracer, Vec<Material>) {
+        (self.tracer, self.materials)
+    }
+
     /// `materials[g]` shades geometry id g of the tracer.
     pub fn new(tracer: Tracer, materials: Vec<Material>, lights: Vec<Light>) -> Result<Self> {
         let geometries = tracer.scene().geometries().len();
@@ -246,7 +251,7 @@ impl World {
             let varied_bsdf;
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
                 (Hit::Hair(h), Some(Material::Hair(m))) => {
-                    varied_bsdf = m.bsdf_at(h.strand.strand, h.s, h.color);
+                    varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.color);
                     Shading::hair(h, &varied_bsdf, wo_world)
                 }
                 (Hit::Surface(s), Some(Material::Diffuse(d))) => Shading::diffuse(s, *d, wo_world),
@@ -278,10 +283,10 @@ impl World {
     fn first_hit(&self, hit: &Hit) -> FirstHit {
         let (albedo, strand) = match (hit, self.materials.get(hit.geom_id() as usize)) {
             (Hit::Hair(h), Some(Material::Hair(m))) => {
-                let p = m.params_at(h.strand.strand, h.s, h.color);
+                let p = m.params_at(h.strand.id, h.s, h.color);
                 (
                     Vec3::from_array(color_from_sigma_a(p.sigma_a, p.beta_n)),
-                    Some(h.strand.strand),
+                    Some(h.strand.id),
                 )
             }
             (Hit::Surface(_), Some(Material::Diffuse(d))) => (d.albedo(), None),

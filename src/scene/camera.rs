@@ -150,6 +150,12 @@ impl Camera {
         self.forward
     }
 
+    /// The side of one pixel of an image `height` pixels tall, per unit of distance from the
+    /// eye, at the image centre (off-centre pixels cover a little less).
+    pub fn pixel_spread(&self, height: u32) -> f32 {
+        2.0 * self.half_extent.y / height.max(1) as f32
+    }
+
     /// Whether [`Self::ray`] uses its lens point (a thin lens) or ignores it (a pinhole).
     pub(crate) fn has_lens(&self) -> bool {
         self.lens_radius > 0.0

@@ -53,6 +53,10 @@ pub struct StrandSegment {
     pub segments: u32,
     /// Primitive id of the strand's first segment.
     pub first_prim: u32,
+    /// The strand's number in the groom it came from, which per-strand material variation
+    /// and the strand AOV use: `strand`, unless the groom's strands were shared out between
+    /// a round and a flat geometry (see [`Curves::subset`]).
+    pub id: u32,
 }
 
 impl StrandSegment {
@@ -75,6 +79,8 @@ pub struct StrandIndex {
     segment_starts: Vec<u32>,
     /// Linear RGB at each polyline point (segments + 1 per strand), strand after strand.
     colors: Option<Vec<[f32; 3]>>,
+    /// Each strand's number in the groom it came from, when it is not its index here.
+    ids: Option<Vec<u32>>,
 }
 
 impl StrandIndex {
@@ -91,6 +97,7 @@ impl StrandIndex {
         let index = StrandIndex {
             segment_starts,
             colors,
+            ids: None,
         };
         if let Some(c) = &index.colors {
             let knots = total as usize + index.strand_count();
@@ -125,6 +132,7 @@ impl StrandIndex {
             segment: prim - first_prim,
             segments: self.segment_starts[strand + 1] - first_prim,
             first_prim,
+            id: self.ids.as_ref().map_or(strand as u32, |ids| ids[strand]),
         })
     }
 
@@ -140,7 +148,9 @@ impl StrandIndex {
 
     /// Heap bytes of the table.
     pub fn heap_bytes(&self) -> usize {
-        self.segment_starts.capacity() * 4 + self.colors.as_ref().map_or(0, |c| c.capacity() * 12)
+        self.segment_starts.capacity() * 4
+            + self.colors.as_ref().map_or(0, |c| c.capacity() * 12)
+            + self.ids.as_ref().map_or(0, |i| i.capacity() * 4)
     }
 }
 
@@ -271,6 +281,56 @@ impl Curves {
         })
     }
 
+    /// The strands that `keep` marks (one flag per strand), copied into curves of their own
+    /// with `shape`; each keeps its number here as its [`StrandSegment::id`], so that a
+    /// groom shared out between shapes varies per strand as it would whole. None when no
+    /// strand is kept.
+    pub fn subset(&self, keep: &[bool], shape: CurveShape) -> Result<Option<Curves>> {
+        let starts = &self.strands.segment_starts;
+        if keep.len() != self.strands.strand_count() {
+            return Err(invalid_arg!(
+                "{} flags for {} strands",
+                keep.len(),
+                self.strands.strand_count()
+            ));
+        }
+        let (mut vertices, mut counts, mut ids) = (Vec::new(), Vec::new(), Vec::new());
+        let mut colors = self.strands.colors.as_ref().map(|_| Vec::new());
+        for (s, _) in keep.iter().enumerate().filter(|(_, k)| **k) {
+            let (a, b) = (starts[s] as usize, starts[s + 1] as usize);
+            let points = self.strand_points(s);
+            counts.push(points.len() as u32);
+            vertices.extend_from_slice(points);
+            ids.push(self.strands.ids.as_ref().map_or(s as u32, |i| i[s]));
+            if let (Some(out), Some(all)) = (&mut colors, &self.strands.colors) {
+                // Segments + 1 colours per strand: s strands' extra ones come before.
+                out.extend_from_slice(&all[a + s..b + s + 1]);
+            }
+        }
+        if counts.is_empty() {
+            return Ok(None);
+        }
+        vertices.reserve_exact(padding_for::<[f32; 4]>());
+        let mut part = Curves::from_control_points(vertices, &counts, colors, self.basis, shape)?;
+        part.strands.ids = Some(ids);
+        Ok(Some(part))
+    }
+
+    /// The control points strand `s` reads (`s` < the strand count).
+    pub fn strand_points(&self, s: usize) -> &[[f32; 4]] {
+        let starts = &self.strands.segment_starts;
+        let first = self.indices();
+        let start = first[starts[s] as usize] as usize;
+        let end = first[starts[s + 1] as usize - 1] as usize + self.basis.points_per_segment();
+        &self.vertices()[start..end]
+    }
+
+    /// The same curves drawn with `shape`.
+    pub fn with_shape(mut self, shape: CurveShape) -> Self {
+        self.shape = shape;
+        self
+    }
+
     pub fn basis(&self) -> CurveBasis {
         self.basis
     }
@@ -385,6 +445,43 @@ mod tests {
     }
 
     #[test]
+    fn a_subset_keeps_its_strands_numbers_points_and_colours() {
+        let s = strands();
+        for basis in CurveBasis::ALL {
+            let whole = Curves::from_strands(&s, basis, CurveShape::Round).unwrap();
+            for keep in [[true, false], [false, true], [true, true]] {
+                let part = whole.subset(&keep, CurveShape::Flat).unwrap().unwrap();
+                assert_eq!(part.shape(), CurveShape::Flat);
+                let kept: Vec<usize> = (0..2).filter(|&k| keep[k]).collect();
+                assert_eq!(part.strands().strand_count(), kept.len(), "{basis:?}");
+                for (local, &s) in kept.iter().enumerate() {
+                    assert_eq!(part.strand_points(local), whole.strand_points(s));
+                    let first = whole.strands().segment_starts[s];
+                    let local_first = part.strands().segment_starts[local];
+                    for seg in 0..whole.strands().locate(first).unwrap().segments {
+                        let (a, b) = (
+                            whole.strands().locate(first + seg).unwrap(),
+                            part.strands().locate(local_first + seg).unwrap(),
+                        );
+                        assert_eq!((b.id, b.segment, b.segments), (s as u32, a.segment, a.segments));
+                        for u in [0.0, 0.3, 1.0] {
+                            assert_eq!(whole.strands().color(&a, u), part.strands().color(&b, u));
+                        }
+                    }
+                }
+                // A subset of a subset still names the strands of the whole.
+                if kept.len() == 2 {
+                    let again = part.subset(&[false, true], CurveShape::Round).unwrap().unwrap();
+                    assert_eq!(again.strands().locate(0).unwrap().id, 1);
+                }
+            }
+            assert_eq!(whole.subset(&[false, false], CurveShape::Flat).unwrap(), None);
+            let e = whole.subset(&[true], CurveShape::Flat).unwrap_err();
+            assert!(e.to_string().contains("1 flags for 2 strands"), "{e}");
+        }
+    }
+
+    #[test]
     fn strands_and_colours_survive() {
         let c = Curves::from_strands(&strands(), CurveBasis::Linear, CurveShape::Round).unwrap();
         let idx = c.strands();
@@ -396,7 +493,8 @@ mod tests {
                 strand: 0,
                 segment: 1,
                 segments: 2,
-                first_prim: 0
+                first_prim: 0,
+                id: 0,
             }
         );
         assert_eq!(at.s(0.5), 0.75);

@@ -10,6 +10,7 @@ pub(crate) mod groom;
 pub mod hair_file;
 pub mod hit;
 pub mod light;
+pub mod ribbons;
 mod light_sample;
 pub mod material;
 pub(crate) mod mesh;
@@ -26,4 +27,5 @@ pub use hair_file::{
 };
 pub use light::{Light, LightEval, LightSample};
 pub use stages::{NoStages, Stage, StageProgress, StageTimes};
+pub use ribbons::GroomShape;
 pub use strands::Strands;

@@ -12,7 +12,8 @@ use hairtrace::description::{
     DEMOS, EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource, SceneDescription,
     demo, quick_look,
 };
-use hairtrace::embree::{CurveBasis, CurveShape, Device};
+use hairtrace::embree::{CurveBasis, Device};
+use hairtrace::scene::GroomShape;
 use hairtrace::render::PixelFilter;
 use hairtrace::render::integrator::Roulette;
 use hairtrace::scene::material::HairColor;
@@ -121,7 +122,7 @@ fn example_keys_reach_the_description() {
     let desc = SceneDescription::from_file(&examples().join("scalp.toml")).unwrap();
     let g = &desc.grooms[0];
     assert_eq!(g.basis, CurveBasis::CatmullRom);
-    assert_eq!(g.shape, CurveShape::Round);
+    assert_eq!(g.shape, GroomShape::Auto);
     assert_eq!(g.transform.rotate_y_deg, 60.0);
     let GroomSource::Scalp(s) = &g.source else {
         panic!("not a scalp: {:?}", g.source)
@@ -491,7 +492,7 @@ fn quick_look_frames_a_hair_file_and_paths_follow_the_scene_file() {
 
     let look = quick_look(&hair).unwrap();
     assert_eq!(look.grooms[0].basis, CurveBasis::BSpline);
-    assert_eq!(look.grooms[0].shape, CurveShape::Round);
+    assert_eq!(look.grooms[0].shape, GroomShape::Auto);
     let built = look.build(device()).unwrap();
     // The automatic camera looks at the groom's centre, the origin.
     let to_centre = (-built.camera.eye()).normalize();

@@ -17,5 +17,6 @@ mod lights;
 mod pbrt;
 mod rehit;
 mod render;
+mod ribbons;
 mod stages;
 mod usd;

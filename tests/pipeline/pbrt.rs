@@ -9,7 +9,8 @@ use hairtrace::Error;
 use hairtrace::bsdf::sigma_a_from_melanin;
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::{EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource};
-use hairtrace::embree::{CurveBasis, CurveShape, Device};
+use hairtrace::embree::{CurveBasis, Device};
+use hairtrace::scene::GroomShape;
 use hairtrace::render::{Aovs, NO_STRAND, NoProgress};
 use hairtrace::scene::material::{HairColor, HairMaterial};
 
@@ -66,7 +67,7 @@ fn the_fixture_reads_into_pbrts_numbers() {
     let g = &d.grooms[0];
     assert_eq!(
         (g.material.as_str(), g.basis, g.shape),
-        ("brown", CurveBasis::Bezier, CurveShape::Round)
+        ("brown", CurveBasis::Bezier, GroomShape::Round)
     );
     let (points, counts) = control_points(&s, 0);
     assert_eq!(counts, [7, 7, 7]);
@@ -91,7 +92,7 @@ fn the_fixture_reads_into_pbrts_numbers() {
     let (points, counts) = control_points(&s, 1);
     assert_eq!(
         (d.grooms[1].basis, d.grooms[1].shape),
-        (CurveBasis::Bezier, CurveShape::Flat)
+        (CurveBasis::Bezier, GroomShape::Flat)
     );
     assert_eq!(counts, [4]);
     assert!(close(

@@ -98,7 +98,7 @@ impl Grooms {
                 counts: Vec::new(),
             };
             let mut groom = GroomDesc::new(source, material);
-            (groom.basis, groom.shape) = (basis, shape);
+            (groom.basis, groom.shape) = (basis, shape.into());
             self.list.push(groom);
             self.list.len() - 1
         });

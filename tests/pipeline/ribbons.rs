@@ -1,0 +1,120 @@
+//! The `auto` curve shape: ribbons for the strands thinner than a pixel give the image of
+//! round tubes within noise, a groom seen both near and far is shared out between the two
+//! shapes, and strands keep their numbers (material variation, the strand AOV) when split.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use hairtrace::description::SceneDescription;
+use hairtrace::embree::{CurveShape, Device, Geometry};
+use hairtrace::render::renderer::RenderOutput;
+use hairtrace::render::{Aovs, NoProgress};
+
+/// A fur ball of `strands` brown strands with per-strand variation, in a uniform sky,
+/// seen from `distance` at `size` x `size` pixels.
+fn fur_ball(shape: &str, seed: u64, distance: f32, size: u32, spp: u32) -> SceneDescription {
+    let text = format!(
+        r#"
+[render]
+width = {size}
+height = {size}
+spp = {spp}
+seed = {seed}
+filter = "box"
+
+[camera]
+eye = [0, 0, {distance}]
+target = [0, 0, 0]
+fov_deg = 33
+
+[materials.brown]
+type = "hair"
+sigma_a = [0.5447, 0.9061, 1.781]
+absorption_variation = 0.5
+roughness_variation = 0.5
+
+[[groom]]
+procedural = "fur_ball"
+basis = "linear"
+shape = "{shape}"
+material = "brown"
+
+[groom.params]
+strands = 4000
+segments = 8
+
+[[light]]
+type = "environment"
+radiance = [1, 1, 1]
+"#
+    );
+    SceneDescription::from_toml(&text, Path::new("."), "ribbons test").unwrap()
+}
+
+fn render(d: &SceneDescription, aovs: Aovs) -> RenderOutput {
+    let built = d.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
+    built.render(aovs, &NoProgress).unwrap()
+}
+
+fn rmse(a: &[f32], b: &[f32]) -> f64 {
+    let sum: f64 = a.iter().zip(b).map(|(x, y)| f64::from(x - y).powi(2)).sum();
+    (sum / a.len() as f64).sqrt()
+}
+
+fn curve_shapes(d: &SceneDescription) -> Vec<CurveShape> {
+    let built = d.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
+    (built.world.tracer.scene().geometries().iter())
+        .filter_map(|g| match g {
+            Geometry::Curves(c) => Some(c.shape()),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn auto_ribbons_give_the_image_of_round_tubes_within_noise() {
+    // At 48 pixels across, every strand is under a pixel wide: `auto` is all ribbons.
+    assert_eq!(curve_shapes(&fur_ball("auto", 0, 5.2, 48, 1)), [CurveShape::Flat]);
+    let spp = 256;
+    let reference = render(&fur_ball("round", 1, 5.2, 48, spp), Aovs::default());
+    let round = render(&fur_ball("round", 2, 5.2, 48, spp), Aovs::default());
+    let auto = render(&fur_ball("auto", 3, 5.2, 48, spp), Aovs::default());
+    let noise = rmse(round.film.rgb(), reference.film.rgb());
+    let auto_error = rmse(auto.film.rgb(), reference.film.rgb());
+    // Two independent round renders differ by their noise alone; a systematic difference of
+    // the ribbons would add to it. 1.15x leaves room for noise, not for a bias of 0.5 noise.
+    assert!(
+        auto_error < 1.15 * noise,
+        "auto differs from round by {auto_error}, round from round by {noise}"
+    );
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
+    let (m_auto, m_ref) = (mean(auto.film.rgb()), mean(reference.film.rgb()));
+    assert!((m_auto - m_ref).abs() < 2e-3 * m_ref, "{m_auto} vs {m_ref}");
+}
+
+#[test]
+fn a_groom_seen_near_and_far_is_shared_out_and_keeps_its_strand_numbers() {
+    // At 256 pixels, a root 0.008 wide is a pixel wide 3.46 units from the eye: from 3.5
+    // units, the roots facing the camera (2.5 units away) are wider and those on the far
+    // side of the unit ball (4.5 units) narrower.
+    let near = |shape| fur_ball(shape, 0, 3.5, 256, 1);
+    assert_eq!(
+        curve_shapes(&near("auto")),
+        [CurveShape::Round, CurveShape::Flat]
+    );
+    assert_eq!(curve_shapes(&near("round")), [CurveShape::Round]);
+    // The first hit's strand is the same strand whichever geometry holds it, except where
+    // a ribbon's edge and a tube's differ (pixels straddling a strand's silhouette).
+    let aovs = Aovs {
+        strand_id: true,
+        ..Aovs::default()
+    };
+    let ids = |shape| render(&near(shape), aovs).film.strand_id().unwrap().to_vec();
+    let (auto, round) = (ids("auto"), ids("round"));
+    let same = auto.iter().zip(&round).filter(|(a, b)| a == b).count();
+    assert!(
+        same as f64 > 0.95 * auto.len() as f64,
+        "{same} of {} pixels see the same strand",
+        auto.len()
+    );
+}

@@ -590,3 +590,63 @@ fn the_default_settings_are_the_rust_defaults() {
     assert_eq!(rust.filter, r.filter);
     assert!(d.progress.is_none() && d.progress_user.is_null());
 }
+
+#[test]
+fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
+    let strands = small_fur();
+    let points = xyzr(&strands);
+    let [round, flat, auto] = [HT_CURVE_ROUND, HT_CURVE_FLAT, HT_CURVE_AUTO].map(|shape| {
+        let h = Handles::new();
+        let hair = h.hair_material();
+        let desc = HtCurvesXyzr {
+            shape,
+            ..xyzr_desc(&points, &strands.counts)
+        };
+        let s = unsafe { ht_scene_add_curves_xyzr(h.scene, &desc, hair, &mut 0) };
+        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        light(&h, true);
+        h
+    });
+    let shapes = |h: &Handles| {
+        let scene = scene_mut(h.scene).ok().unwrap();
+        let (world, _) = scene.prepare(1, scene.built_for.map_or(1, |v| v.1)).unwrap();
+        (world.tracer.scene().geometries().iter())
+            .map(|g| match g {
+                Geometry::Curves(c) => c.shape(),
+                _ => panic!("curves only"),
+            })
+            .collect::<Vec<_>>()
+    };
+    // Roots 0.008 wide, 3 to 5 units from an eye with a 40-degree view: a pixel wide at
+    // 273 to 455 pixels of image height. At 32 every strand is a ribbon; at 1000 every
+    // strand a tube (a 16-pixel crop keeps that render small); at 350, both.
+    let small = settings(32);
+    let tall = HtRenderSettings {
+        width: 1000,
+        height: 1000,
+        crop_x0: 492,
+        crop_y0: 300,
+        crop_x1: 508,
+        crop_y1: 316,
+        ..settings(32)
+    };
+    let image = |h: &Handles, s: &HtRenderSettings| {
+        let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
+        let mut rgb = vec![0.0f32; ((x1 - x0) * (y1 - y0) * 3) as usize];
+        let status = unsafe { ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len()) };
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        bits(&rgb)
+    };
+    let auto_small = image(&auto, &small);
+    assert_eq!(shapes(&auto), [CurveShape::Flat]);
+    assert_eq!(auto_small, image(&flat, &small));
+    let auto_tall = image(&auto, &tall);
+    assert_eq!(shapes(&auto), [CurveShape::Round]);
+    assert_eq!(auto_tall, image(&round, &tall));
+    assert!(auto_tall.iter().any(|&v| f32::from_bits(v) > 0.0));
+    // Back to the first view: built again, the same pixels.
+    assert_eq!(image(&auto, &small), auto_small);
+    let (status, _) = render_c(&auto, &settings(350));
+    assert_eq!(status, HtStatus::HT_OK);
+    assert_eq!(shapes(&auto), [CurveShape::Round, CurveShape::Flat]);
+}

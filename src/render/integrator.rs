@@ -237,16 +237,15 @@ impl World {
             // the light's are skipped when no light is sampled.
             let sample_light =
                 settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some();
-            let (choice, u_light) = if sample_light {
-                (sampler.next_1d(), sampler.next_2d())
+            let [lx, ly, choice, _] = if sample_light {
+                sampler.next_4d()
             } else {
                 sampler.skip();
-                sampler.skip();
-                (0.0, [0.0; 2])
+                [0.0; 4]
             };
-            let u_lobe = sampler.next_1d();
-            let u_dir = sampler.next_2d();
-            let u_rr = sampler.next_1d();
+            let u_light = [lx, ly];
+            // The direction takes the best stratified pair, the lobe and roulette the rest.
+            let [dx, dy, u_lobe, u_rr] = sampler.next_4d();
             // A varied hair material builds its BSDF per hit; the shading point borrows it.
             let varied_bsdf;
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
@@ -263,7 +262,7 @@ impl World {
                 rays += shadow_rays;
                 l += clamp(beta * direct, events + 1, settings);
             }
-            let Some((wi, weight, pdf)) = shading.sample([u_lobe, u_dir[0], u_dir[1]]) else {
+            let Some((wi, weight, pdf)) = shading.sample([u_lobe, dx, dy]) else {
                 break;
             };
             beta *= weight;

@@ -5,7 +5,7 @@
 //! which the path asks for them): never on the thread, the tile order or the crop, so
 //! renders are reproducible bit for bit and crops assemble into the full frame.
 //!
-//! Each request (`next_1d`, `next_2d`) takes the first dimensions of its own
+//! Each request (`next_2d`, `next_4d`) takes the first dimensions of its own
 //! independently scrambled sequence, seeded from the pixel and the request's position
 //! ("padding", as pbrt-v4's PaddedSobolSampler does): every 2D request (a lens point, a
 //! light sample) is stratified across the pixel's samples, requests never correlate with
@@ -49,18 +49,19 @@ impl PixelSampler {
         (s >> 32) as u32
     }
 
-    /// One number in [0, 1).
-    pub fn next_1d(&mut self) -> f32 {
-        let s = self.next_sequence();
-        sobol_burley::sample(self.index, 0, s)
+    /// Two numbers in [0, 1), jointly stratified.
+    pub fn next_2d(&mut self) -> [f32; 2] {
+        let [a, b, _, _] = self.next_4d();
+        [a, b]
     }
 
-    /// Two numbers in [0, 1), jointly stratified. (The crate's four-dimensional call
-    /// returns the same bits as two one-dimensional ones and scrambles the index once.)
-    pub fn next_2d(&mut self) -> [f32; 2] {
+    /// Four numbers in [0, 1): the first four dimensions of one sequence, so the first
+    /// two are as stratified as [`next_2d`](Self::next_2d)'s and all four jointly well
+    /// spread. One request instead of several is what a path vertex needs most: the
+    /// scramble hashes are the sampler's cost.
+    pub fn next_4d(&mut self) -> [f32; 4] {
         let s = self.next_sequence();
-        let v = sobol_burley::sample_4d(self.index, 0, s);
-        [v[0], v[1]]
+        sobol_burley::sample_4d(self.index, 0, s)
     }
 
     /// Passes over one request that this path does not need (a lens sample for a
@@ -93,10 +94,9 @@ mod tests {
     fn deterministic_and_in_range() {
         let draw = |seed, pixel, i| {
             let mut s = PixelSampler::new(seed, pixel, i);
-            let a = s.next_1d();
-            let [b, c] = s.next_2d();
-            let [d, e] = s.next_2d();
-            [a, b, c, d, e]
+            let [a, b, c, d] = s.next_4d();
+            let [e, f] = s.next_2d();
+            [a, b, c, d, e, f]
         };
         for i in [0, 1, 17, 65_535, 65_536, 1 << 20, u32::MAX] {
             let v = draw(42, (3, 9), i);
@@ -132,6 +132,27 @@ mod tests {
     }
 
     #[test]
+    fn a_four_dimensional_request_is_stratified_in_each_dimension_and_its_first_pair() {
+        for request in 0..3 {
+            let mut strata = [[0u8; 64]; 4];
+            let mut grid = [0u8; 64];
+            for i in 0..64 {
+                let mut s = PixelSampler::new(11, (5, 6), i);
+                for _ in 0..request {
+                    s.next_4d();
+                }
+                let v = s.next_4d();
+                for (d, x) in v.iter().enumerate() {
+                    strata[d][(x * 64.0) as usize] += 1;
+                }
+                grid[(v[1] * 8.0) as usize * 8 + (v[0] * 8.0) as usize] += 1;
+            }
+            assert!(strata.iter().flatten().all(|&c| c == 1), "{strata:?}");
+            assert!(grid.iter().all(|&c| c == 1), "8x8 strata: {grid:?}");
+        }
+    }
+
+    #[test]
     fn pixels_and_requests_are_decorrelated() {
         let n = 4096;
         let series = |seed, pixel: (u32, u32), skip: usize| -> Vec<f32> {
@@ -139,9 +160,9 @@ mod tests {
                 .map(|i| {
                     let mut s = PixelSampler::new(seed, pixel, i);
                     for _ in 0..skip {
-                        s.next_1d();
+                        s.next_4d();
                     }
-                    s.next_1d()
+                    s.next_4d()[0]
                 })
                 .collect()
         };

@@ -181,7 +181,7 @@ fn shade(seed: u64, spp: u32) -> impl Fn((u32, u32), &mut PixelAccumulator) + Sy
         for s in 0..spp {
             let mut sampler = PixelSampler::new(seed, (x, y), s);
             let [a, b] = sampler.next_2d();
-            let c = sampler.next_1d();
+            let [c, ..] = sampler.next_4d();
             let radiance = Vec3::new(a + x as f32 * 0.01, b * y as f32, c);
             let hit = (a > 0.3).then_some(FirstHit {
                 albedo: Vec3::new(a, b, c),

@@ -5,8 +5,8 @@ use super::scene::{HtScene, Shape, add_with_id};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
 use crate::description::usd::read_usd_file;
 use crate::embree::{CurveBasis, SharedBuffer};
-use crate::scene::GroomShape;
 use crate::error::{Result, invalid_arg};
+use crate::scene::GroomShape;
 use crate::scene::curves::Curves;
 use crate::scene::mesh::Mesh;
 use crate::scene::{Strands, Thickness, read_hair_file};
@@ -296,7 +296,8 @@ fn add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
-        let curves = Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
+        let curves =
+            Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
         Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
     })
 }

@@ -609,7 +609,9 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     });
     let shapes = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
-        let (world, _) = scene.prepare(1, scene.built_for.map_or(1, |v| v.1)).unwrap();
+        let (world, _) = scene
+            .prepare(1, scene.built_for.map_or(1, |v| v.1))
+            .unwrap();
         (world.tracer.scene().geometries().iter())
             .map(|g| match g {
                 Geometry::Curves(c) => c.shape(),

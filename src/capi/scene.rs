@@ -11,10 +11,10 @@ use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
-use crate::scene::ribbons::{self, GroomShape};
 use crate::scene::light::Light;
 use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
+use crate::scene::ribbons::{self, GroomShape};
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::validate::{length, non_negative, positive};
 use std::ffi::c_char;
@@ -178,9 +178,9 @@ impl HtScene {
             let bounds = match (self.camera, self.added_bounds) {
                 (Some(_), _) => None,
                 (None, Some(b)) => Some(b),
-                (None, None) => Some(
-                    *(self.added_bounds).insert(self.build_tracer(None)?.0.scene().bounds()),
-                ),
+                (None, None) => {
+                    Some(*(self.added_bounds).insert(self.build_tracer(None)?.0.scene().bounds()))
+                }
             };
             let camera = self.camera(aspect, bounds)?;
             let view = (camera, height);
@@ -197,7 +197,10 @@ impl HtScene {
                 Some(w) => w.into_geometry(),
                 None => self.build_tracer(None)?,
             };
-            (self.camera(aspect, Some(geometry.0.scene().bounds()))?, geometry)
+            (
+                self.camera(aspect, Some(geometry.0.scene().bounds()))?,
+                geometry,
+            )
         };
         let world = World::new(geometry.0, geometry.1, self.lights.clone())?;
         Ok((self.world.insert(world), camera))

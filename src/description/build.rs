@@ -10,7 +10,6 @@ use super::{
     BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
     MeshDesc, MeshSource, SceneDescription, Transform,
 };
-use crate::scene::{GroomShape, ribbons};
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device, SceneOptions};
 use crate::error::{Error, Result, invalid_arg};
@@ -26,6 +25,7 @@ use crate::scene::shapes;
 use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
 use crate::scene::strands::Strands;
 use crate::scene::tracer::TracerBuilder;
+use crate::scene::{GroomShape, ribbons};
 use crate::validate::positive;
 
 use super::usd::{is_usd_path, read_usd_file};
@@ -288,7 +288,13 @@ impl GroomDesc {
                             [x, y, z, r * radius_factor]
                         })
                         .collect::<Vec<_>>();
-                    Curves::from_control_points(points, counts, None, self.basis, self.shape.built())
+                    Curves::from_control_points(
+                        points,
+                        counts,
+                        None,
+                        self.basis,
+                        self.shape.built(),
+                    )
                 })?;
                 for p in curves.vertices() {
                     framed.add(Vec3::new(p[0], p[1], p[2]), p[3]);

@@ -13,10 +13,10 @@ use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
     MeshSource, RenderDesc, SceneDescription, Transform,
 };
-use crate::scene::GroomShape;
 use crate::bsdf::sigma_a_preset;
-use crate::embree::{CurveBasis};
+use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
+use crate::scene::GroomShape;
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::{HairColor, HairMaterial};

@@ -106,13 +106,13 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 
-use crate::scene::GroomShape;
 use crate::embree::{CurveBasis, Device, Isa};
 use crate::error::Result;
 use crate::render::integrator::{PathSettings, Roulette, World};
 use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, PixelFilter, Progress};
+use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;

@@ -15,9 +15,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
-use crate::scene::GroomShape;
-use crate::embree::{CurveBasis};
+use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
+use crate::scene::GroomShape;
 use crate::scene::hair_file::{Thickness, write_hair_file};
 use crate::scene::mesh::Mesh;
 

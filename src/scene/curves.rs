@@ -463,7 +463,10 @@ mod tests {
                             whole.strands().locate(first + seg).unwrap(),
                             part.strands().locate(local_first + seg).unwrap(),
                         );
-                        assert_eq!((b.id, b.segment, b.segments), (s as u32, a.segment, a.segments));
+                        assert_eq!(
+                            (b.id, b.segment, b.segments),
+                            (s as u32, a.segment, a.segments)
+                        );
                         for u in [0.0, 0.3, 1.0] {
                             assert_eq!(whole.strands().color(&a, u), part.strands().color(&b, u));
                         }
@@ -471,11 +474,17 @@ mod tests {
                 }
                 // A subset of a subset still names the strands of the whole.
                 if kept.len() == 2 {
-                    let again = part.subset(&[false, true], CurveShape::Round).unwrap().unwrap();
+                    let again = part
+                        .subset(&[false, true], CurveShape::Round)
+                        .unwrap()
+                        .unwrap();
                     assert_eq!(again.strands().locate(0).unwrap().id, 1);
                 }
             }
-            assert_eq!(whole.subset(&[false, false], CurveShape::Flat).unwrap(), None);
+            assert_eq!(
+                whole.subset(&[false, false], CurveShape::Flat).unwrap(),
+                None
+            );
             let e = whole.subset(&[true], CurveShape::Flat).unwrap_err();
             assert!(e.to_string().contains("1 flags for 2 strands"), "{e}");
         }

@@ -10,10 +10,10 @@ pub(crate) mod groom;
 pub mod hair_file;
 pub mod hit;
 pub mod light;
-pub mod ribbons;
 mod light_sample;
 pub mod material;
 pub(crate) mod mesh;
+pub mod ribbons;
 pub(crate) mod shapes;
 pub mod stages;
 pub(crate) mod strands;
@@ -26,6 +26,6 @@ pub use hair_file::{
     Thickness, encode_hair, info_report, parse_hair, read_hair_file, write_hair_file,
 };
 pub use light::{Light, LightEval, LightSample};
-pub use stages::{NoStages, Stage, StageProgress, StageTimes};
 pub use ribbons::GroomShape;
+pub use stages::{NoStages, Stage, StageProgress, StageTimes};
 pub use strands::Strands;

@@ -51,9 +51,10 @@ pub fn thin_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bool> 
     let (eye, spread) = (camera.eye(), camera.pixel_spread(height));
     (0..curves.strands().strand_count())
         .map(|s| {
-            curves.strand_points(s).iter().all(|&[x, y, z, r]| {
-                2.0 * r <= spread * eye.distance(glam::Vec3::new(x, y, z))
-            })
+            curves
+                .strand_points(s)
+                .iter()
+                .all(|&[x, y, z, r]| 2.0 * r <= spread * eye.distance(glam::Vec3::new(x, y, z)))
         })
         .collect()
 }

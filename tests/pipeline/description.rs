@@ -13,9 +13,9 @@ use hairtrace::description::{
     demo, quick_look,
 };
 use hairtrace::embree::{CurveBasis, Device};
-use hairtrace::scene::GroomShape;
 use hairtrace::render::PixelFilter;
 use hairtrace::render::integrator::Roulette;
+use hairtrace::scene::GroomShape;
 use hairtrace::scene::material::HairColor;
 use hairtrace::scene::{FurBall, HairStyle, Thickness, write_hair_file};
 

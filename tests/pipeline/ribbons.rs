@@ -74,7 +74,10 @@ fn curve_shapes(d: &SceneDescription) -> Vec<CurveShape> {
 #[test]
 fn auto_ribbons_give_the_image_of_round_tubes_within_noise() {
     // At 48 pixels across, every strand is under a pixel wide: `auto` is all ribbons.
-    assert_eq!(curve_shapes(&fur_ball("auto", 0, 5.2, 48, 1)), [CurveShape::Flat]);
+    assert_eq!(
+        curve_shapes(&fur_ball("auto", 0, 5.2, 48, 1)),
+        [CurveShape::Flat]
+    );
     let spp = 256;
     let reference = render(&fur_ball("round", 1, 5.2, 48, spp), Aovs::default());
     let round = render(&fur_ball("round", 2, 5.2, 48, spp), Aovs::default());
@@ -109,7 +112,13 @@ fn a_groom_seen_near_and_far_is_shared_out_and_keeps_its_strand_numbers() {
         strand_id: true,
         ..Aovs::default()
     };
-    let ids = |shape| render(&near(shape), aovs).film.strand_id().unwrap().to_vec();
+    let ids = |shape| {
+        render(&near(shape), aovs)
+            .film
+            .strand_id()
+            .unwrap()
+            .to_vec()
+    };
     let (auto, round) = (ids("auto"), ids("round"));
     let same = auto.iter().zip(&round).filter(|(a, b)| a == b).count();
     assert!(

@@ -258,7 +258,13 @@ int main(void) {
     ROW(ht_render_aovs(scene, &s, rgb, 12, rgb + 16, NULL, rgb + 20, 4), BAD,
         "albedo and strand_id overlap");
     ROW(ht_render_aovs(scene, &s, rgb, 12, NULL, NULL, NULL, SIZE_MAX), BAD, "pixel_count");
+    ROW(ht_scene_build(NULL, &s, NULL, NULL), NUL, "scene is NULL");
+    ROW(ht_scene_build(scene, NULL, NULL, NULL), NUL, "settings is NULL");
+    ROW(ht_scene_build(scene, (const HtRenderSettings *)(const void *)(settings_bytes + 1), NULL,
+                       NULL),
+        BAD, "settings = ");
     s.spp = 0;
+    ROW(ht_scene_build(scene, &s, NULL, NULL), BAD, "spp = 0");
     ROW(ht_render(scene, &s, rgb, 12), BAD, "spp = 0");
     s.spp = 1;
     s.filter = 5;

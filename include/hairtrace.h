@@ -456,6 +456,15 @@ typedef struct HtRenderSettings {
 
 #if defined(HT_RENDER)
 /**
+ * Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never
+ * decreasing from call to call. Return false to cancel the build. Called from Embree's
+ * worker threads, never two calls at once; it must return normally (as `HtProgressFn`).
+ */
+typedef bool (*HtBuildProgressFn)(double fraction, void *user);
+#endif
+
+#if defined(HT_RENDER)
+/**
  * Straight segments between consecutive points.
  */
 #define HT_CURVE_LINEAR 0
@@ -1312,12 +1321,35 @@ struct HtRenderSettings ht_render_settings_default(void);
 
 #if defined(HT_RENDER)
 /**
+ * Builds now what `ht_render` with `settings` would build first: the Embree scene (and,
+ * for `HT_CURVE_AUTO` curves, their shapes for this camera and image height), telling
+ * `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom takes tens
+ * of seconds here; a render with the same view then starts at once. Only the size of
+ * `settings` (width, height) matters; its render callback is not called.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
+ * out of range, a scene with no light, or no camera and no geometry to frame);
+ * `HT_ERR_EMBREE` (the build failed); `HT_ERR_CANCELLED` (`progress` returned false: the
+ * scene is left unbuilt, and the next build or render starts over).
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+ * `settings` is NULL or readable.
+ */
+enum HtStatus ht_scene_build(struct HtScene *scene,
+                             const struct HtRenderSettings *settings,
+                             HtBuildProgressFn progress,
+                             void *user);
+#endif
+
+#if defined(HT_RENDER)
+/**
  * Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
  * `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
  * owned by the host. `ht_render_aovs` without AOVs.
  *
- * The first render builds the Embree scene (its time is part of the call); later ones
- * reuse it until geometry is added. Blocks until the image is done, on worker threads of
+ * The first render builds the Embree scene (its time is part of the call, silent:
+ * `ht_scene_build` reports it); later ones reuse it until geometry is added. Blocks until the image is done, on worker threads of
  * its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
  * pixels finished before the callback said stop and 0 elsewhere; on other errors it is
  * left untouched.

@@ -11,6 +11,7 @@ use crate::render::integrator::PathSettings;
 use crate::render::renderer::render;
 use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, NoProgress, PixelFilter, Progress, RenderStatus};
+use crate::scene::stages::{NoStages, Stage, StageProgress};
 use std::ffi::{c_char, c_void};
 use std::ptr::null_mut;
 
@@ -145,12 +146,73 @@ impl Progress for HostProgress {
     }
 }
 
+/// Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never
+/// decreasing from call to call. Return false to cancel the build. Called from Embree's
+/// worker threads, never two calls at once; it must return normally (as `HtProgressFn`).
+pub type HtBuildProgressFn = Option<unsafe extern "C" fn(fraction: f64, user: *mut c_void) -> bool>;
+
+/// The host's build callback as a [`StageProgress`] sink: the BVH stage is the only one a
+/// scene of the C ABI builds (files are read and curves converted when they are added).
+struct HostBuildProgress {
+    callback: unsafe extern "C" fn(f64, *mut c_void) -> bool,
+    user: *mut c_void,
+}
+
+// SAFETY: the stage runner makes the calls one at a time (HtBuildProgressFn's contract),
+// and `user` is only handed back to the host's callback in those calls.
+unsafe impl Sync for HostBuildProgress {}
+
+impl StageProgress for HostBuildProgress {
+    fn update(&self, stage: Stage, fraction: f64) -> bool {
+        // SAFETY: the host's function pointer and its own user pointer.
+        stage != Stage::Bvh || unsafe { (self.callback)(fraction, self.user) }
+    }
+}
+
+/// Builds now what `ht_render` with `settings` would build first: the Embree scene (and,
+/// for `HT_CURVE_AUTO` curves, their shapes for this camera and image height), telling
+/// `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom takes tens
+/// of seconds here; a render with the same view then starts at once. Only the size of
+/// `settings` (width, height) matters; its render callback is not called.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
+/// out of range, a scene with no light, or no camera and no geometry to frame);
+/// `HT_ERR_EMBREE` (the build failed); `HT_ERR_CANCELLED` (`progress` returned false: the
+/// scene is left unbuilt, and the next build or render starts over).
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+/// `settings` is NULL or readable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_build(
+    scene: *mut HtScene,
+    settings: *const HtRenderSettings,
+    progress: HtBuildProgressFn,
+    user: *mut c_void,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        let settings = read_host(settings, "settings")?.to_rust()?;
+        settings.validate()?;
+        let host;
+        let sink: &dyn StageProgress = match progress {
+            Some(callback) => {
+                host = HostBuildProgress { callback, user };
+                &host
+            }
+            None => &NoStages,
+        };
+        scene.prepare(settings.width, settings.height, sink)?;
+        Ok(())
+    })
+}
+
 /// Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
 /// `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
 /// owned by the host. `ht_render_aovs` without AOVs.
 ///
-/// The first render builds the Embree scene (its time is part of the call); later ones
-/// reuse it until geometry is added. Blocks until the image is done, on worker threads of
+/// The first render builds the Embree scene (its time is part of the call, silent:
+/// `ht_scene_build` reports it); later ones reuse it until geometry is added. Blocks until the image is done, on worker threads of
 /// its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
 /// pixels finished before the callback said stop and 0 elsewhere; on other errors it is
 /// left untouched.
@@ -267,7 +329,7 @@ pub unsafe extern "C" fn ht_render_aovs(
             depth: depth.is_some(),
             strand_id: strand_id.is_some(),
         };
-        let (world, camera) = scene.prepare(s.width, s.height)?;
+        let (world, camera) = scene.prepare(s.width, s.height, &NoStages)?;
         let host;
         let progress: &dyn Progress = match s.progress {
             Some(callback) => {

@@ -17,6 +17,7 @@ use crate::scene::curves::Curves;
 use crate::scene::envmap::Environment;
 use crate::scene::light::Light;
 use crate::scene::material::{HairMaterial, Material};
+use crate::scene::stages::NoStages;
 use crate::scene::tracer::TracerBuilder;
 use glam::Vec3;
 use std::ffi::c_void;
@@ -182,7 +183,7 @@ fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
         // The points Embree reads in the shared scene's current build.
         let embree_points = || {
             let scene = scene_mut(scenes[1].scene).ok().unwrap();
-            let (world, _) = scene.prepare(1, 1).unwrap();
+            let (world, _) = scene.prepare(1, 1, &NoStages).unwrap();
             match world.tracer.scene().geometry(0) {
                 Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
                 _ => panic!("curves expected"),
@@ -609,9 +610,8 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     });
     let shapes = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
-        let (world, _) = scene
-            .prepare(1, scene.built_for.map_or(1, |v| v.1))
-            .unwrap();
+        let height = scene.built_for.map_or(1, |v| v.1);
+        let (world, _) = scene.prepare(1, height, &NoStages).unwrap();
         (world.tracer.scene().geometries().iter())
             .map(|g| match g {
                 Geometry::Curves(c) => c.shape(),
@@ -651,4 +651,58 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     let (status, _) = render_c(&auto, &settings(350));
     assert_eq!(status, HtStatus::HT_OK);
     assert_eq!(shapes(&auto), [CurveShape::Round, CurveShape::Flat]);
+}
+
+unsafe extern "C" fn record_build(fraction: f64, user: *mut c_void) -> bool {
+    // SAFETY: the test's Vec<f64>, used by one call at a time (HtBuildProgressFn).
+    let calls = unsafe { &mut *user.cast::<Vec<f64>>() };
+    calls.push(fraction);
+    true
+}
+
+unsafe extern "C" fn cancel_build(fraction: f64, user: *mut c_void) -> bool {
+    unsafe { record_build(fraction, user) };
+    false
+}
+
+#[test]
+fn scene_build_reports_its_progress_and_the_render_reuses_it() {
+    let h = fur_scene(true);
+    let s = settings(24);
+    let tracer_of = |h: &Handles| {
+        let scene = scene_mut(h.scene).ok().unwrap();
+        scene.world.as_ref().map(|w| &raw const w.tracer)
+    };
+    let mut calls: Vec<f64> = Vec::new();
+    let user = (&raw mut calls).cast::<c_void>();
+    let status = unsafe { ht_scene_build(h.scene, &s, Some(record_build), user) };
+    assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+    assert!(calls.windows(2).all(|w| w[0] <= w[1]), "{calls:?}");
+    assert_eq!(calls.last(), Some(&1.0), "{calls:?}");
+    let built = tracer_of(&h).expect("built");
+    let (status, rgb) = render_c(&h, &s);
+    assert_eq!(status, HtStatus::HT_OK);
+    assert!(rgb.iter().any(|&v| v > 0.0));
+    // The render kept the build: same tracer, not a rebuilt one.
+    let after = tracer_of(&h).unwrap();
+    assert_eq!(unsafe { (*after).scene().raw() }, unsafe {
+        (*built).scene().raw()
+    });
+
+    // A cancelled build leaves the scene unbuilt; the next render builds it.
+    let h = fur_scene(true);
+    let mut calls: Vec<f64> = Vec::new();
+    let user = (&raw mut calls).cast::<c_void>();
+    let status = unsafe { ht_scene_build(h.scene, &s, Some(cancel_build), user) };
+    assert_eq!(status, HtStatus::HT_ERR_CANCELLED, "{}", last_error());
+    assert_eq!(calls.len(), 1);
+    assert!(tracer_of(&h).is_none());
+    assert_eq!(render_c(&h, &s).0, HtStatus::HT_OK);
+    // Bad settings are refused before anything is built.
+    let bad = HtRenderSettings { spp: 0, ..s };
+    assert_eq!(
+        unsafe { ht_scene_build(h.scene, &bad, None, null_mut()) },
+        HtStatus::HT_ERR_INVALID_ARG
+    );
+    assert!(last_error().contains("spp = 0"));
 }

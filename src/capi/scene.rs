@@ -15,6 +15,7 @@ use crate::scene::light::Light;
 use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
 use crate::scene::ribbons::{self, GroomShape};
+use crate::scene::stages::{NoStages, StageProgress, StageRunner};
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::validate::{length, non_negative, positive};
 use std::ffi::c_char;
@@ -115,7 +116,11 @@ impl HtScene {
 
     /// The Embree scene and one material per Embree geometry; `auto` curves are shared out
     /// for `view`, or stay round without one.
-    fn build_tracer(&self, view: Option<&View>) -> Result<(Tracer, Vec<Material>)> {
+    fn build_tracer(
+        &self,
+        view: Option<&View>,
+        progress: &dyn StageProgress,
+    ) -> Result<(Tracer, Vec<Material>)> {
         let mut builder = TracerBuilder::new(self.device.clone(), SceneOptions::default())?;
         let mut materials = Vec::with_capacity(self.geometries.len());
         for g in &self.geometries {
@@ -136,7 +141,7 @@ impl HtScene {
             let material = &self.materials[g.material as usize];
             materials.extend(std::iter::repeat_n(material.clone(), added));
         }
-        Ok((builder.build()?, materials))
+        Ok((builder.build_with(&StageRunner::new(progress))?, materials))
     }
 
     /// The host's camera, or one framing `bounds` (the geometry's; needed only without a
@@ -161,10 +166,16 @@ impl HtScene {
         }
     }
 
-    /// The world to render, built or updated as needed, and the camera for an image of
-    /// `width` x `height` pixels. `auto` curves make the build depend on the camera and
-    /// the height: a render with another view builds again.
-    pub(crate) fn prepare(&mut self, width: u32, height: u32) -> Result<(&World, Camera)> {
+    /// The world to render, built or updated as needed (the BVH build reporting to
+    /// `progress`), and the camera for an image of `width` x `height` pixels. `auto` curves
+    /// make the build depend on the camera and the height: a render with another view
+    /// builds again.
+    pub(crate) fn prepare(
+        &mut self,
+        width: u32,
+        height: u32,
+        progress: &dyn StageProgress,
+    ) -> Result<(&World, Camera)> {
         if self.lights.is_empty() {
             return Err(invalid_arg!(
                 "the scene has no light: add an environment, distant or rect light"
@@ -179,7 +190,8 @@ impl HtScene {
                 (Some(_), _) => None,
                 (None, Some(b)) => Some(b),
                 (None, None) => {
-                    Some(*(self.added_bounds).insert(self.build_tracer(None)?.0.scene().bounds()))
+                    let (tracer, _) = self.build_tracer(None, &NoStages)?;
+                    Some(*self.added_bounds.insert(tracer.scene().bounds()))
                 }
             };
             let camera = self.camera(aspect, bounds)?;
@@ -187,15 +199,17 @@ impl HtScene {
             let geometry = match world {
                 Some(w) if self.built_for == Some(view) => w.into_geometry(),
                 _ => {
+                    self.built_for = None;
+                    let built = self.build_tracer(Some(&view), progress)?;
                     self.built_for = Some(view);
-                    self.build_tracer(Some(&view))?
+                    built
                 }
             };
             (camera, geometry)
         } else {
             let geometry = match world {
                 Some(w) => w.into_geometry(),
-                None => self.build_tracer(None)?,
+                None => self.build_tracer(None, progress)?,
             };
             (
                 self.camera(aspect, Some(geometry.0.scene().bounds()))?,

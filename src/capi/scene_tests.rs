@@ -9,6 +9,7 @@ use super::scene::*;
 use crate::capi::bsdf::ht_hair_params_default;
 use crate::capi::ht_last_error;
 use crate::embree::{MemoryMonitor, padding_for};
+use crate::scene::NoStages;
 use crate::scene::{FurBall, write_hair_file};
 use crate::scene::{Strands, Thickness};
 use std::ffi::CStr;
@@ -627,7 +628,11 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
                     ht_scene_add_environment(h.scene, sky.as_ptr()),
                     HtStatus::HT_OK
                 );
-                scene_mut(h.scene).ok().unwrap().prepare(1, 1).unwrap();
+                scene_mut(h.scene)
+                    .ok()
+                    .unwrap()
+                    .prepare(1, 1, &NoStages)
+                    .unwrap();
                 (held_bytes(h.scene()), monitor.current() as usize)
             });
         let segments = strands.segment_count() as f64;

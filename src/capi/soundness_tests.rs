@@ -11,6 +11,7 @@ use super::scene::*;
 use super::scene_tests::{Handles, fails, last_error, small_fur, xyzr, xyzr_desc};
 use crate::capi::bsdf::ht_hair_params_default;
 use crate::embree::Ray;
+use crate::scene::NoStages;
 use glam::Vec3;
 use std::ffi::{CString, c_void};
 use std::ptr::{null, null_mut};
@@ -154,7 +155,7 @@ fn coordinates_embree_cannot_trace_are_refused_when_set() {
 
         // Should a ray Embree refuses ever be formed, it is a miss, not an abort.
         let scene = scene_mut(h.scene).ok().unwrap();
-        let (world, _) = scene.prepare(1, 1).unwrap();
+        let (world, _) = scene.prepare(1, 1, &NoStages).unwrap();
         let bad = Ray::new(Vec3::new(1e19, 0.0, 0.0), Vec3::NEG_X);
         assert!(world.tracer.scene().intersect(&bad, None).is_none());
         let nan = Ray::new(Vec3::new(f32::NAN, 0.0, 4.0), Vec3::NEG_Z);

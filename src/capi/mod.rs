@@ -124,6 +124,7 @@ impl From<&Error> for HtStatus {
             Error::InvalidArg(_) => HtStatus::HT_ERR_INVALID_ARG,
             Error::Io(_) => HtStatus::HT_ERR_IO,
             Error::Image(_) => HtStatus::HT_ERR_IMAGE,
+            #[cfg(feature = "render")]
             e if crate::embree::is_cancelled(e) => HtStatus::HT_ERR_CANCELLED,
             Error::Embree { .. } => HtStatus::HT_ERR_EMBREE,
         }

@@ -61,9 +61,9 @@ const ROWS: [&[Look]; 5] = [
 impl Look {
     fn label(self) -> String {
         match self {
-            Look::Roughness { beta_m, beta_n } => format!("beta_m {beta_m} (beta_n {beta_n})"),
+            Look::Roughness { beta_m, beta_n } => format!("beta_m {beta_m}, beta_n {beta_n}"),
             Look::Preset(name) => name.to_owned(),
-            Look::Color(c) => format!("colour {c} (hair)"),
+            Look::Color(c) => format!("colour {c}"),
             Look::BetaN(b) => format!("beta_n {b}"),
             Look::Alpha(a) => format!("tilt {a} deg"),
             Look::Melanin(m) => format!("melanin {m}"),
@@ -91,7 +91,7 @@ impl Look {
 /// Tile size and samples.
 fn tile(ctx: &Context) -> (u32, u32, u32) {
     if ctx.quick {
-        (64, 48, 4)
+        (128, 96, 4)
     } else {
         (192, 144, 64)
     }
@@ -109,6 +109,8 @@ fn render_tile(ctx: &Context, look: Look) -> Result<Image> {
     let mut desc = bench_scene(ctx, "demo_fur_ball")?;
     desc.render.width = w;
     desc.render.height = h;
+    // Closer than the bench scene's framing: the ball fills the tile.
+    desc.camera.fov_deg = 24.0;
     for m in desc.materials.values_mut() {
         if let MaterialDesc::Hair(hair) = m {
             look.apply(hair)?;

@@ -285,7 +285,6 @@ fn scene_section(ctx: &Context, name: &str) -> Result<String> {
             name: c.name.to_owned(),
             points: c.points.iter().map(|p| (p.1, p.2)).collect(),
             line: true,
-            labels: Vec::new(),
         })
         .collect();
     log_log(

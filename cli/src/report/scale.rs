@@ -128,7 +128,6 @@ pub fn section(ctx: &Context) -> Result<String> {
                 name: (*name).to_owned(),
                 points: pts.iter().map(|p| (p.strands as f64, value(p))).collect(),
                 line: true,
-                labels: Vec::new(),
             })
             .collect();
         log_log(

@@ -78,7 +78,7 @@ fn run_peer(ctx: &Context, python: &PathBuf) -> Result<String> {
         .map_err(|e| Error::InvalidArg(format!("{}: {e}", json.display())))?;
     let f = |v: &Value, path: &[&str]| {
         path.iter()
-            .fold(Some(v), |v, k| v?.get(k))
+            .try_fold(v, |v, k| v.get(k))
             .and_then(Value::as_f64)
             .unwrap_or(f64::NAN)
     };

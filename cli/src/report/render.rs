@@ -5,7 +5,7 @@
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
 use super::{Context, bench_scene};
-use hairtrace::description::{GroomSource, SceneDescription};
+use hairtrace::description::{GroomSource, RenderDesc, SceneDescription};
 use hairtrace::embree::{CurveBasis, CurveShape};
 use hairtrace::image::{Image, compare};
 use hairtrace::render::integrator::Strategy;
@@ -28,62 +28,35 @@ pub struct Knob {
     pub edit: fn(&mut Variant) -> Result<()>,
 }
 
+const fn knob(name: &'static str, edit: fn(&mut Variant) -> Result<()>) -> Knob {
+    Knob { name, edit }
+}
+
 /// The knobs measured, against the reference settings (the scene as written with a
-/// one-pixel box filter and MIS).
+/// one-pixel box filter and MIS). The first is the reference settings themselves.
 pub const KNOBS: &[Knob] = &[
-    Knob {
-        name: "reference settings",
-        edit: |_| Ok(()),
-    },
-    Knob {
-        name: "shape flat",
-        edit: |v| set_shape(v, "flat"),
-    },
-    Knob {
-        name: "shape auto",
-        edit: |v| set_shape(v, "auto"),
-    },
-    Knob {
-        name: "basis linear",
-        edit: |v| set_basis(v, CurveBasis::Linear),
-    },
-    Knob {
-        name: "basis bspline",
-        edit: |v| set_basis(v, CurveBasis::BSpline),
-    },
-    Knob {
-        name: "strategy light",
-        edit: |v| set_strategy(v, Strategy::LightOnly),
-    },
-    Knob {
-        name: "strategy bsdf",
-        edit: |v| set_strategy(v, Strategy::BsdfOnly),
-    },
-    Knob {
-        name: "rr_depth 1",
-        edit: |v| Ok(v.desc.render.rr_depth = 1),
-    },
-    Knob {
-        name: "rr_depth 8",
-        edit: |v| Ok(v.desc.render.rr_depth = 8),
-    },
-    Knob {
-        name: "roulette throughput",
-        edit: |v| Ok(v.desc.render.roulette = "throughput".into()),
-    },
-    Knob {
-        name: "max_depth 16",
-        edit: |v| Ok(v.desc.render.max_depth = v.desc.render.max_depth.min(16)),
-    },
-    Knob {
-        name: "max_depth 4",
-        edit: |v| Ok(v.desc.render.max_depth = 4),
-    },
-    Knob {
-        name: "filter tent",
-        edit: |v| Ok(v.desc.render.filter = "tent".into()),
-    },
+    knob("reference settings", |_| Ok(())),
+    knob("shape flat", |v| set_shape(v, "flat")),
+    knob("shape auto", |v| set_shape(v, "auto")),
+    knob("basis linear", |v| set_basis(v, CurveBasis::Linear)),
+    knob("basis bspline", |v| set_basis(v, CurveBasis::BSpline)),
+    knob("strategy light", |v| set_strategy(v, Strategy::LightOnly)),
+    knob("strategy bsdf", |v| set_strategy(v, Strategy::BsdfOnly)),
+    knob("rr_depth 1", |v| render(v, |r| r.rr_depth = 1)),
+    knob("rr_depth 8", |v| render(v, |r| r.rr_depth = 8)),
+    knob("roulette throughput", |v| {
+        render(v, |r| r.roulette = "throughput".into())
+    }),
+    knob("max_depth 16", |v| render(v, |r| r.max_depth = 16)),
+    knob("max_depth 4", |v| render(v, |r| r.max_depth = 4)),
+    knob("filter tent", |v| render(v, |r| r.filter = "tent".into())),
 ];
+
+/// An edit of the `[render]` settings.
+fn render(v: &mut Variant, edit: fn(&mut RenderDesc)) -> Result<()> {
+    edit(&mut v.desc.render);
+    Ok(())
+}
 
 /// A curve shape by its scene-file name, read through the scene format itself, so that a
 /// shape exists here exactly when scene files accept it.

@@ -37,6 +37,17 @@ struct Set {
     bsdf: HairBsdf,
     reference: RefHair,
     inputs: Vec<Input>,
+    /// The inputs as `eval_batch` takes them, and its outputs.
+    batch: Batch,
+}
+
+#[derive(Default)]
+struct Batch {
+    h: Vec<f32>,
+    wo: Vec<[f32; 3]>,
+    wi: Vec<[f32; 3]>,
+    f: Vec<[f32; 3]>,
+    pdf: Vec<f32>,
 }
 
 /// h at and next to the fibre's edges and centre.
@@ -89,6 +100,13 @@ fn set(params: HairParams, inputs: Vec<Input>) -> Result<Set> {
             p.beta_n.into(),
             p.alpha.into(),
         ),
+        batch: Batch {
+            h: inputs.iter().map(|x| x.h).collect(),
+            wo: inputs.iter().map(|x| x.wo.to_array()).collect(),
+            wi: inputs.iter().map(|x| x.wi.to_array()).collect(),
+            f: vec![[0.0; 3]; inputs.len()],
+            pdf: vec![0.0; inputs.len()],
+        },
         inputs,
     })
 }
@@ -217,19 +235,19 @@ type Outputs = Vec<Option<(Vec3, BsdfEval)>>;
 struct Variant {
     name: &'static str,
     /// Times every input of a set once; returns the calls made.
-    time: fn(&Set) -> usize,
+    time: fn(&mut Set) -> usize,
     /// (wi, f and pdf) for every input of a set; None for a call that returns no value.
-    outputs: Option<fn(&Set) -> Outputs>,
+    outputs: Option<fn(&mut Set) -> Outputs>,
 }
 
-fn eval_outputs(s: &Set) -> Outputs {
+fn eval_outputs(s: &mut Set) -> Outputs {
     s.inputs
         .iter()
         .map(|x| Some((x.wi, s.bsdf.eval(x.h, x.wo, x.wi))))
         .collect()
 }
 
-fn sample_outputs(s: &Set) -> Outputs {
+fn sample_outputs(s: &mut Set) -> Outputs {
     s.inputs
         .iter()
         .map(|x| {
@@ -239,96 +257,59 @@ fn sample_outputs(s: &Set) -> Outputs {
         .collect()
 }
 
-fn batch_outputs(s: &Set) -> Outputs {
-    let (h, wo, wi, mut f, mut pdf) = batch_buffers(s);
-    s.bsdf
-        .eval_batch(&h, &wo, &wi, &mut f, &mut pdf)
-        .expect("slices of one length");
-    s.inputs
-        .iter()
-        .zip(f.iter().zip(&pdf))
+fn batch_outputs(s: &mut Set) -> Outputs {
+    run_batch(s);
+    let b = &s.batch;
+    (s.inputs.iter().zip(b.f.iter().zip(&b.pdf)))
         .map(|(x, (f, &pdf))| {
-            Some((
-                x.wi,
-                BsdfEval {
-                    f: Vec3::from_array(*f),
-                    pdf,
-                },
-            ))
+            let f = Vec3::from_array(*f);
+            Some((x.wi, BsdfEval { f, pdf }))
         })
         .collect()
 }
 
-type Buffers = (
-    Vec<f32>,
-    Vec<[f32; 3]>,
-    Vec<[f32; 3]>,
-    Vec<[f32; 3]>,
-    Vec<f32>,
-);
+fn run_batch(s: &mut Set) {
+    let b = &mut s.batch;
+    (s.bsdf.eval_batch(&b.h, &b.wo, &b.wi, &mut b.f, &mut b.pdf)).expect("slices of one length");
+}
 
-fn batch_buffers(s: &Set) -> Buffers {
-    let n = s.inputs.len();
-    (
-        s.inputs.iter().map(|x| x.h).collect(),
-        s.inputs.iter().map(|x| x.wo.to_array()).collect(),
-        s.inputs.iter().map(|x| x.wi.to_array()).collect(),
-        vec![[0.0; 3]; n],
-        vec![0.0; n],
-    )
+/// Calls `call` on every input of a set, the inputs hidden from the optimiser; returns
+/// the calls made.
+fn each<R>(s: &Set, call: impl Fn(&Input) -> R) -> usize {
+    for x in &s.inputs {
+        black_box(call(black_box(x)));
+    }
+    s.inputs.len()
 }
 
 const VARIANTS: [Variant; 6] = [
     Variant {
         name: "HairBsdf::eval",
-        time: |s| {
-            for x in &s.inputs {
-                black_box(
-                    s.bsdf
-                        .eval(black_box(x.h), black_box(x.wo), black_box(x.wi)),
-                );
-            }
-            s.inputs.len()
-        },
+        time: |s| each(s, |x| s.bsdf.eval(x.h, x.wo, x.wi)),
         outputs: Some(eval_outputs),
     },
     Variant {
         name: "HairBsdf::sample",
-        time: |s| {
-            for x in &s.inputs {
-                black_box(
-                    s.bsdf
-                        .sample(black_box(x.h), black_box(x.wo), black_box(x.u)),
-                );
-            }
-            s.inputs.len()
-        },
+        time: |s| each(s, |x| s.bsdf.sample(x.h, x.wo, x.u)),
         outputs: Some(sample_outputs),
     },
     Variant {
         name: "HairPoint: at + eval + sample (a path vertex)",
         time: |s| {
-            for x in &s.inputs {
-                let p = s.bsdf.at(black_box(x.h), black_box(x.wo));
-                black_box(p.eval(black_box(x.wi)));
-                black_box(p.sample(black_box(x.u)));
-            }
-            s.inputs.len()
+            each(s, |x| {
+                let p = s.bsdf.at(x.h, x.wo);
+                (p.eval(x.wi), p.sample(x.u))
+            })
         },
         outputs: Some(eval_outputs),
     },
     Variant {
         name: "HairBsdf::at (prepare a point)",
-        time: |s| {
-            for x in &s.inputs {
-                black_box(s.bsdf.at(black_box(x.h), black_box(x.wo)));
-            }
-            s.inputs.len()
-        },
+        time: |s| each(s, |x| s.bsdf.at(x.h, x.wo)),
         outputs: None,
     },
     Variant {
-        name: "HairPoint::eval (point prepared, 8 wi each)",
+        name: "HairPoint::eval (one at per 8 evals, per eval)",
         time: |s| {
             for x in &s.inputs {
                 let p = s.bsdf.at(x.h, x.wo);
@@ -339,18 +320,12 @@ const VARIANTS: [Variant; 6] = [
             }
             s.inputs.len() * 8
         },
-        outputs: Some(|s| {
-            s.inputs
-                .iter()
-                .map(|x| Some((x.wi, s.bsdf.at(x.h, x.wo).eval(x.wi))))
-                .collect()
-        }),
+        outputs: Some(eval_outputs),
     },
     Variant {
         name: "HairBsdf::eval_batch (per element)",
         time: |s| {
-            let (h, wo, wi, mut f, mut pdf) = batch_buffers(s);
-            black_box(s.bsdf.eval_batch(&h, &wo, &wi, &mut f, &mut pdf)).ok();
+            run_batch(s);
             s.inputs.len()
         },
         outputs: Some(batch_outputs),
@@ -358,11 +333,11 @@ const VARIANTS: [Variant; 6] = [
 ];
 
 /// Median ns per call of `v` over `reps` rounds of every set.
-fn time_variant(v: &Variant, sets: &[Set], reps: usize) -> f64 {
+fn time_variant(v: &Variant, sets: &mut [Set], reps: usize) -> f64 {
     let rounds = (0..reps)
         .map(|_| {
             let start = Instant::now();
-            let calls: usize = sets.iter().map(|s| (v.time)(s)).sum();
+            let calls: usize = sets.iter_mut().map(|s| (v.time)(s)).sum();
             start.elapsed().as_secs_f64() * 1e9 / calls as f64
         })
         .collect();
@@ -371,13 +346,14 @@ fn time_variant(v: &Variant, sets: &[Set], reps: usize) -> f64 {
 
 /// (max, RMS) relative error of `outputs` over the sets; NaN (a dash in the table) for a
 /// call without outputs.
-fn accuracy(outputs: Option<fn(&Set) -> Outputs>, sets: &[Set]) -> (f64, f64) {
+fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> (f64, f64) {
     let Some(outputs) = outputs else {
         return (f64::NAN, f64::NAN);
     };
     let mut acc = (0.0, 0.0, 0);
     for s in sets {
-        for (x, out) in s.inputs.iter().zip(outputs(s)) {
+        let outs = outputs(s);
+        for (x, out) in s.inputs.iter().zip(outs) {
             let Some((wi, e)) = out else { continue };
             accumulate(&mut acc, s, x, wi, e);
         }
@@ -392,8 +368,8 @@ pub fn steps(_: &Context) -> u64 {
 pub fn section(ctx: &Context) -> Result<String> {
     let mut g = Pcg64::seed_from_u64(2024);
     ctx.step("BSDF inputs");
-    let hard = hard_sets(ctx.quick, &mut g)?;
-    let random = if ctx.quick {
+    let mut hard = hard_sets(ctx.quick, &mut g)?;
+    let mut random = if ctx.quick {
         random_sets(8, 256, &mut g)?
     } else {
         random_sets(64, 1024, &mut g)?
@@ -404,9 +380,9 @@ pub fn section(ctx: &Context) -> Result<String> {
     let mut series = Vec::new();
     for v in &VARIANTS {
         ctx.step(format!("BSDF {}", v.name));
-        let ns = time_variant(v, &random, reps);
-        let (hard_max, hard_rms) = accuracy(v.outputs, &hard);
-        let (random_max, random_rms) = accuracy(v.outputs, &random);
+        let ns = time_variant(v, &mut random, reps);
+        let (hard_max, hard_rms) = accuracy(v.outputs, &mut hard);
+        let (random_max, random_rms) = accuracy(v.outputs, &mut random);
         rows.push(vec![
             format!("`{}`", v.name),
             num(ns, 3),

@@ -2,7 +2,7 @@
 //! renders composed into one labelled contact sheet.
 
 use super::markdown::figure;
-use super::render::{Built, Variant};
+use super::render::{Built, Variant, fewer_strands};
 use super::{Context, bench_scene};
 use hairtrace::bsdf::sigma_a_preset;
 use hairtrace::description::MaterialDesc;
@@ -93,7 +93,7 @@ fn tile(ctx: &Context) -> (u32, u32, u32) {
     if ctx.quick {
         (128, 96, 4)
     } else {
-        (192, 144, 64)
+        (160, 120, 32)
     }
 }
 
@@ -111,6 +111,9 @@ fn render_tile(ctx: &Context, look: Look) -> Result<Image> {
     desc.render.height = h;
     // Closer than the bench scene's framing: the ball fills the tile.
     desc.camera.fov_deg = 24.0;
+    if ctx.quick {
+        fewer_strands(&mut desc, 4);
+    }
     for m in desc.materials.values_mut() {
         if let MaterialDesc::Hair(hair) = m {
             look.apply(hair)?;

@@ -115,8 +115,15 @@ pub fn run(options: &ReportOptions) -> Result<()> {
     let mut body = String::new();
     for (i, s) in SECTIONS.iter().enumerate() {
         ctx.step(s.title);
+        let section_start = Instant::now();
         let text = (s.run)(&ctx).map_err(|e| e.context(format!("report, {}", s.title)))?;
-        body += &format!("\n## {}. {}\n\n{}\n", i + 1, s.title, text.trim_end());
+        body += &format!(
+            "\n## {}. {}\n\n{}\n\n*This section took {:.0} s.*\n",
+            i + 1,
+            s.title,
+            text.trim_end(),
+            section_start.elapsed().as_secs_f64()
+        );
     }
     ctx.bar.finish_and_clear();
     let report = format!(

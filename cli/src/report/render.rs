@@ -104,7 +104,7 @@ fn plan(ctx: &Context, desc: &SceneDescription) -> Plan {
         } else {
             vec![spp / 4, spp / 2, spp]
         },
-        reference_spp: if ctx.quick { 64 } else { 16 * spp },
+        reference_spp: if ctx.quick { 64 } else { 8 * spp },
     }
 }
 
@@ -133,18 +133,23 @@ pub fn reference_variant(ctx: &Context, name: &str) -> Result<Variant> {
     if ctx.quick {
         desc.render.width = (desc.render.width / 4).max(16);
         desc.render.height = (desc.render.height / 4).max(16);
-        for g in &mut desc.grooms {
-            match &mut g.source {
-                GroomSource::FurBall(f) => f.strands = (f.strands / 10).max(100),
-                GroomSource::Scalp(s) => s.strands = (s.strands / 10).max(100),
-                _ => {}
-            }
-        }
+        fewer_strands(&mut desc, 10);
     }
     Ok(Variant {
         desc,
         strategy: Strategy::Mis,
     })
+}
+
+/// Divides the strand count of every procedural groom by `factor` (quick runs).
+pub fn fewer_strands(desc: &mut SceneDescription, factor: usize) {
+    for g in &mut desc.grooms {
+        match &mut g.source {
+            GroomSource::FurBall(f) => f.strands = (f.strands / factor).max(100),
+            GroomSource::Scalp(s) => s.strands = (s.strands / factor).max(100),
+            _ => {}
+        }
+    }
 }
 
 /// A built variant, ready to render at any spp and seed.
@@ -182,6 +187,22 @@ struct Curve {
     points: Vec<(u32, f64, f64, f64)>,
 }
 
+/// The reference is a render of the reference settings too, so its own noise adds to
+/// every measured mean square error: the reference settings' MSE at n spp times
+/// n / reference_spp. The first curve (the reference settings) measures
+/// MSE(n) (1 + n / reference_spp) at its last point, which gives that term; it is taken out
+/// of every point, as bench/peer.py does.
+fn remove_reference_noise(curves: &mut [Curve], reference_spp: u32) {
+    let Some(&(n, _, rmse, _)) = curves.first().and_then(|c| c.points.last()) else {
+        return;
+    };
+    let ratio = f64::from(n) / f64::from(reference_spp);
+    let reference_mse = rmse * rmse * ratio / (1.0 + ratio);
+    for p in curves.iter_mut().flat_map(|c| c.points.iter_mut()) {
+        p.2 = (p.2 * p.2 - reference_mse).max(0.0).sqrt();
+    }
+}
+
 pub fn steps(ctx: &Context) -> u64 {
     let scenes = scene_names(ctx).map_or(1, |s| s.len() as u64);
     scenes * (KNOBS.len() as u64 + 1)
@@ -191,14 +212,15 @@ pub fn section(ctx: &Context) -> Result<String> {
     let mut text = String::from(
         "Each knob changes one setting of the reference settings (the bench scene as \
          written, a one-pixel box filter, MIS) and renders the scene at three sample counts \
-         (seeds 1, 2, 3). Its error is the RMSE over the RGB channels against a reference \
-         render of the reference settings at many samples with a seed no timed render uses; \
-         its time is the path tracing alone (the scene build is in the scale section). A \
-         knob that changes the image (shape, basis, max depth, filter) shows its bias as a \
-         floor its curve cannot go below; one that only changes noise moves its curve \
-         sideways. The tent filter's floor is partly the blur it adds by design, not \
-         error. Efficiency is 1 / (RMSE^2 x seconds) at the scene's spp, relative to the \
-         reference settings'.\n\n",
+         (seeds 1, 2, 3). Its error is the RMSE over the RGB channels against a render of \
+         the reference settings at 8x the scene's samples with a seed no timed render uses, \
+         with the reference's own noise (estimated from the reference settings' renders) \
+         taken out. Its time is the path tracing alone (the scene build is in the scale \
+         section). A knob that changes the image (shape, basis, max depth, filter) shows \
+         its bias as a floor its curve cannot go below; one that only changes noise moves \
+         its curve sideways. The tent filter's floor is partly the blur it adds by design, \
+         not error. Efficiency is 1 / (RMSE^2 x seconds) at the scene's spp, relative to \
+         the reference settings'.\n\n",
     );
     for name in scene_names(ctx)? {
         text += &scene_section(ctx, &name)?;
@@ -239,6 +261,7 @@ fn scene_section(ctx: &Context, name: &str) -> Result<String> {
         }
         ctx.done();
     }
+    remove_reference_noise(&mut curves, plan.reference_spp);
     let r = &base.desc.render;
     let caption = ctx.machine.caption(
         ctx.machine.threads,

@@ -69,6 +69,10 @@ struct ReportArgs {
     /// The bench scenes (run from the repository's root, the default finds them).
     #[arg(long, default_value = "bench/scenes")]
     scenes: PathBuf,
+    /// Take the peer section from an earlier `bench/peer --json FILE` run instead of
+    /// running Blender Cycles.
+    #[arg(long, value_name = "FILE.json")]
+    peers: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -580,6 +584,7 @@ fn main() -> ExitCode {
             quick: a.quick,
             output: a.output.clone(),
             scenes: a.scenes.clone(),
+            peers: a.peers.clone(),
         }),
     };
     match result {

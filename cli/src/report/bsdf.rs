@@ -195,9 +195,9 @@ fn random_sets(sets: usize, per_set: usize, g: &mut Pcg64) -> Result<Vec<Set>> {
 const ABS_FLOOR: f64 = 1e-30;
 
 /// Max and RMS relative error of f (per channel) and pdf at `wi` against the reference,
-/// accumulated into `acc` (max, sum of squares, count). Directions exactly along the
+/// accumulated into `acc`. Directions exactly along the
 /// tangent have no azimuth, so no reference value to compare with: they are left out.
-fn accumulate(acc: &mut (f64, f64, usize), s: &Set, x: &Input, wi: Vec3, got: BsdfEval) {
+fn accumulate(acc: &mut Errors, s: &Set, x: &Input, wi: Vec3, got: BsdfEval) {
     let along = |w: Vec3| w.y == 0.0 && w.z == 0.0;
     if along(x.wo) || along(wi) {
         return;
@@ -215,15 +215,46 @@ fn accumulate(acc: &mut (f64, f64, usize), s: &Set, x: &Input, wi: Vec3, got: Bs
         (got.f.z as f64, want.f[2], cos),
         (got.pdf as f64, want.pdf, 1.0),
     ];
-    for (g, w, scale) in pairs {
+    for (what, (g, w, scale)) in ["f red", "f green", "f blue", "pdf"].iter().zip(pairs) {
         let err = (g - w).abs();
         if err * scale <= ABS_FLOOR {
             continue;
         }
         let rel = err / w.abs().max(1e-300);
-        acc.0 = acc.0.max(rel);
-        acc.1 += rel * rel;
-        acc.2 += 1;
+        if rel > acc.max {
+            let p = s.bsdf.params();
+            acc.worst = format!(
+                "{what} {g:.4e} against {w:.4e} at h = {}, wo = {:?}, wi = {:?}, sigma_a = \
+                 {:?}, eta {}, beta_m {}, beta_n {}, alpha {}",
+                x.h,
+                x.wo.to_array(),
+                wi.to_array(),
+                p.sigma_a,
+                p.eta,
+                p.beta_m,
+                p.beta_n,
+                p.alpha
+            );
+            acc.max = rel;
+        }
+        acc.sum_sq += rel * rel;
+        acc.n += 1;
+    }
+}
+
+/// Relative errors gathered over inputs: the largest (and where), their sum of squares
+/// and count.
+#[derive(Default)]
+struct Errors {
+    max: f64,
+    worst: String,
+    sum_sq: f64,
+    n: usize,
+}
+
+impl Errors {
+    fn rms(&self) -> f64 {
+        (self.sum_sq / self.n.max(1) as f64).sqrt()
     }
 }
 
@@ -344,13 +375,10 @@ fn time_variant(v: &Variant, sets: &mut [Set], reps: usize) -> f64 {
     median(rounds)
 }
 
-/// (max, RMS) relative error of `outputs` over the sets; NaN (a dash in the table) for a
-/// call without outputs.
-fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> (f64, f64) {
-    let Some(outputs) = outputs else {
-        return (f64::NAN, f64::NAN);
-    };
-    let mut acc = (0.0, 0.0, 0);
+/// The relative errors of `outputs` over the sets; None for a call without outputs.
+fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> Option<Errors> {
+    let outputs = outputs?;
+    let mut acc = Errors::default();
     for s in sets {
         let outs = outputs(s);
         for (x, out) in s.inputs.iter().zip(outs) {
@@ -358,7 +386,7 @@ fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> (f64,
             accumulate(&mut acc, s, x, wi, e);
         }
     }
-    (acc.0, (acc.1 / acc.2.max(1) as f64).sqrt())
+    Some(acc)
 }
 
 pub fn steps(_: &Context) -> u64 {
@@ -378,11 +406,21 @@ pub fn section(ctx: &Context) -> Result<String> {
     ctx.done();
     let mut rows = Vec::new();
     let mut series = Vec::new();
+    let mut worst = Vec::new();
     for v in &VARIANTS {
         ctx.step(format!("BSDF {}", v.name));
         let ns = time_variant(v, &mut random, reps);
-        let (hard_max, hard_rms) = accuracy(v.outputs, &mut hard);
-        let (random_max, random_rms) = accuracy(v.outputs, &mut random);
+        let hard_errors = accuracy(v.outputs, &mut hard);
+        let random_errors = accuracy(v.outputs, &mut random);
+        let max_rms = |e: &Option<Errors>| {
+            e.as_ref()
+                .map_or((f64::NAN, f64::NAN), |e| (e.max, e.rms()))
+        };
+        let ((hard_max, hard_rms), (random_max, random_rms)) =
+            (max_rms(&hard_errors), max_rms(&random_errors));
+        if let Some(e) = hard_errors.filter(|_| worst.is_empty()) {
+            worst.push(format!("The worst hard case of `{}`: {}.", v.name, e.worst));
+        }
         rows.push(vec![
             format!("`{}`", v.name),
             num(ns, 3),
@@ -433,7 +471,7 @@ pub fn section(ctx: &Context) -> Result<String> {
          Random: {} parameter sets over the valid ranges (eta from 1.05), uniform h, wo, wi. \
          The point rows time what a renderer's path vertex does; `HairBsdf::at` alone is \
          the (h, wo) work a prepared point saves. The library has one set of special \
-         functions and no lobe culling yet: no other variants to time.\n\n{}\n{}",
+         functions and no lobe culling yet: no other variants to time.\n\n{}\n{}\n\n{}",
         random.len(),
         table(
             &[
@@ -446,6 +484,7 @@ pub fn section(ctx: &Context) -> Result<String> {
             ],
             &rows
         ),
+        worst.join(" "),
         figure(file, "BSDF Pareto plot", &caption),
     ))
 }

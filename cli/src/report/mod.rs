@@ -29,6 +29,8 @@ pub struct ReportOptions {
     pub output: PathBuf,
     /// The bench scenes (bench/scenes/*.toml).
     pub scenes: PathBuf,
+    /// Results of an earlier `bench/peer --json` run, used instead of running the peer.
+    pub peers: Option<PathBuf>,
 }
 
 /// What every section reads: the options, the machine and the progress bar.
@@ -36,6 +38,7 @@ pub struct Context {
     pub quick: bool,
     pub output: PathBuf,
     pub scenes: PathBuf,
+    pub peers: Option<PathBuf>,
     pub machine: Machine,
     bar: ProgressBar,
 }
@@ -102,6 +105,7 @@ pub fn run(options: &ReportOptions) -> Result<()> {
         quick: options.quick,
         output: options.output.clone(),
         scenes: options.scenes.clone(),
+        peers: options.peers.clone(),
         machine: Machine::this(),
         bar: ProgressBar::hidden(),
     };

@@ -121,15 +121,18 @@ pub fn section(ctx: &Context) -> Result<String> {
             probe.render.width, probe.render.height, probe.render.spp, probe.render.seed
         ),
     );
-    let plot = |file: &str, title: &str, y: &str, value: fn(&Point) -> f64| -> Result<String> {
-        let series: Vec<Series> = results
-            .iter()
-            .map(|(name, pts)| Series {
-                name: (*name).to_owned(),
-                points: pts.iter().map(|p| (p.strands as f64, value(p))).collect(),
-                line: true,
-            })
-            .collect();
+    let curve = |name: String, pts: &[Point], value: &dyn Fn(&Point) -> f64| Series {
+        name,
+        points: pts.iter().map(|p| (p.strands as f64, value(p))).collect(),
+        line: true,
+    };
+    // One series per curve type.
+    let by_curve = |value: &dyn Fn(&Point) -> f64| -> Vec<Series> {
+        (results.iter())
+            .map(|(name, pts)| curve((*name).to_owned(), pts, value))
+            .collect()
+    };
+    let plot = |file: &str, title: &str, y: &str, series: Vec<Series>| -> Result<String> {
         log_log(
             &ctx.path(file),
             &Labels {
@@ -147,15 +150,38 @@ pub fn section(ctx: &Context) -> Result<String> {
         "scale_build.png",
         "Time to first pixel against strand count",
         "seconds",
-        |p| p.build,
+        by_curve(&|p| p.build),
     )?;
     figures += &plot(
         "scale_memory.png",
         "Embree memory (peak during the build)",
         "MiB",
-        |p| p.embree_mib,
+        by_curve(&|p| p.embree_mib),
     )?;
-    figures += &plot("scale_rays.png", "Rays per second", "Mrays/s", |p| p.mrays)?;
+    figures += &plot(
+        "scale_rays.png",
+        "Rays per second",
+        "Mrays/s",
+        by_curve(&|p| p.mrays),
+    )?;
+    // The stages of the round curves, each basis: where the time to first pixel goes.
+    let stages = results
+        .iter()
+        .filter(|(name, _)| name.ends_with("round"))
+        .flat_map(|(name, pts)| {
+            Stage::ALL.iter().enumerate().map(move |(i, st)| {
+                curve(format!("{name}: {}", st.name()), pts, &move |p: &Point| {
+                    p.stages[i]
+                })
+            })
+        })
+        .collect();
+    figures += &plot(
+        "scale_stages.png",
+        "Time to first pixel by stage",
+        "seconds",
+        stages,
+    )?;
     let rows: Vec<Vec<String>> = results
         .iter()
         .flat_map(|(name, pts)| {

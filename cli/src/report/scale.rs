@@ -146,24 +146,25 @@ pub fn section(ctx: &Context) -> Result<String> {
         Ok(figure(file, title, &caption))
     };
     let mut figures = String::new();
-    figures += &plot(
-        "scale_build.png",
-        "Time to first pixel against strand count",
-        "seconds",
-        by_curve(&|p| p.build),
-    )?;
-    figures += &plot(
-        "scale_memory.png",
-        "Embree memory (peak during the build)",
-        "MiB",
-        by_curve(&|p| p.embree_mib),
-    )?;
-    figures += &plot(
-        "scale_rays.png",
-        "Rays per second",
-        "Mrays/s",
-        by_curve(&|p| p.mrays),
-    )?;
+    type Value = fn(&Point) -> f64;
+    let per_curve: [(&str, &str, &str, Value); 3] = [
+        (
+            "scale_build.png",
+            "Time to first pixel against strand count",
+            "seconds",
+            |p| p.build,
+        ),
+        (
+            "scale_memory.png",
+            "Embree memory (peak during the build)",
+            "MiB",
+            |p| p.embree_mib,
+        ),
+        ("scale_rays.png", "Rays per second", "Mrays/s", |p| p.mrays),
+    ];
+    for (file, title, y, value) in per_curve {
+        figures += &plot(file, title, y, by_curve(&value))?;
+    }
     // The stages of the round curves, each basis: where the time to first pixel goes.
     let stages = results
         .iter()

@@ -108,10 +108,12 @@ fn plan(ctx: &Context, desc: &SceneDescription) -> Plan {
     }
 }
 
-/// The bench scenes: every `*.toml` of the scenes folder (quick: the fur ball only).
+/// The bench scenes: every `*.toml` of the scenes folder (quick: the fur ball under a
+/// uniform sky, and the one under an HDR map and a small key light, where next-event
+/// estimation matters).
 pub fn scene_names(ctx: &Context) -> Result<Vec<String>> {
     if ctx.quick {
-        return Ok(vec!["fur_ball".into()]);
+        return Ok(vec!["fur_ball".into(), "hdr_fur_ball".into()]);
     }
     let dir = std::fs::read_dir(&ctx.scenes).map_err(|e| hairtrace::Error::io(&ctx.scenes, e))?;
     let mut names: Vec<String> = dir
@@ -241,7 +243,7 @@ fn scene_section(ctx: &Context, name: &str) -> Result<String> {
         ctx.step(format!("{name}: {}", knob.name));
         let mut v = base.clone();
         match (knob.edit)(&mut v) {
-            Err(e) => skipped.push(format!("`{}` ({})", knob.name, e.detail())),
+            Err(e) => skipped.push(format!("`{}` (not applicable: {})", knob.name, e.detail())),
             Ok(()) if v == base && !curves.is_empty() => {
                 skipped.push(format!("`{}` (the scene's own setting)", knob.name));
             }

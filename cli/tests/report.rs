@@ -80,3 +80,21 @@ fn quick_report_is_complete_and_finite() {
         "the peer section says it was not run"
     );
 }
+
+/// Without the bench scenes the report stops at once, in one line that says what to do,
+/// and writes nothing.
+#[test]
+fn report_without_the_bench_scenes_says_where_they_are() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_no_scenes");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_hairtrace"))
+        .args(["report", "--quick", "--scenes", "/nonexistent/scenes", "-o"])
+        .arg(&out)
+        .output()
+        .expect("run hairtrace report");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--scenes"), "{err}");
+    assert!(!out.exists(), "wrote {}", out.display());
+}

@@ -98,6 +98,7 @@ const SECTIONS: [Section; 5] = [
 
 /// Runs every section and writes `REPORT.md`.
 pub fn run(options: &ReportOptions) -> Result<()> {
+    check_scenes(&options.scenes)?;
     std::fs::create_dir_all(&options.output).map_err(|e| Error::io(&options.output, e))?;
     plots::load_font()?;
     let start = Instant::now();
@@ -164,6 +165,24 @@ pub fn median(mut values: Vec<f64>) -> f64 {
 /// A bench scene by name, read from the scenes folder.
 pub fn bench_scene(ctx: &Context, name: &str) -> Result<hairtrace::SceneDescription> {
     hairtrace::SceneDescription::from_file(&scene_path(&ctx.scenes, name))
+}
+
+/// Refuses a scenes folder without the files the sections read, before minutes of work.
+fn check_scenes(dir: &Path) -> Result<()> {
+    let needed = [
+        scene_path(dir, "fur_ball"),
+        scene_path(dir, "hdr_fur_ball"),
+        scene_path(dir, "demo_fur_ball"),
+        scale::scalp_path(dir),
+    ];
+    match needed.iter().find(|p| !p.is_file()) {
+        Some(missing) => Err(Error::InvalidArg(format!(
+            "{} not found: run from the repository's root or pass --scenes with the \
+             bench scenes' folder (bench/scenes)",
+            missing.display()
+        ))),
+        None => Ok(()),
+    }
 }
 
 fn scene_path(dir: &Path, name: &str) -> PathBuf {

@@ -8,6 +8,7 @@ use hairtrace::description::{GroomSource, SceneDescription};
 use hairtrace::embree::{CurveBasis, CurveShape, MemoryMonitor};
 use hairtrace::scene::Stage;
 use hairtrace::{Aovs, NoProgress, Result};
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -53,6 +54,11 @@ fn rss_mib() -> f64 {
         .map_or(0.0, |kib| kib / 1024.0)
 }
 
+/// The stage benchmark's scene, beside the bench scenes' folder.
+pub fn scalp_path(scenes: &Path) -> PathBuf {
+    scene_path(&scenes.join("../stages"), "scalp_1m")
+}
+
 /// The stage benchmark's scalp (bench/stages/scalp_1m.toml) at `strands`, one curve type.
 fn scalp(
     ctx: &Context,
@@ -60,8 +66,7 @@ fn scalp(
     basis: CurveBasis,
     shape: CurveShape,
 ) -> Result<SceneDescription> {
-    let stages = ctx.scenes.join("../stages");
-    let mut desc = SceneDescription::from_file(&scene_path(&stages, "scalp_1m"))?;
+    let mut desc = SceneDescription::from_file(&scalp_path(&ctx.scenes))?;
     for g in &mut desc.grooms {
         (g.basis, g.shape) = (basis, shape);
         if let GroomSource::Scalp(s) = &mut g.source {

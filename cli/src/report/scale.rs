@@ -226,12 +226,13 @@ pub fn section(ctx: &Context) -> Result<String> {
             ],
             &rows
         ),
-        advice(&results),
+        advice(&results, ctx.machine.threads),
     ))
 }
 
-/// Where the time goes at the largest count, and what a user can do, from the numbers.
-fn advice(results: &[(&str, Vec<Point>)]) -> String {
+/// Where the time goes at the largest count, and what a user can do, from the numbers:
+/// each suggestion is made only where this run measured a gain.
+fn advice(results: &[(&str, Vec<Point>)], threads: usize) -> String {
     let last = |name: &str| {
         results
             .iter()
@@ -251,31 +252,57 @@ fn advice(results: &[(&str, Vec<Point>)]) -> String {
         .zip(br.stages)
         .map(|(n, s)| format!("{n} {}%", num(100.0 * s / br.build, 2)))
         .collect();
-    let biggest = stage_names
+    let (biggest, biggest_seconds) = stage_names
         .iter()
         .zip(br.stages)
         .max_by(|a, b| a.1.total_cmp(&b.1))
-        .map_or("", |(n, _)| n);
-    format!(
+        .map_or(("", 0.0), |(n, s)| (*n, s));
+    let mut text = format!(
         "**Where the time goes.** At {} strands the B-spline round scalp takes {} s to its \
-         first pixel: {} (the rest is lights and materials); the largest stage is {biggest}. \
-         The same groom as linear round curves takes {} s ({}x faster) and {} MiB of Embree \
-         memory against {} MiB; flat linear ribbons trace {}x the rays per second of round \
-         ones ({} against {} Mrays/s) at {} s to the first pixel. **What to do:** where the \
-         groom is dense enough that its curvature within a segment is not seen, \
-         `basis = \"linear\"` cuts the build by that factor; where strands are thinner than \
-         a pixel, `shape = \"flat\"` traces faster (the render section gives each choice's \
-         cost in error).\n\n",
+         first pixel: {} (the rest is lights and materials); the largest stage is \
+         {biggest}. **What a user can do**, from these numbers:",
         br.strands,
         num(br.build, 3),
         shares.join(", "),
-        num(lr.build, 3),
-        num(br.build / lr.build, 2),
-        num(lr.embree_mib, 3),
-        num(br.embree_mib, 3),
-        num(lf.mrays / lr.mrays, 2),
-        num(lf.mrays, 3),
-        num(lr.mrays, 3),
-        num(lf.build, 3),
-    )
+    );
+    let build_gain = br.build / lr.build;
+    text += &if build_gain > 1.1 {
+        format!(
+            "\n- `basis = \"linear\"` reaches the first pixel {}x sooner ({} s) with {} MiB \
+             of Embree memory against {} MiB, where the groom has enough points that its \
+             curvature within a segment does not show (the render section gives its error).",
+            num(build_gain, 2),
+            num(lr.build, 3),
+            num(lr.embree_mib, 3),
+            num(br.embree_mib, 3)
+        )
+    } else {
+        format!(
+            "\n- the basis changes the time to first pixel little here ({}x).",
+            num(build_gain, 2)
+        )
+    };
+    let trace_gain = lf.mrays / lr.mrays;
+    text += &if trace_gain > 1.05 {
+        format!(
+            "\n- `shape = \"flat\"` traces {}x the rays per second of round curves ({} \
+             against {} Mrays/s), for strands thinner than a pixel.",
+            num(trace_gain, 2),
+            num(lf.mrays, 3),
+            num(lr.mrays, 3)
+        )
+    } else {
+        format!(
+            "\n- flat ribbons trace no faster than round curves here ({}x).",
+            num(trace_gain, 2)
+        )
+    };
+    if biggest == Stage::Bvh.name() && biggest_seconds > 0.5 * br.build {
+        text += &format!(
+            "\n- the BVH build, Embree's, runs on every thread the device has ({threads} here; \
+             `--threads` or `[render] threads` sets them): a build on a machine with more \
+             free cores is shorter."
+        );
+    }
+    text + "\n\n"
 }

@@ -23,9 +23,9 @@ pub struct Variant {
 
 /// A named change to the reference settings. An edit that fails means the knob does not
 /// apply to this build or scene; the report says so and goes on.
-pub struct Knob {
-    pub name: &'static str,
-    pub edit: fn(&mut Variant) -> Result<()>,
+struct Knob {
+    name: &'static str,
+    edit: fn(&mut Variant) -> Result<()>,
 }
 
 const fn knob(name: &'static str, edit: fn(&mut Variant) -> Result<()>) -> Knob {
@@ -34,7 +34,7 @@ const fn knob(name: &'static str, edit: fn(&mut Variant) -> Result<()>) -> Knob 
 
 /// The knobs measured, against the reference settings (the scene as written with a
 /// one-pixel box filter and MIS). The first is the reference settings themselves.
-pub const KNOBS: &[Knob] = &[
+const KNOBS: &[Knob] = &[
     knob("reference settings", |_| Ok(())),
     knob("shape flat", |v| set_shape(v, "flat")),
     knob("shape auto", |v| set_shape(v, "auto")),
@@ -87,7 +87,7 @@ fn set_strategy(v: &mut Variant, strategy: Strategy) -> Result<()> {
 
 /// The seed of every reference: no timed render uses it (a render sharing the
 /// reference's seed shares its first samples and looks too good).
-pub const REFERENCE_SEED: u64 = 1_000_003;
+const REFERENCE_SEED: u64 = 1_000_003;
 
 /// Sizes of one run: the sample counts of each curve and the reference's.
 struct Plan {
@@ -128,7 +128,7 @@ pub fn scene_names(ctx: &Context) -> Result<Vec<String>> {
 
 /// A bench scene with the reference settings; quick: a tenth of the strands at a quarter
 /// of the size.
-pub fn reference_variant(ctx: &Context, name: &str) -> Result<Variant> {
+fn reference_variant(ctx: &Context, name: &str) -> Result<Variant> {
     let mut desc = bench_scene(ctx, name)?;
     desc.render.filter = "box".into();
     desc.render.filter_radius = None;

@@ -96,7 +96,7 @@ fn run_peer(ctx: &Context, python: &Path) -> Result<String> {
     Ok(format!(
         "`bench/peer.py --quick --repeats 1` in this run (a quarter of each scene's spp, one \
          timed render each; bench/README.md says how it matches the two renderers), {} \
-         threads, seed 1, references at 16x spp with seed 1000003. Its full results: \
+         threads, seed 1, references at 16x those samples with seed 1000003. Its full results: \
          `peers.json`.\n\n{}",
         ctx.machine.threads,
         peer_table(&read_json(&json)?)?

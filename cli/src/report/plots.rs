@@ -118,6 +118,25 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
+/// Series colours: Tableau's ten, then darker shades, so that neighbours in a legend
+/// differ.
+const COLORS: [RGBColor; 14] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+    RGBColor(0, 0, 0),
+    RGBColor(120, 60, 0),
+    RGBColor(0, 80, 40),
+    RGBColor(90, 0, 120),
+];
+
 /// Legend width, right of the plot.
 const LEGEND_WIDTH: u32 = 330;
 
@@ -169,7 +188,7 @@ pub fn log_log(path: &Path, labels: &Labels, series: &[Series]) -> Result<()> {
         .map_err(|e| plot_error(path, e))?;
     let shown = series.iter().filter(|s| s.points.iter().any(plottable));
     for (i, s) in shown.enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+        let color = COLORS[i % COLORS.len()].to_rgba();
         let points: Vec<(f64, f64)> = s.points.iter().copied().filter(plottable).collect();
         if s.line {
             chart

@@ -265,38 +265,42 @@ fn advice(results: &[(&str, Vec<Point>)], threads: usize) -> String {
         num(br.build, 3),
         shares.join(", "),
     );
+    // A suggestion where the gain is worth it, else how small it was.
+    let suggest = |gain: f64, worth: f64, yes: String, no: &str| {
+        if gain > worth {
+            format!("\n- {yes}")
+        } else {
+            format!("\n- {no} ({}x).", num(gain, 2))
+        }
+    };
     let build_gain = br.build / lr.build;
-    text += &if build_gain > 1.1 {
+    text += &suggest(
+        build_gain,
+        1.1,
         format!(
-            "\n- `basis = \"linear\"` reaches the first pixel {}x sooner ({} s) with {} MiB \
-             of Embree memory against {} MiB, where the groom has enough points that its \
+            "`basis = \"linear\"` reaches the first pixel {}x sooner ({} s) with {} MiB of \
+             Embree memory against {} MiB, where the groom has enough points that its \
              curvature within a segment does not show (the render section gives its error).",
             num(build_gain, 2),
             num(lr.build, 3),
             num(lr.embree_mib, 3),
             num(br.embree_mib, 3)
-        )
-    } else {
-        format!(
-            "\n- the basis changes the time to first pixel little here ({}x).",
-            num(build_gain, 2)
-        )
-    };
+        ),
+        "the basis changes the time to first pixel little here",
+    );
     let trace_gain = lf.mrays / lr.mrays;
-    text += &if trace_gain > 1.05 {
+    text += &suggest(
+        trace_gain,
+        1.05,
         format!(
-            "\n- `shape = \"flat\"` traces {}x the rays per second of round curves ({} \
-             against {} Mrays/s), for strands thinner than a pixel.",
+            "`shape = \"flat\"` traces {}x the rays per second of round curves ({} against \
+             {} Mrays/s), for strands thinner than a pixel.",
             num(trace_gain, 2),
             num(lf.mrays, 3),
             num(lr.mrays, 3)
-        )
-    } else {
-        format!(
-            "\n- flat ribbons trace no faster than round curves here ({}x).",
-            num(trace_gain, 2)
-        )
-    };
+        ),
+        "flat ribbons trace no faster than round curves here",
+    );
     if biggest == Stage::Bvh.name() && biggest_seconds > 0.5 * br.build {
         text += &format!(
             "\n- the BVH build, Embree's, runs on every thread the device has ({threads} here; \

@@ -7,7 +7,7 @@ use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
 use super::{Context, median};
 use glam::Vec3;
-use hairtrace::{BsdfEval, HairBsdf, HairParams, Result};
+use hairtrace::{BsdfEval, HairBsdf, HairParams, HairPoint, Result};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::hint::black_box;
@@ -313,7 +313,20 @@ fn each<R>(s: &Set, call: impl Fn(&Input) -> R) -> usize {
     s.inputs.len()
 }
 
-const VARIANTS: [Variant; 6] = [
+/// Calls `call` 8 times on one prepared point per input (with the call's index): what
+/// a point's later calls cost once its (h, wo) work is done, amortised as a renderer
+/// would over its light and BSDF samples. Returns the calls made.
+fn per_point<R>(s: &Set, call: impl Fn(&HairPoint, &Input, usize) -> R) -> usize {
+    for x in &s.inputs {
+        let p = s.bsdf.at(black_box(x.h), black_box(x.wo));
+        for k in 0..8 {
+            black_box(call(&p, black_box(x), k));
+        }
+    }
+    s.inputs.len() * 8
+}
+
+const VARIANTS: [Variant; 7] = [
     Variant {
         name: "HairBsdf::eval",
         time: |s| each(s, |x| s.bsdf.eval(x.h, x.wo, x.wi)),
@@ -341,17 +354,17 @@ const VARIANTS: [Variant; 6] = [
     },
     Variant {
         name: "HairPoint::eval (one at per 8 evals, per eval)",
-        time: |s| {
-            for x in &s.inputs {
-                let p = s.bsdf.at(x.h, x.wo);
-                for k in 0..8 {
-                    let wi = if k % 2 == 0 { x.wi } else { -x.wi };
-                    black_box(p.eval(black_box(wi)));
-                }
-            }
-            s.inputs.len() * 8
-        },
+        time: |s| per_point(s, |p, x, k| p.eval(if k % 2 == 0 { x.wi } else { -x.wi })),
         outputs: Some(eval_outputs),
+    },
+    Variant {
+        name: "HairPoint::sample (one at per 8 samples, per sample)",
+        time: |s| {
+            per_point(s, |p, x, k| {
+                p.sample(x.u.map(|u| (u + k as f32 * 0.125).fract()))
+            })
+        },
+        outputs: Some(sample_outputs),
     },
     Variant {
         name: "HairBsdf::eval_batch (per element)",

@@ -334,6 +334,16 @@ fn scene_section(ctx: &Context, name: &str) -> Result<String> {
         num(reference_seconds, 3),
         table(&header, &rows)
     );
+    let best = (curves.iter())
+        .filter_map(|c| Some((c.name, efficiency(c.points.last()?) / base_eff)))
+        .filter(|(_, e)| e.is_finite())
+        .max_by(|a, b| a.1.total_cmp(&b.1));
+    if let Some((knob, gain)) = best {
+        text += &format!(
+            "Most efficient at {last_spp} spp here: `{knob}`, {}x the reference settings.\n\n",
+            num(gain, 3)
+        );
+    }
     if !skipped.is_empty() {
         text += &format!("Not measured here: {}.\n\n", skipped.join("; "));
     }

@@ -1,7 +1,9 @@
 //! The hairtrace command line: `render` a scene file, a .hair groom or a built-in demo;
 //! `info` describes a .hair groom; `lobes` prints how a hair splits energy between its
 //! lobes; `compare` measures how far a render is from a reference; `export` writes a
-//! scene for a peer renderer.
+//! scene for a peer renderer; `report` measures speed against error and writes REPORT.md.
+
+mod report;
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
@@ -50,6 +52,27 @@ enum Command {
     /// Compare an image with a reference of the same size: RMSE, largest difference and
     /// both means over the RGB channels (one JSON line with --json).
     Compare(CompareArgs),
+    /// Measure speed against error (BSDF variants, render knobs on the bench scenes, scaling
+    /// with strand count, Blender Cycles if installed, a gallery) and write REPORT.md with
+    /// its PNG plots.
+    Report(ReportArgs),
+}
+
+#[derive(Args)]
+struct ReportArgs {
+    /// Tiny sizes (under a minute): checks that the report is produced, measures little.
+    #[arg(long)]
+    quick: bool,
+    /// The folder to write REPORT.md and its plots into (created if missing).
+    #[arg(short, long, default_value = "report")]
+    output: PathBuf,
+    /// The bench scenes (run from the repository's root, the default finds them).
+    #[arg(long, default_value = "bench/scenes")]
+    scenes: PathBuf,
+    /// Take the peer section from an earlier `bench/peer --json FILE` run instead of
+    /// running Blender Cycles.
+    #[arg(long, value_name = "FILE.json")]
+    peers: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -571,6 +594,12 @@ fn main() -> ExitCode {
         Command::Info(a) => info(a),
         Command::Compare(a) => compare(a),
         Command::Export(a) => export(a),
+        Command::Report(a) => report::run(&report::ReportOptions {
+            quick: a.quick,
+            output: a.output.clone(),
+            scenes: a.scenes.clone(),
+            peers: a.peers.clone(),
+        }),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -387,7 +387,9 @@ fn alpha_channel(channels: usize) -> Option<usize> {
     matches!(channels, 2 | 4).then(|| channels - 1)
 }
 
-fn srgb_encode(v: f32) -> f32 {
+/// The sRGB transfer function of a linear value in [0, 1], as the 8-bit writers apply it
+/// (public for hosts that compose their own 8-bit pictures, such as the CLI's report).
+pub fn srgb_encode(v: f32) -> f32 {
     if v <= 0.003_130_8 {
         12.92 * v
     } else {

@@ -1,0 +1,190 @@
+//! `hairtrace report`: measures what each choice costs in time and buys in accuracy (the
+//! hair BSDF's variants, the render knobs on the bench scenes, how building and tracing
+//! scale with strand count, the peer renderer) and writes `REPORT.md` with its PNG plots
+//! and the gallery's contact sheet. Every figure comes from this run on this machine; the
+//! sections are independent, each a module.
+
+mod bsdf;
+mod gallery;
+mod machine;
+mod markdown;
+mod peers;
+mod plots;
+mod render;
+mod scale;
+
+use hairtrace::{Error, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use machine::Machine;
+
+/// What `hairtrace report` was asked for.
+pub struct ReportOptions {
+    /// Tiny sizes everywhere: a check that the whole report still builds (the test suite
+    /// runs it), not a measurement to quote.
+    pub quick: bool,
+    /// Where REPORT.md and its PNGs go (created if missing).
+    pub output: PathBuf,
+    /// The bench scenes (bench/scenes/*.toml).
+    pub scenes: PathBuf,
+    /// Results of an earlier `bench/peer --json` run, used instead of running the peer.
+    pub peers: Option<PathBuf>,
+}
+
+/// What every section reads: the options, the machine and the progress bar.
+pub struct Context {
+    pub quick: bool,
+    pub output: PathBuf,
+    pub scenes: PathBuf,
+    pub peers: Option<PathBuf>,
+    pub machine: Machine,
+    bar: ProgressBar,
+}
+
+impl Context {
+    /// Shows the step a section is on.
+    pub fn step(&self, what: impl Into<String>) {
+        self.bar.set_message(what.into());
+    }
+
+    /// Counts one step of the section done.
+    pub fn done(&self) {
+        self.bar.inc(1);
+    }
+
+    /// A file of the report's folder.
+    pub fn path(&self, name: &str) -> PathBuf {
+        self.output.join(name)
+    }
+}
+
+/// A section: its title, the function that measures and writes it, and how many progress
+/// steps it takes.
+struct Section {
+    title: &'static str,
+    run: fn(&Context) -> Result<String>,
+    steps: fn(&Context) -> u64,
+}
+
+const SECTIONS: [Section; 5] = [
+    Section {
+        title: "BSDF: time against accuracy",
+        run: bsdf::section,
+        steps: bsdf::steps,
+    },
+    Section {
+        title: "Render: error against time on the bench scenes",
+        run: render::section,
+        steps: render::steps,
+    },
+    Section {
+        title: "Gallery",
+        run: gallery::section,
+        steps: gallery::steps,
+    },
+    Section {
+        title: "Scale: strand count, build time, memory, rays per second",
+        run: scale::section,
+        steps: scale::steps,
+    },
+    Section {
+        title: "Peers: Blender Cycles",
+        run: peers::section,
+        steps: peers::steps,
+    },
+];
+
+/// Runs every section and writes `REPORT.md`.
+pub fn run(options: &ReportOptions) -> Result<()> {
+    check_scenes(&options.scenes)?;
+    std::fs::create_dir_all(&options.output).map_err(|e| Error::io(&options.output, e))?;
+    plots::load_font()?;
+    let start = Instant::now();
+    let mut ctx = Context {
+        quick: options.quick,
+        output: options.output.clone(),
+        scenes: options.scenes.clone(),
+        peers: options.peers.clone(),
+        machine: Machine::this(),
+        bar: ProgressBar::hidden(),
+    };
+    let total: u64 = SECTIONS.iter().map(|s| (s.steps)(&ctx)).sum();
+    ctx.bar = ProgressBar::new(total).with_style(
+        ProgressStyle::with_template(
+            "report {bar:40} {pos}/{len} {elapsed_precise} eta {eta_precise} {msg}",
+        )
+        .expect("a valid progress template"),
+    );
+    let mut body = String::new();
+    for (i, s) in SECTIONS.iter().enumerate() {
+        ctx.step(s.title);
+        let section_start = Instant::now();
+        let text = (s.run)(&ctx).map_err(|e| e.context(format!("report, {}", s.title)))?;
+        body += &format!(
+            "\n## {}. {}\n\n{}\n\n*This section took {:.0} s.*\n",
+            i + 1,
+            s.title,
+            text.trim_end(),
+            section_start.elapsed().as_secs_f64()
+        );
+    }
+    ctx.bar.finish_and_clear();
+    let report = format!(
+        "# hairtrace: speed against error\n\n\
+         Written by `hairtrace report{}` in {:.0} s on {}. Every figure below was measured \
+         in that run{}.\n{body}",
+        if ctx.quick { " --quick" } else { "" },
+        start.elapsed().as_secs_f64(),
+        ctx.machine.describe(),
+        if ctx.quick {
+            " at the quick sizes (tiny images, few samples, small grooms): they show that the \
+             report is produced, not what the knobs cost"
+        } else {
+            ""
+        },
+    );
+    let path = ctx.path("REPORT.md");
+    std::fs::write(&path, report).map_err(|e| Error::io(&path, e))?;
+    eprintln!("{}", path.display());
+    Ok(())
+}
+
+/// The median of a non-empty list.
+pub fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// A bench scene by name, read from the scenes folder.
+pub fn bench_scene(ctx: &Context, name: &str) -> Result<hairtrace::SceneDescription> {
+    hairtrace::SceneDescription::from_file(&scene_path(&ctx.scenes, name))
+}
+
+/// Refuses a scenes folder without the files the sections read, before minutes of work.
+fn check_scenes(dir: &Path) -> Result<()> {
+    let needed = [
+        scene_path(dir, "fur_ball"),
+        scene_path(dir, "hdr_fur_ball"),
+        scene_path(dir, "demo_fur_ball"),
+        scale::scalp_path(dir),
+    ];
+    match needed.iter().find(|p| !p.is_file()) {
+        Some(missing) => Err(Error::InvalidArg(format!(
+            "{} not found: run from the repository's root or pass --scenes with the \
+             bench scenes' folder (bench/scenes)",
+            missing.display()
+        ))),
+        None => Ok(()),
+    }
+}
+
+fn scene_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.toml"))
+}

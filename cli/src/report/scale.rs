@@ -1,0 +1,312 @@
+//! Scale section: how building and tracing grow with the strand count, per curve basis and
+//! shape, and where the time before the first pixel goes (the library's build stages).
+
+use super::markdown::{figure, num, table};
+use super::plots::{Labels, Series, log_log};
+use super::{Context, scene_path};
+use hairtrace::description::{GroomSource, SceneDescription};
+use hairtrace::embree::{CurveBasis, CurveShape, MemoryMonitor};
+use hairtrace::scene::Stage;
+use hairtrace::{Aovs, NoProgress, Result};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The curve types compared, by name.
+const CURVES: [(&str, CurveBasis, CurveShape); 4] = [
+    ("linear round", CurveBasis::Linear, CurveShape::Round),
+    ("linear flat", CurveBasis::Linear, CurveShape::Flat),
+    ("bspline round", CurveBasis::BSpline, CurveShape::Round),
+    ("bspline flat", CurveBasis::BSpline, CurveShape::Flat),
+];
+
+fn strand_counts(ctx: &Context) -> Vec<usize> {
+    if ctx.quick {
+        vec![1_000, 10_000]
+    } else {
+        vec![1_000, 10_000, 100_000, 1_000_000]
+    }
+}
+
+/// One build and render of the scalp at one strand count and curve type.
+struct Point {
+    strands: usize,
+    /// Seconds of each build stage (read or generate, curves, BVH) and their total with
+    /// the rest of the build (lights, materials): the time to the first pixel.
+    stages: [f64; 3],
+    build: f64,
+    /// Embree's peak allocation during the build, and the process's resident memory
+    /// growth over it (the groom's own buffers included), MiB.
+    embree_mib: f64,
+    rss_mib: f64,
+    /// Million rays traced per second, shading included.
+    mrays: f64,
+}
+
+/// The process's resident memory now, MiB (Linux; 0 elsewhere).
+fn rss_mib() -> f64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            let line = s.lines().find(|l| l.starts_with("VmRSS:"))?;
+            line.split_whitespace().nth(1)?.parse::<f64>().ok()
+        })
+        .map_or(0.0, |kib| kib / 1024.0)
+}
+
+/// The stage benchmark's scene, beside the bench scenes' folder.
+pub fn scalp_path(scenes: &Path) -> PathBuf {
+    scene_path(&scenes.join("../stages"), "scalp_1m")
+}
+
+/// The stage benchmark's scalp (bench/stages/scalp_1m.toml) at `strands`, one curve type.
+fn scalp(
+    ctx: &Context,
+    strands: usize,
+    basis: CurveBasis,
+    shape: CurveShape,
+) -> Result<SceneDescription> {
+    let mut desc = SceneDescription::from_file(&scalp_path(&ctx.scenes))?;
+    for g in &mut desc.grooms {
+        (g.basis, g.shape) = (basis, shape);
+        if let GroomSource::Scalp(s) = &mut g.source {
+            s.strands = strands;
+        }
+    }
+    let r = &mut desc.render;
+    (r.width, r.height, r.spp) = if ctx.quick {
+        (32, 32, 1)
+    } else {
+        (160, 160, 4)
+    };
+    Ok(desc)
+}
+
+fn measure(desc: &SceneDescription, strands: usize) -> Result<Point> {
+    let device = Arc::new(desc.render.device()?);
+    let monitor = MemoryMonitor::attach(device.clone());
+    let rss = rss_mib();
+    let start = Instant::now();
+    let built = desc.build(device)?;
+    let build = start.elapsed().as_secs_f64();
+    let rss_mib = rss_mib() - rss;
+    let embree_mib = monitor.peak() as f64 / (1024.0 * 1024.0);
+    let stages = Stage::ALL.map(|s| built.stages.get(s));
+    let out = built.render(Aovs::default(), &NoProgress)?;
+    Ok(Point {
+        strands,
+        stages,
+        build,
+        embree_mib,
+        rss_mib,
+        mrays: out.stats.rays as f64 / out.stats.seconds / 1e6,
+    })
+}
+
+pub fn steps(ctx: &Context) -> u64 {
+    (CURVES.len() * strand_counts(ctx).len()) as u64
+}
+
+pub fn section(ctx: &Context) -> Result<String> {
+    let mut results: Vec<(&str, Vec<Point>)> = Vec::new();
+    for (name, basis, shape) in CURVES {
+        let mut points = Vec::new();
+        for strands in strand_counts(ctx) {
+            ctx.step(format!("scale: {name}, {strands} strands"));
+            points.push(measure(&scalp(ctx, strands, basis, shape)?, strands)?);
+            ctx.done();
+        }
+        results.push((name, points));
+    }
+    let probe = scalp(ctx, 0, CurveBasis::Linear, CurveShape::Round)?;
+    let caption = ctx.machine.caption(
+        ctx.machine.threads,
+        &format!(
+            "scalp of bench/stages/scalp_1m.toml x 16 segments, rays/s at {}x{} x {} spp, seed {}",
+            probe.render.width, probe.render.height, probe.render.spp, probe.render.seed
+        ),
+    );
+    let curve = |name: String, pts: &[Point], value: &dyn Fn(&Point) -> f64| Series {
+        name,
+        points: pts.iter().map(|p| (p.strands as f64, value(p))).collect(),
+        line: true,
+    };
+    // One series per curve type.
+    let by_curve = |value: &dyn Fn(&Point) -> f64| -> Vec<Series> {
+        (results.iter())
+            .map(|(name, pts)| curve((*name).to_owned(), pts, value))
+            .collect()
+    };
+    let plot = |file: &str, title: &str, y: &str, series: Vec<Series>| -> Result<String> {
+        log_log(
+            &ctx.path(file),
+            &Labels {
+                title,
+                x: "strands",
+                y,
+                caption: &caption,
+            },
+            &series,
+        )?;
+        Ok(figure(file, title, &caption))
+    };
+    let mut figures = String::new();
+    type Value = fn(&Point) -> f64;
+    let per_curve: [(&str, &str, &str, Value); 3] = [
+        (
+            "scale_build.png",
+            "Time to first pixel against strand count",
+            "seconds",
+            |p| p.build,
+        ),
+        (
+            "scale_memory.png",
+            "Embree memory (peak during the build)",
+            "MiB",
+            |p| p.embree_mib,
+        ),
+        ("scale_rays.png", "Rays per second", "Mrays/s", |p| p.mrays),
+    ];
+    for (file, title, y, value) in per_curve {
+        figures += &plot(file, title, y, by_curve(&value))?;
+    }
+    // The stages of the round curves, each basis: where the time to first pixel goes.
+    let stages = results
+        .iter()
+        .filter(|(name, _)| name.ends_with("round"))
+        .flat_map(|(name, pts)| {
+            Stage::ALL.iter().enumerate().map(move |(i, st)| {
+                curve(format!("{name}: {}", st.name()), pts, &move |p: &Point| {
+                    p.stages[i]
+                })
+            })
+        })
+        .collect();
+    figures += &plot(
+        "scale_stages.png",
+        "Time to first pixel by stage",
+        "seconds",
+        stages,
+    )?;
+    let rows: Vec<Vec<String>> = results
+        .iter()
+        .flat_map(|(name, pts)| {
+            pts.iter().map(move |p| {
+                let mut row = vec![(*name).to_owned(), p.strands.to_string()];
+                row.extend(p.stages.iter().map(|s| num(*s, 3)));
+                row.extend([
+                    num(p.build, 3),
+                    num(p.embree_mib, 3),
+                    num(p.rss_mib, 3),
+                    num(p.mrays, 3),
+                ]);
+                row
+            })
+        })
+        .collect();
+    Ok(format!(
+        "The stage benchmark's scalp (16 segments per strand) built at each strand count \
+         with each curve type, then rendered once. Time to first pixel is the whole build; \
+         its stages are the library's own (generating the strands, converting them to \
+         curves, Embree's BVH build). Memory: Embree's own peak allocation during the build \
+         (its memory monitor), and how much the process's resident memory grew (the \
+         groom's buffers too; freed memory the allocator keeps makes it a lower bound after \
+         the first build).\n\n{}\n{}\n{figures}",
+        table(
+            &[
+                "curves",
+                "strands",
+                "read s",
+                "curves s",
+                "BVH s",
+                "first pixel s",
+                "Embree MiB",
+                "RSS growth MiB",
+                "Mrays/s"
+            ],
+            &rows
+        ),
+        advice(&results, ctx.machine.threads),
+    ))
+}
+
+/// Where the time goes at the largest count, and what a user can do, from the numbers:
+/// each suggestion is made only where this run measured a gain.
+fn advice(results: &[(&str, Vec<Point>)], threads: usize) -> String {
+    let last = |name: &str| {
+        results
+            .iter()
+            .find(|(n, _)| *n == name)
+            .and_then(|(_, p)| p.last())
+    };
+    let (Some(lr), Some(lf), Some(br)) = (
+        last("linear round"),
+        last("linear flat"),
+        last("bspline round"),
+    ) else {
+        return String::new();
+    };
+    let stage_names = Stage::ALL.map(Stage::name);
+    let shares: Vec<String> = stage_names
+        .iter()
+        .zip(br.stages)
+        .map(|(n, s)| format!("{n} {}%", num(100.0 * s / br.build, 2)))
+        .collect();
+    let (biggest, biggest_seconds) = stage_names
+        .iter()
+        .zip(br.stages)
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(("", 0.0), |(n, s)| (*n, s));
+    let mut text = format!(
+        "**Where the time goes.** At {} strands the B-spline round scalp takes {} s to its \
+         first pixel: {} (the rest is lights and materials); the largest stage is \
+         {biggest}. **What a user can do**, from these numbers:",
+        br.strands,
+        num(br.build, 3),
+        shares.join(", "),
+    );
+    // A suggestion where the gain is worth it, else how small it was.
+    let suggest = |gain: f64, worth: f64, yes: String, no: &str| {
+        if gain > worth {
+            format!("\n- {yes}")
+        } else {
+            format!("\n- {no} ({}x).", num(gain, 2))
+        }
+    };
+    let build_gain = br.build / lr.build;
+    text += &suggest(
+        build_gain,
+        1.1,
+        format!(
+            "`basis = \"linear\"` reaches the first pixel {}x sooner ({} s) with {} MiB of \
+             Embree memory against {} MiB, where the groom has enough points that its \
+             curvature within a segment does not show (the render section gives its error).",
+            num(build_gain, 2),
+            num(lr.build, 3),
+            num(lr.embree_mib, 3),
+            num(br.embree_mib, 3)
+        ),
+        "the basis changes the time to first pixel little here",
+    );
+    let trace_gain = lf.mrays / lr.mrays;
+    text += &suggest(
+        trace_gain,
+        1.05,
+        format!(
+            "`shape = \"flat\"` traces {}x the rays per second of round curves ({} against \
+             {} Mrays/s), for strands thinner than a pixel.",
+            num(trace_gain, 2),
+            num(lf.mrays, 3),
+            num(lr.mrays, 3)
+        ),
+        "flat ribbons trace no faster than round curves here",
+    );
+    if biggest == Stage::Bvh.name() && biggest_seconds > 0.5 * br.build {
+        text += &format!(
+            "\n- the BVH build, Embree's, runs on every thread the device has ({threads} here; \
+             `--threads` or `[render] threads` sets them): a build on a machine with more \
+             free cores is shorter."
+        );
+    }
+    text + "\n\n"
+}

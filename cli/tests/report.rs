@@ -1,0 +1,100 @@
+//! `hairtrace report --quick` as the test suite runs it: the report and every plot it
+//! links are written, each section is there, and every number in it is finite.
+
+use std::path::Path;
+use std::process::Command;
+
+const SECTIONS: [&str; 5] = ["BSDF", "Render", "Gallery", "Scale", "Peers"];
+
+/// Every link target `](file)` in a Markdown text.
+fn links(text: &str) -> Vec<&str> {
+    text.split("](")
+        .skip(1)
+        .filter_map(|rest| rest.split_once(')').map(|(target, _)| target))
+        .collect()
+}
+
+/// Every word that reads as a number, or as a float that is not one.
+fn numbers(text: &str) -> Vec<&str> {
+    text.split(|c: char| c.is_whitespace() || "|(),;:*`[]x".contains(c))
+        .map(|w| w.trim_end_matches(['.', '%']))
+        .filter(|w| {
+            let lower = w.to_ascii_lowercase();
+            w.parse::<f64>().is_ok() || ["nan", "inf", "-inf", "infinity"].contains(&lower.as_str())
+        })
+        .collect()
+}
+
+#[test]
+fn quick_report_is_complete_and_finite() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_quick");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_hairtrace"))
+        .args(["report", "--quick", "-o"])
+        .arg(&out)
+        .arg("--scenes")
+        .arg(root.join("bench/scenes"))
+        .env_remove("HT_BENCH_VENV")
+        .output()
+        .expect("run hairtrace report");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = std::fs::read_to_string(out.join("REPORT.md")).expect("REPORT.md written");
+    for (i, s) in SECTIONS.iter().enumerate() {
+        assert!(
+            text.contains(&format!("## {}. {s}", i + 1)),
+            "no section {s}:\n{text}"
+        );
+    }
+    let plots = links(&text);
+    for name in [
+        "bsdf_pareto.png",
+        "render_fur_ball.png",
+        "gallery.png",
+        "scale_build.png",
+    ] {
+        assert!(plots.contains(&name), "{name} not linked: {plots:?}");
+    }
+    for name in &plots {
+        let path = out.join(name);
+        let img = image::open(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(
+            img.width() >= 100 && img.height() >= 100,
+            "{name}: {}x{}",
+            img.width(),
+            img.height()
+        );
+        // A plot or sheet has more than one colour.
+        let rgb = img.to_rgb8();
+        let first = rgb.get_pixel(0, 0);
+        assert!(rgb.pixels().any(|p| p != first), "{name} is blank");
+    }
+    let nums = numbers(&text);
+    assert!(nums.len() > 50, "too few numbers: {nums:?}");
+    for n in nums {
+        let v: f64 = n.parse().unwrap_or(f64::NAN);
+        assert!(v.is_finite(), "non-finite number {n:?} in REPORT.md");
+    }
+    assert!(
+        text.contains("**Not run:**"),
+        "the peer section says it was not run"
+    );
+}
+
+/// Without the bench scenes the report stops at once, in one line that says what to do,
+/// and writes nothing.
+#[test]
+fn report_without_the_bench_scenes_says_where_they_are() {
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_no_scenes");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new(env!("CARGO_BIN_EXE_hairtrace"))
+        .args(["report", "--quick", "--scenes", "/nonexistent/scenes", "-o"])
+        .arg(&out)
+        .output()
+        .expect("run hairtrace report");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--scenes"), "{err}");
+    assert!(!out.exists(), "wrote {}", out.display());
+}

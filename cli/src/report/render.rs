@@ -6,11 +6,11 @@ use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
 use super::{Context, bench_scene};
 use hairtrace::description::{GroomSource, RenderDesc, SceneDescription};
-use hairtrace::embree::{CurveBasis, CurveShape};
+use hairtrace::embree::CurveBasis;
 use hairtrace::image::{Image, compare};
 use hairtrace::render::integrator::Strategy;
+use hairtrace::scene::GroomShape;
 use hairtrace::{Aovs, NoProgress, Result};
-use std::path::Path;
 use std::sync::Arc;
 
 /// What a knob changes: the scene description, and the integrator's strategy (which is
@@ -36,8 +36,8 @@ const fn knob(name: &'static str, edit: fn(&mut Variant) -> Result<()>) -> Knob 
 /// one-pixel box filter and MIS). The first is the reference settings themselves.
 const KNOBS: &[Knob] = &[
     knob("reference settings", |_| Ok(())),
-    knob("shape flat", |v| set_shape(v, "flat")),
-    knob("shape auto", |v| set_shape(v, "auto")),
+    knob("shape flat", |v| set_shape(v, GroomShape::Flat)),
+    knob("shape auto", |v| set_shape(v, GroomShape::Auto)),
     knob("basis linear", |v| set_basis(v, CurveBasis::Linear)),
     knob("basis bspline", |v| set_basis(v, CurveBasis::BSpline)),
     knob("strategy light", |v| set_strategy(v, Strategy::LightOnly)),
@@ -58,19 +58,7 @@ fn render(v: &mut Variant, edit: fn(&mut RenderDesc)) -> Result<()> {
     Ok(())
 }
 
-/// A curve shape by its scene-file name, read through the scene format itself, so that a
-/// shape exists here exactly when scene files accept it.
-fn shape_named(name: &str) -> Result<CurveShape> {
-    let text = format!(
-        "[materials.m]\ntype = \"diffuse\"\nalbedo = [1, 1, 1]\n\
-         [[groom]]\nprocedural = \"fur_ball\"\nmaterial = \"m\"\nshape = \"{name}\"\n"
-    );
-    let desc = SceneDescription::from_toml(&text, Path::new("."), "shape knob")?;
-    Ok(desc.grooms[0].shape)
-}
-
-fn set_shape(v: &mut Variant, name: &str) -> Result<()> {
-    let shape = shape_named(name)?;
+fn set_shape(v: &mut Variant, shape: GroomShape) -> Result<()> {
     v.desc.grooms.iter_mut().for_each(|g| g.shape = shape);
     Ok(())
 }
@@ -130,6 +118,11 @@ pub fn scene_names(ctx: &Context) -> Result<Vec<String>> {
 /// of the size.
 fn reference_variant(ctx: &Context, name: &str) -> Result<Variant> {
     let mut desc = bench_scene(ctx, name)?;
+    // Round tubes, the exact shape, whatever the scene's default: the shape knobs are
+    // measured against them.
+    desc.grooms
+        .iter_mut()
+        .for_each(|g| g.shape = GroomShape::Round);
     desc.render.filter = "box".into();
     desc.render.filter_radius = None;
     if ctx.quick {

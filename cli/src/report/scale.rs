@@ -68,7 +68,7 @@ fn scalp(
 ) -> Result<SceneDescription> {
     let mut desc = SceneDescription::from_file(&scalp_path(&ctx.scenes))?;
     for g in &mut desc.grooms {
-        (g.basis, g.shape) = (basis, shape);
+        (g.basis, g.shape) = (basis, shape.into());
         if let GroomSource::Scalp(s) = &mut g.source {
             s.strands = strands;
         }

@@ -17,6 +17,7 @@ use crate::bsdf::sigma_a_preset;
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
+use super::usd::is_usd_path;
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::{HairColor, HairMaterial};
 
@@ -466,6 +467,16 @@ impl RawGroom {
         let source = match (self.file, self.procedural) {
             (Some(file), None) => {
                 reject("a groom file", &[("params", self.params.is_some())])?;
+                if is_usd_path(&file) {
+                    reject(
+                        "a USD groom: each BasisCurves prim gives its own type, basis and wrap, \
+                         and its widths are diameters",
+                        &[
+                            ("basis", self.basis.is_some()),
+                            ("thickness", self.thickness.is_some()),
+                        ],
+                    )?;
+                }
                 GroomSource::File {
                     path: base_dir.join(file),
                     thickness: self.thickness.map(Thickness::from).unwrap_or_default(),

@@ -6,10 +6,11 @@
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
+use hairtrace::description::convert::{self, ConvertOptions, ConvertSource};
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, usd};
-use hairtrace::embree::Isa;
+use hairtrace::embree::{CurveBasis, Isa};
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::material::HairColor;
@@ -50,6 +51,28 @@ enum Command {
     /// Compare an image with a reference of the same size: RMSE, largest difference and
     /// both means over the RGB channels (one JSON line with --json).
     Compare(CompareArgs),
+    /// Convert grooms between .hair and USD BasisCurves: IN is a .hair file, a USD file, or
+    /// a scene file (.toml: its grooms in world space); OUT's extension picks the format
+    /// (.hair; .usda text, .usdc or .usd crate, .usdz).
+    Convert(ConvertArgs),
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    /// IN OUT, or only OUT with --demo.
+    #[arg(required = true, num_args = 1..=2, value_name = "IN OUT")]
+    files: Vec<PathBuf>,
+    /// A built-in scene's groom instead of a file: furball, furnace, scalp.
+    #[arg(long)]
+    demo: Option<String>,
+    /// The basis a .hair file's points are read with (as a scene's `basis`): bspline (the
+    /// default, as hairtrace renders a bare .hair), catmull_rom, bezier or linear. From USD,
+    /// linear samples cubic curves into polylines.
+    #[arg(long, default_value = "bspline", value_parser = parse_basis)]
+    basis: CurveBasis,
+    /// Read and write .hair thickness as a radius instead of a diameter (the default).
+    #[arg(long)]
+    thickness_is_radius: bool,
 }
 
 #[derive(Args)]
@@ -186,6 +209,10 @@ where
         .map_err(|e| format!("{s:?}: {e}"))?;
     v.try_into()
         .map_err(|_| format!("{s:?}: expected {N} comma-separated numbers"))
+}
+
+fn parse_basis(name: &str) -> Result<CurveBasis, String> {
+    convert::basis_named(name).map_err(|e| e.detail())
 }
 
 /// A named absorption preset's sigma_a.
@@ -505,6 +532,49 @@ fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
+fn convert_groom(args: &ConvertArgs) -> hairtrace::Result<()> {
+    let (source, output) = match (&args.demo, args.files.as_slice()) {
+        (Some(name), [out]) => (ConvertSource::Demo(name), out),
+        (None, [input, out]) => (ConvertSource::File(input), out),
+        (Some(_), _) => {
+            return Err(hairtrace::Error::InvalidArg(
+                "with --demo, give only OUT".into(),
+            ));
+        }
+        (None, _) => {
+            return Err(hairtrace::Error::InvalidArg(
+                "give IN and OUT (or --demo NAME and OUT)".into(),
+            ));
+        }
+    };
+    let opts = ConvertOptions {
+        basis: args.basis,
+        thickness: if args.thickness_is_radius {
+            Thickness::Radius
+        } else {
+            Thickness::Diameter
+        },
+    };
+    let spinner =
+        ProgressBar::new_spinner().with_message(format!("converting to {}", output.display()));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let result = convert::convert(source, output, &opts);
+    spinner.finish_and_clear();
+    let done = result?;
+    for note in &done.notes {
+        eprintln!("hairtrace: note: {note}");
+    }
+    eprintln!(
+        "{}: {} strands, {} points from {} groom{}",
+        output.display(),
+        done.strands,
+        done.points,
+        done.prims,
+        if done.prims == 1 { "" } else { "s" }
+    );
+    Ok(())
+}
+
 fn compare(args: &CompareArgs) -> hairtrace::Result<()> {
     let c = image::compare(
         &image::read_image(&args.image)?,
@@ -557,6 +627,7 @@ fn main() -> ExitCode {
         Command::Info(a) => info(a),
         Command::Compare(a) => compare(a),
         Command::Export(a) => export(a),
+        Command::Convert(a) => convert_groom(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

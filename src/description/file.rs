@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::usd::is_usd_path;
 use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
     MeshSource, RenderDesc, SceneDescription, Transform,
@@ -17,7 +18,6 @@ use crate::bsdf::sigma_a_preset;
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
-use super::usd::is_usd_path;
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::{HairColor, HairMaterial};
 

@@ -95,6 +95,7 @@
 //! entry and key (`scene.toml: groom[1].material: no material named "blond" ...`).
 
 mod build;
+pub mod convert;
 mod demos;
 mod file;
 pub mod pbrt;

@@ -1,7 +1,7 @@
 //! The hairtrace command line: `render` a scene file, a .hair groom or a built-in demo;
 //! `info` describes a .hair groom; `lobes` prints how a hair splits energy between its
 //! lobes; `compare` measures how far a render is from a reference; `export` writes a
-//! scene for a peer renderer.
+//! scene for a peer renderer; `convert` takes grooms between .hair and USD.
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;

@@ -9,7 +9,9 @@ use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 use hairtrace::description::convert::{self, ConvertOptions, ConvertSource};
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, usd};
+use hairtrace::description::{
+    self, BuiltScene, MaterialDesc, SceneDescription, has_extension, usd,
+};
 use hairtrace::embree::{CurveBasis, Isa};
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
@@ -506,11 +508,6 @@ fn peak_memory() -> String {
                 .map(|l| l[6..].trim().to_string())
         })
         .unwrap_or_else(|| "unknown".into())
-}
-
-fn has_extension(path: &std::path::Path, ext: &str) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {

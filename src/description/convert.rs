@@ -18,11 +18,11 @@
 
 use std::path::Path;
 
-use super::SceneDescription;
 use super::demos::demo;
 use super::usd::{
     CurvesToWrite, Layout, StageUnits, UsdCurves, Wrap, is_usd_path, read_usd_file, write_usd_file,
 };
+use super::{SceneDescription, has_extension};
 use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::Strands;
@@ -160,11 +160,6 @@ pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> R
         write_hair_file(output, &strands, opts.thickness)?;
     }
     Ok(converted)
-}
-
-fn has_extension(path: &Path, ext: &str) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
 /// The strand grooms of a scene, placed in world space, each with its basis.

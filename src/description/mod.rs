@@ -355,6 +355,12 @@ pub enum EnvironmentSource {
     },
 }
 
+/// Whether `path` ends in `.ext`, in any case.
+pub fn has_extension(path: &std::path::Path, ext: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
+}
+
 /// What a render needs, built from a description.
 pub struct BuiltScene {
     pub world: World,

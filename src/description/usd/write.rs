@@ -14,7 +14,7 @@ use std::path::Path;
 
 use openusd::sdf::{self, Value, Variability};
 use openusd::tf::Token;
-use openusd::usd::Stage;
+use openusd::usd::{Prim, Stage};
 
 use super::layout::{Layout, Wrap};
 use crate::embree::CurveBasis;
@@ -91,42 +91,39 @@ fn author(prims: &[CurvesToWrite], units: &StageUnits) -> Result<Stage> {
             Ok(())
         })
         .map_err(failed)?;
-    stage
-        .define_prim(sdf::path(&format!("/{ROOT_PRIM}")).map_err(failed)?)
-        .map_err(failed)?
-        .set_type_name("Xform")
-        .map_err(failed)?;
+    let define = |path: &str, kind: &str| -> Result<Prim> {
+        let path = sdf::path(path).map_err(failed)?;
+        let prim = stage.define_prim(path).map_err(failed)?;
+        prim.set_type_name(kind).map_err(failed)
+    };
+    define(&format!("/{ROOT_PRIM}"), "Xform")?;
     for p in prims {
-        let prim = stage
-            .define_prim(sdf::path(&format!("/{ROOT_PRIM}/{}", p.name)).map_err(failed)?)
-            .map_err(failed)?
-            .set_type_name("BasisCurves")
-            .map_err(failed)?;
-        let attr = |name: &str, ty: &str, v: Value| -> Result<openusd::usd::Attribute> {
-            Ok(prim
+        let prim = define(&format!("/{ROOT_PRIM}/{}", p.name), "BasisCurves")?;
+        // Schema attributes (custom = false), with an interpolation when given one.
+        let attr = |name: &str, ty: &str, v: Value, interp: Option<&'static str>| {
+            let a = prim
                 .create_attribute(Token::from(name), ty)
-                .map_err(failed)?
-                .set_custom(false)
-                .map_err(failed)?
-                .set(v)
-                .map_err(failed)?)
+                .map_err(failed)?;
+            let a = a.set_custom(false).and_then(|a| a.set(v)).map_err(failed)?;
+            match interp {
+                Some(i) => a
+                    .set_metadata("interpolation", Value::Token(Token::new(i)))
+                    .map_err(failed),
+                None => Ok(a),
+            }
         };
         let (kind, basis, wrap) = tokens(p.layout);
         for (name, token) in [("type", kind), ("basis", basis), ("wrap", wrap)] {
-            attr(name, "token", Value::Token(Token::new(token)))
-                .map_err(failed)?
+            attr(name, "token", Value::Token(Token::new(token)), None)?
                 .set_variability(Variability::Uniform)
                 .map_err(failed)?;
         }
-        let counts = p
-            .counts
-            .iter()
-            .map(|&c| i32::try_from(c))
-            .collect::<std::result::Result<Vec<_>, _>>()
-            .map_err(failed)?;
-        attr("curveVertexCounts", "int[]", Value::IntVec(counts)).map_err(failed)?;
+        let counts = (p.counts.iter())
+            .map(|&c| i32::try_from(c).map_err(failed))
+            .collect::<Result<Vec<_>>>()?;
+        attr("curveVertexCounts", "int[]", Value::IntVec(counts), None)?;
         let vec3 = |v: &[[f32; 3]]| Value::Vec3fVec(v.iter().map(|&p| p.into()).collect());
-        attr("points", "point3f[]", vec3(&p.points)).map_err(failed)?;
+        attr("points", "point3f[]", vec3(&p.points), None)?;
         let constant = p
             .widths
             .windows(2)
@@ -135,15 +132,14 @@ fn author(prims: &[CurvesToWrite], units: &StageUnits) -> Result<Stage> {
             Some(&w) if constant => (vec![w], "constant"),
             _ => (p.widths.clone(), "vertex"),
         };
-        attr("widths", "float[]", Value::FloatVec(widths))
-            .map_err(failed)?
-            .set_metadata("interpolation", Value::Token(Token::new(interp)))
-            .map_err(failed)?;
+        attr("widths", "float[]", Value::FloatVec(widths), Some(interp))?;
         if let Some(c) = &p.colors {
-            attr("primvars:displayColor", "color3f[]", vec3(c))
-                .map_err(failed)?
-                .set_metadata("interpolation", Value::Token(Token::new("vertex")))
-                .map_err(failed)?;
+            attr(
+                "primvars:displayColor",
+                "color3f[]",
+                vec3(c),
+                Some("vertex"),
+            )?;
         }
     }
     Ok(stage)

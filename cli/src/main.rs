@@ -54,8 +54,7 @@ enum Command {
     /// both means over the RGB channels (one JSON line with --json).
     Compare(CompareArgs),
     /// Convert grooms between .hair and USD BasisCurves: IN is a .hair file, a USD file, or
-    /// a scene file (.toml: its grooms in world space); OUT's extension picks the format
-    /// (.hair; .usda text, .usdc or .usd crate, .usdz).
+    /// a scene file (.toml: its grooms in world space); OUT is .hair or .usda.
     Convert(ConvertArgs),
 }
 

@@ -451,7 +451,7 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
     let (usda, hair, again) = (
         tmp("cli_convert.usda"),
         tmp("cli_convert.hair"),
-        tmp("cli_convert_again.usdc"),
+        tmp("cli_convert_again.usda"),
     );
     let o = hairtrace(&["convert", &scene, &usda]);
     assert!(o.status.success(), "{o:?}");
@@ -467,7 +467,7 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
     );
     assert!(hairtrace(&["convert", &usda, &hair]).status.success());
     assert!(stdout(&hairtrace(&["info", &hair])).contains("strands:  50\npoints:   350\n"));
-    // And round again, to a crate file, reads the same.
+    // And round again reads the same.
     assert!(hairtrace(&["convert", &hair, &again]).status.success());
     let info_again = stdout(&hairtrace(&["info", &again]));
     assert_eq!(info_again, info);

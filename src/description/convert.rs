@@ -78,13 +78,22 @@ struct Groom {
     basis: CurveBasis,
 }
 
-/// Converts the grooms of `source` into `output`, whose extension picks the format (`.hair`,
-/// or USD: `.usda` text, `.usdc`/`.usd` crate, `.usdz`). Errors name the file at fault.
+/// Converts the grooms of `source` into `output`, whose extension picks the format: `.hair`
+/// or `.usda` (USD text; crate files are refused, see [`write_usd_file`]). Errors name the
+/// file at fault.
 pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> Result<Converted> {
     let to_usd = is_usd_path(output);
     if !to_usd && !has_extension(output, "hair") {
         return Err(invalid_arg!(
-            "{}: unknown output extension: give .hair, .usda, .usdc, .usd or .usdz",
+            "{}: unknown output extension: give .hair or .usda",
+            output.display()
+        ));
+    }
+    if to_usd && !has_extension(output, "usda") {
+        return Err(invalid_arg!(
+            "{}: write .usda: the crate files (.usdc, .usd, .usdz) that openusd 0.6 writes are \
+             refused by Pixar's USD library (\"Invalid children found in primChildren\"); \
+             Pixar's `usdcat` turns a .usda into one",
             output.display()
         ));
     }

@@ -11,7 +11,8 @@
 //! hairtrace blends a `.hair` file's colours linearly between points: for pinned cubic curves
 //! usd-core's `ComputeVaryingDataSize` and Hydra count two values fewer per curve than the
 //! schema's segments + 1, so no size would be read the same everywhere.)
-//! The writer prints floats through f64, so every f32 reads back bit for bit.
+//! The writer prints floats through f64, so every f32 reads back bit for bit (a negative zero
+//! as 0: integral values are printed as integers).
 
 use std::path::Path;
 

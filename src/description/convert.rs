@@ -106,47 +106,7 @@ pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> R
         ));
     }
     let mut notes = Vec::new();
-    let grooms = match source {
-        ConvertSource::Demo(name) => scene_grooms(&demo(name)?)?,
-        ConvertSource::File(path) => {
-            std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
-            if is_usd_path(path) {
-                if to_usd {
-                    return Err(invalid_arg!(
-                        "{} and {} are both USD: nothing to convert",
-                        path.display(),
-                        output.display()
-                    ));
-                }
-                let stage = read_usd_file(path)?;
-                (stage.curves.iter())
-                    .map(|c| usd_groom(c, opts.basis, &mut notes))
-                    .collect::<Result<_>>()
-                    .map_err(|e| e.context(path.display()))?
-            } else if has_extension(path, "hair") {
-                if !to_usd {
-                    return Err(invalid_arg!(
-                        "{} and {} are both .hair: nothing to convert",
-                        path.display(),
-                        output.display()
-                    ));
-                }
-                vec![Groom {
-                    name: "groom0".into(),
-                    strands: read_hair_file(path, opts.thickness)?,
-                    basis: opts.basis,
-                }]
-            } else if has_extension(path, "toml") {
-                scene_grooms(&SceneDescription::from_file(path)?)?
-            } else {
-                return Err(invalid_arg!(
-                    "{}: unknown input extension: give .hair, a USD file (.usda, .usdc, .usd, \
-                     .usdz) or a scene file (.toml)",
-                    path.display()
-                ));
-            }
-        }
-    };
+    let grooms = read_grooms(source, output, opts, &mut notes)?;
     let mut converted = Converted {
         prims: grooms.len(),
         strands: grooms.iter().map(|g| g.strands.strand_count()).sum(),
@@ -169,6 +129,65 @@ pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> R
         write_hair_file(output, &strands, opts.thickness)?;
     }
     Ok(converted)
+}
+
+/// The grooms `source` holds, read for `output` (a USD input is for a `.hair` output and the
+/// other way round).
+fn read_grooms(
+    source: ConvertSource,
+    output: &Path,
+    opts: &ConvertOptions,
+    notes: &mut Vec<String>,
+) -> Result<Vec<Groom>> {
+    Ok(match source {
+        ConvertSource::Demo(name) => scene_grooms(&demo(name)?)?,
+        ConvertSource::File(path) => {
+            std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+            if is_usd_path(path) {
+                if is_usd_path(output) {
+                    return Err(invalid_arg!(
+                        "{} and {} are both USD: nothing to convert",
+                        path.display(),
+                        output.display()
+                    ));
+                }
+                let stage = read_usd_file(path)?;
+                if stage.up_axis != "Y" {
+                    notes.push(format!(
+                        "{}: the stage is {}-up; a .hair file has no up axis, and the points \
+                         are kept as authored",
+                        path.display(),
+                        stage.up_axis
+                    ));
+                }
+                (stage.curves.iter())
+                    .map(|c| usd_groom(c, opts.basis, notes))
+                    .collect::<Result<_>>()
+                    .map_err(|e| e.context(path.display()))?
+            } else if has_extension(path, "hair") {
+                if !is_usd_path(output) {
+                    return Err(invalid_arg!(
+                        "{} and {} are both .hair: nothing to convert",
+                        path.display(),
+                        output.display()
+                    ));
+                }
+                vec![Groom {
+                    name: "groom0".into(),
+                    strands: read_hair_file(path, opts.thickness)?,
+                    basis: opts.basis,
+                }]
+            } else if has_extension(path, "toml") {
+                scene_grooms(&SceneDescription::from_file(path)?)?
+            } else {
+                return Err(invalid_arg!(
+                    "{}: unknown input extension: give .hair, a USD file (.usda, .usdc, .usd, \
+                     .usdz) or a scene file (.toml)",
+                    path.display()
+                ));
+            }
+        }
+    })
 }
 
 /// The strand grooms of a scene, placed in world space, each with its basis.

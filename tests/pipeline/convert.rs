@@ -179,6 +179,12 @@ fn usd_to_hair_to_usd_keeps_the_curves() {
         let (a, b) = (read_usd_file(&src).unwrap(), read_usd_file(&usda).unwrap());
         same(&a.curves[0], &b.curves[0], case);
     }
+    // A Z-up stage keeps its points as authored, and a note says so.
+    let z_up = tmp("z_up.usda");
+    let text = std::fs::read_to_string(fixtures().join("case0.usda")).unwrap();
+    std::fs::write(&z_up, text.replace("upAxis = \"Y\"", "upAxis = \"Z\"")).unwrap();
+    let notes = run(&z_up, &tmp("z_up.hair"), "linear").unwrap();
+    assert!(notes.iter().any(|n| n.contains("Z-up")), "{notes:?}");
     // The linear prim of a nested, scaled and turned stage, in world space; the stage's
     // other prims have no colours, so none are written, and a note says so.
     let hair = tmp("all_bases_linear.hair");

@@ -74,6 +74,9 @@ struct ConvertArgs {
     /// Read and write .hair thickness as a radius instead of a diameter (the default).
     #[arg(long)]
     thickness_is_radius: bool,
+    /// Polyline segments per curve segment when --basis linear samples cubic USD curves.
+    #[arg(long, default_value_t = ConvertOptions::default().samples_per_segment)]
+    samples: u32,
 }
 
 #[derive(Args)]
@@ -550,6 +553,7 @@ fn convert_groom(args: &ConvertArgs) -> hairtrace::Result<()> {
         } else {
             Thickness::Diameter
         },
+        samples_per_segment: args.samples,
     };
     let spinner =
         ProgressBar::new_spinner().with_message(format!("converting to {}", output.display()));

@@ -13,8 +13,8 @@
 //!
 //! USD prims become `.hair` strands in world space when their curves are one of those forms
 //! for the chosen basis; with the linear basis, every cubic curve is sampled into a polyline
-//! of [`SAMPLES_PER_SEGMENT`] segments per curve segment. Any other prim is refused with the
-//! way out named, never approximated silently.
+//! of [`ConvertOptions::samples_per_segment`] segments per curve segment. Any other prim is
+//! refused with the way out named, never approximated silently.
 
 use std::path::Path;
 
@@ -27,11 +27,6 @@ use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::Strands;
 use crate::scene::hair_file::{Thickness, read_hair_file, write_hair_file};
-
-/// Polyline segments per curve segment when a cubic USD curve is written as linear `.hair`
-/// strands: the sampled points lie on the curve, the chords between them within about
-/// 1/500 of a segment's length of it for hair-like bends.
-pub const SAMPLES_PER_SEGMENT: usize = 8;
 
 /// Where the grooms come from.
 #[derive(Debug, Clone, Copy)]
@@ -49,13 +44,21 @@ pub struct ConvertOptions {
     /// `.hair` and a `[[groom]]` entry: B-spline).
     pub basis: CurveBasis,
     pub thickness: Thickness,
+    /// Polyline segments per curve segment when a cubic USD curve is written as linear
+    /// `.hair` strands (the sampled points lie on the curve); at least 1.
+    pub samples_per_segment: u32,
 }
+
+/// The default of [`ConvertOptions::samples_per_segment`]: chords within about 1/500 of a
+/// segment's length of the curve for hair-like bends.
+const SAMPLES_PER_SEGMENT: u32 = 8;
 
 impl Default for ConvertOptions {
     fn default() -> Self {
         ConvertOptions {
             basis: CurveBasis::BSpline,
             thickness: Thickness::Diameter,
+            samples_per_segment: SAMPLES_PER_SEGMENT,
         }
     }
 }
@@ -82,6 +85,9 @@ struct Groom {
 /// or `.usda` (USD text; crate files are refused, see [`write_usd_file`]). Errors name the
 /// file at fault.
 pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> Result<Converted> {
+    if opts.samples_per_segment == 0 {
+        return Err(invalid_arg!("samples per segment: must be at least 1"));
+    }
     let to_usd = is_usd_path(output);
     if !to_usd && !has_extension(output, "hair") {
         return Err(invalid_arg!(
@@ -161,7 +167,7 @@ fn read_grooms(
                     ));
                 }
                 (stage.curves.iter())
-                    .map(|c| usd_groom(c, opts.basis, notes))
+                    .map(|c| usd_groom(c, opts, notes))
                     .collect::<Result<_>>()
                     .map_err(|e| e.context(path.display()))?
             } else if has_extension(path, "hair") {
@@ -307,8 +313,8 @@ pub fn basis_named(name: &str) -> Result<CurveBasis> {
 
 /// One USD prim as polylines for `basis`: its own points when its curves are what `basis`
 /// draws through them, sampled curves when `basis` is linear, else an error.
-fn usd_groom(c: &UsdCurves, basis: CurveBasis, notes: &mut Vec<String>) -> Result<Groom> {
-    let layout = c.layout;
+fn usd_groom(c: &UsdCurves, opts: &ConvertOptions, notes: &mut Vec<String>) -> Result<Groom> {
+    let (layout, basis) = (c.layout, opts.basis);
     let exact = usd_layout(basis) == layout
         || (basis == CurveBasis::Linear && layout.basis == CurveBasis::Linear);
     if !exact && basis != CurveBasis::Linear {
@@ -328,9 +334,8 @@ fn usd_groom(c: &UsdCurves, basis: CurveBasis, notes: &mut Vec<String>) -> Resul
     }
     if !exact {
         notes.push(format!(
-            "{}: {:?} {:?} curves sampled into polylines, {SAMPLES_PER_SEGMENT} segments per \
-             curve segment",
-            c.path, layout.basis, layout.wrap
+            "{}: {:?} {:?} curves sampled into polylines, {} segments per curve segment",
+            c.path, layout.basis, layout.wrap, opts.samples_per_segment
         ));
     }
     if c.melanin.is_some() {
@@ -370,7 +375,14 @@ fn usd_groom(c: &UsdCurves, basis: CurveBasis, notes: &mut Vec<String>) -> Resul
                 _ => {}
             }
         } else {
-            sample_curve(layout.basis, ctl, segments, ends, &mut s);
+            sample_curve(
+                layout.basis,
+                ctl,
+                segments,
+                opts.samples_per_segment,
+                ends,
+                &mut s,
+            );
         }
         s.counts.push((s.points.len() - before) as u32);
         start += m as usize;
@@ -406,22 +418,24 @@ fn cubic_weights(basis: CurveBasis, t: f64) -> [f64; 4] {
 }
 
 /// Appends one cubic curve of Embree control points `ctl` to `out` as a polyline through
-/// the curve at [`SAMPLES_PER_SEGMENT`] steps per segment; colours (given at segment ends)
-/// are blended linearly, as the renderer blends them. A radius the basis takes to <= 0 (a
+/// the curve at `steps` steps per segment; colours (given at segment ends) are blended
+/// linearly, as the renderer blends them. A radius the basis takes to <= 0 (a
 /// Catmull-Rom overshoot) becomes the segment's smallest control radius.
 fn sample_curve(
     basis: CurveBasis,
     ctl: &[[f32; 4]],
     segments: usize,
+    steps: u32,
     ends: Option<&[[f32; 3]]>,
     out: &mut Strands,
 ) {
+    let steps = steps as usize;
     let stride = basis.segment_stride();
     for seg in 0..segments {
         let cp = &ctl[seg * stride..seg * stride + 4];
         let last = seg + 1 == segments;
-        for k in 0..SAMPLES_PER_SEGMENT + usize::from(last) {
-            let t = k as f64 / SAMPLES_PER_SEGMENT as f64;
+        for k in 0..steps + usize::from(last) {
+            let t = k as f64 / steps as f64;
             let w = cubic_weights(basis, t);
             let v: [f32; 4] = std::array::from_fn(|c| {
                 (0..4).map(|j| w[j] * f64::from(cp[j][c])).sum::<f64>() as f32

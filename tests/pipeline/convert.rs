@@ -5,9 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use hairtrace::description::convert::{
-    ConvertOptions, ConvertSource, SAMPLES_PER_SEGMENT, basis_named, convert,
-};
+use hairtrace::description::convert::{ConvertOptions, ConvertSource, basis_named, convert};
 use hairtrace::description::usd::{UsdCurves, read_usd_file};
 use hairtrace::embree::{CurveBasis, CurveShape};
 use hairtrace::scene::curves::Curves;
@@ -26,7 +24,7 @@ fn tmp(name: &str) -> PathBuf {
 fn opts(basis: &str) -> ConvertOptions {
     ConvertOptions {
         basis: basis_named(basis).unwrap(),
-        thickness: Thickness::Diameter,
+        ..ConvertOptions::default()
     }
 }
 
@@ -239,7 +237,7 @@ fn cubic_curves_are_sampled_for_linear_or_refused() {
     let notes = run(&src, &hair, "linear").unwrap();
     assert!(notes.iter().any(|n| n.contains("sampled")), "{notes:?}");
     let s = read_hair_file(&hair, Thickness::Diameter).unwrap();
-    let k = SAMPLES_PER_SEGMENT as u32;
+    let k = ConvertOptions::default().samples_per_segment;
     assert_eq!(s.counts, [k + 1, 3 * k + 1]);
     // The samples lie on the B-spline: its value at a segment's start and middle.
     let c = &read_usd_file(&src).unwrap().curves[0].control;
@@ -256,6 +254,20 @@ fn cubic_curves_are_sampled_for_linear_or_refused() {
         }
         assert!((s.radii[at] - want[3]).abs() < 1e-7);
     }
+    // The density is the caller's: 3 segments per curve segment; 0 is refused.
+    let three = ConvertOptions {
+        samples_per_segment: 3,
+        ..opts("linear")
+    };
+    convert(ConvertSource::File(&src), &hair, &three).unwrap();
+    let s = read_hair_file(&hair, Thickness::Diameter).unwrap();
+    assert_eq!(s.counts, [4, 10]);
+    let none = ConvertOptions {
+        samples_per_segment: 0,
+        ..opts("linear")
+    };
+    let m = convert(ConvertSource::File(&src), &hair, &none).unwrap_err();
+    assert!(m.to_string().contains("at least 1"), "{m}");
     // A whole stage of every basis and wrap goes to linear .hair; melanin has nowhere to go.
     let notes = run(&fixtures().join("all_bases.usdc"), &hair, "linear").unwrap();
     assert!(notes.iter().any(|n| n.contains("melanin")), "{notes:?}");

@@ -97,9 +97,8 @@ pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> R
     }
     if to_usd && !has_extension(output, "usda") {
         return Err(invalid_arg!(
-            "{}: write .usda: the crate files (.usdc, .usd, .usdz) that openusd 0.6 writes are \
-             refused by Pixar's USD library (\"Invalid children found in primChildren\"); \
-             Pixar's `usdcat` turns a .usda into one",
+            "{}: write .usda: Pixar's USD library cannot read the crate files (.usdc, .usd, \
+             .usdz) that openusd 0.6 writes; Pixar's `usdcat` turns a .usda into one",
             output.display()
         ));
     }

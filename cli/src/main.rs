@@ -1,17 +1,21 @@
 //! The hairtrace command line: `render` a scene file, a .hair groom or a built-in demo;
 //! `info` describes a .hair groom; `lobes` prints how a hair splits energy between its
 //! lobes; `compare` measures how far a render is from a reference; `export` writes a
-//! scene for a peer renderer; `report` measures speed against error and writes REPORT.md.
+//! scene for a peer renderer; `report` measures speed against error and writes REPORT.md;
+//! `convert` takes grooms between .hair and USD.
 
 mod report;
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
 use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
+use hairtrace::description::convert::{self, ConvertOptions, ConvertSource};
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, usd};
-use hairtrace::embree::Isa;
+use hairtrace::description::{
+    self, BuiltScene, MaterialDesc, SceneDescription, has_extension, usd,
+};
+use hairtrace::embree::{CurveBasis, Isa};
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::material::HairColor;
@@ -56,6 +60,9 @@ enum Command {
     /// with strand count, Blender Cycles if installed, a gallery) and write REPORT.md with
     /// its PNG plots.
     Report(ReportArgs),
+    /// Convert grooms between .hair and USD BasisCurves: IN is a .hair file, a USD file, or
+    /// a scene file (.toml: its grooms in world space); OUT is .hair or .usda.
+    Convert(ConvertArgs),
 }
 
 #[derive(Args)]
@@ -73,6 +80,27 @@ struct ReportArgs {
     /// running Blender Cycles.
     #[arg(long, value_name = "FILE.json")]
     peers: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    /// IN OUT, or only OUT with --demo.
+    #[arg(required = true, num_args = 1..=2, value_name = "IN OUT")]
+    files: Vec<PathBuf>,
+    /// A built-in scene's groom instead of a file: furball, furnace, scalp.
+    #[arg(long)]
+    demo: Option<String>,
+    /// The basis a .hair file's points are read with (as a scene's `basis`): bspline (the
+    /// default, as hairtrace renders a bare .hair), catmull_rom, bezier or linear. From USD,
+    /// linear samples cubic curves into polylines.
+    #[arg(long, default_value = "bspline", value_parser = parse_basis)]
+    basis: CurveBasis,
+    /// Read and write .hair thickness as a radius instead of a diameter (the default).
+    #[arg(long)]
+    thickness_is_radius: bool,
+    /// Polyline segments per curve segment when --basis linear samples cubic USD curves.
+    #[arg(long, default_value_t = ConvertOptions::default().samples_per_segment)]
+    samples: u32,
 }
 
 #[derive(Args)]
@@ -213,6 +241,10 @@ where
         .map_err(|e| format!("{s:?}: {e}"))?;
     v.try_into()
         .map_err(|_| format!("{s:?}: expected {N} comma-separated numbers"))
+}
+
+fn parse_basis(name: &str) -> Result<CurveBasis, String> {
+    convert::basis_named(name).map_err(|e| e.detail())
 }
 
 /// A named absorption preset's sigma_a.
@@ -518,11 +550,6 @@ fn peak_memory() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-fn has_extension(path: &std::path::Path, ext: &str) -> bool {
-    path.extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
-}
-
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     if has_extension(&args.file, "pbrt") {
         print!("{}", PbrtScene::from_file(&args.file)?.info_report());
@@ -539,6 +566,50 @@ fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     };
     let strands = read_hair_file(&args.file, thickness)?;
     print!("{}", info_report(&strands));
+    Ok(())
+}
+
+fn convert_groom(args: &ConvertArgs) -> hairtrace::Result<()> {
+    let (source, output) = match (&args.demo, args.files.as_slice()) {
+        (Some(name), [out]) => (ConvertSource::Demo(name), out),
+        (None, [input, out]) => (ConvertSource::File(input), out),
+        (Some(_), _) => {
+            return Err(hairtrace::Error::InvalidArg(
+                "with --demo, give only OUT".into(),
+            ));
+        }
+        (None, _) => {
+            return Err(hairtrace::Error::InvalidArg(
+                "give IN and OUT (or --demo NAME and OUT)".into(),
+            ));
+        }
+    };
+    let opts = ConvertOptions {
+        basis: args.basis,
+        thickness: if args.thickness_is_radius {
+            Thickness::Radius
+        } else {
+            Thickness::Diameter
+        },
+        samples_per_segment: args.samples,
+    };
+    let spinner =
+        ProgressBar::new_spinner().with_message(format!("converting to {}", output.display()));
+    spinner.enable_steady_tick(std::time::Duration::from_millis(200));
+    let result = convert::convert(source, output, &opts);
+    spinner.finish_and_clear();
+    let done = result?;
+    for note in &done.notes {
+        eprintln!("hairtrace: note: {note}");
+    }
+    eprintln!(
+        "{}: {} strands, {} points from {} groom{}",
+        output.display(),
+        done.strands,
+        done.points,
+        done.prims,
+        if done.prims == 1 { "" } else { "s" }
+    );
     Ok(())
 }
 
@@ -600,6 +671,7 @@ fn main() -> ExitCode {
             scenes: a.scenes.clone(),
             peers: a.peers.clone(),
         }),
+        Command::Convert(a) => convert_groom(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -434,3 +434,64 @@ fn info_and_render_read_usd() {
     .unwrap();
     assert_one_line_error(&hairtrace(&["info", &bad]), "cli_bad.usda");
 }
+
+/// A procedural groom goes to USD and back: `convert` takes a scene file or a demo, writes
+/// a stage that `info` reads, and the stage converts back to the same .hair strands; the
+/// summary names what was written; bad paths and extensions are one-line errors.
+#[test]
+fn convert_takes_a_procedural_groom_to_usd_and_back() {
+    let scene = tmp("cli_convert.toml");
+    std::fs::write(
+        &scene,
+        "[materials.h]\ntype = \"hair\"\nmelanin = [1, 0]\n\
+         [[groom]]\nprocedural = \"fur_ball\"\nmaterial = \"h\"\n\
+         [groom.params]\nstrands = 50\nsegments = 6\n",
+    )
+    .unwrap();
+    let (usda, hair, again) = (
+        tmp("cli_convert.usda"),
+        tmp("cli_convert.hair"),
+        tmp("cli_convert_again.usda"),
+    );
+    let o = hairtrace(&["convert", &scene, &usda]);
+    assert!(o.status.success(), "{o:?}");
+    let said = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        said.contains("50 strands, 350 points from 1 groom"),
+        "{said}"
+    );
+    let info = stdout(&hairtrace(&["info", &usda]));
+    assert!(
+        info.contains("prim /Groom/groom0 (BSpline, Pinned)\n  strands:  50\n  points:   350"),
+        "{info}"
+    );
+    assert!(hairtrace(&["convert", &usda, &hair]).status.success());
+    assert!(stdout(&hairtrace(&["info", &hair])).contains("strands:  50\npoints:   350\n"));
+    // And round again reads the same.
+    assert!(hairtrace(&["convert", &hair, &again]).status.success());
+    let info_again = stdout(&hairtrace(&["info", &again]));
+    assert_eq!(info_again, info);
+    // A demo's groom, by name.
+    let demo = tmp("cli_convert_demo.usda");
+    assert!(
+        hairtrace(&["convert", "--demo", "furnace", &demo])
+            .status
+            .success()
+    );
+    assert!(stdout(&hairtrace(&["info", &demo])).contains("strands:  10000"));
+    for (args, needle) in [
+        (vec![scene.as_str(), "out.obj"], "unknown output extension"),
+        (vec!["missing.hair", usda.as_str()], "missing.hair"),
+        (
+            vec!["--demo", "furnace", &scene, &usda],
+            "with --demo, give only OUT",
+        ),
+        (vec![usda.as_str(), "/no/such/dir/x.hair"], "does not exist"),
+        (vec!["--basis", "cubic", &hair, &usda], "unknown basis"),
+        (vec![&usd_fixture("case4.usda"), &hair], "--basis linear"),
+    ] {
+        let mut all = vec!["convert"];
+        all.extend(args);
+        assert_one_line_error(&hairtrace(&all), needle);
+    }
+}

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::usd::is_usd_path;
 use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
     MeshSource, RenderDesc, SceneDescription, Transform,
@@ -469,6 +470,16 @@ impl RawGroom {
         let source = match (self.file, self.procedural) {
             (Some(file), None) => {
                 reject("a groom file", &[("params", self.params.is_some())])?;
+                if is_usd_path(&file) {
+                    reject(
+                        "a USD groom: each BasisCurves prim gives its own type, basis and wrap, \
+                         and its widths are diameters",
+                        &[
+                            ("basis", self.basis.is_some()),
+                            ("thickness", self.thickness.is_some()),
+                        ],
+                    )?;
+                }
                 GroomSource::File {
                     path: base_dir.join(file),
                     thickness: self.thickness.map(Thickness::from).unwrap_or_default(),

@@ -95,6 +95,7 @@
 //! entry and key (`scene.toml: groom[1].material: no material named "blond" ...`).
 
 mod build;
+pub mod convert;
 mod demos;
 mod file;
 pub mod pbrt;
@@ -353,6 +354,12 @@ pub enum EnvironmentSource {
         height: usize,
         rgb: Vec<f32>,
     },
+}
+
+/// Whether `path` ends in `.ext`, in any case.
+pub fn has_extension(path: &std::path::Path, ext: &str) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
 /// What a render needs, built from a description.

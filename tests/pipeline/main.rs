@@ -6,6 +6,7 @@
 
 mod architecture;
 mod camera_film;
+mod convert;
 mod curves_geometry;
 mod description;
 mod farm;

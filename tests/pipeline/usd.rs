@@ -309,6 +309,32 @@ fn scene_files_take_usd_grooms() {
     assert!((eyes[1].x - eyes[0].x - 5.0).abs() < 1e-3, "{eyes:?}");
 }
 
+/// A USD groom says its own basis and its widths are diameters: the `[[groom]]` keys that
+/// would say otherwise for a .hair file are refused, naming the key, not silently ignored.
+#[test]
+fn scene_files_refuse_hair_keys_on_usd_grooms() {
+    for key in ["basis = \"linear\"", "thickness = \"radius\""] {
+        let toml = format!(
+            "[materials.h]\ntype = \"hair\"\nmelanin = [0.5, 0.1]\n\
+             [[groom]]\nfile = \"all_bases.usda\"\nmaterial = \"h\"\n{key}\n"
+        );
+        let m = SceneDescription::from_toml(&toml, &fixtures(), "usd.toml")
+            .unwrap_err()
+            .to_string();
+        let name = key.split(' ').next().unwrap();
+        assert!(
+            m.contains(&format!("groom[0].{name}")) && m.contains("does not apply to a USD groom"),
+            "{m}"
+        );
+    }
+    // The keys that do apply (shape, radius_scale, placement) are still taken.
+    let toml = "[materials.h]\ntype = \"hair\"\nmelanin = [0.5, 0.1]\n\
+                [[groom]]\nfile = \"all_bases.usda\"\nmaterial = \"h\"\nshape = \"flat\"\n\
+                radius_scale = 2.0\nscale = 3.0\n";
+    let desc = SceneDescription::from_toml(toml, &fixtures(), "usd.toml").unwrap();
+    assert_eq!(desc.grooms[0].radius_scale, 2.0);
+}
+
 /// `primvars:melanin` (eumelanin per curve) becomes a strand colour that the renderer's
 /// colour-to-absorption fit, at the material's beta_n, turns back into the melanin's sigma_a.
 #[test]

@@ -5,6 +5,7 @@
 
 mod layout;
 mod prim;
+mod write;
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -17,6 +18,7 @@ use crate::error::{Error, Result, invalid_arg};
 use crate::scene::curves::Curves;
 
 pub use layout::{Interpolation, Layout, Wrap};
+pub use write::{CurvesToWrite, ROOT_PRIM, StageUnits, write_usd_file};
 
 /// Bytes a USD file may have: the reader keeps the whole stage in memory.
 const MAX_FILE_BYTES: u64 = 1 << 32;
@@ -54,6 +56,9 @@ pub struct UsdCurves {
     pub control_counts: Vec<u32>,
     /// `primvars:displayColor` at every segment end (segments + 1 per curve), if authored.
     pub colors: Option<Vec<[f32; 3]>>,
+    /// `primvars:displayColor` at every authored point, if authored with `constant`,
+    /// `uniform` or `vertex` interpolation (what a `.hair` file holds per point).
+    pub point_colors: Option<Vec<[f32; 3]>>,
     /// `primvars:melanin`: the eumelanin concentration of each curve, if authored.
     pub melanin: Option<Vec<f32>>,
 }

@@ -307,6 +307,8 @@ pub(super) fn read_basis_curves(
     let mut control = Vec::with_capacity(control_total);
     let mut control_counts = Vec::with_capacity(counts.len());
     let mut out_colors = colors.as_ref().map(|_| Vec::new());
+    let mut point_colors =
+        (colors.is_some() && color_interp != Interpolation::Varying).then(Vec::new);
     let (mut vertex_start, mut varying_start) = (0, 0);
     let mut pos = Vec::new();
     let mut radii = Vec::new();
@@ -353,6 +355,9 @@ pub(super) fn read_basis_curves(
                     }
                 }
                 _ => {
+                    if let Some(p) = &mut point_colors {
+                        p.extend_from_slice(&v);
+                    }
                     let mut ext = Vec::new();
                     layout.extend(&v, &mut ext, |c, _| c.map(|x| x.clamp(0.0, 1.0)));
                     layout.segment_ends(&ext, s, out);
@@ -381,6 +386,7 @@ pub(super) fn read_basis_curves(
         control,
         control_counts,
         colors: out_colors,
+        point_colors,
         melanin,
     })
 }

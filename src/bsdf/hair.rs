@@ -17,7 +17,7 @@ use super::params::HairParams;
 use super::{BsdfEval, BsdfSample, LocalBsdf};
 use crate::error::{Result, invalid_arg};
 use crate::math::fast::atan2;
-use crate::math::{Lanes, safe_asin, safe_sqrt};
+use crate::math::{Lanes, cos_from_sin, safe_asin, safe_sqrt};
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_PI, PI, TAU};
 use wide::{f32x4, f32x8};
@@ -172,7 +172,7 @@ impl HairBsdf {
         let zero = T::splat(0.0);
         let h = h.max(-one).min(one);
         let sin_to = wo[0].max(-one).min(one);
-        let cos_to = safe_sqrt(one - sin_to * sin_to);
+        let cos_to = cos_from_sin(sin_to);
         let tilt = |p: usize| {
             let (s, c) = (T::splat(self.tilt[p].0), T::splat(self.tilt[p].1));
             (sin_to * c + cos_to * s, (cos_to * c - sin_to * s).abs())
@@ -183,22 +183,25 @@ impl HairBsdf {
         // written this way it never divides by cos to, which is 0 along the tangent.
         let eta = T::splat(self.params.eta);
         let sin_gt = h * cos_to / (eta * eta - sin_to * sin_to).sqrt();
-        let cos_gt = safe_sqrt(one - sin_gt * sin_gt);
+        let cos_gt = cos_from_sin(sin_gt);
         let gamma_t = safe_asin(sin_gt);
         let gamma_o = safe_asin(h);
         let sin_tt = sin_to / eta;
-        let cos_tt = safe_sqrt(one - sin_tt * sin_tt);
+        let cos_tt = cos_from_sin(sin_tt);
         let path = T::splat(2.0) * cos_gt / cos_tt;
         let sigma = self.params.sigma_a.map(T::splat);
         let transmit = T::exp_neg3([0, 1, 2].map(|c| -(sigma[c] * path)));
 
-        let fr = fresnel_dielectric(cos_to * safe_sqrt(one - h * h), eta);
+        // Near grazing incidence F is within a few ulps of 1, so 1 - F is taken from the
+        // Fresnel formulas directly rather than by subtraction.
+        let (fr, ft) = fresnel_dielectric(cos_to * cos_from_sin(h), eta);
         let lobes = |t: T| {
-            let tt = (one - fr) * (one - fr) * t;
+            let tt = ft * ft * t;
             let trt = tt * t * fr;
-            // Residual sum of p >= 3: trt * t f / (1 - t f). When t f reaches 1 (no
-            // absorption at grazing Fresnel = 1) the numerator is 0 too and the limit is 0.
-            let denom = one - t * fr;
+            // Residual sum of p >= 3: trt * t f / (1 - t f), with 1 - t f = (1 - t) + t (1 - f)
+            // free of the cancellation of 1 - f. When it is 0 (no absorption at grazing
+            // Fresnel = 1) the numerator is 0 too and the limit is 0.
+            let denom = (one - t) + t * ft;
             let residual = T::branch(denom.gt(zero), || trt * t * fr / denom, || zero);
             [fr, tt, trt, residual]
         };
@@ -229,7 +232,7 @@ impl HairBsdf {
     fn eval_lobes<T: Lanes>(&self, o: &Outgoing<T>, wo: [T; 3], wi: [T; 3]) -> ([T; 3], T) {
         let one = T::splat(1.0);
         let sin_ti = wi[0].max(-one).min(one);
-        let cos_ti = safe_sqrt(one - sin_ti * sin_ti);
+        let cos_ti = cos_from_sin(sin_ti);
         // phi_i - phi_o from the yz components directly: one atan2, defined along the tangent.
         let phi = atan2(wo[1] * wi[2] - wo[2] * wi[1], wo[1] * wi[1] + wo[2] * wi[2]);
 
@@ -259,7 +262,7 @@ impl HairBsdf {
     #[inline(always)]
     fn eval_lobes_packed(&self, o: &Outgoing<f32>, wo: [f32; 3], wi: [f32; 3]) -> ([f32; 3], f32) {
         let sin_ti = wi[0].clamp(-1.0, 1.0);
-        let cos_ti = safe_sqrt(1.0 - sin_ti * sin_ti);
+        let cos_ti = cos_from_sin(sin_ti);
         let phi = atan2(wo[1] * wi[2] - wo[2] * wi[1], wo[1] * wi[1] + wo[2] * wi[2]);
 
         let [(s0, c0), (s1, c1), (s2, c2)] = o.tilted;
@@ -435,23 +438,36 @@ const U_MIN: f32 = 1.0 / 33_554_432.0;
 /// The largest f32 below one.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Unpolarised Fresnel reflectance from outside into a dielectric of index eta > 1 at
-/// incidence cosine cos_i in [0, 1]; 1 at grazing incidence, never divides by zero.
+/// Unpolarised Fresnel reflectance F from outside into a dielectric of index eta > 1 at
+/// incidence cosine cos_i in [0, 1], and its complement 1 - F computed on its own: near
+/// grazing incidence F is within a few ulps of 1 and 1 - F by subtraction would keep
+/// none of its digits. F is 1 and 1 - F is 0 at grazing incidence; never divides by zero.
 /// Written with e = eta^2 - 1 = (eta - 1)(eta + 1) factored out of both amplitudes, so that
 /// an index just above 1 keeps its precision instead of cancelling in (eta c - cos t).
 #[inline(always)]
-fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> T {
+fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> (T, T) {
     let one = T::splat(1.0);
     let e = (eta - one) * (eta + one);
     let q = e.sqrt();
     let c2 = cos_i * cos_i;
-    // eta cos_t = sqrt(eta^2 - sin_i^2) by Snell's law. At grazing incidence it is q
+    // w = eta cos_t = sqrt(eta^2 - sin_i^2) by Snell's law. At grazing incidence it is q
     // exactly, so both ratios below are exactly 1 and F is exactly 1 (no leak into 1 - F).
-    let eta_cos_t = (e + c2).sqrt();
-    let perp = q / (cos_i + eta_cos_t);
+    let w = (e + c2).sqrt();
+    let inv_perp = one / (cos_i + w);
+    let inv_par = one / (eta * eta * cos_i + w);
+    // Amplitudes with e factored out: r_perp = (c - w) / (c + w) = -e / (c + w)^2 and
+    // r_par = (eta^2 c - w) / (eta^2 c + w) = e ((e + 2) c^2 - 1) / (eta^2 c + w)^2.
+    let perp = q * inv_perp;
     let r_perp = perp * perp;
-    let par = q / (eta * eta * cos_i + eta_cos_t);
+    let par = q * inv_par;
     let r_par = par * par * ((e + T::splat(2.0)) * c2 - one);
     // Rounding can lift the grazing value just above 1, which would leak into 1 - F.
-    (T::splat(0.5) * (r_par * r_par + r_perp * r_perp)).min(one)
+    let f = (T::splat(0.5) * (r_par * r_par + r_perp * r_perp)).min(one);
+    // 1 - r^2 = 4 c w / (c + w)^2 for perp and 4 eta^2 c w / (eta^2 c + w)^2 for par.
+    let eta2 = eta * eta;
+    let t = T::splat(2.0)
+        * cos_i
+        * w
+        * (inv_perp * inv_perp + eta2 * inv_par * inv_par);
+    (f, t.min(one))
 }

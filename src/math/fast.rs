@@ -1,6 +1,6 @@
-//! exp, asin and atan2 (and ln, for the samplers) for the BSDF's hot path, written once over [`Lanes`] so that the
+//! exp and atan2 (and ln, for the samplers) for the BSDF's hot path, written once over [`Lanes`] so that the
 //! scalar and the batched evaluation compute the same bits. They use the classic range
-//! reductions with short polynomials (Cephes' coefficients for asin and atan, the Taylor
+//! reductions with short polynomials (Cephes' coefficients for atan, the Taylor
 //! series of e^r on |r| <= ln2/2) and cost no function call: about 2 ulp, measured
 //! against f64 in the unit tests below.
 
@@ -35,25 +35,6 @@ pub(crate) fn exp_neg<T: Lanes>(x: T) -> T {
                     + r * (c(1.0 / 24.0)
                         + r * (c(1.0 / 120.0) + r * (c(1.0 / 720.0) + r * c(1.0 / 5040.0)))))));
     T::select(x.lt(c(LOWEST)), c(0.0), p * n.pow2i())
-}
-
-/// asin(x) for x in [-1, 1].
-#[inline(always)]
-pub fn asin<T: Lanes>(x: T) -> T {
-    let c = T::splat;
-    let a = x.abs();
-    let big = a.gt(c(0.5));
-    // Above 1/2: asin(a) = pi/2 - 2 asin(sqrt((1 - a) / 2)).
-    let z = T::select(big, c(0.5) * (c(1.0) - a), a * a);
-    let s = T::select(big, z.sqrt(), a);
-    let p = ((((c(4.216_32e-2) * z + c(2.418_131_1e-2)) * z + c(4.547_002_6e-2)) * z
-        + c(7.495_300_3e-2))
-        * z
-        + c(1.666_675_2e-1))
-        * z
-        * s
-        + s;
-    T::select(big, c(FRAC_PI_2) - c(2.0) * p, p).copysign(x)
 }
 
 /// atan2(y, x) with the conventions of `f32::atan2`, signed zeros included.
@@ -129,19 +110,6 @@ mod tests {
     }
 
     #[test]
-    fn asin_is_accurate() {
-        let mut worst = 0.0f64;
-        for i in 0..=200_000 {
-            let x = -1.0 + 2.0 * i as f32 / 200_000.0;
-            let want = f64::from(x).asin();
-            worst = worst.max((f64::from(asin(x)) - want).abs() / want.abs().max(1e-3));
-        }
-        assert!(worst < 3e-7, "asin worst error {worst}");
-        assert_eq!(asin(1.0f32), FRAC_PI_2);
-        assert_eq!(asin(0.0f32), 0.0);
-    }
-
-    #[test]
     fn atan2_is_accurate_in_every_quadrant() {
         let mut worst = 0.0f64;
         for i in 0..2000 {
@@ -205,11 +173,9 @@ mod tests {
         let xs: [f32; 8] = [-0.0, -1e-8, -0.3, -1.0, -17.5, -60.0, -87.2, -90.0];
         let ys: [f32; 8] = [0.0, -0.0, 0.3, -0.7, 1.0, -1.0, 0.999, 0.5];
         let e = exp_neg(f32x8::new(xs)).to_array();
-        let a = asin(f32x8::new(ys)).to_array();
         let t = atan2(f32x8::new(ys), f32x8::new(xs)).to_array();
         for k in 0..8 {
             assert_eq!(e[k].to_bits(), exp_neg(xs[k]).to_bits());
-            assert_eq!(a[k].to_bits(), asin(ys[k]).to_bits());
             assert_eq!(t[k].to_bits(), atan2(ys[k], xs[k]).to_bits());
         }
     }

@@ -49,14 +49,14 @@ struct Outgoing<T> {
     cos_to: T,
     /// (sin, |cos|) of theta_o shifted by each explicit lobe's cuticle tilt.
     tilted: [(T, T); EXPLICIT_LOBES],
-    /// Where each explicit lobe is centred in azimuth, as a unit (y, z) direction: wo's
+    /// Where each explicit lobe is centred in azimuth, as a (y, z) direction: wo's
     /// azimuth turned by the deflection Phi(p) = 2 p gamma_t - 2 gamma_o + p pi. Kept as a
     /// direction rather than an angle, the offset of wi from it comes from one atan2 of
     /// small cross and dot products, accurate to a few ulps of the offset itself; going
     /// through angles near pi (phi_i - phi_o, 2 gamma_o, pi) costs ulps of pi (2.4e-7 rad),
     /// which a narrow logistic (s = 0.0017) turns into 1.4e-4 relative per ulp.
     centre: [(T, T); EXPLICIT_LOBES],
-    /// wo's own azimuth as a unit (y, z) direction (see [`azimuth_o`]).
+    /// wo's own azimuth as a (y, z) direction (see [`azimuth_o`]).
     azimuth: (T, T),
     /// Attenuation Ap per lobe and channel.
     ap: [[T; 3]; 4],
@@ -406,10 +406,11 @@ impl HairBsdf {
             (o.azimuth, TAU * u_phi)
         };
         let (sin_d, cos_d) = dphi.sin_cos();
+        let scale = cos_ti / (base.0 * base.0 + base.1 * base.1).sqrt();
         let wi = Vec3::new(
             sin_ti,
-            cos_ti * (base.0 * cos_d - base.1 * sin_d),
-            cos_ti * (base.1 * cos_d + base.0 * sin_d),
+            scale * (base.0 * cos_d - base.1 * sin_d),
+            scale * (base.1 * cos_d + base.0 * sin_d),
         );
         let e = self.eval_at(at, wi);
         (e.pdf > 0.0).then_some(BsdfSample {
@@ -476,22 +477,28 @@ fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> (T, T) {
     (f, t.min(one))
 }
 
-/// The unit (y, z) direction of wo's azimuth; (1, 0) along the tangent, which has none
-/// (evaluation and sampling then share that convention). Scaled by the larger component
-/// first so that tiny components neither underflow nor lose digits when squared.
+/// wo's azimuth as a (y, z) direction of length 1e-4 to sqrt(2); (1, 0) along the tangent,
+/// which has none (evaluation and sampling then share that convention). Lengths do not
+/// matter to the offsets (atan2 of products), but tiny components are scaled up so that
+/// their products with wi's cannot underflow.
 #[inline(always)]
 fn azimuth_o<T: Lanes>(wo: [T; 3]) -> (T, T) {
     let (one, zero) = (T::splat(1.0), T::splat(0.0));
     let m = wo[1].abs().max(wo[2].abs());
     let defined = m.gt(zero);
-    let inv_m = one / T::select(defined, m, one);
-    let (y, z) = (
-        T::select(defined, wo[1] * inv_m, one),
-        T::select(defined, wo[2] * inv_m, zero),
+    let scale = T::branch(
+        m.lt(T::splat(MIN_AZIMUTH_O)),
+        || one / T::select(defined, m, one),
+        || one,
     );
-    let inv_len = one / (y * y + z * z).sqrt();
-    (y * inv_len, z * inv_len)
+    (
+        T::select(defined, wo[1] * scale, one),
+        T::select(defined, wo[2] * scale, zero),
+    )
 }
+
+/// Below this largest yz component, wo's azimuth is rescaled (see [`azimuth_o`]).
+const MIN_AZIMUTH_O: f32 = 1e-4;
 
 /// Below this |wi.y| and |wi.z|, wi is taken to be along the tangent: its azimuth is
 /// meaningless (and products with it could underflow), so it is given wo's.
@@ -509,7 +516,7 @@ fn azimuth_i<T: Lanes>(azimuth_o: (T, T), wi: [T; 3]) -> (T, T) {
 }
 
 /// Signed azimuthal offset in [-pi, pi] of the direction (y, z) from a lobe centred at the
-/// unit direction (cy, cz): one atan2 of their cross and dot products.
+/// direction (cy, cz): one atan2 of their cross and dot products.
 #[inline(always)]
 fn offset<T: Lanes>(cy: T, cz: T, y: T, z: T) -> T {
     atan2(cy * z - cz * y, cy * y + cz * z)

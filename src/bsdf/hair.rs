@@ -225,13 +225,13 @@ impl HairBsdf {
         );
         let mul = |a: (T, T), b: (T, T)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
         let azimuth = azimuth_o(wo);
-        let r = mul(azimuth, turn_o);
-        let tt_centre = mul(r, turn_t);
+        let r_centre = mul(azimuth, turn_o);
+        let tt_centre = mul(r_centre, turn_t);
         Outgoing {
             sin_to,
             cos_to,
             tilted,
-            centre: [r, tt_centre, mul(tt_centre, turn_t)],
+            centre: [r_centre, tt_centre, mul(tt_centre, turn_t)],
             azimuth,
             ap,
             lobe_pdf: [0, 1, 2, 3].map(|p| mean(p) * inv_total),

@@ -2,7 +2,7 @@
 //! deflection angle, trimmed to [-pi, pi] and renormalised there.
 
 use crate::math::Lanes;
-use crate::math::fast::{exp_neg, ln, round};
+use crate::math::fast::{exp_neg, ln};
 use std::f32::consts::PI;
 
 /// Azimuthal logistic scale for roughness beta_n (Chiang et al. 2016, eq. 8).
@@ -55,11 +55,4 @@ impl TrimmedLogistic {
         let q = self.cdf_lo + (1.0 - u) * self.mass;
         (self.s * ln(p / q)).clamp(-PI, PI)
     }
-}
-
-/// Wraps an angle into [-pi, pi].
-#[inline(always)]
-pub(crate) fn wrap_angle<T: Lanes>(x: T) -> T {
-    let tau = T::splat(std::f32::consts::TAU);
-    x - tau * round(x * T::splat(1.0 / std::f32::consts::TAU))
 }

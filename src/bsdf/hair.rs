@@ -7,19 +7,19 @@
 //!
 //! Work is split by what it depends on: [`HairBsdf::new`] computes everything that
 //! depends on the parameters alone; `Outgoing` what depends on (h, wo) (Fresnel,
-//! absorption, deflection angles), shared by sampling and evaluation; the per-wi part is
+//! absorption, the lobes' azimuthal centres), shared by sampling and evaluation; the per-wi part is
 //! the four lobes. Both stages are generic over [`Lanes`], so `eval_batch` runs the same
 //! code eight inputs at a time.
 
-use super::azimuthal::{TrimmedLogistic, azimuthal_scale, wrap_angle};
+use super::azimuthal::{TrimmedLogistic, azimuthal_scale};
 use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
 use super::params::HairParams;
 use super::{BsdfEval, BsdfSample, LocalBsdf};
 use crate::error::{Result, invalid_arg};
 use crate::math::fast::atan2;
-use crate::math::{Lanes, safe_asin, safe_sqrt};
+use crate::math::{Lanes, cos_from_sin};
 use glam::Vec3;
-use std::f32::consts::{FRAC_1_PI, PI, TAU};
+use std::f32::consts::{FRAC_1_PI, TAU};
 use wide::{f32x4, f32x8};
 
 /// Number of explicit lobes (R, TT, TRT); the residual lobe comes after them.
@@ -49,8 +49,15 @@ struct Outgoing<T> {
     cos_to: T,
     /// (sin, |cos|) of theta_o shifted by each explicit lobe's cuticle tilt.
     tilted: [(T, T); EXPLICIT_LOBES],
-    /// Azimuthal deflection Phi(p) = 2 p gamma_t - 2 gamma_o + p pi of each explicit lobe.
-    deflection: [T; EXPLICIT_LOBES],
+    /// Where each explicit lobe is centred in azimuth, as a (y, z) direction: wo's
+    /// azimuth turned by the deflection Phi(p) = 2 p gamma_t - 2 gamma_o + p pi. Kept as a
+    /// direction rather than an angle, the offset of wi from it comes from one atan2 of
+    /// small cross and dot products, accurate to a few ulps of the offset itself; going
+    /// through angles near pi (phi_i - phi_o, 2 gamma_o, pi) costs ulps of pi (2.4e-7 rad),
+    /// which a narrow logistic (s = 0.0017) turns into 1.4e-4 relative per ulp.
+    centre: [(T, T); EXPLICIT_LOBES],
+    /// wo's own azimuth as a (y, z) direction (see [`azimuth_o`]).
+    azimuth: (T, T),
     /// Attenuation Ap per lobe and channel.
     ap: [[T; 3]; 4],
     /// Probability of sampling each lobe: its mean attenuation over the total.
@@ -89,10 +96,8 @@ impl HairBsdf {
 
     /// The (h, wo) part of a point, without the reference back to the BSDF.
     fn vertex(&self, h: f32, wo: Vec3) -> Vertex {
-        let wo = wo.to_array();
         Vertex {
-            wo,
-            o: self.outgoing(h, wo),
+            o: self.outgoing(h, wo.to_array()),
         }
     }
 
@@ -153,7 +158,7 @@ impl HairBsdf {
             let wov = [0, 1, 2].map(|c| gather(wo, c));
             let wiv = [0, 1, 2].map(|c| gather(wi, c));
             let o = self.outgoing(hv, wov);
-            let (fv, pv) = self.eval_lobes(&o, wov, wiv);
+            let (fv, pv) = self.eval_lobes(&o, wiv);
             let fa = fv.map(f32x8::to_array);
             let pa = pv.to_array();
             for k in 0..len {
@@ -172,7 +177,7 @@ impl HairBsdf {
         let zero = T::splat(0.0);
         let h = h.max(-one).min(one);
         let sin_to = wo[0].max(-one).min(one);
-        let cos_to = safe_sqrt(one - sin_to * sin_to);
+        let cos_to = cos_from_sin(sin_to);
         let tilt = |p: usize| {
             let (s, c) = (T::splat(self.tilt[p].0), T::splat(self.tilt[p].1));
             (sin_to * c + cos_to * s, (cos_to * c - sin_to * s).abs())
@@ -183,22 +188,24 @@ impl HairBsdf {
         // written this way it never divides by cos to, which is 0 along the tangent.
         let eta = T::splat(self.params.eta);
         let sin_gt = h * cos_to / (eta * eta - sin_to * sin_to).sqrt();
-        let cos_gt = safe_sqrt(one - sin_gt * sin_gt);
-        let gamma_t = safe_asin(sin_gt);
-        let gamma_o = safe_asin(h);
+        let cos_gt = cos_from_sin(sin_gt);
         let sin_tt = sin_to / eta;
-        let cos_tt = safe_sqrt(one - sin_tt * sin_tt);
+        let cos_tt = cos_from_sin(sin_tt);
         let path = T::splat(2.0) * cos_gt / cos_tt;
         let sigma = self.params.sigma_a.map(T::splat);
         let transmit = T::exp_neg3([0, 1, 2].map(|c| -(sigma[c] * path)));
 
-        let fr = fresnel_dielectric(cos_to * safe_sqrt(one - h * h), eta);
+        // Near grazing incidence F is within a few ulps of 1, so 1 - F is taken from the
+        // Fresnel formulas directly rather than by subtraction.
+        let cos_go = cos_from_sin(h);
+        let (fr, ft) = fresnel_dielectric(cos_to * cos_go, eta);
         let lobes = |t: T| {
-            let tt = (one - fr) * (one - fr) * t;
+            let tt = ft * ft * t;
             let trt = tt * t * fr;
-            // Residual sum of p >= 3: trt * t f / (1 - t f). When t f reaches 1 (no
-            // absorption at grazing Fresnel = 1) the numerator is 0 too and the limit is 0.
-            let denom = one - t * fr;
+            // Residual sum of p >= 3: trt * t f / (1 - t f), with 1 - t f = (1 - t) + t (1 - f)
+            // free of the cancellation of 1 - f. When it is 0 (no absorption at grazing
+            // Fresnel = 1) the numerator is 0 too and the limit is 0.
+            let denom = (one - t) + t * ft;
             let residual = T::branch(denom.gt(zero), || trt * t * fr / denom, || zero);
             [fr, tt, trt, residual]
         };
@@ -208,17 +215,24 @@ impl HairBsdf {
         let mean = |p: usize| (r[p] + g[p] + b[p]) * third;
         // The R lobe's Fresnel term is > 0 for eta > 1, so the total is never 0.
         let inv_total = one / (mean(0) + mean(1) + mean(2) + mean(3));
-        let two_gt = T::splat(2.0) * gamma_t;
-        let two_go = T::splat(2.0) * gamma_o;
+
+        // Turns as complex numbers, of length 1 up to rounding: by -2 gamma_o,
+        // conj(cos gamma_o + i h)^2; by 2 gamma_t + pi, -(cos gamma_t + i sin gamma_t)^2.
+        let turn_o = ((cos_go - h) * (cos_go + h), -(T::splat(2.0) * cos_go * h));
+        let turn_t = (
+            -((cos_gt - sin_gt) * (cos_gt + sin_gt)),
+            -(T::splat(2.0) * cos_gt * sin_gt),
+        );
+        let mul = |a: (T, T), b: (T, T)| (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0);
+        let azimuth = azimuth_o(wo);
+        let r_centre = mul(azimuth, turn_o);
+        let tt_centre = mul(r_centre, turn_t);
         Outgoing {
             sin_to,
             cos_to,
             tilted,
-            deflection: [
-                -two_go,
-                two_gt - two_go + T::splat(PI),
-                two_gt + two_gt - two_go + T::splat(TAU),
-            ],
+            centre: [r_centre, tt_centre, mul(tt_centre, turn_t)],
+            azimuth,
             ap,
             lobe_pdf: [0, 1, 2, 3].map(|p| mean(p) * inv_total),
         }
@@ -226,20 +240,20 @@ impl HairBsdf {
 
     /// The per-wi stage over inputs in lanes (the batch): sums the lobes into (f, pdf).
     #[inline(always)]
-    fn eval_lobes<T: Lanes>(&self, o: &Outgoing<T>, wo: [T; 3], wi: [T; 3]) -> ([T; 3], T) {
+    fn eval_lobes<T: Lanes>(&self, o: &Outgoing<T>, wi: [T; 3]) -> ([T; 3], T) {
         let one = T::splat(1.0);
         let sin_ti = wi[0].max(-one).min(one);
-        let cos_ti = safe_sqrt(one - sin_ti * sin_ti);
-        // phi_i - phi_o from the yz components directly: one atan2, defined along the tangent.
-        let phi = atan2(wo[1] * wi[2] - wo[2] * wi[1], wo[1] * wi[1] + wo[2] * wi[2]);
+        let cos_ti = cos_from_sin(sin_ti);
+        let (wy, wz) = azimuth_i(o.azimuth, wi);
 
         let mut f = [T::splat(0.0); 3];
         let mut pdf = T::splat(0.0);
         for p in 0..=EXPLICIT_LOBES {
             let weight = if p < EXPLICIT_LOBES {
                 let (sin_to, cos_to) = o.tilted[p];
+                let (cy, cz) = o.centre[p];
                 self.mp[p].eval(sin_ti, cos_ti, sin_to, cos_to)
-                    * self.np.eval(wrap_angle(phi - o.deflection[p]))
+                    * self.np.eval(offset(cy, cz, wy, wz))
             } else {
                 self.mp[p].eval(sin_ti, cos_ti, o.sin_to, o.cos_to) * T::splat(0.5 * FRAC_1_PI)
             };
@@ -257,10 +271,10 @@ impl HairBsdf {
     /// Every lane runs the operations [`Self::eval_lobes`] runs for that lobe, and the
     /// lobes are summed in the same order, so the two agree bit for bit.
     #[inline(always)]
-    fn eval_lobes_packed(&self, o: &Outgoing<f32>, wo: [f32; 3], wi: [f32; 3]) -> ([f32; 3], f32) {
+    fn eval_lobes_packed(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> ([f32; 3], f32) {
         let sin_ti = wi[0].clamp(-1.0, 1.0);
-        let cos_ti = safe_sqrt(1.0 - sin_ti * sin_ti);
-        let phi = atan2(wo[1] * wi[2] - wo[2] * wi[1], wo[1] * wi[1] + wo[2] * wi[2]);
+        let cos_ti = cos_from_sin(sin_ti);
+        let (wy, wz) = azimuth_i(o.azimuth, wi);
 
         let [(s0, c0), (s1, c1), (s2, c2)] = o.tilted;
         let sin_to = f32x4::new([s0, s1, s2, o.sin_to]);
@@ -268,9 +282,12 @@ impl HairBsdf {
         let mp = self
             .mp_packed
             .eval(f32x4::splat(sin_ti), f32x4::splat(cos_ti), sin_to, cos_to);
-        let [d0, d1, d2] = o.deflection;
-        let np = self.np.eval(wrap_angle(
-            f32x4::splat(phi) - f32x4::new([d0, d1, d2, 0.0]),
+        let [(y0, z0), (y1, z1), (y2, z2)] = o.centre;
+        let np = self.np.eval(offset(
+            f32x4::new([y0, y1, y2, 0.0]),
+            f32x4::new([z0, z1, z2, 0.0]),
+            f32x4::splat(wy),
+            f32x4::splat(wz),
         ));
         let mut np = np.to_array();
         np[EXPLICIT_LOBES] = 0.5 * FRAC_1_PI;
@@ -352,7 +369,6 @@ impl OwnedPoint {
 /// What a point keeps of (h, wo).
 #[derive(Clone, Copy)]
 struct Vertex {
-    wo: [f32; 3],
     o: Outgoing<f32>,
 }
 
@@ -360,7 +376,7 @@ impl HairBsdf {
     /// f and pdf toward wi at a prepared vertex.
     #[inline(always)]
     fn eval_at(&self, at: &Vertex, wi: Vec3) -> BsdfEval {
-        let (f, pdf) = self.eval_lobes_packed(&at.o, at.wo, wi.to_array());
+        let (f, pdf) = self.eval_lobes_packed(&at.o, wi.to_array());
         BsdfEval {
             f: Vec3::from_array(f),
             pdf,
@@ -370,7 +386,7 @@ impl HairBsdf {
     /// Samples wi at a prepared vertex; see [`HairBsdf::sample`].
     #[inline]
     fn sample_at(&self, at: &Vertex, u: [f32; 3]) -> Option<BsdfSample> {
-        let (o, wo) = (&at.o, at.wo);
+        let o = &at.o;
         let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
         // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
         // density underflows, from being sampled with a whole 2^-24 of probability.
@@ -382,24 +398,19 @@ impl HairBsdf {
             (o.sin_to, o.cos_to)
         };
         let (sin_ti, cos_ti) = self.mp[p].sample(sin_to, cos_to, [u_theta, u[2]]);
-        let dphi = if p < EXPLICIT_LOBES {
-            o.deflection[p] + self.np.sample(u_phi)
+        // The azimuth: the lobe's centre turned by a logistic offset; the residual lobe's
+        // is uniform.
+        let (base, dphi) = if p < EXPLICIT_LOBES {
+            (o.centre[p], self.np.sample(u_phi))
         } else {
-            TAU * u_phi
-        };
-
-        // Rotate wo's azimuth by dphi; wo along the tangent has none, any will do.
-        let len_o = (wo[1] * wo[1] + wo[2] * wo[2]).sqrt();
-        let (cos_po, sin_po) = if len_o > 0.0 {
-            (wo[1] / len_o, wo[2] / len_o)
-        } else {
-            (1.0, 0.0)
+            (o.azimuth, TAU * u_phi)
         };
         let (sin_d, cos_d) = dphi.sin_cos();
+        let scale = cos_ti / (base.0 * base.0 + base.1 * base.1).sqrt();
         let wi = Vec3::new(
             sin_ti,
-            cos_ti * (cos_po * cos_d - sin_po * sin_d),
-            cos_ti * (sin_po * cos_d + cos_po * sin_d),
+            scale * (base.0 * cos_d - base.1 * sin_d),
+            scale * (base.1 * cos_d + base.0 * sin_d),
         );
         let e = self.eval_at(at, wi);
         (e.pdf > 0.0).then_some(BsdfSample {
@@ -435,23 +446,78 @@ const U_MIN: f32 = 1.0 / 33_554_432.0;
 /// The largest f32 below one.
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// Unpolarised Fresnel reflectance from outside into a dielectric of index eta > 1 at
-/// incidence cosine cos_i in [0, 1]; 1 at grazing incidence, never divides by zero.
+/// Unpolarised Fresnel reflectance F from outside into a dielectric of index eta > 1 at
+/// incidence cosine cos_i in [0, 1], and its complement 1 - F computed on its own: near
+/// grazing incidence F is within a few ulps of 1 and 1 - F by subtraction would keep
+/// none of its digits. F is 1 and 1 - F is 0 at grazing incidence; never divides by zero.
 /// Written with e = eta^2 - 1 = (eta - 1)(eta + 1) factored out of both amplitudes, so that
 /// an index just above 1 keeps its precision instead of cancelling in (eta c - cos t).
 #[inline(always)]
-fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> T {
+fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> (T, T) {
     let one = T::splat(1.0);
     let e = (eta - one) * (eta + one);
     let q = e.sqrt();
     let c2 = cos_i * cos_i;
-    // eta cos_t = sqrt(eta^2 - sin_i^2) by Snell's law. At grazing incidence it is q
+    // w = eta cos_t = sqrt(eta^2 - sin_i^2) by Snell's law. At grazing incidence it is q
     // exactly, so both ratios below are exactly 1 and F is exactly 1 (no leak into 1 - F).
-    let eta_cos_t = (e + c2).sqrt();
-    let perp = q / (cos_i + eta_cos_t);
+    let w = (e + c2).sqrt();
+    let inv_perp = one / (cos_i + w);
+    let inv_par = one / (eta * eta * cos_i + w);
+    // Amplitudes with e factored out: r_perp = (c - w) / (c + w) = -e / (c + w)^2 and
+    // r_par = (eta^2 c - w) / (eta^2 c + w) = e ((e + 2) c^2 - 1) / (eta^2 c + w)^2.
+    let perp = q * inv_perp;
     let r_perp = perp * perp;
-    let par = q / (eta * eta * cos_i + eta_cos_t);
+    let par = q * inv_par;
     let r_par = par * par * ((e + T::splat(2.0)) * c2 - one);
     // Rounding can lift the grazing value just above 1, which would leak into 1 - F.
-    (T::splat(0.5) * (r_par * r_par + r_perp * r_perp)).min(one)
+    let f = (T::splat(0.5) * (r_par * r_par + r_perp * r_perp)).min(one);
+    // 1 - r^2 = 4 c w / (c + w)^2 for perp and 4 eta^2 c w / (eta^2 c + w)^2 for par.
+    let eta2 = eta * eta;
+    let t = T::splat(2.0) * cos_i * w * (inv_perp * inv_perp + eta2 * inv_par * inv_par);
+    (f, t.min(one))
+}
+
+/// wo's azimuth as a (y, z) direction of length 1e-4 to sqrt(2); (1, 0) along the tangent,
+/// which has none (evaluation and sampling then share that convention). Lengths do not
+/// matter to the offsets (atan2 of products), but tiny components are scaled up so that
+/// their products with wi's cannot underflow.
+#[inline(always)]
+fn azimuth_o<T: Lanes>(wo: [T; 3]) -> (T, T) {
+    let (one, zero) = (T::splat(1.0), T::splat(0.0));
+    let m = wo[1].abs().max(wo[2].abs());
+    let defined = m.gt(zero);
+    let scale = T::branch(
+        m.lt(T::splat(MIN_AZIMUTH_O)),
+        || one / T::select(defined, m, one),
+        || one,
+    );
+    (
+        T::select(defined, wo[1] * scale, one),
+        T::select(defined, wo[2] * scale, zero),
+    )
+}
+
+/// Below this largest yz component, wo's azimuth is rescaled (see [`azimuth_o`]).
+const MIN_AZIMUTH_O: f32 = 1e-4;
+
+/// Below this |wi.y| and |wi.z|, wi is taken to be along the tangent: its azimuth is
+/// meaningless (and products with it could underflow), so it is given wo's.
+const MIN_AZIMUTH: f32 = 1e-30;
+
+/// wi's (y, z) for the azimuthal offsets: as it is, or wo's azimuth along the tangent
+/// (phi_i - phi_o = 0 there: one azimuth for all the lobes, as the model has).
+#[inline(always)]
+fn azimuth_i<T: Lanes>(azimuth_o: (T, T), wi: [T; 3]) -> (T, T) {
+    let defined = wi[1].abs().max(wi[2].abs()).gt(T::splat(MIN_AZIMUTH));
+    (
+        T::select(defined, wi[1], azimuth_o.0),
+        T::select(defined, wi[2], azimuth_o.1),
+    )
+}
+
+/// Signed azimuthal offset in [-pi, pi] of the direction (y, z) from a lobe centred at the
+/// direction (cy, cz): one atan2 of their cross and dot products.
+#[inline(always)]
+fn offset<T: Lanes>(cy: T, cz: T, y: T, z: T) -> T {
+    atan2(cy * z - cz * y, cy * y + cz * z)
 }

@@ -8,7 +8,7 @@
 
 use crate::math::bessel::{SPLIT, i0_large_scaled, i0_small};
 use crate::math::fast::{exp_neg, ln};
-use crate::math::{Lanes, safe_sqrt};
+use crate::math::{Lanes, cos_from_sin, safe_sqrt};
 
 /// Variance v of the R lobe for longitudinal roughness beta_m (Chiang et al. 2016, eq. 7).
 /// TT uses v/4, TRT and the residual 4v.
@@ -71,7 +71,7 @@ impl LongitudinalLobe {
         let cos_psi = 1.0 - x;
         let cos_phi = (std::f32::consts::TAU * u[1]).cos();
         let sin_ti = (-cos_psi * sin_to + sin_psi * cos_phi * cos_to).clamp(-1.0, 1.0);
-        (sin_ti, safe_sqrt(1.0 - sin_ti * sin_ti))
+        (sin_ti, cos_from_sin(sin_ti))
     }
 }
 

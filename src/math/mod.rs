@@ -29,8 +29,10 @@ pub(crate) fn safe_sqrt<T: Lanes>(x: T) -> T {
     x.max(T::splat(0.0)).sqrt()
 }
 
-/// asin of a value that round-off may have pushed just outside [-1, 1].
+/// sqrt(1 - x^2) for x in [-1, 1], as (1 - x)(1 + x): near |x| = 1, 1 - x is exact where
+/// 1 - x^2 would lose the low digits of x^2 (up to 2.5e-5 relative near x = 0.9998).
 #[inline(always)]
-pub(crate) fn safe_asin<T: Lanes>(x: T) -> T {
-    fast::asin(x.max(T::splat(-1.0)).min(T::splat(1.0)))
+pub(crate) fn cos_from_sin<T: Lanes>(x: T) -> T {
+    let one = T::splat(1.0);
+    safe_sqrt((one - x) * (one + x))
 }

@@ -11,3 +11,4 @@ mod lobes;
 mod normalisation;
 mod sampling;
 mod sweep;
+mod tangent;

@@ -3,6 +3,7 @@
 //! direction helpers ([`sphere`]), plus the glue between them and the crate's f32 API.
 
 pub mod chi2;
+pub mod pbrt_f32;
 pub mod quad;
 pub mod reference;
 pub mod sphere;

@@ -124,20 +124,25 @@ impl HtScene {
         let mut builder = TracerBuilder::new(self.device.clone(), SceneOptions::default())?;
         let mut materials = Vec::with_capacity(self.geometries.len());
         for g in &self.geometries {
-            let parts = match (&g.shape, view) {
-                (Shape::AutoCurves(c), Some((camera, height))) => {
-                    ribbons::share_out(c.clone(), camera, *height)?
-                }
-                (Shape::Curves(c) | Shape::AutoCurves(c), _) => vec![c.clone()],
+            // Embree geometries made of this one (two for auto curves split by shape).
+            let added = match (&g.shape, view) {
                 (Shape::Mesh(m), _) => {
                     builder.add_mesh(m.clone())?;
-                    Vec::new()
+                    1
+                }
+                (Shape::AutoCurves(c), Some((camera, height))) => {
+                    let parts = ribbons::share_out(c.clone(), camera, *height)?;
+                    let n = parts.len();
+                    for part in parts {
+                        builder.add_curves(part)?;
+                    }
+                    n
+                }
+                (Shape::Curves(c) | Shape::AutoCurves(c), _) => {
+                    builder.add_curves(c.clone())?;
+                    1
                 }
             };
-            let added = parts.len().max(1);
-            for part in parts {
-                builder.add_curves(part)?;
-            }
             let material = &self.materials[g.material as usize];
             materials.extend(std::iter::repeat_n(material.clone(), added));
         }

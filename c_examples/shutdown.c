@@ -7,6 +7,7 @@
 
 #include <dirent.h>
 #include <stdio.h>
+#include <time.h>
 
 /* Threads of this process, or -1 if /proc cannot be read. */
 static int thread_count(void) {
@@ -15,6 +16,18 @@ static int thread_count(void) {
     int n = 0;
     for (struct dirent *e = readdir(dir); e != NULL; e = readdir(dir)) n += e->d_name[0] != '.';
     closedir(dir);
+    return n;
+}
+
+/* The thread count once it is down to `target`, or after a second of waiting: a joined
+ * thread has finished its work but may still be on its way out of the kernel's list. */
+static int settled_thread_count(int target) {
+    const struct timespec tick = {0, 10 * 1000 * 1000};
+    int n = thread_count();
+    for (int i = 0; i < 100 && n > target; i++) {
+        nanosleep(&tick, NULL);
+        n = thread_count();
+    }
     return n;
 }
 
@@ -57,7 +70,8 @@ static int render_once(HtDevice **device, HtScene **scene) {
 int main(void) {
     HtDevice *device = NULL;
     HtScene *scene = NULL;
-    printf("threads start %d\n", thread_count());
+    const int start = thread_count();
+    printf("threads start %d\n", start);
     if (ht_shutdown() != HT_OK) return 1; /* nothing started yet: nothing to join */
     if (render_once(&device, &scene)) return 1;
     printf("threads rendered %d\n", thread_count());
@@ -67,12 +81,12 @@ int main(void) {
     ht_device_free(device);
     printf("threads freed %d\n", thread_count());
     s = ht_shutdown();
-    printf("shutdown %s threads %d\n", ht_status_str((int32_t)s), thread_count());
+    printf("shutdown %s threads %d\n", ht_status_str((int32_t)s), settled_thread_count(start));
     /* The library starts again on demand. */
     if (render_once(&device, &scene)) return 1;
     ht_scene_free(scene);
     ht_device_free(device);
     s = ht_shutdown();
-    printf("again %s threads %d\n", ht_status_str((int32_t)s), thread_count());
+    printf("again %s threads %d\n", ht_status_str((int32_t)s), settled_thread_count(start));
     return 0;
 }

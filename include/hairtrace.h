@@ -508,9 +508,9 @@ typedef bool (*HtBuildProgressFn)(double fraction, void *user);
 #if defined(HT_RENDER)
 /**
  * Per strand, at each render: a ribbon where the strand is at most one pixel wide from
- * the camera, a tube elsewhere. Its images agree with round ones within noise on the
- * bench scenes, at 1.2-1.3x the speed (README, "Fidelity knobs"). A render with another
- * camera or image height than the last one builds the scene's BVH again.
+ * the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
+ * tubes, at an error within the noise of a render (README, "Curve shapes"). A render
+ * with another camera or image height than the last one builds the scene's BVH again.
  */
 #define HT_CURVE_AUTO 2
 #endif

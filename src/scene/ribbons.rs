@@ -6,7 +6,7 @@
 //! (by up to a radius) and at end caps and joints, differences that a strand thinner than a
 //! pixel hides inside the pixel. A flat linear curve costs Embree 1.5-1.8x less per ray than
 //! a round one, and the ribbons' images agree with the tubes' within noise on the bench
-//! scenes (README, "Fidelity knobs").
+//! scenes (README, "Curve shapes").
 
 use crate::embree::CurveShape;
 use crate::error::Result;

@@ -5,8 +5,9 @@
 //! blocks the same light and is hit across the same h. It differs in the depth of the hit
 //! (by up to a radius) and at end caps and joints, differences that a strand thinner than a
 //! pixel hides inside the pixel. A flat linear curve costs Embree 1.5-1.8x less per ray than
-//! a round one, and the ribbons' images agree with the tubes' within noise on the bench
-//! scenes (README, "Curve shapes").
+//! a round one. On the bench scenes the ribbons' images differ from the tubes' by under a
+//! third of a bench render's own noise (RMSE at equal samples 2-4% higher; README, "Curve
+//! shapes").
 
 use crate::embree::CurveShape;
 use crate::error::Result;

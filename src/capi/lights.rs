@@ -14,6 +14,7 @@ fn add_light(
     boundary(|| {
         let scene = scene_mut(scene)?;
         scene.lights.push(light()?);
+        scene.lights_changed = true;
         Ok(())
     })
 }

@@ -47,6 +47,8 @@ pub struct HtScene {
     pub(super) lens: Option<(f32, f32)>,
     /// The last build; None until the first render and after geometry is added.
     pub(super) world: Option<World>,
+    /// Lights were added since `world` was built.
+    pub(super) lights_changed: bool,
     /// The view the `auto` curves of `world` were shared out for.
     pub(super) built_for: Option<View>,
     /// The bounds of the geometry as added (`auto` curves round), which frame a scene
@@ -187,10 +189,9 @@ impl HtScene {
             ));
         }
         let aspect = width as f32 / height as f32;
-        let world = self.world.take();
-        let (camera, geometry) = if self.has_auto_curves() {
-            // Framed on the curves as added (round), so that the view never depends on
-            // the shapes it picks.
+        // `auto` curves are shared out for the view, which is framed on the curves as
+        // added (round), so that it never depends on the shapes it picks.
+        let view = if self.has_auto_curves() {
             let bounds = match (self.camera, self.added_bounds) {
                 (Some(_), _) => None,
                 (None, Some(b)) => Some(b),
@@ -199,30 +200,32 @@ impl HtScene {
                     Some(*self.added_bounds.insert(tracer.scene().bounds()))
                 }
             };
-            let camera = self.camera(aspect, bounds)?;
-            let view = (camera, height);
-            let geometry = match world {
-                Some(w) if self.built_for == Some(view) => w.into_geometry(),
-                _ => {
-                    self.built_for = None;
-                    let built = self.build_tracer(Some(&view), progress)?;
-                    self.built_for = Some(view);
+            let view = (self.camera(aspect, bounds)?, height);
+            if self.built_for != Some(view) {
+                self.world = None;
+            }
+            Some(view)
+        } else {
+            None
+        };
+        if self.world.is_none() || self.lights_changed {
+            let (tracer, materials) = match self.world.take() {
+                Some(world) => world.into_geometry(),
+                None => {
+                    let built = self.build_tracer(view.as_ref(), progress)?;
+                    self.built_for = view;
                     built
                 }
             };
-            (camera, geometry)
-        } else {
-            let geometry = match world {
-                Some(w) => w.into_geometry(),
-                None => self.build_tracer(None, progress)?,
-            };
-            (
-                self.camera(aspect, Some(geometry.0.scene().bounds()))?,
-                geometry,
-            )
+            self.world = Some(World::new(tracer, materials, self.lights.clone())?);
+            self.lights_changed = false;
+        }
+        let world = self.world.as_ref().expect("built above");
+        let camera = match view {
+            Some((camera, _)) => camera,
+            None => self.camera(aspect, Some(world.tracer.scene().bounds()))?,
         };
-        let world = World::new(geometry.0, geometry.1, self.lights.clone())?;
-        Ok((self.world.insert(world), camera))
+        Ok((world, camera))
     }
 }
 
@@ -345,6 +348,7 @@ pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut Ht
             camera: None,
             lens: None,
             world: None,
+            lights_changed: false,
             built_for: None,
             added_bounds: None,
         });

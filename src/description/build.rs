@@ -281,15 +281,8 @@ impl GroomDesc {
             // conversion to do.
             GroomSource::ControlPoints { points, counts } => {
                 let curves = stages.run(Stage::Curves, (i, grooms), |_| {
-                    let points = points
-                        .iter()
-                        .map(|&[x, y, z, r]| {
-                            let [x, y, z] = place([x, y, z]);
-                            [x, y, z, r * radius_factor]
-                        })
-                        .collect::<Vec<_>>();
                     Curves::from_control_points(
-                        points,
+                        super::placed(points, place, radius_factor),
                         counts,
                         None,
                         self.basis,

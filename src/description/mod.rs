@@ -362,6 +362,22 @@ pub fn has_extension(path: &std::path::Path, ext: &str) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case(ext))
 }
 
+/// Control points (x, y, z, radius) moved by `place`, radii multiplied by `radius_scale`:
+/// a groom's control points where its scene entry puts them.
+pub(crate) fn placed(
+    points: &[[f32; 4]],
+    place: impl Fn([f32; 3]) -> [f32; 3],
+    radius_scale: f32,
+) -> Vec<[f32; 4]> {
+    points
+        .iter()
+        .map(|&[x, y, z, r]| {
+            let [x, y, z] = place([x, y, z]);
+            [x, y, z, r * radius_scale]
+        })
+        .collect()
+}
+
 /// What a render needs, built from a description.
 pub struct BuiltScene {
     pub world: World,

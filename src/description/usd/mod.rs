@@ -79,16 +79,8 @@ impl UsdCurves {
             Some(m) => Some(self.melanin_colors(m, beta_n)?),
             None => self.colors.clone(),
         };
-        let control = self
-            .control
-            .iter()
-            .map(|&[x, y, z, r]| {
-                let [x, y, z] = point([x, y, z]);
-                [x, y, z, r * radius_scale]
-            })
-            .collect::<Vec<_>>();
         Curves::from_control_points(
-            control,
+            super::placed(&self.control, point, radius_scale),
             &self.control_counts,
             colors,
             self.layout.basis,

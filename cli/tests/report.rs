@@ -30,11 +30,24 @@ fn quick_report_is_complete_and_finite() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
     let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_quick");
     let _ = std::fs::remove_dir_all(&out);
+    // A peer run as bench/peer.py writes it: hairtrace at half Cycles' RMSE in the same
+    // time reaches Cycles' RMSE in a quarter of the time, a speedup of 4.
+    let peers = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_quick_peers.json");
+    std::fs::write(
+        &peers,
+        r#"[{"scene": "fur_ball", "spp": 16,
+             "renderers": {"hairtrace": {"seconds": 2.0, "rmse": 0.01},
+                           "Cycles": {"seconds": 2.0, "rmse": 0.02}},
+             "converged": {"rmse_between_references": 0.003, "expected_from_noise": 0.004}}]"#,
+    )
+    .unwrap();
     let o = Command::new(env!("CARGO_BIN_EXE_hairtrace"))
         .args(["report", "--quick", "-o"])
         .arg(&out)
         .arg("--scenes")
         .arg(root.join("bench/scenes"))
+        .arg("--peers")
+        .arg(&peers)
         .env_remove("HT_BENCH_VENV")
         .output()
         .expect("run hairtrace report");
@@ -75,10 +88,35 @@ fn quick_report_is_complete_and_finite() {
         let v: f64 = n.parse().unwrap_or(f64::NAN);
         assert!(v.is_finite(), "non-finite number {n:?} in REPORT.md");
     }
-    assert!(
-        text.contains("**Not run:**"),
-        "the peer section says it was not run"
-    );
+    let peers = &text[text.find(". Peers").expect("the peers section")..];
+    let row = peers.lines().find(|l| l.starts_with("| fur_ball")).unwrap();
+    let cells: Vec<&str> = row.split('|').map(str::trim).collect();
+    assert_eq!(cells[7..9], ["0.500", "4.00"], "{row}");
+}
+
+/// A `--peers` file that is not a peer benchmark's results is refused at once, named, before
+/// any work and without writing anything.
+#[test]
+fn report_refuses_a_bad_peers_file_at_once() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let out = dir.join("report_bad_peers");
+    let _ = std::fs::remove_dir_all(&out);
+    let peers = dir.join("bad_peers.json");
+    std::fs::write(&peers, r#"{"scene": 1}"#).unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_hairtrace"))
+        .args(["report", "--quick", "--peers"])
+        .arg(&peers)
+        .arg("--scenes")
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes"))
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .expect("run hairtrace report");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{err}");
+    assert!(err.contains("bad_peers.json"), "{err}");
+    assert!(err.contains("not a list of scenes"), "{err}");
+    assert!(!out.exists(), "wrote {}", out.display());
 }
 
 /// Without the bench scenes the report stops at once, in one line that says what to do,

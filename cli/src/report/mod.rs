@@ -99,6 +99,9 @@ const SECTIONS: [Section; 5] = [
 /// Runs every section and writes `REPORT.md`.
 pub fn run(options: &ReportOptions) -> Result<()> {
     check_scenes(&options.scenes)?;
+    if let Some(peers) = &options.peers {
+        peers::check_file(peers)?;
+    }
     std::fs::create_dir_all(&options.output).map_err(|e| Error::io(&options.output, e))?;
     plots::load_font()?;
     let start = Instant::now();

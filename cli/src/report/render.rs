@@ -4,7 +4,7 @@
 
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
-use super::{Context, bench_scene};
+use super::{Context, bench_scene, median};
 use hairtrace::description::{GroomSource, RenderDesc, SceneDescription};
 use hairtrace::embree::CurveBasis;
 use hairtrace::image::{Image, compare};
@@ -175,6 +175,15 @@ impl Built {
     }
 }
 
+/// One knob's runs at one sample count: their seconds, and the error and rays per sample
+/// of the first (the same in every run).
+struct Runs {
+    spp: u32,
+    seconds: Vec<f64>,
+    rmse: f64,
+    rays: f64,
+}
+
 /// One knob's measurements on one scene.
 struct Curve {
     name: &'static str,
@@ -198,24 +207,31 @@ fn remove_reference_noise(curves: &mut [Curve], reference_spp: u32) {
     }
 }
 
+/// Timed runs of each knob at each sample count, taken knob after knob in turn so that
+/// the machine's drift falls on every knob alike; the table and plot give their median.
+fn rounds(ctx: &Context) -> usize {
+    if ctx.quick { 1 } else { 3 }
+}
+
 pub fn steps(ctx: &Context) -> u64 {
     let scenes = scene_names(ctx).map_or(1, |s| s.len() as u64);
-    scenes * (KNOBS.len() as u64 + 1)
+    scenes * (KNOBS.len() * rounds(ctx) + 1) as u64
 }
 
 pub fn section(ctx: &Context) -> Result<String> {
-    let mut text = String::from(
+    let mut text = format!(
         "Each knob changes one setting of the reference settings (the bench scene as \
          written, a one-pixel box filter, MIS) and renders the scene at three sample counts \
          (seeds 1, 2, 3). Its error is the RMSE over the RGB channels against a render of \
          the reference settings at 8x the scene's samples with a seed no timed render uses, \
          with the reference's own noise (estimated from the reference settings' renders) \
          taken out. Its time is the path tracing alone (the scene build is in the scale \
-         section). A knob that changes the image (shape, basis, max depth, filter) shows \
+         section), the median of {} runs taken knob after knob in turn. A knob that changes the image (shape, basis, max depth, filter) shows \
          its bias as a floor its curve cannot go below; one that only changes noise moves \
          its curve sideways. The tent filter's floor is partly the blur it adds by design, \
          not error. Efficiency is 1 / (RMSE^2 x seconds) at the scene's spp, relative to \
          the reference settings'.\n\n",
+        rounds(ctx)
     );
     for name in scene_names(ctx)? {
         text += &scene_section(ctx, &name)?;
@@ -230,32 +246,55 @@ fn scene_section(ctx: &Context, name: &str) -> Result<String> {
     let (reference, reference_seconds, _) =
         Built::new(&base)?.render(plan.reference_spp, REFERENCE_SEED)?;
     ctx.done();
-    let mut curves = Vec::new();
+    let rounds = rounds(ctx);
+    let mut built = Vec::new();
     let mut skipped = Vec::new();
     for knob in KNOBS {
-        ctx.step(format!("{name}: {}", knob.name));
+        ctx.step(format!("{name}: {}, building", knob.name));
         let mut v = base.clone();
         match (knob.edit)(&mut v) {
             Err(e) => skipped.push(format!("`{}` (not applicable: {})", knob.name, e.detail())),
-            Ok(()) if v == base && !curves.is_empty() => {
+            Ok(()) if v == base && !built.is_empty() => {
                 skipped.push(format!("`{}` (the scene's own setting)", knob.name));
             }
             Ok(()) => {
-                let mut built = Built::new(&v)?;
-                let mut points = Vec::new();
-                for (seed, &spp) in (1..).zip(&plan.spp) {
-                    let (image, seconds, rays) = built.render(spp, seed)?;
-                    let rmse = compare(&image, &reference)?.rmse;
-                    points.push((spp, seconds, rmse, rays));
-                }
-                curves.push(Curve {
-                    name: knob.name,
-                    points,
-                });
+                built.push((knob.name, Built::new(&v)?));
+                continue;
             }
         }
-        ctx.done();
+        (0..rounds).for_each(|_| ctx.done());
     }
+    // Round 0 measures each point's error too: a seed gives the same image every round.
+    let mut measured: Vec<Vec<Runs>> = (0..built.len()).map(|_| Vec::new()).collect();
+    for round in 0..rounds {
+        for ((knob, b), points) in built.iter_mut().zip(&mut measured) {
+            ctx.step(format!("{name}: {knob}, run {}/{rounds}", round + 1));
+            for (i, (seed, &spp)) in (1..).zip(&plan.spp).enumerate() {
+                let (image, seconds, rays) = b.render(spp, seed)?;
+                if round == 0 {
+                    let rmse = compare(&image, &reference)?.rmse;
+                    points.push(Runs {
+                        spp,
+                        seconds: vec![seconds],
+                        rmse,
+                        rays,
+                    });
+                } else {
+                    points[i].seconds.push(seconds);
+                }
+            }
+            ctx.done();
+        }
+    }
+    let mut curves: Vec<Curve> = (built.iter().zip(measured))
+        .map(|((knob, _), points)| Curve {
+            name: knob,
+            points: (points.into_iter())
+                .map(|r| (r.spp, median(r.seconds), r.rmse, r.rays))
+                .collect(),
+        })
+        .collect();
+    drop(built);
     remove_reference_noise(&mut curves, plan.reference_spp);
     let r = &base.desc.render;
     let caption = ctx.machine.caption(

@@ -4,7 +4,8 @@ scenes, measured with the CLI: for each scene, a reference of the exact settings
 the scene's spp (a seed no timed render uses), then REPEATS rounds in which every
 variant renders the scene as written at its spp (seed = round), the variants
 interleaved so that a load change on a shared machine touches them alike. Prints a
-Markdown table of medians: path-tracing seconds, rays per camera sample, RMSE against
+Markdown table of medians: path-tracing seconds, the process's CPU time relative to the
+exact settings', rays per camera sample, RMSE against
 the reference (its own noise taken out, as the report does) and efficiency
 1 / (RMSE^2 x seconds) relative to the exact settings; and each knob's bias: the RMSE
 between its own render at the reference's spp and seed and the reference (the shared
@@ -17,6 +18,7 @@ an upper bound of it).
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -46,12 +48,17 @@ def spp_of(scene: Path) -> int:
 
 
 def render(scene, out, spp, seed, threads, extra):
+    """Path-tracing seconds, rays per camera sample and the CPU seconds of the whole
+    process (build included: less disturbed by other work on a shared machine)."""
     stats = out.with_suffix(".json")
     cmd = [str(HAIRTRACE), "render", str(scene), "--spp", str(spp), "--seed", str(seed),
            "--threads", str(threads), "-o", str(out), "--stats", str(stats), *extra]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     s = json.loads(stats.read_text())
-    return s["seconds"], s["rays"] / max(s["samples"], 1)
+    return s["seconds"], s["rays"] / max(s["samples"], 1), cpu
 
 
 def rmse(image, reference):
@@ -65,26 +72,31 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--no-bias", action="store_true", help="skip the bias renders")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="knobs-"))
-    print("| scene | variant | seconds | rays/sample | RMSE | efficiency vs exact | bias (RMSE at 8x spp, shared seed) |")
-    print("|---|---|---|---|---|---|---|")
+    print("| scene | variant | seconds | CPU time vs exact | rays/sample | RMSE "
+          "| efficiency vs exact | bias (RMSE at 8x spp, shared seed) |")
+    print("|---|---|---|---|---|---|---|---|")
     for name in args.scenes.split(","):
         scene = ROOT / "bench" / "scenes" / f"{name}.toml"
         spp = spp_of(scene)
         reference = tmp / f"{name}_ref.exr"
         render(scene, reference, 8 * spp, REFERENCE_SEED, args.threads, [])
         bias = {"exact": 0.0}
-        for v, extra in list(VARIANTS.items())[1:]:
+        for v, extra in [] if args.no_bias else list(VARIANTS.items())[1:]:
             out = tmp / f"{name}_{v.replace(' ', '_')}_bias.exr"
             render(scene, out, 8 * spp, REFERENCE_SEED, args.threads, extra)
             bias[v] = rmse(out, reference)
+        names = list(VARIANTS)
         runs = {v: [] for v in VARIANTS}
         for seed in range(1, args.repeats + 1):
-            for v, extra in VARIANTS.items():
+            # Each round starts one variant later, so that none always runs first.
+            k = (seed - 1) % len(VARIANTS)
+            for v in names[k:] + names[:k]:
                 out = tmp / f"{name}_{v.replace(' ', '_')}_{seed}.exr"
-                seconds, rays = render(scene, out, spp, seed, args.threads, extra)
-                runs[v].append((seconds, rays, rmse(out, reference)))
+                seconds, rays, cpu = render(scene, out, spp, seed, args.threads, VARIANTS[v])
+                runs[v].append((seconds, rays, rmse(out, reference), cpu))
         # The reference carries the exact settings' variance / 8: taken out of every MSE.
         exact_mse = statistics.median(r[2] ** 2 for r in runs["exact"])
         noise = exact_mse * (1 / 8) / (1 + 1 / 8)
@@ -93,12 +105,14 @@ def main():
             seconds = statistics.median(x[0] for x in r)
             rays = statistics.median(x[1] for x in r)
             err = max(statistics.median(x[2] ** 2 for x in r) - noise, 0.0) ** 0.5
-            rows[v] = (seconds, rays, err)
+            cpu = statistics.median(x[3] for x in r)
+            rows[v] = (seconds, rays, err, cpu)
         base = 1 / (rows["exact"][2] ** 2 * rows["exact"][0])
-        for v, (seconds, rays, err) in rows.items():
+        for v, (seconds, rays, err, cpu) in rows.items():
             eff = 1 / (err ** 2 * seconds) / base if err > 0 else float("inf")
-            print(f"| {name} | {v} | {seconds:.3f} | {rays:.2f} | {err:.4g} | {eff:.3f} "
-                  f"| {bias[v]:.3g} |")
+            b = f"{bias[v]:.3g}" if v in bias else ""
+            print(f"| {name} | {v} | {seconds:.3f} | {cpu / rows['exact'][3]:.3f} | {rays:.2f} "
+                  f"| {err:.4g} | {eff:.3f} | {b} |")
         sys.stdout.flush()
 
 

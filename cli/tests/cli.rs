@@ -502,7 +502,15 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
 #[test]
 fn render_takes_the_fidelity_knobs() {
     let common = [
-        "render", "--width", "24", "--height", "24", "--spp", "2", "--max-depth", "4",
+        "render",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--spp",
+        "2",
+        "--max-depth",
+        "4",
     ];
     let image = |name: &str, knob: &[&str]| {
         let out = tmp(name);
@@ -516,14 +524,8 @@ fn render_takes_the_fidelity_knobs() {
             .pixels
     };
     let exact = image("cli_exact.exr", &[]);
-    assert_eq!(
-        image("cli_deep4.exr", &["--deep-bounce-depth", "4"]),
-        exact
-    );
-    assert_ne!(
-        image("cli_deep1.exr", &["--deep-bounce-depth", "1"]),
-        exact
-    );
+    assert_eq!(image("cli_deep4.exr", &["--deep-bounce-depth", "4"]), exact);
+    assert_ne!(image("cli_deep1.exr", &["--deep-bounce-depth", "1"]), exact);
     assert_ne!(image("cli_cull.exr", &["--lobe-cull", "0.2"]), exact);
     let out = tmp("cli_knob_error.exr");
     for (knob, value, needle) in [

@@ -184,8 +184,16 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
         let rust_knob = RenderSettings { path, ..rust };
         let out = render(&world, &camera, &rust_knob, Aovs::default(), &NoProgress).unwrap();
         let got = c_image(knob);
-        assert_eq!(got, bits(out.film.rgb()), "{deep_bounce_depth}, {lobe_cull}");
-        assert_eq!(got == exact_rgb, deep_bounce_depth == 6, "{deep_bounce_depth}, {lobe_cull}");
+        assert_eq!(
+            got,
+            bits(out.film.rgb()),
+            "{deep_bounce_depth}, {lobe_cull}"
+        );
+        assert_eq!(
+            got == exact_rgb,
+            deep_bounce_depth == 6,
+            "{deep_bounce_depth}, {lobe_cull}"
+        );
     }
 }
 
@@ -505,7 +513,11 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             lobe_cull: 1.0,
             ..s
         };
-        fails(ht_render(h.scene, &cull, ptr, len), INVALID, "lobe_cull = 1");
+        fails(
+            ht_render(h.scene, &cull, ptr, len),
+            INVALID,
+            "lobe_cull = 1",
+        );
         let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
             let n = null_mut();
             ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)

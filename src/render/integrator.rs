@@ -11,7 +11,7 @@ use super::film::FirstHit;
 use super::sampler::PixelSampler;
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
-use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, LocalBsdf, Lobes};
+use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, Lobes, LocalBsdf};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};

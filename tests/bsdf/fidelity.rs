@@ -6,8 +6,7 @@
 use crate::chi2::{Config, run_all};
 use crate::common::sphere::uniform_sphere;
 use crate::common::{
-    Timer, bsdf, brown, d3, dir_deg, params, random_h, random_params, random_u, reference, rng,
-    v3,
+    Timer, brown, bsdf, d3, dir_deg, params, random_h, random_params, random_u, reference, rng, v3,
 };
 use crate::furnace::crate_integrals;
 use glam::Vec3;
@@ -110,8 +109,8 @@ fn merged_sample_weight_is_the_total_attenuation() {
             };
             let w = s.f * s.wi.z.abs() / s.pdf;
             for c in 0..3 {
-                let rel = (f64::from(w[c]) - f64::from(total[c])).abs()
-                    / f64::from(total[c]).max(1e-30);
+                let rel =
+                    (f64::from(w[c]) - f64::from(total[c])).abs() / f64::from(total[c]).max(1e-30);
                 worst = worst.max(rel);
             }
         }
@@ -163,7 +162,12 @@ fn merged_lobe_keeps_the_energy() {
 #[test]
 fn culled_lobes_lose_exactly_their_energy() {
     let _t = Timer::start("culled_lobes_lose_exactly_their_energy");
-    for (sigma_a, threshold) in [([0.0; 3], 0.1), (brown(), 0.1), (brown(), 0.3), (BLACK, 0.2)] {
+    for (sigma_a, threshold) in [
+        ([0.0; 3], 0.1),
+        (brown(), 0.1),
+        (brown(), 0.3),
+        (BLACK, 0.2),
+    ] {
         let b = bsdf(&params(sigma_a, 1.55, 0.3, 0.3, 2.0));
         for (to, po, h) in VIEWS {
             let wo = dir_deg(to, po);
@@ -177,7 +181,12 @@ fn culled_lobes_lose_exactly_their_energy() {
                 .filter(|&p| p == strongest || peak[p] >= f64::from(threshold) * total)
                 .collect();
             let dropped = (0..3)
-                .map(|c| (0..4).filter(|p| !kept.contains(p)).map(|p| a[p][c]).sum::<f64>())
+                .map(|c| {
+                    (0..4)
+                        .filter(|p| !kept.contains(p))
+                        .map(|p| a[p][c])
+                        .sum::<f64>()
+                })
                 .fold(0.0, f64::max);
             assert!(
                 dropped > 10.0 * TOLERANCE,

@@ -434,7 +434,10 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
             &["render", "\"maybe\"", "sqrt or throughput"],
         ),
         ("rr_depth = 0", &["render", "rr_depth = 0"]),
-        ("deep_bounce_depth = 0", &["render", "deep_bounce_depth = 0"]),
+        (
+            "deep_bounce_depth = 0",
+            &["render", "deep_bounce_depth = 0"],
+        ),
         (
             "max_depth = 4\ndeep_bounce_depth = 5",
             &["render", "deep_bounce_depth = 5", "max_depth = 4"],

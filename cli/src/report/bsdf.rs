@@ -399,7 +399,9 @@ const VARIANTS: [Variant; 10] = [
     Variant {
         name: "HairPoint, merged lobe (deep bounces): at + eval + sample",
         time: |s| each(s, |x| vertex(s, x, Lobes::Merged)),
-        outputs: Some(|s| lobes_outputs(s, Lobes::Merged)),
+        // It keeps each (h, wo)'s energy, not the model's value at any one direction:
+        // its error is the render section's to measure.
+        outputs: None,
     },
     Variant {
         name: "HairBsdf::eval_batch (per element)",
@@ -431,7 +433,10 @@ fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> Optio
         let outs = outputs(s);
         // A lobes variant gives an eval and a sample per input.
         let per_input = outs.len() / s.inputs.len().max(1);
-        let inputs = s.inputs.iter().flat_map(|x| std::iter::repeat_n(x, per_input));
+        let inputs = s
+            .inputs
+            .iter()
+            .flat_map(|x| std::iter::repeat_n(x, per_input));
         for (x, out) in inputs.zip(outs) {
             let Some((wi, e)) = out else { continue };
             accumulate(&mut acc, s, x, wi, e);
@@ -523,10 +528,10 @@ pub fn section(ctx: &Context) -> Result<String> {
          The point rows time what a renderer's path vertex does; `HairBsdf::at` alone is \
          the (h, wo) work a prepared point saves. The culled and merged rows are the \
          renderer's fidelity knobs `lobe_cull` and `deep_bounce_depth` at one vertex, their \
-         eval and sample both judged against the whole model: culling's error is the \
-         dropped lobes', and the merged lobe, which keeps only each (h, wo)'s energy, is \
-         by design far from the model at any one direction (its cost in a render is in \
-         the render section). The library has one set of special functions: no other \
+         eval and sample both judged against the whole model (culling's error is the \
+         dropped lobes'); the merged lobe keeps only each (h, wo)'s energy, not the \
+         model's value at any one direction, so its error is measured in the render \
+         section. The library has one set of special functions: no other \
          variants to time.\n\n{}\n{}\n\n{}",
         random.len(),
         table(

@@ -50,9 +50,15 @@ const KNOBS: &[Knob] = &[
     knob("max_depth 16", |v| render(v, |r| r.max_depth = 16)),
     knob("max_depth 4", |v| render(v, |r| r.max_depth = 4)),
     knob("filter tent", |v| render(v, |r| r.filter = "tent".into())),
-    knob("deep_bounce_depth 1", |v| render(v, |r| r.deep_bounce_depth = Some(1))),
-    knob("deep_bounce_depth 2", |v| render(v, |r| r.deep_bounce_depth = Some(2))),
-    knob("deep_bounce_depth 4", |v| render(v, |r| r.deep_bounce_depth = Some(4))),
+    knob("deep_bounce_depth 1", |v| {
+        render(v, |r| r.deep_bounce_depth = Some(1))
+    }),
+    knob("deep_bounce_depth 2", |v| {
+        render(v, |r| r.deep_bounce_depth = Some(2))
+    }),
+    knob("deep_bounce_depth 4", |v| {
+        render(v, |r| r.deep_bounce_depth = Some(4))
+    }),
     knob("lobe_cull 0.01", |v| render(v, |r| r.lobe_cull = 0.01)),
     knob("lobe_cull 0.1", |v| render(v, |r| r.lobe_cull = 0.1)),
 ];

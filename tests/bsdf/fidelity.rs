@@ -18,6 +18,11 @@ const BLACK: [f32; 3] = [2.9, 5.1, 10.2];
 /// Views (theta_o deg, phi_o deg, h) of the furnace and chi-square tests.
 const VIEWS: [(f64, f64, f32); 3] = [(-60.0, 10.0, -0.6), (0.0, 100.0, 0.2), (40.0, -150.0, 0.9)];
 
+/// A random h, wo and sample numbers.
+fn random_vertex(g: &mut impl rand::Rng) -> (f32, Vec3, [f32; 3]) {
+    (random_h(g), v3(uniform_sphere(g)), random_u(g))
+}
+
 fn bits(e: BsdfEval) -> ([u32; 3], u32) {
     (e.f.to_array().map(f32::to_bits), e.pdf.to_bits())
 }
@@ -65,11 +70,7 @@ fn culled_and_merged_samples_are_their_eval() {
     for _ in 0..200 {
         let b = bsdf(&random_params(&mut g, true));
         for _ in 0..300 {
-            let (h, wo, u) = (
-                random_h(&mut g),
-                v3(uniform_sphere(&mut g)),
-                random_u(&mut g),
-            );
+            let (h, wo, u) = random_vertex(&mut g);
             for lobes in [Lobes::Culled(0.05), Lobes::Culled(0.5), Lobes::Merged] {
                 let p = b.at_lobes(h, wo, lobes);
                 let Some(s) = p.sample(u) else { continue };
@@ -98,11 +99,7 @@ fn merged_sample_weight_is_the_total_attenuation() {
     for _ in 0..100 {
         let b = bsdf(&random_params(&mut g, true));
         for _ in 0..200 {
-            let (h, wo, u) = (
-                random_h(&mut g),
-                v3(uniform_sphere(&mut g)),
-                random_u(&mut g),
-            );
+            let (h, wo, u) = random_vertex(&mut g);
             let total: Vec3 = b.lobe_energies(h, wo).iter().sum();
             let Some(s) = b.at_lobes(h, wo, Lobes::Merged).sample(u) else {
                 continue;

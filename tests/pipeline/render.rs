@@ -47,28 +47,8 @@ fn mean(rgb: &[f32]) -> f64 {
 
 #[test]
 fn white_fur_in_a_white_furnace_is_invisible() {
-    let white = HairMaterial {
-        color: HairColor::SigmaA([0.0; 3]),
-        ..HairMaterial::default()
-    };
-    let env = Light::Environment(Environment::uniform(Vec3::ONE).unwrap());
-    let world = fur_world(white, vec![env], 3000);
-    let settings = RenderSettings {
-        width: 32,
-        height: 32,
-        spp: 16,
-        seed: 3,
-        ..RenderSettings::default()
-    };
-    let out = render(&world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
-    assert_eq!(out.status, RenderStatus::Complete);
-    let rgb = out.film.rgb();
-    assert!(rgb.iter().all(|v| v.is_finite()));
-    let m = mean(rgb);
-    println!(
-        "furnace mean {m:.5}, {} rays in {:.2} s",
-        out.stats.rays, out.stats.seconds
-    );
+    let (m, se) = furnace_mean(PathSettings::default());
+    println!("furnace mean {m:.5} ± {se:.5}");
     assert!((m - 1.0).abs() < 0.01, "furnace mean {m}");
 }
 
@@ -198,6 +178,23 @@ fn strategies_agree(max_depth: u32) {
     }
 }
 
+/// The 24 x 24 RGB image of `world` at `spp` samples, with these path settings.
+fn small_image(world: &World, spp: u32, seed: u64, path: PathSettings) -> Vec<f32> {
+    let settings = RenderSettings {
+        width: 24,
+        height: 24,
+        spp,
+        seed,
+        path,
+        ..RenderSettings::default()
+    };
+    render(world, &camera(), &settings, Aovs::default(), &NoProgress)
+        .unwrap()
+        .film
+        .rgb()
+        .to_vec()
+}
+
 /// The indirect clamp leaves light that scattered once alone, whichever strategy found
 /// it: with one event allowed, a clamp far below every contribution changes no bit;
 /// with more, it darkens the image.
@@ -205,23 +202,12 @@ fn strategies_agree(max_depth: u32) {
 fn clamp_indirect_touches_only_indirect_light() {
     let world = lit_world();
     let image = |max_depth: u32, clamp_indirect: Option<f32>| {
-        let settings = RenderSettings {
-            width: 24,
-            height: 24,
-            spp: 8,
-            seed: 5,
-            path: PathSettings {
-                max_depth,
-                clamp_indirect,
-                ..PathSettings::default()
-            },
-            ..RenderSettings::default()
+        let path = PathSettings {
+            max_depth,
+            clamp_indirect,
+            ..PathSettings::default()
         };
-        render(&world, &camera(), &settings, Aovs::default(), &NoProgress)
-            .unwrap()
-            .film
-            .rgb()
-            .to_vec()
+        small_image(&world, 8, 5, path)
     };
     let tiny = Some(1e-4);
     let direct = image(1, None);
@@ -316,6 +302,7 @@ fn furnace_mean(path: PathSettings) -> (f64, f64) {
         ..RenderSettings::default()
     };
     let out = render(&world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
+    assert_eq!(out.status, RenderStatus::Complete);
     let rgb = out.film.rgb();
     assert!(rgb.iter().all(|v| v.is_finite()));
     let n = rgb.len() as f64;
@@ -348,23 +335,12 @@ fn deep_bounces_keep_the_furnace_and_culling_darkens_it() {
 fn deep_bounce_depth_at_max_depth_is_exact_bit_for_bit() {
     let world = lit_world();
     let image = |deep_bounce_depth: Option<u32>| {
-        let settings = RenderSettings {
-            width: 24,
-            height: 24,
-            spp: 4,
-            seed: 7,
-            path: PathSettings {
-                max_depth: 6,
-                deep_bounce_depth,
-                ..PathSettings::default()
-            },
-            ..RenderSettings::default()
+        let path = PathSettings {
+            max_depth: 6,
+            deep_bounce_depth,
+            ..PathSettings::default()
         };
-        render(&world, &camera(), &settings, Aovs::default(), &NoProgress)
-            .unwrap()
-            .film
-            .rgb()
-            .to_vec()
+        small_image(&world, 4, 7, path)
     };
     let exact = image(None);
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();

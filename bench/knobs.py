@@ -10,7 +10,8 @@ the reference (its own noise taken out, as the report does) and efficiency
 1 / (RMSE^2 x seconds) relative to the exact settings; and each knob's bias: the RMSE
 between its own render at the reference's spp and seed and the reference (the shared
 seed makes their noise largely common, so this is mostly the knob's converged error,
-an upper bound of it).
+an upper bound of it), and the change of the image's mean it brings (energy gained or
+lost; the pixels' noise averages out of it).
 
     cargo build --release && python3 bench/knobs.py [--repeats 3] [--scenes a,b] [--threads 2]
 """
@@ -61,10 +62,15 @@ def render(scene, out, spp, seed, threads, extra):
     return s["seconds"], s["rays"] / max(s["samples"], 1), cpu
 
 
-def rmse(image, reference):
+def compare(image, reference):
+    """`hairtrace compare --json`: rmse, mean, reference_mean, max_abs."""
     o = subprocess.run([str(HAIRTRACE), "compare", str(image), str(reference), "--json"],
                        check=True, capture_output=True, text=True)
-    return json.loads(o.stdout)["rmse"]
+    return json.loads(o.stdout)
+
+
+def rmse(image, reference):
+    return compare(image, reference)["rmse"]
 
 
 def main():
@@ -76,18 +82,19 @@ def main():
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="knobs-"))
     print("| scene | variant | seconds | CPU time vs exact | rays/sample | RMSE "
-          "| efficiency vs exact | bias (RMSE at 8x spp, shared seed) |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| efficiency vs exact | bias (RMSE at 8x spp, shared seed) | image mean change |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for name in args.scenes.split(","):
         scene = ROOT / "bench" / "scenes" / f"{name}.toml"
         spp = spp_of(scene)
         reference = tmp / f"{name}_ref.exr"
         render(scene, reference, 8 * spp, REFERENCE_SEED, args.threads, [])
-        bias = {"exact": 0.0}
+        bias = {"exact": (0.0, 0.0)}
         for v, extra in [] if args.no_bias else list(VARIANTS.items())[1:]:
             out = tmp / f"{name}_{v.replace(' ', '_')}_bias.exr"
             render(scene, out, 8 * spp, REFERENCE_SEED, args.threads, extra)
-            bias[v] = rmse(out, reference)
+            c = compare(out, reference)
+            bias[v] = (c["rmse"], c["mean"] / c["reference_mean"] - 1)
         names = list(VARIANTS)
         runs = {v: [] for v in VARIANTS}
         for seed in range(1, args.repeats + 1):
@@ -110,7 +117,7 @@ def main():
         base = 1 / (rows["exact"][2] ** 2 * rows["exact"][0])
         for v, (seconds, rays, err, cpu) in rows.items():
             eff = 1 / (err ** 2 * seconds) / base if err > 0 else float("inf")
-            b = f"{bias[v]:.3g}" if v in bias else ""
+            b = f"{bias[v][0]:.3g} | {100 * bias[v][1]:+.2f}%" if v in bias else " | "
             print(f"| {name} | {v} | {seconds:.3f} | {cpu / rows['exact'][3]:.3f} | {rays:.2f} "
                   f"| {err:.4g} | {eff:.3f} | {b} |")
         sys.stdout.flush()

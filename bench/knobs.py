@@ -35,6 +35,8 @@ VARIANTS = {
     "deep_bounce_depth 1": ["--deep-bounce-depth", "1"],
     "deep_bounce_depth 2": ["--deep-bounce-depth", "2"],
     "deep_bounce_depth 4": ["--deep-bounce-depth", "4"],
+    "deep_bounce_depth 8": ["--deep-bounce-depth", "8"],
+    "deep_bounce_depth 16": ["--deep-bounce-depth", "16"],
     "lobe_cull 0.01": ["--lobe-cull", "0.01"],
     "lobe_cull 0.1": ["--lobe-cull", "0.1"],
 }
@@ -79,7 +81,12 @@ def main():
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--no-bias", action="store_true", help="skip the bias renders")
+    ap.add_argument("--variants", help="comma-separated names (exact is always run)")
     args = ap.parse_args()
+    if args.variants:
+        wanted = {"exact", *args.variants.split(",")}
+        for v in [v for v in VARIANTS if v not in wanted]:
+            del VARIANTS[v]
     tmp = Path(tempfile.mkdtemp(prefix="knobs-"))
     print("| scene | variant | seconds | CPU time vs exact | rays/sample | RMSE "
           "| efficiency vs exact | bias (RMSE at 8x spp, shared seed) | image mean change |")

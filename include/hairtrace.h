@@ -453,10 +453,11 @@ typedef struct HtRenderSettings {
     void *progress_user;
     /**
      * Past this many scattering events a hair BSDF is one merged lobe: the same energy
-     * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights; cheaper
-     * per event. 0 (the default): the exact model at every event. Otherwise in [1,
-     * max_depth]; max_depth changes nothing. README, "Speed against error", has what it
-     * costs and buys. (ABI 5.)
+     * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
+     * per event and far less noisy on light hair, but biased (light hair comes out
+     * brighter), so off by default. 0 (the default): the exact model at every event.
+     * Otherwise in [1, max_depth]; max_depth changes nothing. README, "Speed against
+     * error", has what it costs and buys. (ABI 5.)
      */
     uint32_t deep_bounce_depth;
     /**

@@ -160,7 +160,8 @@ struct RenderArgs {
     #[arg(long, value_parser = ["sqrt", "throughput"])]
     roulette: Option<String>,
     /// Past this many scattering events, hair scatters through one merged lobe (the same
-    /// energy, no azimuthal highlights), which is cheaper (default: exact at every event).
+    /// energy, no azimuthal highlights): less noise on light hair, at a bias (default:
+    /// exact at every event).
     #[arg(long, value_name = "N")]
     deep_bounce_depth: Option<u32>,
     /// Drop hair lobes whose attenuation is below this fraction of the total, in [0, 1)

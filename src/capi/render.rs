@@ -74,10 +74,11 @@ pub struct HtRenderSettings {
     /// Passed to `progress` as it is.
     pub progress_user: *mut c_void,
     /// Past this many scattering events a hair BSDF is one merged lobe: the same energy
-    /// (albedo), the residual lobe's longitudinal spread, no azimuthal highlights; cheaper
-    /// per event. 0 (the default): the exact model at every event. Otherwise in [1,
-    /// max_depth]; max_depth changes nothing. README, "Speed against error", has what it
-    /// costs and buys. (ABI 5.)
+    /// (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
+    /// per event and far less noisy on light hair, but biased (light hair comes out
+    /// brighter), so off by default. 0 (the default): the exact model at every event.
+    /// Otherwise in [1, max_depth]; max_depth changes nothing. README, "Speed against
+    /// error", has what it costs and buys. (ABI 5.)
     pub deep_bounce_depth: u32,
     /// Hair lobes whose attenuation (largest channel) is below this fraction of the total
     /// are dropped from evaluation and sampling (the strongest lobe is always kept); in

@@ -99,9 +99,10 @@ pub struct PathSettings {
     pub clamp_indirect: Option<f32>,
     pub strategy: Strategy,
     /// Past this many scattering events a hair BSDF is its merged lobe ([`Lobes::Merged`]:
-    /// the same energy, no azimuthal structure); None = the exact model at every event,
-    /// the default (README, "Speed against error": what it costs and buys). In [1,
-    /// max_depth]; max_depth leaves every event exact.
+    /// the same energy, no azimuthal structure: less noise on light hair, at a bias);
+    /// None = the exact model at every event, the default (README, "Speed against
+    /// error": what it costs and buys). In [1, max_depth]; max_depth leaves every event
+    /// exact.
     pub deep_bounce_depth: Option<u32>,
     /// Hair lobes whose attenuation is below this fraction of the total are dropped
     /// ([`Lobes::Culled`]); 0 = off, the default. In [0, 1).

@@ -222,8 +222,8 @@ pub fn section(ctx: &Context) -> Result<String> {
          the reference settings at 8x the scene's samples with a seed no timed render uses, \
          with the reference's own noise (estimated from the reference settings' renders) \
          taken out. Its time is the path tracing alone (the scene build is in the scale \
-         section). A knob that changes the image (shape, basis, max depth, filter) shows \
-         its bias as a floor its curve cannot go below; one that only changes noise moves \
+         section). A knob that changes the image (shape, basis, max depth, filter, the hair \
+         fidelity knobs `deep_bounce_depth` and `lobe_cull`) shows its bias as a floor its curve cannot go below; one that only changes noise moves \
          its curve sideways. The tent filter's floor is partly the blur it adds by design, \
          not error. Efficiency is 1 / (RMSE^2 x seconds) at the scene's spp, relative to \
          the reference settings'.\n\n",

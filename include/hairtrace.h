@@ -26,7 +26,7 @@
  * Version of the C ABI; bumped on any incompatible change of a signature or struct. The
  * shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
  */
-#define HT_ABI_VERSION 4
+#define HT_ABI_VERSION 5
 
 /**
  * The major part of the library version, which `ht_version()` returns as a string. The
@@ -451,6 +451,22 @@ typedef struct HtRenderSettings {
      * Passed to `progress` as it is.
      */
     void *progress_user;
+    /**
+     * Past this many scattering events a hair BSDF is one merged lobe: the same energy
+     * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
+     * per event and far less noisy on light hair, but biased (light hair comes out
+     * brighter), so off by default. 0 (the default): the exact model at every event.
+     * Otherwise in [1, max_depth]; max_depth changes nothing. README, "Speed against
+     * error", has what it costs and buys. (ABI 5.)
+     */
+    uint32_t deep_bounce_depth;
+    /**
+     * Hair lobes whose attenuation (largest channel) is below this fraction of the total
+     * are dropped from evaluation and sampling (the strongest lobe is always kept); in
+     * [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
+     * measured, saves no time: off by default (README, "Speed against error"). (ABI 5.)
+     */
+    float lobe_cull;
 } HtRenderSettings;
 #endif
 
@@ -1314,7 +1330,8 @@ enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
 #if defined(HT_RENDER)
 /**
  * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
- * crop), a tent filter of radius 1, no callback.
+ * crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
+ * deep-bounce lobe, no lobe culling).
  */
 struct HtRenderSettings ht_render_settings_default(void);
 #endif

@@ -55,7 +55,7 @@ pub mod render;
 pub mod scene;
 mod validate;
 
-pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, LocalBsdf};
+pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf};
 #[cfg(feature = "render")]
 pub use description::{BuiltScene, SceneDescription};
 #[cfg(feature = "render")]

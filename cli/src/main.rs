@@ -159,6 +159,15 @@ struct RenderArgs {
     /// throughput.
     #[arg(long, value_parser = ["sqrt", "throughput"])]
     roulette: Option<String>,
+    /// Past this many scattering events, hair scatters through one merged lobe (the same
+    /// energy, no azimuthal highlights): less noise on light hair, at a bias (default:
+    /// exact at every event).
+    #[arg(long, value_name = "N")]
+    deep_bounce_depth: Option<u32>,
+    /// Drop hair lobes whose attenuation is below this fraction of the total, in [0, 1)
+    /// (default 0: none).
+    #[arg(long, value_name = "T")]
+    lobe_cull: Option<f32>,
     /// Curve shape of every groom, over the scene's: auto (the default: a ribbon facing the
     /// ray where a strand is at most a pixel wide, a tube elsewhere), round or flat.
     #[arg(long, value_parser = ["auto", "round", "flat"])]
@@ -437,6 +446,8 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     if let Some(roulette) = &args.roulette {
         r.roulette.clone_from(roulette);
     }
+    r.deep_bounce_depth = args.deep_bounce_depth.or(r.deep_bounce_depth);
+    r.lobe_cull = args.lobe_cull.unwrap_or(r.lobe_cull);
     if let Some(filter) = &args.filter {
         r.filter.clone_from(filter);
     }

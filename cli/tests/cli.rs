@@ -495,3 +495,46 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
         assert_one_line_error(&hairtrace(&all), needle);
     }
 }
+
+/// `--deep-bounce-depth` and `--lobe-cull` reach the renderer: a deep-bounce depth of
+/// `--max-depth` is the exact image bit for bit (EXR keeps the bits), an earlier one
+/// and culling change it; out-of-range values are one-line errors naming the setting.
+#[test]
+fn render_takes_the_fidelity_knobs() {
+    let common = [
+        "render",
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--spp",
+        "2",
+        "--max-depth",
+        "4",
+    ];
+    let image = |name: &str, knob: &[&str]| {
+        let out = tmp(name);
+        let mut args: Vec<&str> = common.to_vec();
+        args.extend(knob);
+        args.extend(["-o", out.as_str()]);
+        let o = hairtrace(&args);
+        assert!(o.status.success(), "{o:?}");
+        hairtrace::image::read_image(std::path::Path::new(&out))
+            .unwrap()
+            .pixels
+    };
+    let exact = image("cli_exact.exr", &[]);
+    assert_eq!(image("cli_deep4.exr", &["--deep-bounce-depth", "4"]), exact);
+    assert_ne!(image("cli_deep1.exr", &["--deep-bounce-depth", "1"]), exact);
+    assert_ne!(image("cli_cull.exr", &["--lobe-cull", "0.2"]), exact);
+    let out = tmp("cli_knob_error.exr");
+    for (knob, value, needle) in [
+        ("--deep-bounce-depth", "5", "deep_bounce_depth = 5"),
+        ("--deep-bounce-depth", "0", "deep_bounce_depth = 0"),
+        ("--lobe-cull", "1", "lobe_cull = 1"),
+    ] {
+        let mut args: Vec<&str> = common.to_vec();
+        args.extend([knob, value, "-o", out.as_str()]);
+        assert_one_line_error(&hairtrace(&args), needle);
+    }
+}

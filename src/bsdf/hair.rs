@@ -10,6 +10,10 @@
 //! absorption, the lobes' azimuthal centres), shared by sampling and evaluation; the per-wi part is
 //! the four lobes. Both stages are generic over [`Lanes`], so `eval_batch` runs the same
 //! code eight inputs at a time.
+//!
+//! A point may also evaluate less than the whole model ([`Lobes`]): the renderer's two
+//! fidelity knobs, lobe culling and the merged lobe of deep bounces (README, "Speed
+//! against error", has what each costs and buys).
 
 use super::azimuthal::{TrimmedLogistic, azimuthal_scale};
 use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
@@ -40,6 +44,24 @@ pub struct HairBsdf {
     np: TrimmedLogistic,
     /// (sin, cos) of the cuticle shift of theta_o for R, TT, TRT: -2 alpha, alpha, 4 alpha.
     tilt: [(f32, f32); EXPLICIT_LOBES],
+}
+
+/// How much of the model a point evaluates, samples and integrates to.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Lobes {
+    /// The whole model.
+    #[default]
+    All,
+    /// The lobes whose attenuation (its largest channel) is below this fraction of the
+    /// total's largest channel are dropped from f, pdf and sampling alike (the sampling
+    /// renormalised over the lobes kept); the strongest lobe is always kept. 0 keeps
+    /// every lobe. Lost energy: the dropped lobes'.
+    Culled(f32),
+    /// One azimuthally uniform lobe that carries the energy of all four, with the
+    /// residual lobe's (widest) longitudinal spread: the same albedo at (h, wo), without
+    /// the highlights' shapes. Costs one longitudinal lobe per eval instead of four lobes
+    /// and three azimuths: the approximation for deep bounces.
+    Merged,
 }
 
 /// Everything that depends on (h, wo) but not on wi.
@@ -88,16 +110,28 @@ impl HairBsdf {
     /// and shared by every `eval`, `pdf` and `sample` at that point (next-event
     /// estimation and BSDF sampling of a path vertex use the same point).
     pub fn at(&self, h: f32, wo: Vec3) -> HairPoint<'_> {
+        self.at_lobes(h, wo, Lobes::All)
+    }
+
+    /// [`Self::at`] with only the lobes `lobes` asks for.
+    pub fn at_lobes(&self, h: f32, wo: Vec3, lobes: Lobes) -> HairPoint<'_> {
         HairPoint {
             bsdf: self,
-            at: self.vertex(h, wo),
+            at: self.vertex(h, wo, lobes),
         }
     }
 
     /// The (h, wo) part of a point, without the reference back to the BSDF.
-    fn vertex(&self, h: f32, wo: Vec3) -> Vertex {
+    fn vertex(&self, h: f32, wo: Vec3, lobes: Lobes) -> Vertex {
+        let mut o = self.outgoing(h, wo.to_array());
+        match lobes {
+            Lobes::All => {}
+            Lobes::Culled(threshold) => cull(&mut o, threshold),
+            Lobes::Merged => merge(&mut o),
+        }
         Vertex {
-            o: self.outgoing(h, wo.to_array()),
+            o,
+            merged: lobes == Lobes::Merged,
         }
     }
 
@@ -114,7 +148,7 @@ impl HairBsdf {
     /// Energy of each lobe (R, TT, TRT, residual) leaving wo at h: the lobes' Mp and Np
     /// integrate to one, so this is Ap.
     pub fn lobe_energies(&self, h: f32, wo: Vec3) -> [Vec3; 4] {
-        self.vertex(h, wo).o.ap.map(Vec3::from_array)
+        self.vertex(h, wo, Lobes::All).o.ap.map(Vec3::from_array)
     }
 
     /// Samples wi: `u[0]` picks the lobe (proportionally to its mean attenuation) and is
@@ -267,6 +301,18 @@ impl HairBsdf {
         ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
     }
 
+    /// The per-wi stage of a merged point ([`Lobes::Merged`]): the residual lobe alone,
+    /// which [`merge`] gave every lobe's energy and the whole sampling weight.
+    #[inline(always)]
+    fn eval_merged(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> ([f32; 3], f32) {
+        let sin_ti = wi[0].clamp(-1.0, 1.0);
+        let cos_ti = cos_from_sin(sin_ti);
+        let weight = self.mp[RESIDUAL].eval(sin_ti, cos_ti, o.sin_to, o.cos_to) * (0.5 * FRAC_1_PI);
+        let inv_cos = inv_cos(wi[2]);
+        let f = o.ap[RESIDUAL].map(|a| weight * a * inv_cos);
+        (f, weight)
+    }
+
     /// The per-wi stage of one evaluation, with the four lobes in the lanes of an f32x4.
     /// Every lane runs the operations [`Self::eval_lobes`] runs for that lobe, and the
     /// lobes are summed in the same order, so the two agree bit for bit.
@@ -301,14 +347,52 @@ impl HairBsdf {
             }
             pdf += w * lobe_pdf;
         }
-        let cos_wi = wi[2].abs();
-        let inv_cos = if cos_wi > MIN_COS_WI {
-            1.0 / cos_wi
-        } else {
-            1.0
-        };
+        let inv_cos = inv_cos(wi[2]);
         ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
     }
+}
+
+/// 1/|wi.z|, or 1 where |wi.z| is below [`MIN_COS_WI`].
+#[inline(always)]
+fn inv_cos(wi_z: f32) -> f32 {
+    let cos_wi = wi_z.abs();
+    if cos_wi > MIN_COS_WI {
+        1.0 / cos_wi
+    } else {
+        1.0
+    }
+}
+
+/// The index of the residual lobe, after the explicit ones.
+const RESIDUAL: usize = EXPLICIT_LOBES;
+
+/// Drops the lobes of `o` whose largest channel of attenuation is below `threshold`
+/// times the largest channel of the total (never the strongest lobe), and renormalises
+/// the sampling weights over those kept. Keeps every bit of `o` when none is dropped.
+fn cull(o: &mut Outgoing<f32>, threshold: f32) {
+    let peak = o.ap.map(|a| a[0].max(a[1]).max(a[2]));
+    let total = (0..3)
+        .map(|c| o.ap.iter().map(|a| a[c]).sum::<f32>())
+        .fold(0.0, f32::max);
+    let strongest = (0..4).fold(0, |s, p| if peak[p] > peak[s] { p } else { s });
+    let dropped = |p: usize| p != strongest && peak[p] < threshold * total;
+    if !(0..4).any(dropped) {
+        return;
+    }
+    for p in (0..4).filter(|&p| dropped(p)) {
+        o.ap[p] = [0.0; 3];
+        o.lobe_pdf[p] = 0.0;
+    }
+    let inv_kept = 1.0 / o.lobe_pdf.iter().sum::<f32>();
+    o.lobe_pdf = o.lobe_pdf.map(|w| w * inv_kept);
+}
+
+/// Gives the residual lobe the energy of all four and the whole sampling weight
+/// ([`Lobes::Merged`]).
+fn merge(o: &mut Outgoing<f32>) {
+    let ap = o.ap;
+    o.ap[RESIDUAL] = std::array::from_fn(|c| ap.iter().map(|a| a[c]).sum());
+    o.lobe_pdf = [0.0, 0.0, 0.0, 1.0];
 }
 
 impl LocalBsdf for HairPoint<'_> {
@@ -352,7 +436,7 @@ impl OwnedPoint {
     pub(crate) fn new(bsdf: &HairBsdf, h: f32, wo: Vec3) -> Self {
         Self {
             bsdf: *bsdf,
-            at: bsdf.vertex(h, wo),
+            at: bsdf.vertex(h, wo, Lobes::All),
         }
     }
 
@@ -370,13 +454,19 @@ impl OwnedPoint {
 #[derive(Clone, Copy)]
 struct Vertex {
     o: Outgoing<f32>,
+    /// Evaluated as [`Lobes::Merged`].
+    merged: bool,
 }
 
 impl HairBsdf {
     /// f and pdf toward wi at a prepared vertex.
     #[inline(always)]
     fn eval_at(&self, at: &Vertex, wi: Vec3) -> BsdfEval {
-        let (f, pdf) = self.eval_lobes_packed(&at.o, wi.to_array());
+        let (f, pdf) = if at.merged {
+            self.eval_merged(&at.o, wi.to_array())
+        } else {
+            self.eval_lobes_packed(&at.o, wi.to_array())
+        };
         BsdfEval {
             f: Vec3::from_array(f),
             pdf,
@@ -421,18 +511,20 @@ impl HairBsdf {
     }
 }
 
-/// Picks a lobe with probability `lobe_pdf[p]` and rescales u into [0, 1) for reuse.
+/// Picks a lobe with probability `lobe_pdf[p]` and rescales u into [0, 1) for reuse. A u
+/// that rounding carries past the weights goes to the last lobe of nonzero weight.
 fn pick_lobe(lobe_pdf: &[f32; 4], u: f32) -> (usize, f32) {
+    let last = lobe_pdf.iter().rposition(|&w| w > 0.0).unwrap_or(RESIDUAL);
     let mut u = u;
-    for (p, &w) in lobe_pdf.iter().enumerate().take(3) {
+    for (p, &w) in lobe_pdf.iter().enumerate().take(last) {
         if u < w {
             return (p, (u / w).min(ONE_MINUS_EPSILON));
         }
         u -= w;
     }
-    let w = lobe_pdf[3];
+    let w = lobe_pdf[last];
     (
-        3,
+        last,
         if w > 0.0 {
             (u / w).clamp(0.0, ONE_MINUS_EPSILON)
         } else {

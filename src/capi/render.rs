@@ -73,10 +73,23 @@ pub struct HtRenderSettings {
     pub progress: HtProgressFn,
     /// Passed to `progress` as it is.
     pub progress_user: *mut c_void,
+    /// Past this many scattering events a hair BSDF is one merged lobe: the same energy
+    /// (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
+    /// per event and far less noisy on light hair, but biased (light hair comes out
+    /// brighter), so off by default. 0 (the default): the exact model at every event.
+    /// Otherwise in [1, max_depth]; max_depth changes nothing. README, "Speed against
+    /// error", has what it costs and buys. (ABI 5.)
+    pub deep_bounce_depth: u32,
+    /// Hair lobes whose attenuation (largest channel) is below this fraction of the total
+    /// are dropped from evaluation and sampling (the strongest lobe is always kept); in
+    /// [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
+    /// measured, saves no time: off by default (README, "Speed against error"). (ABI 5.)
+    pub lobe_cull: f32,
 }
 
 /// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
-/// crop), a tent filter of radius 1, no callback.
+/// crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
+/// deep-bounce lobe, no lobe culling).
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
     let d = RenderSettings::default();
@@ -96,6 +109,8 @@ pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
         filter_radius: d.filter.name().1.unwrap_or(1.0),
         progress: None,
         progress_user: null_mut(),
+        deep_bounce_depth: d.path.deep_bounce_depth.unwrap_or(0),
+        lobe_cull: d.path.lobe_cull,
     }
 }
 
@@ -122,6 +137,8 @@ impl HtRenderSettings {
             filter,
             path: PathSettings {
                 max_depth: self.max_depth,
+                deep_bounce_depth: (self.deep_bounce_depth > 0).then_some(self.deep_bounce_depth),
+                lobe_cull: self.lobe_cull,
                 ..PathSettings::default()
             },
         })

@@ -8,7 +8,7 @@ use crate::capi::scene::*;
 use crate::capi::scene_tests::{Handles, fails, last_error, small_fur, xyzr, xyzr_desc};
 use crate::embree::{CurveBasis, CurveShape, Device, Geometry, SceneOptions};
 use crate::image::read_image;
-use crate::render::integrator::World;
+use crate::render::integrator::{PathSettings, World};
 use crate::render::renderer::render;
 use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, NoProgress, PixelFilter};
@@ -156,6 +156,45 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
     let out = render(&world, &camera, &rust_box, Aovs::default(), &NoProgress).unwrap();
     assert_eq!(bits(&box_rgb), bits(out.film.rgb()));
     assert_ne!(bits(&box_rgb), bits(&rgb));
+
+    // So do the fidelity knobs: each C render is the Rust render with the same path
+    // settings, and a deep-bounce depth of max_depth is the exact image.
+    let exact = HtRenderSettings {
+        max_depth: 6,
+        ..settings(32)
+    };
+    let c_image = |s: HtRenderSettings| {
+        let (status, rgb) = render_c(&h, &s);
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        bits(&rgb)
+    };
+    let exact_rgb = c_image(exact);
+    for (deep_bounce_depth, lobe_cull) in [(6, 0.0), (1, 0.0), (0, 0.2)] {
+        let knob = HtRenderSettings {
+            deep_bounce_depth,
+            lobe_cull,
+            ..exact
+        };
+        let path = PathSettings {
+            max_depth: 6,
+            deep_bounce_depth: (deep_bounce_depth > 0).then_some(deep_bounce_depth),
+            lobe_cull,
+            ..PathSettings::default()
+        };
+        let rust_knob = RenderSettings { path, ..rust };
+        let out = render(&world, &camera, &rust_knob, Aovs::default(), &NoProgress).unwrap();
+        let got = c_image(knob);
+        assert_eq!(
+            got,
+            bits(out.film.rgb()),
+            "{deep_bounce_depth}, {lobe_cull}"
+        );
+        assert_eq!(
+            got == exact_rgb,
+            deep_bounce_depth == 6,
+            "{deep_bounce_depth}, {lobe_cull}"
+        );
+    }
 }
 
 #[test]
@@ -460,6 +499,25 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             ..s
         };
         fails(ht_render(h.scene, &radius, ptr, len), INVALID, "radius NaN");
+        let deep = HtRenderSettings {
+            max_depth: 4,
+            deep_bounce_depth: 5,
+            ..s
+        };
+        fails(
+            ht_render(h.scene, &deep, ptr, len),
+            INVALID,
+            "deep_bounce_depth = 5: must be in [1, max_depth = 4]",
+        );
+        let cull = HtRenderSettings {
+            lobe_cull: 1.0,
+            ..s
+        };
+        fails(
+            ht_render(h.scene, &cull, ptr, len),
+            INVALID,
+            "lobe_cull = 1",
+        );
         let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
             let n = null_mut();
             ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)
@@ -589,6 +647,7 @@ fn the_default_settings_are_the_rust_defaults() {
     let rust = d.to_rust().unwrap();
     assert_eq!(rust.crop, None, "the full frame");
     assert_eq!(rust.filter, r.filter);
+    assert_eq!(rust.path, r.path, "no deep-bounce lobe, no lobe culling");
     assert!(d.progress.is_none() && d.progress_user.is_null());
 }
 

@@ -17,6 +17,8 @@
 //! rr_depth = 2            # Russian roulette after this many events
 //! roulette = "sqrt"        # survival sqrt(throughput), or "throughput"
 //! clamp_indirect = 10.0    # absent: no clamping
+//! deep_bounce_depth = 4    # hair past 4 events: one merged lobe (absent: exact throughout)
+//! lobe_cull = 0.01         # drop hair lobes below 1% of the attenuation (default 0: none)
 //! crop = [0, 0, 320, 240]  # [x0, y0, x1, y1) of the full frame
 //! filter = "tent"          # or "box" (one pixel)
 //! filter_radius = 1.0      # the tent's half-width in pixels
@@ -154,6 +156,10 @@ pub struct RenderDesc {
     /// "sqrt" (the default) or "throughput": see [`Roulette`].
     pub roulette: String,
     pub clamp_indirect: Option<f32>,
+    /// Past this many events a hair BSDF is one merged lobe; None: exact at every event.
+    pub deep_bounce_depth: Option<u32>,
+    /// Hair lobes below this fraction of the attenuation are dropped; 0: none.
+    pub lobe_cull: f32,
     pub crop: Option<[u32; 4]>,
     /// "tent" (the default) or "box".
     pub filter: String,
@@ -175,6 +181,8 @@ impl Default for RenderDesc {
             rr_depth: s.path.rr_depth,
             roulette: s.path.roulette.name().to_string(),
             clamp_indirect: s.path.clamp_indirect,
+            deep_bounce_depth: s.path.deep_bounce_depth,
+            lobe_cull: s.path.lobe_cull,
             crop: s.crop,
             filter: s.filter.name().0.to_string(),
             filter_radius: None,
@@ -204,6 +212,8 @@ impl RenderDesc {
                 rr_depth: self.rr_depth,
                 roulette: Roulette::named(&self.roulette)?,
                 clamp_indirect: self.clamp_indirect,
+                deep_bounce_depth: self.deep_bounce_depth,
+                lobe_cull: self.lobe_cull,
                 ..PathSettings::default()
             },
         };

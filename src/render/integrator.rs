@@ -11,7 +11,7 @@ use super::film::FirstHit;
 use super::sampler::PixelSampler;
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
-use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, LocalBsdf};
+use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, Lobes, LocalBsdf};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
@@ -98,6 +98,15 @@ pub struct PathSettings {
     /// more scattering events; biased, reduces fireflies); None = off, the default.
     pub clamp_indirect: Option<f32>,
     pub strategy: Strategy,
+    /// Past this many scattering events a hair BSDF is its merged lobe ([`Lobes::Merged`]:
+    /// the same energy, no azimuthal structure: less noise on light hair, at a bias);
+    /// None = the exact model at every event, the default (README, "Speed against
+    /// error": what it costs and buys). In [1, max_depth]; max_depth leaves every event
+    /// exact.
+    pub deep_bounce_depth: Option<u32>,
+    /// Hair lobes whose attenuation is below this fraction of the total are dropped
+    /// ([`Lobes::Culled`]); 0 = off, the default. In [0, 1).
+    pub lobe_cull: f32,
 }
 
 impl Default for PathSettings {
@@ -108,6 +117,8 @@ impl Default for PathSettings {
             roulette: Roulette::default(),
             clamp_indirect: None,
             strategy: Strategy::Mis,
+            deep_bounce_depth: None,
+            lobe_cull: 0.0,
         }
     }
 }
@@ -125,7 +136,33 @@ impl PathSettings {
         if let Some(c) = self.clamp_indirect {
             positive("clamp_indirect", c)?;
         }
+        if let Some(n) = self.deep_bounce_depth {
+            if n == 0 || n > self.max_depth {
+                return Err(invalid_arg!(
+                    "deep_bounce_depth = {n}: must be in [1, max_depth = {}] (unset, or 0 \
+                     in C, for the exact BSDF at every event)",
+                    self.max_depth
+                ));
+            }
+        }
+        if !(0.0..1.0).contains(&self.lobe_cull) {
+            return Err(invalid_arg!(
+                "lobe_cull = {}: must be in [0, 1) (0: every lobe)",
+                self.lobe_cull
+            ));
+        }
         Ok(())
+    }
+
+    /// The hair lobes a vertex evaluates after `events` scattering events.
+    fn lobes(&self, events: u32) -> Lobes {
+        if self.deep_bounce_depth.is_some_and(|n| events >= n) {
+            Lobes::Merged
+        } else if self.lobe_cull > 0.0 {
+            Lobes::Culled(self.lobe_cull)
+        } else {
+            Lobes::All
+        }
     }
 }
 
@@ -251,7 +288,7 @@ impl World {
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
                 (Hit::Hair(h), Some(Material::Hair(m))) => {
                     varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.color);
-                    Shading::hair(h, &varied_bsdf, wo_world)
+                    Shading::hair(h, &varied_bsdf, wo_world, settings.lobes(events))
                 }
                 (Hit::Surface(s), Some(Material::Diffuse(d))) => Shading::diffuse(s, *d, wo_world),
                 _ => break,
@@ -402,10 +439,10 @@ enum Point<'a> {
 }
 
 impl<'a> Shading<'a> {
-    fn hair(h: &HairHit, bsdf: &'a HairBsdf, wo_world: Vec3) -> Self {
+    fn hair(h: &HairHit, bsdf: &'a HairBsdf, wo_world: Vec3, lobes: Lobes) -> Self {
         Shading {
             frame: h.frame,
-            point: Point::Hair(bsdf.at(h.h, h.frame.to_local(wo_world))),
+            point: Point::Hair(bsdf.at_lobes(h.h, h.frame.to_local(wo_world), lobes)),
         }
     }
 

@@ -13,7 +13,7 @@ use crate::common::chi2::{Chi2Result, Grid, dump_tables, pearson};
 use crate::common::quad::gauss_legendre;
 use crate::common::reference::RefHair;
 use crate::common::{Timer, bsdf, d3, dir_deg, par_map, params, random_u, reference, rng, v3};
-use hairtrace::{HairBsdf, HairParams};
+use hairtrace::{HairBsdf, HairParams, Lobes};
 use std::path::Path;
 
 const GRID: Grid = Grid {
@@ -34,17 +34,24 @@ const VIEWS: [(f64, f64, f32); 4] = [
 ];
 
 #[derive(Clone, Copy, Debug)]
-struct Config {
-    p: HairParams,
-    theta_o: f64,
-    phi_o: f64,
-    h: f32,
+pub(crate) struct Config {
+    pub p: HairParams,
+    pub theta_o: f64,
+    pub phi_o: f64,
+    pub h: f32,
+    /// The lobes the point samples and evaluates.
+    pub lobes: Lobes,
 }
 
 impl Config {
     fn name(&self) -> String {
+        let lobes = match self.lobes {
+            Lobes::All => String::new(),
+            Lobes::Culled(t) => format!("_cull{t}"),
+            Lobes::Merged => "_merged".into(),
+        };
         format!(
-            "b{}_a{}_s{}_to{}_po{}_h{}",
+            "b{}_a{}_s{}_to{}_po{}_h{}{lobes}",
             self.p.beta_m,
             self.p.alpha,
             if self.p.sigma_a == [0.0; 3] {
@@ -74,6 +81,7 @@ fn configs() -> Vec<Config> {
                         theta_o,
                         phi_o,
                         h,
+                        lobes: Lobes::All,
                     });
                 }
             }
@@ -93,9 +101,9 @@ fn histogram(
     let mut g = rng(seed);
     let mut counts = vec![0.0; GRID.cells()];
     let mut none = 0;
-    let wo = c.wo();
+    let point = b.at_lobes(c.h, c.wo(), c.lobes);
     for _ in 0..SAMPLES {
-        match b.sample(c.h, wo, random_u(&mut g)) {
+        match point.sample(random_u(&mut g)) {
             Some(s) => counts[GRID.cell(map(d3(s.wi)))] += 1.0,
             None => none += 1,
         }
@@ -121,8 +129,8 @@ struct Outcome {
 fn run(c: &Config, seed: u64) -> Outcome {
     let b = bsdf(&c.p);
     let r = reference(&c.p);
-    let wo = c.wo();
-    let prob = cell_probabilities(&r, c, |wi| b.pdf(c.h, wo, v3(wi)) as f64);
+    let point = b.at_lobes(c.h, c.wo(), c.lobes);
+    let prob = cell_probabilities(&r, c, |wi| point.eval(v3(wi)).pdf as f64);
     let total: f64 = prob.iter().sum();
     let expected: Vec<f64> = prob.iter().map(|p| p * SAMPLES as f64).collect();
     let (observed, none) = histogram(&b, c, seed, |w| w);
@@ -139,7 +147,7 @@ fn dump_dir() -> &'static Path {
     Path::new(env!("CARGO_TARGET_TMPDIR"))
 }
 
-fn run_all(configs: &[Config], first_seed: u64, threshold: f64) {
+pub(crate) fn run_all(configs: &[Config], first_seed: u64, threshold: f64) {
     let outcomes = par_map(
         &configs.iter().enumerate().collect::<Vec<_>>(),
         |&(i, c)| run(c, first_seed + i as u64),
@@ -247,6 +255,7 @@ fn chi2_rejects_wrong_distributions() {
         theta_o: 20.0,
         phi_o: 60.0,
         h: 0.3,
+        lobes: Lobes::All,
     };
     let b = bsdf(&c.p);
     let r = reference(&c.p);

@@ -6,6 +6,7 @@
 mod common;
 
 mod chi2;
+mod fidelity;
 mod furnace;
 mod lobes;
 mod normalisation;

@@ -384,7 +384,7 @@ fn missing_files_are_io_errors_that_name_them() {
 }
 
 #[test]
-fn render_keys_pick_the_filter_and_the_roulette() {
+fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
     let d = parse(&format!(
         "[render]\nfilter = \"box\"\nroulette = \"throughput\"\nrr_depth = 3\n{BASE}"
     ))
@@ -400,13 +400,24 @@ fn render_keys_pick_the_filter_and_the_roulette() {
         d.render.settings().unwrap().filter,
         PixelFilter::tent(2.0).unwrap()
     );
-    // The defaults: a tent of one pixel, roulette on sqrt(throughput) after two events.
+    let d = parse(&format!(
+        "[render]\ndeep_bounce_depth = 3\nlobe_cull = 0.05\n{BASE}"
+    ))
+    .unwrap();
+    let s = d.render.settings().unwrap();
+    assert_eq!(
+        (s.path.deep_bounce_depth, s.path.lobe_cull),
+        (Some(3), 0.05)
+    );
+    // The defaults: a tent of one pixel, roulette on sqrt(throughput) after two events,
+    // the exact hair BSDF at every event.
     let s = parse(BASE).unwrap().render.settings().unwrap();
     assert_eq!(s.filter, PixelFilter::default());
     assert_eq!(
         (s.path.roulette, s.path.rr_depth),
         (Roulette::SqrtThroughput, 2)
     );
+    assert_eq!((s.path.deep_bounce_depth, s.path.lobe_cull), (None, 0.0));
 
     for (keys, expect) in [
         (
@@ -423,6 +434,15 @@ fn render_keys_pick_the_filter_and_the_roulette() {
             &["render", "\"maybe\"", "sqrt or throughput"],
         ),
         ("rr_depth = 0", &["render", "rr_depth = 0"]),
+        (
+            "deep_bounce_depth = 0",
+            &["render", "deep_bounce_depth = 0"],
+        ),
+        (
+            "max_depth = 4\ndeep_bounce_depth = 5",
+            &["render", "deep_bounce_depth = 5", "max_depth = 4"],
+        ),
+        ("lobe_cull = 1.5", &["render", "lobe_cull = 1.5"]),
     ] {
         let e = build_error(&format!("[render]\n{keys}\n{BASE}")).to_string();
         assert_contains(&e, expect);

@@ -47,28 +47,8 @@ fn mean(rgb: &[f32]) -> f64 {
 
 #[test]
 fn white_fur_in_a_white_furnace_is_invisible() {
-    let white = HairMaterial {
-        color: HairColor::SigmaA([0.0; 3]),
-        ..HairMaterial::default()
-    };
-    let env = Light::Environment(Environment::uniform(Vec3::ONE).unwrap());
-    let world = fur_world(white, vec![env], 3000);
-    let settings = RenderSettings {
-        width: 32,
-        height: 32,
-        spp: 16,
-        seed: 3,
-        ..RenderSettings::default()
-    };
-    let out = render(&world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
-    assert_eq!(out.status, RenderStatus::Complete);
-    let rgb = out.film.rgb();
-    assert!(rgb.iter().all(|v| v.is_finite()));
-    let m = mean(rgb);
-    println!(
-        "furnace mean {m:.5}, {} rays in {:.2} s",
-        out.stats.rays, out.stats.seconds
-    );
+    let (m, se) = furnace_mean(PathSettings::default());
+    println!("furnace mean {m:.5} ± {se:.5}");
     assert!((m - 1.0).abs() < 0.01, "furnace mean {m}");
 }
 
@@ -198,6 +178,23 @@ fn strategies_agree(max_depth: u32) {
     }
 }
 
+/// The 24 x 24 RGB image of `world` at `spp` samples, with these path settings.
+fn small_image(world: &World, spp: u32, seed: u64, path: PathSettings) -> Vec<f32> {
+    let settings = RenderSettings {
+        width: 24,
+        height: 24,
+        spp,
+        seed,
+        path,
+        ..RenderSettings::default()
+    };
+    render(world, &camera(), &settings, Aovs::default(), &NoProgress)
+        .unwrap()
+        .film
+        .rgb()
+        .to_vec()
+}
+
 /// The indirect clamp leaves light that scattered once alone, whichever strategy found
 /// it: with one event allowed, a clamp far below every contribution changes no bit;
 /// with more, it darkens the image.
@@ -205,23 +202,12 @@ fn strategies_agree(max_depth: u32) {
 fn clamp_indirect_touches_only_indirect_light() {
     let world = lit_world();
     let image = |max_depth: u32, clamp_indirect: Option<f32>| {
-        let settings = RenderSettings {
-            width: 24,
-            height: 24,
-            spp: 8,
-            seed: 5,
-            path: PathSettings {
-                max_depth,
-                clamp_indirect,
-                ..PathSettings::default()
-            },
-            ..RenderSettings::default()
+        let path = PathSettings {
+            max_depth,
+            clamp_indirect,
+            ..PathSettings::default()
         };
-        render(&world, &camera(), &settings, Aovs::default(), &NoProgress)
-            .unwrap()
-            .film
-            .rgb()
-            .to_vec()
+        small_image(&world, 8, 5, path)
     };
     let tiny = Some(1e-4);
     let direct = image(1, None);
@@ -295,4 +281,124 @@ fn furnace_demo_renders_to_one() {
     let m = mean(rgb);
     println!("furnace demo mean {m:.5} ({} rays)", out.stats.rays);
     assert!((m - 1.0).abs() < 0.01, "furnace demo mean {m}");
+}
+
+/// A white fur ball (3000 strands) in a white furnace with these path settings: the mean
+/// of the image and its standard error (every pixel's expected value is 1 when energy is
+/// kept).
+fn furnace_mean(path: PathSettings) -> (f64, f64) {
+    let white = HairMaterial {
+        color: HairColor::SigmaA([0.0; 3]),
+        ..HairMaterial::default()
+    };
+    let env = Light::Environment(Environment::uniform(Vec3::ONE).unwrap());
+    let world = fur_world(white, vec![env], 3000);
+    let settings = RenderSettings {
+        width: 32,
+        height: 32,
+        spp: 16,
+        seed: 3,
+        path,
+        ..RenderSettings::default()
+    };
+    let out = render(&world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
+    assert_eq!(out.status, RenderStatus::Complete);
+    let rgb = out.film.rgb();
+    assert!(rgb.iter().all(|v| v.is_finite()));
+    let n = rgb.len() as f64;
+    let m = mean(rgb);
+    let var = rgb.iter().map(|&v| (f64::from(v) - m).powi(2)).sum::<f64>() / (n - 1.0);
+    (m, (var / n).sqrt())
+}
+
+/// The deep-bounce lobe keeps each event's energy: with every event after the first
+/// merged, white fur in a white furnace still renders to 1 within 1%. Lobe culling,
+/// which drops energy by design, darkens it (so the setting reaches the BSDF).
+#[test]
+fn deep_bounces_keep_the_furnace_and_culling_darkens_it() {
+    let (merged, se) = furnace_mean(PathSettings {
+        deep_bounce_depth: Some(1),
+        ..PathSettings::default()
+    });
+    let (culled, _) = furnace_mean(PathSettings {
+        lobe_cull: 0.1,
+        ..PathSettings::default()
+    });
+    println!("furnace: merged after 1 event {merged:.5} ± {se:.5}, culled at 0.1 {culled:.5}");
+    assert!((merged - 1.0).abs() < 0.01, "merged furnace {merged}");
+    assert!(culled < 0.97, "culled furnace {culled}");
+}
+
+/// deep_bounce_depth = max_depth leaves every event exact: the image is the exact one bit
+/// for bit (and an earlier depth changes it, so the setting is used).
+#[test]
+fn deep_bounce_depth_at_max_depth_is_exact_bit_for_bit() {
+    let world = lit_world();
+    let image = |deep_bounce_depth: Option<u32>| {
+        let path = PathSettings {
+            max_depth: 6,
+            deep_bounce_depth,
+            ..PathSettings::default()
+        };
+        small_image(&world, 4, 7, path)
+    };
+    let exact = image(None);
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&image(Some(6))), bits(&exact));
+    assert_ne!(bits(&image(Some(1))), bits(&exact));
+}
+
+/// Out-of-range fidelity settings are refused with a message naming the setting.
+#[test]
+fn fidelity_settings_out_of_range_are_refused() {
+    let path = PathSettings {
+        max_depth: 8,
+        ..PathSettings::default()
+    };
+    for (bad, words) in [
+        (
+            PathSettings {
+                deep_bounce_depth: Some(0),
+                ..path
+            },
+            "deep_bounce_depth = 0",
+        ),
+        (
+            PathSettings {
+                deep_bounce_depth: Some(9),
+                ..path
+            },
+            "deep_bounce_depth = 9: must be in [1, max_depth = 8]",
+        ),
+        (
+            PathSettings {
+                lobe_cull: -0.1,
+                ..path
+            },
+            "lobe_cull = -0.1",
+        ),
+        (
+            PathSettings {
+                lobe_cull: 1.0,
+                ..path
+            },
+            "lobe_cull = 1: must be in [0, 1)",
+        ),
+        (
+            PathSettings {
+                lobe_cull: f32::NAN,
+                ..path
+            },
+            "lobe_cull = NaN",
+        ),
+    ] {
+        let e = bad.validate().unwrap_err().to_string();
+        assert!(e.contains(words), "{e}");
+    }
+    let fine = PathSettings {
+        deep_bounce_depth: Some(8),
+        lobe_cull: 0.5,
+        ..path
+    };
+    fine.validate().unwrap();
 }

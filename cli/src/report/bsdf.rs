@@ -7,7 +7,7 @@ use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
 use super::{Context, median};
 use glam::Vec3;
-use hairtrace::{BsdfEval, HairBsdf, HairParams, HairPoint, Result};
+use hairtrace::{BsdfEval, HairBsdf, HairParams, HairPoint, Lobes, Result};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::hint::black_box;
@@ -288,6 +288,26 @@ fn sample_outputs(s: &mut Set) -> Outputs {
         .collect()
 }
 
+/// What a path vertex gets from a point of `lobes` (at + eval + sample), per input.
+fn vertex(s: &Set, x: &Input, lobes: Lobes) -> (BsdfEval, Option<hairtrace::BsdfSample>) {
+    let p = s.bsdf.at_lobes(x.h, x.wo, lobes);
+    (p.eval(x.wi), p.sample(x.u))
+}
+
+/// The evaluations and samples of points of `lobes`, judged against the whole model.
+fn lobes_outputs(s: &Set, lobes: Lobes) -> Outputs {
+    s.inputs
+        .iter()
+        .flat_map(|x| {
+            let (e, sample) = vertex(s, x, lobes);
+            [
+                Some((x.wi, e)),
+                sample.map(|r| (r.wi, BsdfEval { f: r.f, pdf: r.pdf })),
+            ]
+        })
+        .collect()
+}
+
 fn batch_outputs(s: &mut Set) -> Outputs {
     run_batch(s);
     let b = &s.batch;
@@ -326,7 +346,7 @@ fn per_point<R>(s: &Set, call: impl Fn(&HairPoint, &Input, usize) -> R) -> usize
     s.inputs.len() * 8
 }
 
-const VARIANTS: [Variant; 7] = [
+const VARIANTS: [Variant; 10] = [
     Variant {
         name: "HairBsdf::eval",
         time: |s| each(s, |x| s.bsdf.eval(x.h, x.wo, x.wi)),
@@ -367,6 +387,23 @@ const VARIANTS: [Variant; 7] = [
         outputs: Some(sample_outputs),
     },
     Variant {
+        name: "HairPoint, lobes culled below 0.01: at + eval + sample",
+        time: |s| each(s, |x| vertex(s, x, Lobes::Culled(0.01))),
+        outputs: Some(|s| lobes_outputs(s, Lobes::Culled(0.01))),
+    },
+    Variant {
+        name: "HairPoint, lobes culled below 0.1: at + eval + sample",
+        time: |s| each(s, |x| vertex(s, x, Lobes::Culled(0.1))),
+        outputs: Some(|s| lobes_outputs(s, Lobes::Culled(0.1))),
+    },
+    Variant {
+        name: "HairPoint, merged lobe (deep bounces): at + eval + sample",
+        time: |s| each(s, |x| vertex(s, x, Lobes::Merged)),
+        // It keeps each (h, wo)'s energy, not the model's value at any one direction:
+        // its error is the render section's to measure.
+        outputs: None,
+    },
+    Variant {
         name: "HairBsdf::eval_batch (per element)",
         time: |s| {
             run_batch(s);
@@ -394,7 +431,13 @@ fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> Optio
     let mut acc = Errors::default();
     for s in sets {
         let outs = outputs(s);
-        for (x, out) in s.inputs.iter().zip(outs) {
+        // A lobes variant gives an eval and a sample per input.
+        let per_input = outs.len() / s.inputs.len().max(1);
+        let inputs = s
+            .inputs
+            .iter()
+            .flat_map(|x| std::iter::repeat_n(x, per_input));
+        for (x, out) in inputs.zip(outs) {
             let Some((wi, e)) = out else { continue };
             accumulate(&mut acc, s, x, wi, e);
         }
@@ -483,8 +526,13 @@ pub fn section(ctx: &Context) -> Result<String> {
          sin(theta) = 0.99999 of the tangent, grazing, wi = +-wo and half a turn away. \
          Random: {} parameter sets over the valid ranges (eta from 1.05), uniform h, wo, wi. \
          The point rows time what a renderer's path vertex does; `HairBsdf::at` alone is \
-         the (h, wo) work a prepared point saves. The library has one set of special \
-         functions and no lobe culling yet: no other variants to time.\n\n{}\n{}\n\n{}",
+         the (h, wo) work a prepared point saves. The culled and merged rows are the \
+         renderer's fidelity knobs `lobe_cull` and `deep_bounce_depth` at one vertex, their \
+         eval and sample both judged against the whole model (culling's error is the \
+         dropped lobes'); the merged lobe keeps only each (h, wo)'s energy, not the \
+         model's value at any one direction, so its error is measured in the render \
+         section. The library has one set of special functions: no other \
+         variants to time.\n\n{}\n{}\n\n{}",
         random.len(),
         table(
             &[

@@ -50,6 +50,17 @@ const KNOBS: &[Knob] = &[
     knob("max_depth 16", |v| render(v, |r| r.max_depth = 16)),
     knob("max_depth 4", |v| render(v, |r| r.max_depth = 4)),
     knob("filter tent", |v| render(v, |r| r.filter = "tent".into())),
+    knob("deep_bounce_depth 1", |v| {
+        render(v, |r| r.deep_bounce_depth = Some(1))
+    }),
+    knob("deep_bounce_depth 2", |v| {
+        render(v, |r| r.deep_bounce_depth = Some(2))
+    }),
+    knob("deep_bounce_depth 4", |v| {
+        render(v, |r| r.deep_bounce_depth = Some(4))
+    }),
+    knob("lobe_cull 0.01", |v| render(v, |r| r.lobe_cull = 0.01)),
+    knob("lobe_cull 0.1", |v| render(v, |r| r.lobe_cull = 0.1)),
 ];
 
 /// An edit of the `[render]` settings.
@@ -226,8 +237,10 @@ pub fn section(ctx: &Context) -> Result<String> {
          the reference settings at 8x the scene's samples with a seed no timed render uses, \
          with the reference's own noise (estimated from the reference settings' renders) \
          taken out. Its time is the path tracing alone (the scene build is in the scale \
-         section), the median of {} runs taken knob after knob in turn. A knob that changes the image (shape, basis, max depth, filter) shows \
-         its bias as a floor its curve cannot go below; one that only changes noise moves \
+         section), the median of {} runs taken knob after knob in turn. A knob that \
+         changes the image (shape, basis, max depth, filter, the hair fidelity knobs \
+         `deep_bounce_depth` and `lobe_cull`) shows its bias as a floor its curve cannot go \
+         below; one that only changes noise moves \
          its curve sideways. The tent filter's floor is partly the blur it adds by design, \
          not error. Efficiency is 1 / (RMSE^2 x seconds) at the scene's spp, relative to \
          the reference settings'.\n\n",

@@ -13,6 +13,8 @@ use rand_pcg::Pcg64;
 use std::hint::black_box;
 use std::time::Instant;
 
+#[path = "../../../tests/bsdf/common/pbrt_f32.rs"]
+mod pbrt_f32;
 #[allow(dead_code)] // the tests use more of it than the report does
 #[path = "../../../tests/bsdf/common/reference.rs"]
 mod reference;
@@ -20,6 +22,7 @@ mod reference;
 #[path = "../../../tests/bsdf/common/sphere.rs"]
 mod sphere;
 
+use pbrt_f32::PbrtHair;
 use reference::RefHair;
 use sphere::{normalize, tilt, uniform_sphere};
 
@@ -36,6 +39,9 @@ struct Input {
 struct Set {
     bsdf: HairBsdf,
     reference: RefHair,
+    /// The accuracy tests' yardstick: pbrt-v3's evaluation in f32 with libm's special
+    /// functions, beside the library's own fast exp and log.
+    port: PbrtHair,
     inputs: Vec<Input>,
     /// The inputs as `eval_batch` takes them, and its outputs.
     batch: Batch,
@@ -93,6 +99,7 @@ fn set(params: HairParams, inputs: Vec<Input>) -> Result<Set> {
     let p = &params;
     Ok(Set {
         bsdf: HairBsdf::new(p)?,
+        port: PbrtHair::new(p),
         reference: RefHair::new(
             p.sigma_a.map(f64::from),
             p.eta.into(),
@@ -278,6 +285,22 @@ fn eval_outputs(s: &mut Set) -> Outputs {
         .collect()
 }
 
+fn port_outputs(s: &mut Set) -> Outputs {
+    s.inputs
+        .iter()
+        .map(|x| {
+            let (f, pdf) = s.port.eval(x.h, x.wo.to_array(), x.wi.to_array());
+            Some((
+                x.wi,
+                BsdfEval {
+                    f: Vec3::from_array(f),
+                    pdf,
+                },
+            ))
+        })
+        .collect()
+}
+
 fn sample_outputs(s: &mut Set) -> Outputs {
     s.inputs
         .iter()
@@ -346,7 +369,7 @@ fn per_point<R>(s: &Set, call: impl Fn(&HairPoint, &Input, usize) -> R) -> usize
     s.inputs.len() * 8
 }
 
-const VARIANTS: [Variant; 10] = [
+const VARIANTS: [Variant; 11] = [
     Variant {
         name: "HairBsdf::eval",
         time: |s| each(s, |x| s.bsdf.eval(x.h, x.wo, x.wi)),
@@ -402,6 +425,11 @@ const VARIANTS: [Variant; 10] = [
         // It keeps each (h, wo)'s energy, not the model's value at any one direction:
         // its error is the render section's to measure.
         outputs: None,
+    },
+    Variant {
+        name: "pbrt-v3's eval in plain f32, libm special functions (the tests' port)",
+        time: |s| each(s, |x| s.port.eval(x.h, x.wo.to_array(), x.wi.to_array())),
+        outputs: Some(port_outputs),
     },
     Variant {
         name: "HairBsdf::eval_batch (per element)",
@@ -531,8 +559,11 @@ pub fn section(ctx: &Context) -> Result<String> {
          eval and sample both judged against the whole model (culling's error is the \
          dropped lobes'); the merged lobe keeps only each (h, wo)'s energy, not the \
          model's value at any one direction, so its error is measured in the render \
-         section. The library has one set of special functions: no other \
-         variants to time.\n\n{}\n{}\n\n{}",
+         section. The library's special functions are its own fast exp and log \
+         (`math::fast`); the port row is pbrt-v3's evaluation in plain f32 with libm's exp, \
+         log and Bessel series (the accuracy tests' yardstick, \
+         tests/bsdf/common/pbrt_f32.rs), eval only: it has no hard-case RMS, since it \
+         gives no finite value at h = +-1 without absorption.\n\n{}\n{}\n\n{}",
         random.len(),
         table(
             &[

@@ -1,0 +1,89 @@
+//! The PATHS tree as openusd 0.6's `build_compressed_paths` walks it, lengths only.
+//!
+//! Entry i names its path (`path_indices[i]`), the token appended to its parent's path
+//! (`tokens[i]`, negative for a property) and where the walk goes next (`jumps[i]`: -1 a
+//! child follows, 0 a sibling follows, n > 0 a child follows and a sibling is n entries
+//! on, anything else: neither). openusd follows these without checking them: two entries
+//! that jump to the same place make it walk that subtree twice, and a chain of them makes
+//! the walk exponential; each path string is its parent's plus a token, so a deep chain of
+//! long tokens adds up quadratically. Here each entry must be reached once, and the
+//! strings' lengths must add up to the budget.
+
+use super::Refusal;
+
+/// The three decoded arrays of the PATHS section.
+pub(super) struct Tree<'a> {
+    pub path_indices: &'a [i32],
+    pub tokens: &'a [i32],
+    pub jumps: &'a [i32],
+}
+
+impl Tree<'_> {
+    /// The length of every path openusd builds, by path index (0 for an index it never
+    /// builds), for `path_count` paths whose tokens have `token_lengths`; refused if an
+    /// entry is reached twice or out of range, or if the lengths add up beyond `budget`.
+    pub fn lengths(
+        &self,
+        path_count: usize,
+        token_lengths: &[u64],
+        budget: u64,
+    ) -> Result<Vec<u64>, Refusal> {
+        let count = self.jumps.len();
+        if count == 0 {
+            return Ok(vec![0; path_count]);
+        }
+        let slot = |i: i32| -> Result<usize, Refusal> {
+            usize::try_from(i)
+                .ok()
+                .filter(|&i| i < path_count)
+                .ok_or_else(|| format!("PATHS: an entry names path {i} of {path_count}"))
+        };
+        let mut lengths = vec![0u64; path_count];
+        let mut seen = vec![false; count];
+        let mut total = 0u64;
+        // (next entry, length of the parent's path; 0: the next entry is the root)
+        let mut pending = vec![(0usize, 0u64)];
+        while let Some((mut index, mut parent)) = pending.pop() {
+            loop {
+                if index >= count || std::mem::replace(&mut seen[index], true) {
+                    return Err(format!(
+                        "PATHS: the tree's jumps reach entry {index} twice or beyond the {count} entries"
+                    ));
+                }
+                let length = if parent == 0 {
+                    let root = slot(i32::try_from(index).unwrap_or(-1))?;
+                    lengths[root] = 1;
+                    // openusd's parent becomes "/" for the rest of this entry.
+                    parent = 1;
+                    1
+                } else {
+                    let token = self.tokens[index].unsigned_abs() as usize;
+                    let name = token_lengths.get(token).ok_or_else(|| {
+                        format!("PATHS: an entry names token {token} of {}", token_lengths.len())
+                    })?;
+                    let length = parent + 1 + name;
+                    lengths[slot(self.path_indices[index])?] = length;
+                    length
+                };
+                total = total.saturating_add(length);
+                if total > budget {
+                    return Err(format!(
+                        "PATHS: the paths' names add up to more than the {budget} bytes allowed"
+                    ));
+                }
+                let jump = self.jumps[index];
+                let child = jump > 0 || jump == -1;
+                if child && jump > 0 {
+                    pending.push((index + jump as usize, parent));
+                }
+                if child {
+                    parent = lengths[slot(self.path_indices[index])?];
+                } else if jump != 0 {
+                    break;
+                }
+                index += 1;
+            }
+        }
+        Ok(lengths)
+    }
+}

@@ -129,7 +129,7 @@ fn every_fixture_renders_a_visible_image() {
     }
 }
 
-fn refused(text: impl AsRef<[u8]>, name: &str) -> String {
+pub(crate) fn refused(text: impl AsRef<[u8]>, name: &str) -> String {
     let dir = std::env::temp_dir().join(format!("hairtrace-usd-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);

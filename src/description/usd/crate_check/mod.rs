@@ -94,7 +94,7 @@ impl<'a> At<'a> {
     fn bytes(&mut self, n: u64, what: &str) -> Result<&'a [u8], Refusal> {
         if n > self.left() {
             return Err(format!(
-                "{what} claims {n} bytes at offset {}, the file has {} there",
+                "{what} claims {n} bytes at offset {}, only {} bytes follow",
                 self.pos,
                 self.left()
             ));
@@ -133,7 +133,7 @@ impl<'a> At<'a> {
         match count.checked_mul(size) {
             Some(n) if n <= self.left() => Ok(()),
             _ => Err(format!(
-                "{what} claims {count} items of {size} bytes at offset {}, the file has {} bytes there",
+                "{what} claims {count} items of {size} bytes at offset {}, only {} bytes follow",
                 self.pos,
                 self.left()
             )),
@@ -248,12 +248,17 @@ impl<'a> Crate<'a> {
     fn records(&self, count: u64, size: u64, what: &str) -> Result<u64, Refusal> {
         match count.checked_mul(size) {
             Some(n) if n <= self.budget => Ok(n),
-            _ => Err(format!(
-                "{what} claims {count} items ({size} bytes each in memory), more than the {} bytes \
-                 allowed for this {}-byte file",
-                self.budget,
-                self.data.len()
-            )),
+            _ => {
+                let claim = match size {
+                    1 => format!("{count} bytes"),
+                    _ => format!("{count} items ({size} bytes each in memory)"),
+                };
+                Err(format!(
+                    "{what} claims {claim}, more than the {} bytes allowed for this {}-byte file",
+                    self.budget,
+                    self.data.len()
+                ))
+            }
         }
     }
 

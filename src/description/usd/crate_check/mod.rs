@@ -407,3 +407,33 @@ fn decode_ints(raw: &[u8], count: usize) -> Option<Vec<i32>> {
     }
     Some(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integer_coding_decodes_common_and_8_16_32_bit_deltas() {
+        // 5, 6, 7, 300, 300, 70300: deltas 5 (8-bit), 1, 1 (common), 293 (16-bit), 0
+        // (8-bit), 70000 (32-bit).
+        let mut raw = 1i32.to_le_bytes().to_vec();
+        raw.extend([0b10_00_00_01, 0b11_01]);
+        raw.push(5);
+        raw.extend(293i16.to_le_bytes());
+        raw.push(0);
+        raw.extend(70000i32.to_le_bytes());
+        assert_eq!(
+            decode_ints(&raw, 6),
+            Some(vec![5, 6, 7, 300, 300, 70300])
+        );
+        assert_eq!(decode_ints(&raw[..raw.len() - 1], 6), None);
+        assert_eq!(decode_ints(&raw[..5], 6), None);
+    }
+
+    #[test]
+    fn the_integer_buffer_is_sized_as_openusd_sizes_it() {
+        assert_eq!(ints_capacity(0), 0);
+        assert_eq!(ints_capacity(5), 4 + 2 + 20);
+        assert_eq!(ints_capacity(u64::MAX), u64::MAX);
+    }
+}

@@ -87,3 +87,45 @@ impl Tree<'_> {
         Ok(lengths)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The root, /A with a child /A/b, and /A's sibling /B; tokens "", "A", "b", "B".
+    const TOKENS: [u64; 4] = [0, 1, 1, 1];
+
+    fn lengths(jumps: &[i32], budget: u64) -> Result<Vec<u64>, Refusal> {
+        let n = jumps.len() as i32;
+        let indices: Vec<i32> = (0..n).collect();
+        let tree = Tree {
+            path_indices: &indices,
+            tokens: &indices,
+            jumps,
+        };
+        tree.lengths(jumps.len(), &TOKENS, budget)
+    }
+
+    #[test]
+    fn a_tree_gives_each_path_its_parents_length_plus_its_name() {
+        // root: child; A: child and sibling 2 on; b: leaf; B: leaf.
+        assert_eq!(lengths(&[-1, 2, -2, -2], 100), Ok(vec![1, 3, 5, 3]));
+    }
+
+    #[test]
+    fn jumps_that_reach_an_entry_twice_are_refused() {
+        // Each entry has a child (the next) and a sibling (also the next): openusd would
+        // walk entry i 2^i times.
+        let m = lengths(&[-1, 1, 1, -2], 100).unwrap_err();
+        assert!(m.contains("reach entry 3 twice"), "{m}");
+        let m = lengths(&[-1, 7, -2, -2], 100).unwrap_err();
+        assert!(m.contains("beyond the 4 entries"), "{m}");
+    }
+
+    #[test]
+    fn names_adding_up_beyond_the_budget_are_refused() {
+        assert!(lengths(&[-1, 2, -2, -2], 12).is_ok());
+        let m = lengths(&[-1, 2, -2, -2], 11).unwrap_err();
+        assert!(m.contains("add up to more than the 11 bytes"), "{m}");
+    }
+}

@@ -277,8 +277,7 @@ fn truncated_and_corrupted_crate_files_are_refused() {
         let m = refused(&good[..cut], &format!("cut{cut}.usdc"));
         assert!(m.contains(&format!("cut{cut}.usdc")), "{m}");
     }
-    // A crate file with bytes flipped inside its tables is not tested here: openusd 0.6
-    // allocates whatever counts such a file claims (see docs/formats.md, "Limits").
+    // Counts set beyond the file inside the tables: tests/pipeline/usd_crate.rs.
     let mut bad = good.clone();
     bad[8..16].fill(0xFF);
     let m = refused(&bad, "bad_toc.usdc");

@@ -43,10 +43,10 @@ mod values;
 use std::collections::HashMap;
 
 /// What a check of one layer found wrong.
-pub type Refusal = String;
+pub(super) type Refusal = String;
 
 /// A crate file starts with these 8 bytes.
-pub const MAGIC: &[u8; 8] = b"PXR-USDC";
+pub(super) const MAGIC: &[u8; 8] = b"PXR-USDC";
 
 /// Each allocation may be this many times the layer's size ...
 const EXPANSION: u64 = 64;
@@ -60,7 +60,7 @@ const SPEC_ENTRY: u64 = 160;
 
 /// Refuses `data` (a whole crate file) if openusd 0.6 could allocate beyond the bound in
 /// the module doc reading it, recurse without limit, or loop for ever.
-pub fn check_crate(data: &[u8]) -> Result<(), Refusal> {
+pub(super) fn check_crate(data: &[u8]) -> Result<(), Refusal> {
     let file = Crate::open(data)?;
     values::check_fields(&file)
 }

@@ -17,8 +17,12 @@ use super::usd::refused;
 const HUGE: u64 = 1 << 40;
 
 fn fixture(name: &str) -> Vec<u8> {
-    std::fs::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/usd").join(name))
-        .unwrap()
+    std::fs::read(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/fixtures/usd")
+            .join(name),
+    )
+    .unwrap()
 }
 
 /// values.usdc with the offsets of its sections and fields, found by openusd's own reader.
@@ -95,7 +99,10 @@ fn a_tokens_block_of_2_to_the_40_bytes_is_refused() {
     assert_says(&m, "TOKENS section claims 1099511627776 bytes at offset");
     assert_says(&m, "tokens_compressed.usdc");
     let m = v.refused_at(tokens + 8, HUGE, "tokens_uncompressed");
-    assert_says(&m, "TOKENS section claims 1099511627776 bytes, more than the");
+    assert_says(
+        &m,
+        "TOKENS section claims 1099511627776 bytes, more than the",
+    );
     let m = v.refused_at(tokens, 5, "tokens_count");
     assert_says(&m, "TOKENS section claims 5 tokens, its block holds");
 }
@@ -104,14 +111,22 @@ fn a_tokens_block_of_2_to_the_40_bytes_is_refused() {
 fn section_counts_beyond_the_file_are_refused() {
     let v = Values::new();
     for (section, skip, says) in [
-        ("STRINGS", 0, "STRINGS section claims 1099511627776 items of 4 bytes"),
+        (
+            "STRINGS",
+            0,
+            "STRINGS section claims 1099511627776 items of 4 bytes",
+        ),
         ("FIELDS", 0, "FIELDS claims 1099511627776 items"),
         ("FIELDSETS", 0, "FIELDSETS claims 1099511627776 items"),
         ("PATHS", 0, "PATHS claims 1099511627776 items"),
         ("PATHS", 8, "PATHS entries claims 1099511627776 items"),
         ("SPECS", 0, "SPECS claims 1099511627776 items"),
         // The compressed size of FIELDS' first block.
-        ("FIELDS", 8, "FIELDS tokens claims 1099511627776 bytes at offset"),
+        (
+            "FIELDS",
+            8,
+            "FIELDS tokens claims 1099511627776 bytes at offset",
+        ),
     ] {
         let m = v.refused_at(v.section(section) + skip, HUGE, section);
         assert_says(&m, says);
@@ -119,7 +134,10 @@ fn section_counts_beyond_the_file_are_refused() {
     // The table of contents: a section reaching beyond the file.
     let toc = v.read_u64(16) as usize;
     let m = v.refused_at(toc + 8 + 16 + 8, HUGE, "toc");
-    assert_says(&m, "TOKENS section claims 1099511627776 bytes at offset 2048, the file has");
+    assert_says(
+        &m,
+        "TOKENS section claims 1099511627776 bytes at offset 2048, the file has",
+    );
     let m = v.refused_at(toc, 64, "toc_count");
     assert_says(&m, "64 sections");
 }
@@ -130,14 +148,46 @@ fn array_counts_beyond_the_file_are_refused() {
     // (field, type, what the check says); every array here is from crate version 0.7 on:
     // a u64 count at the payload.
     for (name, ty, says) in [
-        ("default", 24, "an array claims 1099511627776 items of 12 bytes"), // points
-        ("default", 15, "an array claims 1099511627776 items of 128 bytes"), // matrices
-        ("default", 3, "a compressed array claims 1099511627776 items"),    // int, compressed
-        ("default", 5, "a compressed array claims 1099511627776 items"),    // int64, compressed
-        ("default", 8, "a compressed array claims 1099511627776 items"),    // float, compressed
-        ("default", 11, "a token array claims 1099511627776 items of 4 bytes"),
-        ("default", 10, "a list claims 1099511627776 items of 4 bytes"), // strings
-        ("primChildren", 41, "a list claims 1099511627776 items of 4 bytes"),
+        (
+            "default",
+            24,
+            "an array claims 1099511627776 items of 12 bytes",
+        ), // points
+        (
+            "default",
+            15,
+            "an array claims 1099511627776 items of 128 bytes",
+        ), // matrices
+        (
+            "default",
+            3,
+            "a compressed array claims 1099511627776 items",
+        ), // int, compressed
+        (
+            "default",
+            5,
+            "a compressed array claims 1099511627776 items",
+        ), // int64, compressed
+        (
+            "default",
+            8,
+            "a compressed array claims 1099511627776 items",
+        ), // float, compressed
+        (
+            "default",
+            11,
+            "a token array claims 1099511627776 items of 4 bytes",
+        ),
+        (
+            "default",
+            10,
+            "a list claims 1099511627776 items of 4 bytes",
+        ), // strings
+        (
+            "primChildren",
+            41,
+            "a list claims 1099511627776 items of 4 bytes",
+        ),
     ] {
         let at = v.payload(name, ty);
         let m = v.refused_at(at, HUGE, &format!("array{ty}"));
@@ -167,17 +217,40 @@ fn list_op_and_map_counts_beyond_the_file_are_refused() {
     let v = Values::new();
     // A list op: a header byte, then each list's u64 count.
     for (name, ty, says) in [
-        ("apiSchemas", 32, "a list claims 1099511627776 items of 4 bytes"),
-        ("variantSetNames", 33, "a list claims 1099511627776 items of 4 bytes"),
-        ("targetPaths", 34, "a list claims 1099511627776 items of 4 bytes"),
-        ("references", 35, "a reference list claims 1099511627776 items of 32 bytes"),
-        ("payload", 55, "a payload list claims 1099511627776 items of 24 bytes"),
+        (
+            "apiSchemas",
+            32,
+            "a list claims 1099511627776 items of 4 bytes",
+        ),
+        (
+            "variantSetNames",
+            33,
+            "a list claims 1099511627776 items of 4 bytes",
+        ),
+        (
+            "targetPaths",
+            34,
+            "a list claims 1099511627776 items of 4 bytes",
+        ),
+        (
+            "references",
+            35,
+            "a reference list claims 1099511627776 items of 32 bytes",
+        ),
+        (
+            "payload",
+            55,
+            "a payload list claims 1099511627776 items of 24 bytes",
+        ),
     ] {
         let m = v.refused_at(v.payload(name, ty) + 1, HUGE, name);
         assert_says(&m, says);
     }
     let m = v.refused_at(v.payload("variantSelection", 45), HUGE, "variants");
-    assert_says(&m, "variant selections claims 1099511627776 items of 8 bytes");
+    assert_says(
+        &m,
+        "variant selections claims 1099511627776 items of 8 bytes",
+    );
 }
 
 #[test]
@@ -210,7 +283,10 @@ fn time_samples_beyond_the_file_are_refused() {
     let times = (v.read_u64(times_at) & ((1 << 48) - 1)) as usize;
     let count_at = times_at + 8 + v.read_u64(times_at + 8) as usize;
     let m = v.refused_with(
-        &[(times, &HUGE.to_le_bytes()), (count_at, &HUGE.to_le_bytes())],
+        &[
+            (times, &HUGE.to_le_bytes()),
+            (count_at, &HUGE.to_le_bytes()),
+        ],
         "samples_count",
     );
     assert_says(&m, "an array claims 1099511627776 items of 8 bytes");
@@ -237,9 +313,18 @@ fn usdz_packages_are_checked() {
     let mut hostile = v.data.clone();
     let tokens = v.section("TOKENS");
     hostile[tokens + 16..tokens + 24].copy_from_slice(&HUGE.to_le_bytes());
-    let m = refused(package(&hostile, zip::CompressionMethod::Stored), "hostile.usdz");
-    assert_says(&m, "package entry layer.usdc: TOKENS section claims 1099511627776 bytes");
-    let m = refused(package(&v.data, zip::CompressionMethod::Deflated), "deflated.usdz");
+    let m = refused(
+        package(&hostile, zip::CompressionMethod::Stored),
+        "hostile.usdz",
+    );
+    assert_says(
+        &m,
+        "package entry layer.usdc: TOKENS section claims 1099511627776 bytes",
+    );
+    let m = refused(
+        package(&v.data, zip::CompressionMethod::Deflated),
+        "deflated.usdz",
+    );
     assert_says(&m, "package entry layer.usdc is compressed");
 }
 

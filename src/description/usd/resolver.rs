@@ -70,7 +70,11 @@ impl Resolver for CheckingResolver {
         self.inner.get_asset_info(asset_path, resolved)
     }
 
-    fn get_modification_timestamp(&self, asset_path: &str, resolved: &ResolvedPath) -> Option<SystemTime> {
+    fn get_modification_timestamp(
+        &self,
+        asset_path: &str,
+        resolved: &ResolvedPath,
+    ) -> Option<SystemTime> {
         self.inner.get_modification_timestamp(asset_path, resolved)
     }
 

@@ -228,7 +228,10 @@ impl<'a> Crate<'a> {
             let name = String::from_utf8_lossy(name).into_owned();
             let start = at.u64("a section start")?;
             let size = at.u64("a section size")?;
-            if start.checked_add(size).is_none_or(|end| end > self.data.len() as u64) {
+            if start
+                .checked_add(size)
+                .is_none_or(|end| end > self.data.len() as u64)
+            {
                 return Err(format!(
                     "{name} section claims {size} bytes at offset {start}, the file has {}",
                     self.data.len()
@@ -422,10 +425,7 @@ mod tests {
         raw.extend(293i16.to_le_bytes());
         raw.push(0);
         raw.extend(70000i32.to_le_bytes());
-        assert_eq!(
-            decode_ints(&raw, 6),
-            Some(vec![5, 6, 7, 300, 300, 70300])
-        );
+        assert_eq!(decode_ints(&raw, 6), Some(vec![5, 6, 7, 300, 300, 70300]));
         assert_eq!(decode_ints(&raw[..raw.len() - 1], 6), None);
         assert_eq!(decode_ints(&raw[..5], 6), None);
     }

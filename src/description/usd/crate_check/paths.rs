@@ -59,7 +59,10 @@ impl Tree<'_> {
                 } else {
                     let token = self.tokens[index].unsigned_abs() as usize;
                     let name = token_lengths.get(token).ok_or_else(|| {
-                        format!("PATHS: an entry names token {token} of {}", token_lengths.len())
+                        format!(
+                            "PATHS: an entry names token {token} of {}",
+                            token_lengths.len()
+                        )
                     })?;
                     let length = parent + 1 + name;
                     lengths[slot(self.path_indices[index])?] = length;

@@ -12,7 +12,9 @@ use openusd::{sdf, tf};
 use super::{At, Crate, Refusal, Version, ints_capacity};
 
 /// Deepest nesting of values (dictionaries in dictionaries, time samples of
-/// dictionaries, ...): openusd recurses once per level, with no limit of its own.
+/// dictionaries, ...): openusd recurses once per level, with no limit of its own, at
+/// about 2 KiB of stack a level (a 1000-deep dictionary needed over 1 MiB), so 32 levels
+/// fit any thread's stack; Pixar's files nest a few.
 const MAX_DEPTH: u32 = 32;
 
 /// Bytes of one dictionary or map entry in openusd's `HashMap`, spare slots included.
@@ -177,10 +179,14 @@ impl<'a> Walk<'_, 'a> {
             Some(None) => return Err(format!("the value at offset {at} contains itself")),
             Some(Some(cost)) if depth + cost.depth <= MAX_DEPTH => return Ok(*cost),
             Some(Some(_)) => {
-                return Err(format!("values nest deeper than {MAX_DEPTH} (at offset {at})"));
+                return Err(format!(
+                    "values nest deeper than {MAX_DEPTH} (at offset {at})"
+                ));
             }
             None if depth > MAX_DEPTH => {
-                return Err(format!("values nest deeper than {MAX_DEPTH} (at offset {at})"));
+                return Err(format!(
+                    "values nest deeper than {MAX_DEPTH} (at offset {at})"
+                ));
             }
             None => {}
         }
@@ -225,10 +231,10 @@ impl<'a> Walk<'_, 'a> {
             ty::MATRIX2D..=ty::QUATH | ty::VEC2D..=ty::VEC4I if array => {
                 self.plain_array(rep, element_size(code), 3)?
             }
-            ty::TOKEN_LIST_OP | ty::UNREGISTERED_VALUE_LIST_OP if !inlined => {
+            ty::TOKEN_LIST_OP if !inlined => {
                 self.list_op(rep, |w, at| w.names(at, Names::Tokens))?
             }
-            ty::STRING_LIST_OP if !inlined => {
+            ty::STRING_LIST_OP | ty::UNREGISTERED_VALUE_LIST_OP if !inlined => {
                 self.list_op(rep, |w, at| w.names(at, Names::Strings))?
             }
             ty::PATH_LIST_OP if !inlined => self.list_op(rep, |w, at| w.names(at, Names::Paths))?,
@@ -279,9 +285,8 @@ impl<'a> Walk<'_, 'a> {
         } else {
             at.u64("an array's count")?
         };
-        let compressed = compressed_from.is_some_and(|from| version >= from)
-            && rep.compressed()
-            && count >= 4;
+        let compressed =
+            compressed_from.is_some_and(|from| version >= from) && rep.compressed() && count >= 4;
         Ok(Some((count, compressed, at)))
     }
 
@@ -406,7 +411,11 @@ impl<'a> Walk<'_, 'a> {
 
     /// Payloads: asset path, prim path and (from 0.8.0) a layer offset.
     fn payloads(&mut self, at: &mut At) -> Result<Cost, Refusal> {
-        let offset = if self.file.version >= Version(0, 8, 0) { 16 } else { 0 };
+        let offset = if self.file.version >= Version(0, 8, 0) {
+            16
+        } else {
+            0
+        };
         let count = at.u64("a payload list's count")?;
         at.fits(count, 8 + offset, "a payload list")?;
         self.count_work(count)?;
@@ -509,7 +518,9 @@ fn jump(at: &mut At) -> Result<(), Refusal> {
         .filter(|&o| o >= 8)
         .and_then(|o| o.checked_add(from as u64))
         .filter(|&to| to <= at.end as u64)
-        .ok_or_else(|| format!("the offset {offset} at offset {from} does not point forward into the file"))?;
+        .ok_or_else(|| {
+            format!("the offset {offset} at offset {from} does not point forward into the file")
+        })?;
     at.pos = to as usize;
     Ok(())
 }
@@ -520,7 +531,9 @@ fn name_length(file: &Crate, names: Names, index: u32) -> Result<u64, Refusal> {
     let (found, of) = match names {
         Names::Tokens => (file.tokens.get(i).copied(), file.tokens.len()),
         Names::Strings => (
-            file.strings.get(i).and_then(|&t| file.tokens.get(t as usize).copied()),
+            file.strings
+                .get(i)
+                .and_then(|&t| file.tokens.get(t as usize).copied()),
             file.strings.len(),
         ),
         Names::Paths => (file.paths.get(i).copied(), file.paths.len()),

@@ -193,21 +193,13 @@ impl<'a> Crate<'a> {
             file.read_fields(s)?;
         }
         if let Some(s) = find("FIELDSETS") {
-            let mut at = file.section(s, "FIELDSETS")?;
-            let count = at.u64("FIELDSETS count")?;
-            file.records(count, RECORD, "FIELDSETS")?;
-            file.block(&mut at, ints_capacity(count), "FIELDSETS")?;
+            file.coded_section(s, "FIELDSETS", RECORD, 1)?;
         }
         if let Some(s) = find("PATHS") {
             file.read_paths(s)?;
         }
         if let Some(s) = find("SPECS") {
-            let mut at = file.section(s, "SPECS")?;
-            let count = at.u64("SPECS count")?;
-            file.records(count, SPEC_ENTRY, "SPECS")?;
-            for _ in 0..3 {
-                file.block(&mut at, ints_capacity(count), "SPECS")?;
-            }
+            file.coded_section(s, "SPECS", SPEC_ENTRY, 3)?;
         }
         Ok(file)
     }
@@ -297,6 +289,24 @@ impl<'a> Crate<'a> {
         decode_ints(&raw, count as usize).ok_or_else(|| {
             format!("{what}: the integer coding holds fewer than the {count} integers claimed")
         })
+    }
+
+    /// A section of a u64 count and `blocks` integer-coded blocks of that many integers,
+    /// kept as records of `record` bytes each (FIELDSETS, SPECS).
+    fn coded_section(
+        &self,
+        s: (u64, u64),
+        name: &str,
+        record: u64,
+        blocks: usize,
+    ) -> Result<(), Refusal> {
+        let mut at = self.section(s, name)?;
+        let count = at.u64(name)?;
+        self.records(count, record, name)?;
+        for _ in 0..blocks {
+            self.block(&mut at, ints_capacity(count), name)?;
+        }
+        Ok(())
     }
 
     fn read_tokens(&mut self, s: (u64, u64)) -> Result<(), Refusal> {

@@ -252,13 +252,18 @@ impl<'a> Walk<'_, 'a> {
                 let mut at = self.at(rep.payload(), "a layer offset vector")?;
                 self.pods(&mut at, 16)?
             }
-            ty::VARIANT_SELECTION_MAP if plain => self.variant_selections(rep)?,
+            ty::VARIANT_SELECTION_MAP if plain => {
+                self.pairs(rep, Names::Strings, MAP_ENTRY, "variant selections")?
+            }
             ty::TIME_SAMPLES if !inlined && !rep.compressed() => self.time_samples(rep, depth)?,
             ty::DICTIONARY if plain => {
                 let mut at = self.at(rep.payload(), "a dictionary")?;
                 self.dictionary(&mut at, depth)?
             }
-            ty::RELOCATES if !inlined => self.relocates(rep)?,
+            ty::RELOCATES if !inlined => {
+                let entry = 2 * size_of::<sdf::Path>() as u64;
+                self.pairs(rep, Names::Paths, entry, "relocates")?
+            }
             _ => Cost::default(),
         };
         Ok(cost)
@@ -433,28 +438,17 @@ impl<'a> Walk<'_, 'a> {
         Ok(Cost::bytes(asset + path))
     }
 
-    fn variant_selections(&mut self, rep: Rep) -> Result<Cost, Refusal> {
+    /// A u64 count and as many pairs of string or path indices, into a map or a list of
+    /// `entry`-byte items (variant selections, relocates).
+    fn pairs(&mut self, rep: Rep, names: Names, entry: u64, what: &str) -> Result<Cost, Refusal> {
         let file = self.file;
-        let mut at = self.at(rep.payload(), "variant selections")?;
-        let count = at.u64("variant selections' count")?;
-        at.fits(count, 8, "variant selections")?;
+        let mut at = self.at(rep.payload(), what)?;
+        let count = at.u64(what)?;
+        at.fits(count, 8, what)?;
         self.count_work(count)?;
-        let mut bytes = count * MAP_ENTRY;
+        let mut bytes = count * entry;
         for _ in 0..2 * count {
-            bytes += name_length(file, Names::Strings, at.u32("a variant selection")?)?;
-        }
-        Ok(Cost::bytes(bytes))
-    }
-
-    fn relocates(&mut self, rep: Rep) -> Result<Cost, Refusal> {
-        let file = self.file;
-        let mut at = self.at(rep.payload(), "relocates")?;
-        let count = at.u64("relocates' count")?;
-        at.fits(count, 8, "relocates")?;
-        self.count_work(count)?;
-        let mut bytes = count * 2 * size_of::<sdf::Path>() as u64;
-        for _ in 0..2 * count {
-            bytes += name_length(file, Names::Paths, at.u32("a relocated path")?)?;
+            bytes += name_length(file, names, at.u32(what)?)?;
         }
         Ok(Cost::bytes(bytes))
     }

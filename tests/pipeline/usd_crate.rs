@@ -292,6 +292,41 @@ fn time_samples_beyond_the_file_are_refused() {
     assert_says(&m, "an array claims 1099511627776 items of 8 bytes");
 }
 
+/// Layers a stage brings in (a sublayer, a reference) are checked as the root is.
+#[test]
+fn crate_layers_a_stage_brings_in_are_checked() {
+    let v = Values::new();
+    let dir = std::env::temp_dir().join(format!("hairtrace-layers-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut hostile = v.data.clone();
+    let tokens = v.section("TOKENS");
+    hostile[tokens + 16..tokens + 24].copy_from_slice(&HUGE.to_le_bytes());
+    std::fs::write(dir.join("hostile.usdc"), &hostile).unwrap();
+    for (name, text) in [
+        (
+            "sublayer.usda",
+            "#usda 1.0\n(\n    subLayers = [@./hostile.usdc@]\n)\n",
+        ),
+        (
+            "reference.usda",
+            "#usda 1.0\ndef Xform \"a\" (\n    references = @./hostile.usdc@</hair>\n)\n{\n}\n",
+        ),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        match read_usd_file(&path) {
+            Err(Error::InvalidArg(m)) => {
+                assert_says(&m, name);
+                assert_says(
+                    &m,
+                    "hostile.usdc: TOKENS section claims 1099511627776 bytes",
+                );
+            }
+            other => panic!("{name}: expected an invalid-argument error, got {other:?}"),
+        }
+    }
+}
+
 /// A .usdz package is checked whole: its crate layer with a hostile TOKENS block, and an
 /// entry stored compressed, are refused.
 #[test]

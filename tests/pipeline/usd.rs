@@ -197,6 +197,37 @@ fn bad_files_are_refused_with_a_message() {
             curves_prim(&ok.replace("[0.1] (interpolation = \"constant\")", "[0.1, 0.2]")),
             "2 widths for Vertex",
         ),
+        // usd-core counts a pinned curve's varying values as its points - 2: 2 for 4.
+        (
+            "pinned_varying_len",
+            curves_prim(
+                &ok.replace(
+                    "\"linear\"",
+                    "\"cubic\"\nuniform token basis = \"bspline\"\nuniform token wrap = \"pinned\"",
+                )
+                .replace(
+                    "[0.1] (interpolation = \"constant\")",
+                    "[0.1, 0.2, 0.3, 0.4] (interpolation = \"varying\")",
+                ),
+            ),
+            "4 widths for Varying interpolation: 2 expected",
+        ),
+        (
+            "pinned_varying_two_points",
+            curves_prim(
+                &ok.replace(
+                    "\"linear\"",
+                    "\"cubic\"\nuniform token basis = \"bspline\"\nuniform token wrap = \"pinned\"",
+                )
+                .replace("[4]", "[2]")
+                .replace("(0,0,0),(0,1,0),(0,2,0),(0,3,0)", "(0,0,0),(0,1,0)")
+                .replace(
+                    "[0.1] (interpolation = \"constant\")",
+                    "[0.1] (interpolation = \"varying\")",
+                ),
+            ),
+            "a pinned curve of 2 points has no varying values",
+        ),
         (
             "zero_width",
             curves_prim(&ok.replace("[0.1]", "[0]")),

@@ -263,7 +263,7 @@ mod tests {
         out
     }
 
-    /// usd-core 25's `ComputeVaryingDataSize` for one curve of n points: periodic n,
+    /// usd-core 26.11's `ComputeVaryingDataSize` for one curve of n points: periodic n,
     /// nonperiodic and pinned n - 2 (B-spline, Catmull-Rom); the pinned curve's end
     /// segments take the end values.
     #[test]

@@ -25,7 +25,7 @@
 //! | `read_strings` | `read_vec::<u32>(count)` | exact, within the section |
 //! | `read_fields` | `read_encoded_ints(count)`, `read_compressed::<u64>(count)`, `Vec<Field>` | [`Crate::block`] for both blocks, count × 32 <= B |
 //! | `read_fieldsets`, `read_specs` | `read_encoded_ints(count)` (× 3 for specs), `Vec<Spec>`, then `CrateData::open`'s `HashMap::with_capacity(specs)` | [`Crate::block`], count × 160 <= B |
-//! | `read_paths` | `vec![Path; path_count]`, three `read_encoded_ints(count)`; `build_compressed_paths` makes one string per entry, each its parent's plus a token | counts × 32 <= B; the tree walked as openusd walks it ([`paths`]): each entry reached once (repeats would make the walk exponential), names summed <= B |
+//! | `read_paths` | `vec![Path; path_count]`, three `read_encoded_ints(count)`; `build_compressed_paths` makes one string per entry, each its parent's plus a token | counts × 32 <= B; the tree walked as openusd walks it ([`paths`]): each entry reached once (repeats would make the walk exponential), names summed <= B, each name one USD allows (a stray `}` sent openusd's composition into unbounded recursion) |
 //! | `read_encoded_ints` (`coding::decode_ints`) | `vec![0u8; 4 + count/4 + 4 count]` before decompressing, `Vec::with_capacity(count)` | [`Crate::block`]: compressed size within the section, these sizes <= B |
 //! | `read_ints`, `read_floats`, `read_gf_array`, `read_vec_array`, token arrays | `read_vec(count)` or, compressed, `read_encoded_ints(count)` / LUT `read_vec(lut)` + `vec![T; count]` | exact element sizes against the bytes after the count; compressed: the sizes above <= B ([`values`]) |
 //! | `read_indexed_vec` (string, token, path and asset vectors and list ops) | `read_vec::<u32>(count)`, one clone of each named string | exact, and the named strings' lengths summed into the value's total |
@@ -148,6 +148,8 @@ struct Crate<'a> {
     version: Version,
     budget: u64,
     tokens: Vec<u64>,
+    /// What each token may name in a path.
+    names: Vec<paths::Name>,
     /// The token each string names.
     strings: Vec<u32>,
     /// Length of each path openusd builds, by path index (0: never built).
@@ -177,6 +179,7 @@ impl<'a> Crate<'a> {
             version,
             budget,
             tokens: Vec::new(),
+            names: Vec::new(),
             strings: Vec::new(),
             paths: Vec::new(),
             reps: Vec::new(),
@@ -317,6 +320,7 @@ impl<'a> Crate<'a> {
         let raw = self.decompress(block, size, "TOKENS section")?;
         if let Some(text) = raw.strip_suffix(&[0]) {
             self.tokens = text.split(|&b| b == 0).map(|t| t.len() as u64).collect();
+            self.names = text.split(|&b| b == 0).map(paths::Name::of).collect();
         }
         if self.tokens.len() as u64 != count {
             return Err(format!(
@@ -372,7 +376,7 @@ impl<'a> Crate<'a> {
             tokens: &names,
             jumps: &jumps,
         };
-        self.paths = tree.lengths(path_count as usize, &self.tokens, self.budget)?;
+        self.paths = tree.lengths(path_count as usize, &self.tokens, &self.names, self.budget)?;
         Ok(())
     }
 }

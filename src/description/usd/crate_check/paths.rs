@@ -7,9 +7,51 @@
 //! that jump to the same place make it walk that subtree twice, and a chain of them makes
 //! the walk exponential; each path string is its parent's plus a token, so a deep chain of
 //! long tokens adds up quadratically. Here each entry must be reached once, and the
-//! strings' lengths must add up to the budget.
+//! strings' lengths must add up to the budget. Each name must also be one USD allows (an
+//! identifier, namespaced for a property, or a variant selection `{set=selection}`), as
+//! Pixar's reader requires: openusd parses paths by their punctuation, and a stray `}` in a
+//! prim name sent its composition into unbounded recursion.
 
 use super::Refusal;
+
+/// What a token may name in a path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Name {
+    /// A prim or a property.
+    Identifier,
+    /// A property only (`primvars:displayColor`).
+    Namespaced,
+    /// A variant selection (`{look=plain}`), after a prim.
+    Variant,
+    Invalid,
+}
+
+impl Name {
+    pub fn of(token: &[u8]) -> Self {
+        let Ok(text) = std::str::from_utf8(token) else {
+            return Name::Invalid;
+        };
+        let identifier = |s: &str| {
+            let mut chars = s.chars();
+            chars.next().is_some_and(|c| c == '_' || c.is_alphabetic())
+                && chars.all(|c| c == '_' || c.is_alphanumeric())
+        };
+        if identifier(text) {
+            Name::Identifier
+        } else if text.split(':').all(identifier) {
+            Name::Namespaced
+        } else {
+            let selection = |s: &str| s.chars().all(|c| c.is_alphanumeric() || "_|-.".contains(c));
+            match text.strip_prefix('{').and_then(|t| t.strip_suffix('}')) {
+                Some(t) => match t.split_once('=') {
+                    Some((set, choice)) if identifier(set) && selection(choice) => Name::Variant,
+                    _ => Name::Invalid,
+                },
+                None => Name::Invalid,
+            }
+        }
+    }
+}
 
 /// The three decoded arrays of the PATHS section.
 pub(super) struct Tree<'a> {
@@ -26,6 +68,7 @@ impl Tree<'_> {
         &self,
         path_count: usize,
         token_lengths: &[u64],
+        names: &[Name],
         budget: u64,
     ) -> Result<Vec<u64>, Refusal> {
         let count = self.jumps.len();
@@ -64,6 +107,18 @@ impl Tree<'_> {
                             token_lengths.len()
                         )
                     })?;
+                    let property = self.tokens[index] < 0;
+                    match (names[token], property) {
+                        (Name::Identifier, _)
+                        | (Name::Namespaced, true)
+                        | (Name::Variant, false) => {}
+                        _ => {
+                            return Err(format!(
+                                "PATHS: token {token} is not a valid {} name",
+                                if property { "property" } else { "prim" }
+                            ));
+                        }
+                    }
                     let length = parent + 1 + name;
                     lengths[slot(self.path_indices[index])?] = length;
                     length
@@ -97,6 +152,12 @@ mod tests {
 
     /// The root, /A with a child /A/b, and /A's sibling /B; tokens "", "A", "b", "B".
     const TOKENS: [u64; 4] = [0, 1, 1, 1];
+    const NAMES: [Name; 4] = [
+        Name::Invalid,
+        Name::Identifier,
+        Name::Identifier,
+        Name::Identifier,
+    ];
 
     fn lengths(jumps: &[i32], budget: u64) -> Result<Vec<u64>, Refusal> {
         let n = jumps.len() as i32;
@@ -106,7 +167,7 @@ mod tests {
             tokens: &indices,
             jumps,
         };
-        tree.lengths(jumps.len(), &TOKENS, budget)
+        tree.lengths(jumps.len(), &TOKENS, &NAMES, budget)
     }
 
     #[test]
@@ -123,6 +184,44 @@ mod tests {
         assert!(m.contains("reach entry 3 twice"), "{m}");
         let m = lengths(&[-1, 7, -2, -2], 100).unwrap_err();
         assert!(m.contains("beyond the 4 entries"), "{m}");
+    }
+
+    #[test]
+    fn names_are_identifiers_namespaced_properties_or_variant_selections() {
+        for (token, name) in [
+            ("hair", Name::Identifier),
+            ("_c2_bézier", Name::Identifier),
+            ("primvars:displayColor", Name::Namespaced),
+            ("{look=plain}", Name::Variant),
+            ("{look=}", Name::Variant),
+            ("c2_cubic_be}ier", Name::Invalid),
+            ("2d", Name::Invalid),
+            ("a/b", Name::Invalid),
+            ("", Name::Invalid),
+            ("{look}", Name::Invalid),
+            ("[/target]", Name::Invalid),
+        ] {
+            assert_eq!(Name::of(token.as_bytes()), name, "{token}");
+        }
+        let indices = [0, 1, 2, 3];
+        let names = [
+            Name::Invalid,
+            Name::Identifier,
+            Name::Namespaced,
+            Name::Namespaced,
+        ];
+        let tree = |tokens: &[i32]| {
+            Tree {
+                path_indices: &indices,
+                tokens,
+                jumps: &[-1, -1, 0, -2],
+            }
+            .lengths(4, &TOKENS, &names, 100)
+        };
+        // A namespaced name names a property (negative token), not a prim.
+        assert!(tree(&[0, 1, -2, -3]).is_ok());
+        let m = tree(&[0, 1, -2, 3]).unwrap_err();
+        assert!(m.contains("token 3 is not a valid prim name"), "{m}");
     }
 
     #[test]

@@ -267,6 +267,18 @@ fn paths_with_invalid_names_are_refused() {
     assert_says(&m, "is not a valid prim name");
 }
 
+/// A prim's children named twice (a random mutation listed an empty name, which made
+/// openusd's traversal loop, growing its stack until the allocation failed).
+#[test]
+fn children_named_twice_are_refused() {
+    let v = Values::new();
+    // The root's primChildren: a u64 count, then u32 token indices.
+    let at = v.payload("primChildren", 41) + 8;
+    let first = v.data[at..at + 4].to_vec();
+    let m = v.refused_with(&[(at + 4, &first)], "children_twice");
+    assert_says(&m, "which is not a name or is repeated");
+}
+
 #[test]
 fn dictionaries_that_loop_or_nest_too_deep_are_refused() {
     let v = Values::new();

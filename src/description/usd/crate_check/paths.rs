@@ -23,6 +23,8 @@ pub(super) enum Name {
     Namespaced,
     /// A variant selection (`{look=plain}`), after a prim.
     Variant,
+    /// A variant's name that is not an identifier (`red-1`), in a list of variants.
+    Selection,
     Invalid,
 }
 
@@ -36,12 +38,14 @@ impl Name {
             chars.next().is_some_and(|c| c == '_' || c.is_alphabetic())
                 && chars.all(|c| c == '_' || c.is_alphanumeric())
         };
+        let selection = |s: &str| s.chars().all(|c| c.is_alphanumeric() || "_|-.".contains(c));
         if identifier(text) {
             Name::Identifier
         } else if text.split(':').all(identifier) {
             Name::Namespaced
+        } else if !text.is_empty() && !text.starts_with('.') && selection(text) {
+            Name::Selection
         } else {
-            let selection = |s: &str| s.chars().all(|c| c.is_alphanumeric() || "_|-.".contains(c));
             match text.strip_prefix('{').and_then(|t| t.strip_suffix('}')) {
                 Some(t) => match t.split_once('=') {
                     Some((set, choice)) if identifier(set) && selection(choice) => Name::Variant,
@@ -195,11 +199,14 @@ mod tests {
             ("{look=plain}", Name::Variant),
             ("{look=}", Name::Variant),
             ("c2_cubic_be}ier", Name::Invalid),
-            ("2d", Name::Invalid),
+            ("2d", Name::Selection),
             ("a/b", Name::Invalid),
             ("", Name::Invalid),
             ("{look}", Name::Invalid),
             ("[/target]", Name::Invalid),
+            ("red-1", Name::Selection),
+            (".", Name::Invalid),
+            ("..", Name::Invalid),
         ] {
             assert_eq!(Name::of(token.as_bytes()), name, "{token}");
         }

@@ -4,11 +4,12 @@
 //! recursion of dictionaries, time samples and references (depth and cycles). Values are
 //! not decoded: only counts, indices and the offsets that lead to nested values are read.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::mem::size_of;
 
 use openusd::{sdf, tf};
 
+use super::paths::Name;
 use super::{At, Crate, Refusal, Version, ints_capacity};
 
 /// Deepest nesting of values (dictionaries in dictionaries, time samples of
@@ -225,7 +226,7 @@ impl<'a> Walk<'_, 'a> {
                 self.names_at(rep, Names::Strings)?
             }
             ty::STRING_VECTOR if !inlined => self.names_at(rep, Names::Strings)?,
-            ty::TOKEN_VECTOR if !inlined => self.names_at(rep, Names::Tokens)?,
+            ty::TOKEN_VECTOR if !inlined => self.children(rep)?,
             ty::PATH_VECTOR if !inlined => self.names_at(rep, Names::Paths)?,
             ty::TOKEN if array => self.token_array(rep)?,
             ty::MATRIX2D..=ty::QUATH | ty::VEC2D..=ty::VEC4I if array => {
@@ -374,6 +375,32 @@ impl<'a> Walk<'_, 'a> {
             bytes += name_length(self.file, names, at.u32("an index")?)?;
         }
         Ok(Cost::bytes(bytes))
+    }
+
+    /// A token vector, which Pixar's files use for names of children (`primChildren`,
+    /// `properties`, variant sets and variants): openusd appends each to its parent's path,
+    /// so each must be a name (an empty one or `.` made its traversal loop for ever) and
+    /// appear once (repeats multiply the prims a traversal visits at each level).
+    fn children(&mut self, rep: Rep) -> Result<Cost, Refusal> {
+        let mut at = self.at(rep.payload(), "a list of names")?;
+        let list = at.pos;
+        let cost = self.names(&mut at, Names::Tokens)?;
+        at.pos = list;
+        let count = at.u64("a list of names")?;
+        let mut seen = HashSet::new();
+        for _ in 0..count {
+            let token = at.u32("a name")?;
+            let valid = !matches!(
+                self.file.names[token as usize],
+                Name::Variant | Name::Invalid
+            );
+            if !valid || !seen.insert(token) {
+                return Err(format!(
+                    "the list of names at offset {list} holds token {token}, which is not a name or is repeated"
+                ));
+            }
+        }
+        Ok(cost)
     }
 
     /// A u64 count and as many `size`-byte numbers.

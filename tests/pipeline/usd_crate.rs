@@ -253,6 +253,15 @@ fn list_op_and_map_counts_beyond_the_file_are_refused() {
     );
 }
 
+/// An int array whose representation is also flagged inlined: openusd reads it at its
+/// payload all the same (a random mutation of converted_by_usd_core.usdc, whose compressed
+/// block then claimed 20 GiB).
+#[test]
+fn an_inlined_int_array_is_read_as_openusd_reads_it() {
+    let m = refused(fixture("mutated_inlined_ints.usdc"), "inlined_ints.usdc");
+    assert_says(&m, "a compressed array claims 21474836482 bytes at offset");
+}
+
 /// A prim name that is not an identifier (a random mutation made "bezier" "be}ier", and
 /// openusd's composition recursed until the stack overflowed).
 #[test]

@@ -313,10 +313,12 @@ impl<'a> Walk<'_, 'a> {
         size: u64,
         compressed_from: Option<Version>,
     ) -> Result<Cost, Refusal> {
-        if rep.inlined() {
+        // openusd refuses an inlined float array, but reads an inlined int array's payload
+        // as an offset all the same.
+        let floats = compressed_from == Some(Version(0, 6, 0));
+        if floats && rep.inlined() {
             return Ok(Cost::default());
         }
-        let floats = compressed_from == Some(Version(0, 6, 0));
         let file = self.file;
         let Some((count, compressed, mut at)) = self.array_head(rep, compressed_from)? else {
             return Ok(Cost::default());

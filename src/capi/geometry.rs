@@ -350,9 +350,8 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
 /// non-UTF-8 path, a file that is not a USD stage or fails to compose, a prim the reader
 /// refuses, an unknown shape, a material that is not hair). Nothing is added on error.
 ///
-/// Untrusted files: a corrupt binary crate file (.usdc, or inside .usdz) can make the USD
-/// crate (openusd 0.6) try to allocate without bound, which aborts the process; text
-/// (.usda) is checked and fuzzed. Read .usdc only from sources you trust
+/// Crate files (.usdc, and those inside a .usdz) are checked before they are parsed, so a
+/// corrupt or hostile file gives `HT_ERR_INVALID_ARG` rather than a huge allocation
 /// (docs/formats.md, "Limits").
 ///
 /// # Safety

@@ -21,3 +21,4 @@ mod render;
 mod ribbons;
 mod stages;
 mod usd;
+mod usd_crate;

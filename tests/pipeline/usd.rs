@@ -129,7 +129,7 @@ fn every_fixture_renders_a_visible_image() {
     }
 }
 
-fn refused(text: impl AsRef<[u8]>, name: &str) -> String {
+pub(crate) fn refused(text: impl AsRef<[u8]>, name: &str) -> String {
     let dir = std::env::temp_dir().join(format!("hairtrace-usd-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
@@ -196,6 +196,37 @@ fn bad_files_are_refused_with_a_message() {
             "widths_len",
             curves_prim(&ok.replace("[0.1] (interpolation = \"constant\")", "[0.1, 0.2]")),
             "2 widths for Vertex",
+        ),
+        // usd-core counts a pinned curve's varying values as its points - 2: 2 for 4.
+        (
+            "pinned_varying_len",
+            curves_prim(
+                &ok.replace(
+                    "\"linear\"",
+                    "\"cubic\"\nuniform token basis = \"bspline\"\nuniform token wrap = \"pinned\"",
+                )
+                .replace(
+                    "[0.1] (interpolation = \"constant\")",
+                    "[0.1, 0.2, 0.3, 0.4] (interpolation = \"varying\")",
+                ),
+            ),
+            "4 widths for Varying interpolation: 2 expected",
+        ),
+        (
+            "pinned_varying_two_points",
+            curves_prim(
+                &ok.replace(
+                    "\"linear\"",
+                    "\"cubic\"\nuniform token basis = \"bspline\"\nuniform token wrap = \"pinned\"",
+                )
+                .replace("[4]", "[2]")
+                .replace("(0,0,0),(0,1,0),(0,2,0),(0,3,0)", "(0,0,0),(0,1,0)")
+                .replace(
+                    "[0.1] (interpolation = \"constant\")",
+                    "[0.1] (interpolation = \"varying\")",
+                ),
+            ),
+            "a pinned curve of 2 points has no varying values",
         ),
         (
             "zero_width",
@@ -277,8 +308,7 @@ fn truncated_and_corrupted_crate_files_are_refused() {
         let m = refused(&good[..cut], &format!("cut{cut}.usdc"));
         assert!(m.contains(&format!("cut{cut}.usdc")), "{m}");
     }
-    // A crate file with bytes flipped inside its tables is not tested here: openusd 0.6
-    // allocates whatever counts such a file claims (see docs/formats.md, "Limits").
+    // Counts set beyond the file inside the tables: tests/pipeline/usd_crate.rs.
     let mut bad = good.clone();
     bad[8..16].fill(0xFF);
     let m = refused(&bad, "bad_toc.usdc");

@@ -10,7 +10,11 @@
 //! - periodic: the first points repeated after the last, so that the closing segments exist
 //!   (linear and Bezier: the first point; B-spline and Catmull-Rom: the first three).
 //!
-//! `widths` and `displayColor` with `varying` interpolation hold one value per segment end;
+//! `widths` and `displayColor` with `varying` interpolation hold one value per segment end
+//! (per segment for periodic curves), counted as usd-core's `ComputeVaryingDataSize` and
+//! Hydra count them: a pinned B-spline or Catmull-Rom curve of n points has n - 1 segments
+//! but n - 2 varying values, those of the same curve nonperiodic, so its two end segments
+//! take the first and last values out to the end points ([`Layout::varying_ends`]);
 //! radii are mapped to control points so that the basis reproduces those values at the
 //! segment ends (exactly for linear, Bezier and Catmull-Rom, and for B-splines wherever the
 //! widths change linearly), colours are taken as they are, since the renderer interpolates
@@ -80,11 +84,30 @@ impl Layout {
         s.filter(|&s| s > 0)
     }
 
-    /// Values a `varying` primvar holds for a curve of `segments` segments.
+    /// Values a `varying` primvar holds for a curve of `segments` segments (usd-core's
+    /// count: a pinned curve has those of its nonperiodic self, two fewer than its segment
+    /// ends, none for two points).
     pub fn varying_count(self, segments: usize) -> usize {
         match self.effective_wrap() {
             Wrap::Periodic => segments,
-            _ => segments + 1,
+            Wrap::Pinned => segments - 1,
+            Wrap::Nonperiodic => segments + 1,
+        }
+    }
+
+    /// The value at each segment end of a curve from its `varying` values `v`: as they are,
+    /// but for a pinned curve, whose end segments reach the end points with the first and
+    /// last values.
+    pub fn varying_ends<T: Copy>(self, v: &[T]) -> Vec<T> {
+        match (self.effective_wrap(), v) {
+            (Wrap::Pinned, [first, .., last]) | (Wrap::Pinned, [first @ last]) => {
+                let mut out = Vec::with_capacity(v.len() + 2);
+                out.push(*first);
+                out.extend_from_slice(v);
+                out.push(*last);
+                out
+            }
+            _ => v.to_vec(),
         }
     }
 
@@ -130,12 +153,14 @@ impl Layout {
         }
     }
 
-    /// Per-point radii of one curve of `n` points from its `varying` radii `w` (one per
-    /// segment end; see the module notes).
+    /// Per-point radii of one curve of `n` points from its `varying` radii `w` (see the
+    /// module notes).
     pub fn varying_to_points(self, w: &[f32], n: usize) -> Vec<[f32; 1]> {
         let positive = |r: f32, fallback: f32| if r > 0.0 { r } else { fallback };
         match (self.basis, self.effective_wrap()) {
-            (CurveBasis::Linear, _) | (_, Wrap::Pinned) => w.iter().map(|&r| [r]).collect(),
+            (CurveBasis::Linear, _) => w.iter().map(|&r| [r]).collect(),
+            // The segment ends of a pinned curve are its points.
+            (_, Wrap::Pinned) => self.varying_ends(w).into_iter().map(|r| [r]).collect(),
             (CurveBasis::Bezier, wrap) => (0..n)
                 .map(|i| {
                     let (j, k) = (i / 3, i % 3);
@@ -238,6 +263,34 @@ mod tests {
         out
     }
 
+    /// usd-core 26.11's `ComputeVaryingDataSize` for one curve of n points: periodic n,
+    /// nonperiodic and pinned n - 2 (B-spline, Catmull-Rom); the pinned curve's end
+    /// segments take the end values.
+    #[test]
+    fn varying_counts_are_usd_cores() {
+        for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
+            for n in 2..9 {
+                for (wrap, want) in [
+                    (Wrap::Periodic, n),
+                    (Wrap::Nonperiodic, n.max(3) - 2),
+                    (Wrap::Pinned, n - 2),
+                ] {
+                    let l = layout(basis, wrap);
+                    if let Some(s) = l.segments(n) {
+                        assert_eq!(l.varying_count(s), want, "{basis:?} {wrap:?} {n}");
+                    }
+                }
+            }
+            let l = layout(basis, Wrap::Pinned);
+            assert_eq!(l.varying_ends(&[1, 2, 3]), [1, 1, 2, 3, 3]);
+            assert_eq!(l.varying_ends(&[4]), [4, 4, 4]);
+            assert_eq!(
+                layout(basis, Wrap::Nonperiodic).varying_ends(&[1, 2]),
+                [1, 2]
+            );
+        }
+    }
+
     #[test]
     fn pinned_adds_the_reflected_phantom_points_of_the_spec() {
         for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
@@ -302,15 +355,17 @@ mod tests {
     }
 
     /// Varying radii reach the segment ends: each basis evaluated at the ends of the radii
-    /// it was given returns the authored values (linear widths, so B-splines are exact too).
+    /// it was given returns the authored values (linear widths, so B-splines are exact too;
+    /// a pinned B-spline's widths stop changing at its end segments, so there its ends are
+    /// exact and the values between within a sixth of the step).
     #[test]
     fn varying_widths_are_the_radii_at_the_segment_ends() {
-        for (basis, wrap, n) in [
-            (CurveBasis::Bezier, Wrap::Nonperiodic, 7),
-            (CurveBasis::BSpline, Wrap::Nonperiodic, 6),
-            (CurveBasis::CatmullRom, Wrap::Nonperiodic, 6),
-            (CurveBasis::BSpline, Wrap::Pinned, 4),
-            (CurveBasis::CatmullRom, Wrap::Pinned, 4),
+        for (basis, wrap, n, tolerance) in [
+            (CurveBasis::Bezier, Wrap::Nonperiodic, 7, 1e-5),
+            (CurveBasis::BSpline, Wrap::Nonperiodic, 6, 1e-5),
+            (CurveBasis::CatmullRom, Wrap::Nonperiodic, 6, 1e-5),
+            (CurveBasis::BSpline, Wrap::Pinned, 5, 0.25 / 6.0 + 1e-5),
+            (CurveBasis::CatmullRom, Wrap::Pinned, 5, 1e-5),
         ] {
             let l = layout(basis, wrap);
             let s = l.segments(n).unwrap();
@@ -319,18 +374,21 @@ mod tests {
                 .collect();
             let r = l.varying_to_points(&w, n);
             assert_eq!(r.len(), n, "{basis:?} {wrap:?}");
+            let w = l.varying_ends(&w);
             let mut ext = Vec::new();
             l.extend(&r, &mut ext, |x, _| x);
             let as3: Vec<[f32; 3]> = ext.iter().map(|&[x]| [x / 10.0; 3]).collect();
             let mut ends = Vec::new();
             l.segment_ends(&as3, s, &mut ends);
             let got: Vec<f32> = ends.iter().map(|e| e[0] * 10.0).collect();
+            assert_eq!(got.len(), w.len());
             for (g, want) in got.iter().zip(&w) {
                 assert!(
-                    (g - want).abs() < 1e-5,
+                    (g - want).abs() < tolerance,
                     "{basis:?} {wrap:?}: {got:?} vs {w:?}"
                 );
             }
+            assert!((got[0] - w[0]).abs() < 1e-5 && (got[s] - w[s]).abs() < 1e-5);
         }
     }
 }

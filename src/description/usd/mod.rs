@@ -3,8 +3,10 @@
 //! for Embree (see [`Layout`] for the basis and wrap conversions). See docs/formats.md for
 //! what is read, the primvar names and what is refused.
 
+mod crate_check;
 mod layout;
 mod prim;
+mod resolver;
 mod write;
 
 use std::fmt::Write as _;
@@ -123,11 +125,14 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
     let name = path
         .to_str()
         .ok_or_else(|| at(invalid_arg!("the path is not valid UTF-8")))?;
-    // openusd 0.6 indexes some tables of a corrupt .usdc without checking them, and panics:
-    // the panic is caught here and becomes this file's error (the stage is dropped with it).
+    // Every layer passes the crate check on its way in (see `resolver`). openusd 0.6 still
+    // indexes some tables of a corrupt .usdc without checking them, and panics: the panic
+    // is caught here and becomes this file's error (the stage is dropped with it).
     let read = std::panic::catch_unwind(|| {
-        let stage =
-            Stage::open(name).map_err(|e| invalid_arg!("not a readable USD stage: {e:#}"))?;
+        let stage = Stage::builder()
+            .resolver(resolver::CheckingResolver::default())
+            .open(name)
+            .map_err(|e| invalid_arg!("not a readable USD stage: {e:#}"))?;
         let grooms = read_stage(&stage, meta.len())?;
         // Composition is lazy: its errors (cycles, missing layers) are known once every
         // prim has been visited.

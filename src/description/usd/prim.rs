@@ -150,14 +150,28 @@ fn transform_point(m: &Matrix4d, p: [f32; 3]) -> [f32; 3] {
     })
 }
 
-/// Values per curve a primvar of `interp` has: how many for each curve of `counts`.
-fn expected_len(interp: Interpolation, layout: Layout, counts: &[usize], segs: &[usize]) -> usize {
-    match interp {
+/// How many values a primvar of `interp` has for curves of `counts` points and `segs`
+/// segments; refused for `varying` if a curve has none (a pinned curve of two points).
+fn expected_len(
+    interp: Interpolation,
+    layout: Layout,
+    counts: &[usize],
+    segs: &[usize],
+) -> Result<usize> {
+    Ok(match interp {
         Interpolation::Constant => 1,
         Interpolation::Uniform => counts.len(),
         Interpolation::Vertex => counts.iter().sum(),
-        Interpolation::Varying => segs.iter().map(|&s| layout.varying_count(s)).sum(),
-    }
+        Interpolation::Varying => {
+            if let Some(i) = segs.iter().position(|&s| layout.varying_count(s) == 0) {
+                return Err(invalid_arg!(
+                    "curve {i}: a pinned curve of 2 points has no varying values (usd-core \
+                     counts its points - 2); author its values per vertex"
+                ));
+            }
+            segs.iter().map(|&s| layout.varying_count(s)).sum()
+        }
+    })
 }
 
 /// Splits `values` of `interp` into the values of curve `i` (start offsets precomputed).
@@ -236,7 +250,7 @@ pub(super) fn read_basis_curves(
     let widths = floats(&widths_attr, "widths")?
         .ok_or_else(|| invalid_arg!("no widths: the fibres' diameters must be authored"))?;
     let widths_interp = interpolation(&widths_attr, "widths", Interpolation::Vertex)?;
-    let want = expected_len(widths_interp, layout, &counts, &segs);
+    let want = expected_len(widths_interp, layout, &counts, &segs)?;
     if widths.len() != want {
         return Err(invalid_arg!(
             "{} widths for {widths_interp:?} interpolation: {want} expected",
@@ -258,7 +272,7 @@ pub(super) fn read_basis_curves(
         Interpolation::Constant,
     )?;
     if let Some(c) = &colors {
-        let want = expected_len(color_interp, layout, &counts, &segs);
+        let want = expected_len(color_interp, layout, &counts, &segs)?;
         if c.len() != want {
             return Err(invalid_arg!(
                 "{} displayColor values for {color_interp:?} interpolation: {want} expected",
@@ -349,6 +363,7 @@ pub(super) fn read_basis_curves(
             );
             match color_interp {
                 Interpolation::Varying => {
+                    let v = layout.varying_ends(&v);
                     out.extend_from_slice(&v);
                     if v.len() == s {
                         out.push(v[0]);

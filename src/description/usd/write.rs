@@ -7,10 +7,9 @@
 //! Every prim is authored with what the UsdGeom schema needs to be read anywhere: `type`,
 //! `basis` and `wrap` (uniform tokens), `points`, `curveVertexCounts`, `widths` as
 //! **diameters** (`constant` when every width is the same, else `vertex`), and, when there are
-//! colours, `primvars:displayColor` with `vertex` interpolation. (Not `varying`, although
-//! hairtrace blends a `.hair` file's colours linearly between points: for pinned cubic curves
-//! usd-core's `ComputeVaryingDataSize` and Hydra count two values fewer per curve than the
-//! schema's segments + 1, so no size would be read the same everywhere.)
+//! colours, `primvars:displayColor` with `vertex` interpolation (not `varying`: `vertex`
+//! keeps each point's colour as the `.hair` file has it, and a pinned curve of two points
+//! has no `varying` values in usd-core's count).
 //! The writer prints floats through f64, so every f32 reads back bit for bit (a negative zero
 //! as 0: integral values are printed as integers).
 

@@ -1,0 +1,117 @@
+//! The asset resolver stages are opened with: openusd's default resolver, except that
+//! every layer it hands to openusd (root, sublayers, references, payloads, the layers of
+//! a .usdz) is read into memory first, within the size the reader accepts, and a crate
+//! file, or a package holding crate files, must pass [`check_crate`] before openusd
+//! parses it. openusd opens a .usdz by reading the whole package through `open_asset` and
+//! parsing its first layer from memory, so the package is checked whole: every entry
+//! must be stored uncompressed (as the USDZ format requires; a compressed entry could
+//! inflate without bound) and every crate entry must pass.
+
+use std::io::{self, Read};
+use std::time::SystemTime;
+
+use openusd::ar::{self, Asset, AssetInfo, DefaultResolver, ResolvedPath, Resolver};
+
+use super::crate_check::{MAGIC, Refusal, check_crate};
+
+/// openusd's [`DefaultResolver`] with each asset checked before it is handed on.
+#[derive(Default)]
+pub(super) struct CheckingResolver {
+    inner: DefaultResolver,
+}
+
+impl CheckingResolver {
+    /// The bytes of `resolved`, refused if they are more than `max` or fail
+    /// [`check_layer`].
+    fn checked(&self, resolved: &ResolvedPath) -> io::Result<Vec<u8>> {
+        let refused = |why: String| io::Error::new(io::ErrorKind::InvalidData, why);
+        let name = resolved.to_string();
+        if let Some((package, _)) = ar::split_package_relative_path_outer(&name) {
+            // The default resolver reads a packaged layer straight from the package on
+            // disk: the package is checked whole first.
+            self.checked(&ResolvedPath::new(package))?;
+        }
+        let asset = self.inner.open_asset(resolved)?;
+        let limit = super::MAX_FILE_BYTES;
+        let mut bytes = Vec::new();
+        asset.take(limit + 1).read_to_end(&mut bytes)?;
+        if bytes.len() as u64 > limit {
+            return Err(refused(format!(
+                "{name}: larger than the {limit} bytes this reader accepts"
+            )));
+        }
+        check_layer(&bytes).map_err(|why| refused(format!("{name}: {why}")))?;
+        Ok(bytes)
+    }
+}
+
+impl Resolver for CheckingResolver {
+    fn create_identifier(&self, asset_path: &str, anchor: Option<&ResolvedPath>) -> String {
+        self.inner.create_identifier(asset_path, anchor)
+    }
+
+    fn resolve(&self, asset_path: &str) -> Option<ResolvedPath> {
+        self.inner.resolve(asset_path)
+    }
+
+    fn resolve_for_new_asset(&self, asset_path: &str) -> Option<ResolvedPath> {
+        self.inner.resolve_for_new_asset(asset_path)
+    }
+
+    fn open_asset(&self, resolved: &ResolvedPath) -> io::Result<Box<dyn Asset>> {
+        Ok(Box::new(io::Cursor::new(self.checked(resolved)?)))
+    }
+
+    fn get_extension<'a>(&self, asset_path: &'a str) -> &'a str {
+        self.inner.get_extension(asset_path)
+    }
+
+    fn get_asset_info(&self, asset_path: &str, resolved: &ResolvedPath) -> AssetInfo {
+        self.inner.get_asset_info(asset_path, resolved)
+    }
+
+    fn get_modification_timestamp(
+        &self,
+        asset_path: &str,
+        resolved: &ResolvedPath,
+    ) -> Option<SystemTime> {
+        self.inner.get_modification_timestamp(asset_path, resolved)
+    }
+
+    fn identity(&self) -> String {
+        self.inner.identity()
+    }
+}
+
+/// Checks one asset: a crate file, or each file of a zip package (a .usdz); anything else
+/// (text layers) passes, the text parser checks it.
+fn check_layer(bytes: &[u8]) -> Result<(), Refusal> {
+    if bytes.starts_with(MAGIC) {
+        check_crate(bytes)
+    } else if bytes.starts_with(b"PK\x03\x04") {
+        check_package(bytes)
+    } else {
+        Ok(())
+    }
+}
+
+fn check_package(bytes: &[u8]) -> Result<(), Refusal> {
+    let unreadable = |e: zip::result::ZipError| format!("not a readable USDZ package: {e}");
+    let mut package = zip::ZipArchive::new(io::Cursor::new(bytes)).map_err(unreadable)?;
+    for i in 0..package.len() {
+        let mut entry = package.by_index(i).map_err(unreadable)?;
+        let name = entry.name().to_string();
+        if entry.compression() != zip::CompressionMethod::Stored {
+            return Err(format!(
+                "package entry {name} is compressed: USDZ packages store their files uncompressed"
+            ));
+        }
+        let mut data = Vec::new();
+        (&mut entry)
+            .take(bytes.len() as u64)
+            .read_to_end(&mut data)
+            .map_err(|e| format!("package entry {name}: {e}"))?;
+        check_layer(&data).map_err(|why| format!("package entry {name}: {why}"))?;
+    }
+    Ok(())
+}

@@ -396,6 +396,23 @@ fn usdz_packages_are_checked() {
         "deflated.usdz",
     );
     assert_says(&m, "package entry layer.usdc is compressed");
+
+    // Packages nested 8 deep are checked through; 9 deep are refused before the stack
+    // could run out on a deeper nest.
+    let nest = |depth: usize| {
+        (0..depth).fold(v.data.clone(), |inner, _| {
+            package(&inner, zip::CompressionMethod::Stored)
+        })
+    };
+    let path = std::env::temp_dir().join(format!("hairtrace-nest-{}.usdz", std::process::id()));
+    std::fs::write(&path, nest(8)).unwrap();
+    let error = read_usd_file(&path)
+        .err()
+        .map(|e| e.to_string())
+        .unwrap_or_default();
+    assert!(!error.contains("nested"), "{error}");
+    let m = refused(nest(9), "nested.usdz");
+    assert_says(&m, "packages nested more than 8 deep");
 }
 
 /// Every 8-byte-aligned u64 of every crate fixture set to 2^40, 2^62 and u64::MAX, and

@@ -83,19 +83,33 @@ impl Resolver for CheckingResolver {
     }
 }
 
+/// Packages inside packages are checked to this depth: each level holds a copy of what it
+/// contains, and a hostile file could otherwise nest until the stack runs out.
+const MAX_PACKAGE_NESTING: usize = 8;
+
 /// Checks one asset: a crate file, or each file of a zip package (a .usdz); anything else
 /// (text layers) passes, the text parser checks it.
 fn check_layer(bytes: &[u8]) -> Result<(), Refusal> {
+    check_nested(bytes, 0)
+}
+
+/// [`check_layer`] of an asset inside `depth` packages.
+fn check_nested(bytes: &[u8], depth: usize) -> Result<(), Refusal> {
     if bytes.starts_with(MAGIC) {
         check_crate(bytes)
     } else if bytes.starts_with(b"PK\x03\x04") {
-        check_package(bytes)
+        if depth == MAX_PACKAGE_NESTING {
+            return Err(format!(
+                "packages nested more than {MAX_PACKAGE_NESTING} deep"
+            ));
+        }
+        check_package(bytes, depth)
     } else {
         Ok(())
     }
 }
 
-fn check_package(bytes: &[u8]) -> Result<(), Refusal> {
+fn check_package(bytes: &[u8], depth: usize) -> Result<(), Refusal> {
     let unreadable = |e: zip::result::ZipError| format!("not a readable USDZ package: {e}");
     let mut package = zip::ZipArchive::new(io::Cursor::new(bytes)).map_err(unreadable)?;
     for i in 0..package.len() {
@@ -111,7 +125,7 @@ fn check_package(bytes: &[u8]) -> Result<(), Refusal> {
             .take(bytes.len() as u64)
             .read_to_end(&mut data)
             .map_err(|e| format!("package entry {name}: {e}"))?;
-        check_layer(&data).map_err(|why| format!("package entry {name}: {why}"))?;
+        check_nested(&data, depth + 1).map_err(|why| format!("package entry {name}: {why}"))?;
     }
     Ok(())
 }

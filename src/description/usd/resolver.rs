@@ -21,8 +21,8 @@ pub(super) struct CheckingResolver {
 }
 
 impl CheckingResolver {
-    /// The bytes of `resolved`, refused if they are more than `max` or fail
-    /// [`check_layer`].
+    /// The bytes of `resolved`, refused if they are more than the reader's
+    /// `MAX_FILE_BYTES` or fail [`check_layer`].
     fn checked(&self, resolved: &ResolvedPath) -> io::Result<Vec<u8>> {
         let refused = |why: String| io::Error::new(io::ErrorKind::InvalidData, why);
         let name = resolved.to_string();

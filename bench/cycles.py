@@ -180,7 +180,9 @@ def configure_render(scene, desc, args):
     cycles.blur_glossy = 0.0
     cycles.sample_clamp_direct = 0.0
     cycles.sample_clamp_indirect = 0.0
-    cycles.light_sampling_threshold = 0.0
+    # Cycles' default (0.01): its unbiased shadow-ray roulette, the counterpart of
+    # hairtrace's light_threshold, which is on by default too.
+    cycles.light_sampling_threshold = 0.01
     cycles.caustics_reflective = True
     cycles.caustics_refractive = True
     # Cycles counts bounces after the first hit: N bounces are N + 1 scattering events.

@@ -168,6 +168,11 @@ struct RenderArgs {
     /// (default 0: none).
     #[arg(long, value_name = "T")]
     lobe_cull: Option<f32>,
+    /// Shadow-ray roulette: a light sample contributing less than this to a pixel traces
+    /// its shadow ray with probability contribution / threshold (unbiased; 0: every
+    /// shadow ray; default 0.03).
+    #[arg(long, value_name = "T")]
+    light_threshold: Option<f32>,
     /// Curve shape of every groom, over the scene's: auto (the default: a ribbon facing the
     /// ray where a strand is at most a pixel wide, a tube elsewhere), round or flat.
     #[arg(long, value_parser = ["auto", "round", "flat"])]
@@ -448,6 +453,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     }
     r.deep_bounce_depth = args.deep_bounce_depth.or(r.deep_bounce_depth);
     r.lobe_cull = args.lobe_cull.unwrap_or(r.lobe_cull);
+    r.light_threshold = args.light_threshold.unwrap_or(r.light_threshold);
     if let Some(filter) = &args.filter {
         r.filter.clone_from(filter);
     }

@@ -496,7 +496,7 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
     }
 }
 
-/// `--deep-bounce-depth` and `--lobe-cull` reach the renderer: a deep-bounce depth of
+/// `--deep-bounce-depth`, `--lobe-cull` and `--light-threshold` reach the renderer: a deep-bounce depth of
 /// `--max-depth` is the exact image bit for bit (EXR keeps the bits), an earlier one
 /// and culling change it; out-of-range values are one-line errors naming the setting.
 #[test]
@@ -527,11 +527,16 @@ fn render_takes_the_fidelity_knobs() {
     assert_eq!(image("cli_deep4.exr", &["--deep-bounce-depth", "4"]), exact);
     assert_ne!(image("cli_deep1.exr", &["--deep-bounce-depth", "1"]), exact);
     assert_ne!(image("cli_cull.exr", &["--lobe-cull", "0.2"]), exact);
+    assert_ne!(
+        image("cli_every_shadow_ray.exr", &["--light-threshold", "0"]),
+        exact
+    );
     let out = tmp("cli_knob_error.exr");
     for (knob, value, needle) in [
         ("--deep-bounce-depth", "5", "deep_bounce_depth = 5"),
         ("--deep-bounce-depth", "0", "deep_bounce_depth = 0"),
         ("--lobe-cull", "1", "lobe_cull = 1"),
+        ("--light-threshold", "inf", "light_threshold = inf"),
     ] {
         let mut args: Vec<&str> = common.to_vec();
         args.extend([knob, value, "-o", out.as_str()]);

@@ -18,7 +18,7 @@
 use super::azimuthal::{TrimmedLogistic, azimuthal_scale};
 use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
 use super::params::HairParams;
-use super::{BsdfEval, BsdfSample, LocalBsdf};
+use super::{BsdfEval, BsdfSample, LocalBsdf, WeightedSample};
 use crate::error::{Result, invalid_arg};
 use crate::math::fast::atan2;
 use crate::math::{Lanes, cos_from_sin};
@@ -403,6 +403,10 @@ impl LocalBsdf for HairPoint<'_> {
     fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
         HairPoint::sample(self, u)
     }
+
+    fn sample_weight(&self, u: [f32; 3]) -> Option<WeightedSample> {
+        self.bsdf.sample_weight_at(&self.at, u)
+    }
 }
 
 /// [`HairBsdf`] at a fixed (h, wo); see [`HairBsdf::at`].
@@ -476,6 +480,30 @@ impl HairBsdf {
     /// Samples wi at a prepared vertex; see [`HairBsdf::sample`].
     #[inline]
     fn sample_at(&self, at: &Vertex, u: [f32; 3]) -> Option<BsdfSample> {
+        let (wi, _) = self.draw(at, u);
+        let e = self.eval_at(at, wi);
+        (e.pdf > 0.0).then_some(BsdfSample {
+            wi,
+            f: e.f,
+            pdf: e.pdf,
+        })
+    }
+
+    /// The direction of [`Self::sample_at`], weighted by the lobe that drew it alone:
+    /// lobe p is picked with probability P(p) and its Mp and Np are sampled exactly, so
+    /// f_p |cos| / (P(p) pdf_p) is Ap / P(p), with no lobe evaluated at wi. Its mean is
+    /// the albedo, as the mixture's f |cos| / pdf; since P(p) is proportional to Ap's
+    /// mean over the channels, that mean of the weight is the same constant either way.
+    #[inline]
+    fn sample_weight_at(&self, at: &Vertex, u: [f32; 3]) -> Option<WeightedSample> {
+        let (wi, p) = self.draw(at, u);
+        let weight = Vec3::from_array(at.o.ap[p]) / at.o.lobe_pdf[p];
+        weight.is_finite().then_some(WeightedSample { wi, weight })
+    }
+
+    /// A direction from lobe p, picked by `u[0]`, and p.
+    #[inline(always)]
+    fn draw(&self, at: &Vertex, u: [f32; 3]) -> (Vec3, usize) {
         let o = &at.o;
         let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
         // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
@@ -502,12 +530,7 @@ impl HairBsdf {
             scale * (base.0 * cos_d - base.1 * sin_d),
             scale * (base.1 * cos_d + base.0 * sin_d),
         );
-        let e = self.eval_at(at, wi);
-        (e.pdf > 0.0).then_some(BsdfSample {
-            wi,
-            f: e.f,
-            pdf: e.pdf,
-        })
+        (wi, p)
     }
 }
 

@@ -39,6 +39,15 @@ pub struct BsdfSample {
     pub pdf: f32,
 }
 
+/// A sampled incident direction with its path weight, for a path that needs no pdf.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WeightedSample {
+    pub wi: Vec3,
+    /// An unbiased estimate of `f * |wi.z| / pdf`: its expectation over the samples is
+    /// the BSDF's albedo, as the exact ratio's is.
+    pub weight: Vec3,
+}
+
 /// A BSDF at one shading point, its outgoing direction (and, for hair, h) fixed: what a
 /// path vertex evaluates toward lights and samples to go on, in the local frame.
 pub trait LocalBsdf {
@@ -47,4 +56,14 @@ pub trait LocalBsdf {
     /// A direction drawn from `u` in [0, 1)^3 (`u[0]` picks among lobes where there are
     /// several); None where the density is zero.
     fn sample(&self, u: [f32; 3]) -> Option<BsdfSample>;
+    /// The direction [`Self::sample`] draws from the same `u`, with a path weight that a
+    /// BSDF of several lobes may take from the lobe that drew it alone, without evaluating
+    /// the others there (cheaper; `eval` still gives the pdf where MIS needs it).
+    fn sample_weight(&self, u: [f32; 3]) -> Option<WeightedSample> {
+        let s = self.sample(u)?;
+        Some(WeightedSample {
+            wi: s.wi,
+            weight: s.f * s.wi.z.abs() / s.pdf,
+        })
+    }
 }

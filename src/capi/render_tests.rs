@@ -169,16 +169,24 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
         bits(&rgb)
     };
     let exact_rgb = c_image(exact);
-    for (deep_bounce_depth, lobe_cull) in [(6, 0.0), (1, 0.0), (0, 0.2)] {
+    let default_threshold = PathSettings::default().light_threshold;
+    for (deep_bounce_depth, lobe_cull, light_threshold) in [
+        (6, 0.0, default_threshold),
+        (1, 0.0, default_threshold),
+        (0, 0.2, default_threshold),
+        (6, 0.0, 0.0),
+    ] {
         let knob = HtRenderSettings {
             deep_bounce_depth,
             lobe_cull,
+            light_threshold,
             ..exact
         };
         let path = PathSettings {
             max_depth: 6,
             deep_bounce_depth: (deep_bounce_depth > 0).then_some(deep_bounce_depth),
             lobe_cull,
+            light_threshold,
             ..PathSettings::default()
         };
         let rust_knob = RenderSettings { path, ..rust };
@@ -187,12 +195,12 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
         assert_eq!(
             got,
             bits(out.film.rgb()),
-            "{deep_bounce_depth}, {lobe_cull}"
+            "{deep_bounce_depth}, {lobe_cull}, {light_threshold}"
         );
         assert_eq!(
             got == exact_rgb,
-            deep_bounce_depth == 6,
-            "{deep_bounce_depth}, {lobe_cull}"
+            deep_bounce_depth == 6 && light_threshold == default_threshold,
+            "{deep_bounce_depth}, {lobe_cull}, {light_threshold}"
         );
     }
 }
@@ -518,6 +526,17 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             INVALID,
             "lobe_cull = 1",
         );
+        for bad in [-0.5, f32::NAN, f32::INFINITY] {
+            let threshold = HtRenderSettings {
+                light_threshold: bad,
+                ..s
+            };
+            fails(
+                ht_render(h.scene, &threshold, ptr, len),
+                INVALID,
+                "light_threshold",
+            );
+        }
         let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
             let n = null_mut();
             ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)

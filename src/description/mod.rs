@@ -19,6 +19,7 @@
 //! clamp_indirect = 10.0    # absent: no clamping
 //! deep_bounce_depth = 4    # hair past 4 events: one merged lobe (absent: exact throughout)
 //! lobe_cull = 0.01         # drop hair lobes below 1% of the attenuation (default 0: none)
+//! light_threshold = 0.03   # shadow-ray roulette below this contribution (default; 0: every ray)
 //! crop = [0, 0, 320, 240]  # [x0, y0, x1, y1) of the full frame
 //! filter = "tent"          # or "box" (one pixel)
 //! filter_radius = 1.0      # the tent's half-width in pixels
@@ -160,6 +161,8 @@ pub struct RenderDesc {
     pub deep_bounce_depth: Option<u32>,
     /// Hair lobes below this fraction of the attenuation are dropped; 0: none.
     pub lobe_cull: f32,
+    /// Shadow-ray roulette below this contribution; 0: every shadow ray.
+    pub light_threshold: f32,
     pub crop: Option<[u32; 4]>,
     /// "tent" (the default) or "box".
     pub filter: String,
@@ -183,6 +186,7 @@ impl Default for RenderDesc {
             clamp_indirect: s.path.clamp_indirect,
             deep_bounce_depth: s.path.deep_bounce_depth,
             lobe_cull: s.path.lobe_cull,
+            light_threshold: s.path.light_threshold,
             crop: s.crop,
             filter: s.filter.name().0.to_string(),
             filter_radius: None,
@@ -214,6 +218,7 @@ impl RenderDesc {
                 clamp_indirect: self.clamp_indirect,
                 deep_bounce_depth: self.deep_bounce_depth,
                 lobe_cull: self.lobe_cull,
+                light_threshold: self.light_threshold,
                 ..PathSettings::default()
             },
         };

@@ -17,7 +17,7 @@ use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
 use crate::math::{Frame, luminance};
 use crate::scene::hit::{HairHit, Hit, SurfaceHit};
-use crate::scene::light::Light;
+use crate::scene::light::{Light, LightEval};
 use crate::scene::material::Material;
 use crate::scene::tracer::{SpawnedRay, Tracer};
 use crate::validate::positive;
@@ -107,7 +107,20 @@ pub struct PathSettings {
     /// Hair lobes whose attenuation is below this fraction of the total are dropped
     /// ([`Lobes::Culled`]); 0 = off, the default. In [0, 1).
     pub lobe_cull: f32,
+    /// Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
+    /// (path throughput included, largest channel) is below this value has its shadow ray
+    /// traced with probability contribution / threshold, and is reweighted by the inverse:
+    /// unbiased, and most of the shadow rays of hair carry almost nothing (narrow lobes,
+    /// dim deep paths). In the image's units; 0 traces every shadow ray. The default was
+    /// chosen on the bench scenes (README, "Render efficiency").
+    pub light_threshold: f32,
 }
+
+/// The least probability with which shadow-ray roulette traces a shadow ray.
+const MIN_SHADOW_SURVIVAL: f32 = 1.0 / 1_048_576.0;
+
+/// [`PathSettings::light_threshold`]'s default.
+pub const DEFAULT_LIGHT_THRESHOLD: f32 = 0.03;
 
 impl Default for PathSettings {
     fn default() -> Self {
@@ -119,6 +132,7 @@ impl Default for PathSettings {
             strategy: Strategy::Mis,
             deep_bounce_depth: None,
             lobe_cull: 0.0,
+            light_threshold: DEFAULT_LIGHT_THRESHOLD,
         }
     }
 }
@@ -144,6 +158,12 @@ impl PathSettings {
                     self.max_depth
                 ));
             }
+        }
+        if !(self.light_threshold.is_finite() && self.light_threshold >= 0.0) {
+            return Err(invalid_arg!(
+                "light_threshold = {}: must be finite and >= 0 (0: every shadow ray)",
+                self.light_threshold
+            ));
         }
         if !(0.0..1.0).contains(&self.lobe_cull) {
             return Err(invalid_arg!(
@@ -251,16 +271,15 @@ impl World {
             ray: Ray::new(org, dir),
             exclude: None,
         };
-        // The BSDF pdf of the direction that produced `ray`, for MIS on the emission it
-        // finds; None for camera rays, which see emission with full weight.
-        let mut bsdf_pdf: Option<f32> = None;
+        // How `ray` was made, for MIS on the emission it finds.
+        let mut came = Came::Camera;
         // `events` scattering events precede the ray traced in this iteration.
         for events in 0..=settings.max_depth {
             let hit = self.tracer.intersect_spawned(&ray);
             rays += 1;
             let t_hit = hit.as_ref().map_or(f32::INFINITY, Hit::t);
             let contribution =
-                self.emission(ray.ray.org, ray.ray.dir, t_hit, bsdf_pdf, settings.strategy);
+                self.emission(ray.ray.org, ray.ray.dir, t_hit, came, settings.strategy);
             l += clamp(beta * contribution, events, settings);
             let Some(hit) = hit else { break };
             if events == 0 && aovs {
@@ -274,13 +293,17 @@ impl World {
             // the light's are skipped when no light is sampled.
             let sample_light =
                 settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some();
-            let [lx, ly, choice, _] = if sample_light {
+            let [lx, ly, choice, u_shadow] = if sample_light {
                 sampler.next_4d()
             } else {
                 sampler.skip();
                 [0.0; 4]
             };
-            let u_light = [lx, ly];
+            let u_light = LightU {
+                choice,
+                point: [lx, ly],
+                roulette: u_shadow,
+            };
             // The direction takes the best stratified pair, the lobe and roulette the rest.
             let [dx, dy, u_lobe, u_rr] = sampler.next_4d();
             // A varied hair material builds its BSDF per hit; the shading point borrows it.
@@ -294,16 +317,14 @@ impl World {
                 _ => break,
             };
             if sample_light {
-                let (direct, shadow_rays) =
-                    self.direct(&hit, &shading, choice, u_light, settings.strategy);
+                let (direct, shadow_rays) = self.direct(&hit, &shading, beta, u_light, settings);
                 rays += shadow_rays;
-                l += clamp(beta * direct, events + 1, settings);
+                l += clamp(direct, events + 1, settings);
             }
-            let Some((wi, weight, pdf)) = shading.sample([u_lobe, dx, dy]) else {
+            let Some(s) = shading.sample([u_lobe, dx, dy]) else {
                 break;
             };
-            beta *= weight;
-            bsdf_pdf = Some(pdf);
+            beta *= s.weight;
             if events + 1 >= settings.rr_depth {
                 let survive = settings.roulette.survival(beta);
                 if u_rr >= survive {
@@ -311,7 +332,14 @@ impl World {
                 }
                 beta /= survive;
             }
-            ray = self.tracer.spawn(&hit, wi, f32::INFINITY);
+            ray = self.tracer.spawn(&hit, s.wi, f32::INFINITY);
+            // The BSDF's pdf costs a whole evaluation of its lobes: it is computed only
+            // for a ray that may find a light next-event estimation also samples.
+            let mis = settings.strategy == Strategy::Mis
+                && self.sampled_light_along(ray.ray.org, ray.ray.dir);
+            came = Came::Bsdf {
+                pdf: mis.then(|| shading.pdf(s.local)),
+            };
         }
         (l, first, rays)
     }
@@ -336,39 +364,38 @@ impl World {
     }
 
     /// Emission met by a ray: lights at infinity when it escapes, rect lights nearer than
-    /// its hit. `bsdf_pdf` is None for camera rays (full weight).
-    fn emission(
-        &self,
-        org: Vec3,
-        dir: Vec3,
-        t_hit: f32,
-        bsdf_pdf: Option<f32>,
-        strategy: Strategy,
-    ) -> Vec3 {
+    /// its hit.
+    fn emission(&self, org: Vec3, dir: Vec3, t_hit: f32, came: Came, strategy: Strategy) -> Vec3 {
         let dir_n = dir.normalize();
         let mut sum = Vec3::ZERO;
         for (i, light) in self.lights.iter().enumerate() {
-            // Lights at infinity are met by rays that escape; a rect by one that reaches it
-            // before any geometry.
-            let reached = if light.is_infinite() {
-                t_hit == f32::INFINITY
-            } else {
-                light.intersect(org, dir).is_some_and(|t| t < t_hit)
-            };
-            let Some(e) = reached.then(|| light.eval_li(org, dir_n)).flatten() else {
+            let Some(e) = emitted(light, org, dir, dir_n, t_hit) else {
                 continue;
             };
             // A light never chosen for next-event estimation is found only this way.
             let light_pdf = self.choice_pdf(i) * e.pdf;
-            let weight = match (bsdf_pdf, strategy) {
-                (None, _) | (Some(_), Strategy::BsdfOnly) => 1.0,
-                (Some(_), _) if light_pdf == 0.0 => 1.0,
-                (Some(_), Strategy::LightOnly) => 0.0,
-                (Some(pdf), Strategy::Mis) => power_heuristic(1.0, pdf, 1.0, light_pdf),
+            let weight = match (came, strategy) {
+                (Came::Camera, _) | (_, Strategy::BsdfOnly) => 1.0,
+                _ if light_pdf == 0.0 => 1.0,
+                (_, Strategy::LightOnly) => 0.0,
+                // `sampled_light_along` saw this light, so the pdf is there.
+                (Came::Bsdf { pdf }, Strategy::Mis) => {
+                    pdf.map_or(1.0, |pdf| power_heuristic(1.0, pdf, 1.0, light_pdf))
+                }
             };
             sum += e.radiance * weight;
         }
         sum
+    }
+
+    /// Whether the ray (org, dir) may meet, at any distance, a light that next-event
+    /// estimation samples: the cases where [`Self::emission`] needs the BSDF's pdf.
+    fn sampled_light_along(&self, org: Vec3, dir: Vec3) -> bool {
+        let dir_n = dir.normalize();
+        self.lights.iter().enumerate().any(|(i, light)| {
+            self.choice_pdf(i) > 0.0
+                && emitted(light, org, dir, dir_n, f32::INFINITY).is_some_and(|e| e.pdf > 0.0)
+        })
     }
 
     fn choice_pdf(&self, light: usize) -> f32 {
@@ -376,24 +403,25 @@ impl World {
     }
 
     /// Next-event estimation: one light, chosen by power, one direction toward it.
-    /// Returns the contribution and the number of shadow rays traced (0 or 1).
+    /// Returns the contribution to the pixel of the path of throughput `beta`, and the
+    /// number of shadow rays traced (0 or 1).
     fn direct(
         &self,
         hit: &Hit,
         shading: &Shading,
-        u_choice: f32,
-        u: [f32; 2],
-        strategy: Strategy,
+        beta: Vec3,
+        u: LightU,
+        settings: &PathSettings,
     ) -> (Vec3, u32) {
         let none = (Vec3::ZERO, 0);
         let Some(choice) = &self.light_choice else {
             return none;
         };
-        let (_, _, index) = choice.sample(u_choice);
+        let (_, _, index) = choice.sample(u.choice);
         let (Some(light), choice_pdf) = (self.lights.get(index), self.choice_pdf(index)) else {
             return none;
         };
-        let Some(ls) = light.sample_li(hit.p(), u) else {
+        let Some(ls) = light.sample_li(hit.p(), u.point) else {
             return none;
         };
         if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.radiance == Vec3::ZERO {
@@ -402,6 +430,27 @@ impl World {
         let (f_cos, bsdf_pdf) = shading.eval(ls.wi);
         if f_cos == Vec3::ZERO {
             return none;
+        }
+        let light_pdf = ls.pdf * choice_pdf;
+        let weight = if ls.is_delta || settings.strategy == Strategy::LightOnly {
+            1.0
+        } else {
+            power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
+        };
+        let mut contribution = beta * f_cos * ls.radiance * (weight / light_pdf);
+        let largest = contribution.max_element();
+        // A degenerate (NaN) contribution traces nothing, as a zero one.
+        if largest.is_nan() || largest <= 0.0 {
+            return none;
+        }
+        if largest < settings.light_threshold {
+            // A survivor's largest channel becomes the threshold: no fireflies. The floor
+            // keeps the survival probability one that `u` (a multiple of 2^-24) can draw.
+            let survive = (largest / settings.light_threshold).max(MIN_SHADOW_SURVIVAL);
+            if u.roulette >= survive {
+                return none;
+            }
+            contribution /= survive;
         }
         let tfar = if ls.distance.is_finite() {
             ls.distance * (1.0 - 1e-4)
@@ -414,14 +463,44 @@ impl World {
         {
             return (Vec3::ZERO, 1);
         }
-        let light_pdf = ls.pdf * choice_pdf;
-        let weight = if ls.is_delta || strategy == Strategy::LightOnly {
-            1.0
-        } else {
-            power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
-        };
-        (f_cos * ls.radiance * (weight / light_pdf), 1)
+        (contribution, 1)
     }
+}
+
+/// The numbers of one light sample: which light, where on it, and the shadow-ray
+/// roulette.
+struct LightU {
+    choice: f32,
+    point: [f32; 2],
+    roulette: f32,
+}
+
+/// How the ray a path traces was made.
+#[derive(Debug, Clone, Copy)]
+enum Came {
+    /// From the camera: emission is seen with full weight.
+    Camera,
+    /// By BSDF sampling. `pdf` is its density, for MIS, where the ray may meet a light
+    /// that next-event estimation samples; None elsewhere.
+    Bsdf { pdf: Option<f32> },
+}
+
+/// What `light` emits toward `org` along (dir, its unit dir_n) if the ray reaches it: a
+/// light at infinity when the ray's hit is at infinity, a rect when it is nearer.
+fn emitted(light: &Light, org: Vec3, dir: Vec3, dir_n: Vec3, t_hit: f32) -> Option<LightEval> {
+    let reached = if light.is_infinite() {
+        t_hit == f32::INFINITY
+    } else {
+        light.intersect(org, dir).is_some_and(|t| t < t_hit)
+    };
+    reached.then(|| light.eval_li(org, dir_n)).flatten()
+}
+
+/// A direction drawn at a vertex: in world and local frames, with its path weight.
+struct VertexSample {
+    wi: Vec3,
+    local: Vec3,
+    weight: Vec3,
 }
 
 /// A BSDF at a path vertex with its local frame: world directions go through the frame
@@ -468,10 +547,19 @@ impl<'a> Shading<'a> {
         (e.f * local.z.abs(), e.pdf)
     }
 
-    /// A world direction, its path weight f |cos| / pdf and its pdf.
-    fn sample(&self, u: [f32; 3]) -> Option<(Vec3, Vec3, f32)> {
-        let s = self.local().sample(u)?;
-        Some((self.frame.to_world(s.wi), s.f * s.wi.z.abs() / s.pdf, s.pdf))
+    /// A direction and its path weight ([`LocalBsdf::sample_weight`]).
+    fn sample(&self, u: [f32; 3]) -> Option<VertexSample> {
+        let s = self.local().sample_weight(u)?;
+        Some(VertexSample {
+            wi: self.frame.to_world(s.wi),
+            local: s.wi,
+            weight: s.weight,
+        })
+    }
+
+    /// The BSDF pdf of the local direction `local`.
+    fn pdf(&self, local: Vec3) -> f32 {
+        self.local().eval(local).pdf
     }
 }
 

@@ -401,13 +401,17 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
         PixelFilter::tent(2.0).unwrap()
     );
     let d = parse(&format!(
-        "[render]\ndeep_bounce_depth = 3\nlobe_cull = 0.05\n{BASE}"
+        "[render]\ndeep_bounce_depth = 3\nlobe_cull = 0.05\nlight_threshold = 0\n{BASE}"
     ))
     .unwrap();
     let s = d.render.settings().unwrap();
     assert_eq!(
-        (s.path.deep_bounce_depth, s.path.lobe_cull),
-        (Some(3), 0.05)
+        (
+            s.path.deep_bounce_depth,
+            s.path.lobe_cull,
+            s.path.light_threshold
+        ),
+        (Some(3), 0.05, 0.0)
     );
     // The defaults: a tent of one pixel, roulette on sqrt(throughput) after two events,
     // the exact hair BSDF at every event.
@@ -418,6 +422,7 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
         (Roulette::SqrtThroughput, 2)
     );
     assert_eq!((s.path.deep_bounce_depth, s.path.lobe_cull), (None, 0.0));
+    assert_eq!(s.path.light_threshold, 0.03);
 
     for (keys, expect) in [
         (
@@ -443,6 +448,7 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
             &["render", "deep_bounce_depth = 5", "max_depth = 4"],
         ),
         ("lobe_cull = 1.5", &["render", "lobe_cull = 1.5"]),
+        ("light_threshold = -1", &["render", "light_threshold = -1"]),
     ] {
         let e = build_error(&format!("[render]\n{keys}\n{BASE}")).to_string();
         assert_contains(&e, expect);

@@ -121,61 +121,101 @@ fn mis_agrees_with_light_and_bsdf_sampling() {
 
 fn strategies_agree(max_depth: u32) {
     let world = lit_world();
-    const SEEDS: u64 = 64;
-    let quadrant_means = |strategy: Strategy| -> Vec<(f64, f64)> {
-        let per_seed: Vec<[f64; 4]> = (0..SEEDS)
-            .map(|seed| {
-                let path = PathSettings {
-                    strategy,
-                    max_depth,
-                    ..PathSettings::default()
-                };
-                let settings = RenderSettings {
-                    width: 24,
-                    height: 24,
-                    spp: 8,
-                    seed,
-                    path,
-                    ..RenderSettings::default()
-                };
-                let out =
-                    render(&world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
-                let rgb = out.film.rgb();
-                let mut q = [0.0f64; 4];
-                for y in 0..24 {
-                    for x in 0..24 {
-                        let i = 3 * (y * 24 + x);
-                        q[(y / 12) * 2 + x / 12] +=
-                            f64::from(rgb[i] + rgb[i + 1] + rgb[i + 2]) / (3.0 * 144.0);
-                    }
-                }
-                q
-            })
-            .collect();
-        (0..4)
-            .map(|k| {
-                let m = per_seed.iter().map(|q| q[k]).sum::<f64>() / SEEDS as f64;
-                let var =
-                    per_seed.iter().map(|q| (q[k] - m).powi(2)).sum::<f64>() / (SEEDS - 1) as f64;
-                (m, (var / SEEDS as f64).sqrt())
-            })
-            .collect()
+    let means = |strategy| {
+        quadrant_means(
+            &world,
+            PathSettings {
+                strategy,
+                max_depth,
+                ..PathSettings::default()
+            },
+        )
     };
-    let mis = quadrant_means(Strategy::Mis);
+    let mis = means(Strategy::Mis);
     for other in [Strategy::LightOnly, Strategy::BsdfOnly] {
-        let o = quadrant_means(other);
-        for k in 0..4 {
-            let ((a, sa), (b, sb)) = (mis[k], o[k]);
-            let bound = 4.0 * (sa * sa + sb * sb).sqrt() + 1e-4;
-            println!(
-                "depth {max_depth}, quadrant {k}: MIS {a:.4} ± {sa:.4}, {other:?} {b:.4} ± {sb:.4}"
-            );
-            assert!(
-                (a - b).abs() < bound,
-                "depth {max_depth}, quadrant {k}: MIS {a} vs {other:?} {b} (bound {bound})"
-            );
-        }
+        let label = format!("depth {max_depth}, MIS vs {other:?}");
+        assert_quadrants_agree(&label, &mis, &means(other));
     }
+}
+
+/// Mean and standard error of each image quadrant's mean over 64 seeds of a 24 x 24,
+/// 8-spp render, and the rays per camera sample.
+fn quadrant_means(world: &World, path: PathSettings) -> (Vec<(f64, f64)>, f64) {
+    const SEEDS: u64 = 64;
+    let mut rays = 0.0;
+    let per_seed: Vec<[f64; 4]> = (0..SEEDS)
+        .map(|seed| {
+            let settings = RenderSettings {
+                width: 24,
+                height: 24,
+                spp: 8,
+                seed,
+                path,
+                ..RenderSettings::default()
+            };
+            let out = render(world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
+            rays += out.stats.rays as f64 / out.stats.samples as f64 / SEEDS as f64;
+            let rgb = out.film.rgb();
+            let mut q = [0.0f64; 4];
+            for y in 0..24 {
+                for x in 0..24 {
+                    let i = 3 * (y * 24 + x);
+                    q[(y / 12) * 2 + x / 12] +=
+                        f64::from(rgb[i] + rgb[i + 1] + rgb[i + 2]) / (3.0 * 144.0);
+                }
+            }
+            q
+        })
+        .collect();
+    let quadrants = (0..4)
+        .map(|k| {
+            let m = per_seed.iter().map(|q| q[k]).sum::<f64>() / SEEDS as f64;
+            let var = per_seed.iter().map(|q| (q[k] - m).powi(2)).sum::<f64>() / (SEEDS - 1) as f64;
+            (m, (var / SEEDS as f64).sqrt())
+        })
+        .collect();
+    (quadrants, rays)
+}
+
+/// Each quadrant's means agree within 4 standard errors.
+fn assert_quadrants_agree(label: &str, a: &(Vec<(f64, f64)>, f64), b: &(Vec<(f64, f64)>, f64)) {
+    for k in 0..4 {
+        let ((ma, sa), (mb, sb)) = (a.0[k], b.0[k]);
+        let bound = 4.0 * (sa * sa + sb * sb).sqrt() + 1e-4;
+        println!("{label}, quadrant {k}: {ma:.4} ± {sa:.4} vs {mb:.4} ± {sb:.4}");
+        assert!(
+            (ma - mb).abs() < bound,
+            "{label}, quadrant {k}: {ma} vs {mb} (bound {bound})"
+        );
+    }
+}
+
+/// Shadow-ray roulette is unbiased: with every shadow ray traced (threshold 0), at the
+/// default threshold and at a threshold of 1 (above nearly every contribution: most
+/// shadow rays then live by roulette), the lit fur ball renders to the same image within
+/// the noise, with fewer rays each time.
+#[test]
+fn shadow_ray_roulette_keeps_the_image_and_saves_rays() {
+    let world = lit_world();
+    let at = |light_threshold| {
+        quadrant_means(
+            &world,
+            PathSettings {
+                light_threshold,
+                ..PathSettings::default()
+            },
+        )
+    };
+    let every = at(0.0);
+    let default = at(PathSettings::default().light_threshold);
+    let all_roulette = at(1.0);
+    println!(
+        "rays per sample: {:.3} (every shadow ray), {:.3} (default), {:.3} (all by roulette)",
+        every.1, default.1, all_roulette.1
+    );
+    assert_quadrants_agree("threshold 0 vs default", &every, &default);
+    assert_quadrants_agree("threshold 0 vs 1", &every, &all_roulette);
+    assert!(every.1 > default.1 && default.1 > all_roulette.1);
 }
 
 /// The 24 x 24 RGB image of `world` at `spp` samples, with these path settings.

@@ -69,6 +69,16 @@ impl Roulette {
         }
     }
 
+    /// The probability that a path goes on when it is decided at a hit, before the
+    /// vertex is shaded (where no light is sampled: `World::radiance`): the square of
+    /// [`Self::survival`], which also stands in for the attenuation of the vertex it has
+    /// not seen. Measured on the uniform-sky fur ball: as many rays and the same error as
+    /// the rule after the vertex, in 9% less time (README, "Render efficiency").
+    pub fn survival_at_hit(self, beta: Vec3) -> f32 {
+        let s = self.survival(beta);
+        s * s
+    }
+
     /// The probability that a path with throughput `beta` goes on.
     pub fn survival(self, beta: Vec3) -> f32 {
         let m = beta.max_element();
@@ -91,7 +101,9 @@ pub struct PathSettings {
     /// Russian roulette may end a path after this many events (1: after the first).
     /// The default, 2, always traces the ray that leaves the first hit: on the bench
     /// scenes that is 1.2-1.25x more efficient than 1 and than 3 (README, "Render
-    /// efficiency"), because the first bounce carries most of the image's light.
+    /// efficiency"), because the first bounce carries most of the image's light. Where
+    /// no light is sampled, roulette decides at the hits after the first instead, before
+    /// they are shaded ([`Roulette::survival_at_hit`]): 1 then acts as 2.
     pub rr_depth: u32,
     pub roulette: Roulette,
     /// Upper bound on the luminance of any one contribution of indirect light (two or
@@ -274,14 +286,38 @@ impl World {
         // How `ray` was made, for MIS on the emission it finds.
         let mut came = Came::Camera;
         // `events` scattering events precede the ray traced in this iteration.
+        let sample_light = settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some();
+        // Without next-event estimation a vertex's only product is the path's continuation,
+        // so roulette decides at the hit, before the hit record and the BSDF are built.
+        let roulette_at_hit = !sample_light;
         for events in 0..=settings.max_depth {
-            let hit = self.tracer.intersect_spawned(&ray);
+            let found = self.tracer.find_spawned(&ray);
             rays += 1;
-            let t_hit = hit.as_ref().map_or(f32::INFINITY, Hit::t);
+            let t_hit = found.as_ref().map_or(f32::INFINITY, |h| h.t);
             let contribution =
                 self.emission(ray.ray.org, ray.ray.dir, t_hit, came, settings.strategy);
             l += clamp(beta * contribution, events, settings);
-            let Some(hit) = hit else { break };
+            let Some(found) = found else { break };
+            // A fixed number of requests per bounce keeps the sample sequence aligned;
+            // the light's are skipped when no light is sampled.
+            let [lx, ly, choice, u_shadow] = if sample_light {
+                sampler.next_4d()
+            } else {
+                sampler.skip();
+                [0.0; 4]
+            };
+            // The direction takes the best stratified pair, the lobe and roulette the rest.
+            let [dx, dy, u_lobe, u_rr] = sampler.next_4d();
+            if roulette_at_hit && events > 0 && events + 1 >= settings.rr_depth {
+                let survive = settings.roulette.survival_at_hit(beta);
+                if u_rr >= survive {
+                    break;
+                }
+                beta /= survive;
+            }
+            let Some(hit) = self.tracer.record_spawned(&ray, &found) else {
+                break;
+            };
             if events == 0 && aovs {
                 first = Some(self.first_hit(&hit));
             }
@@ -289,23 +325,11 @@ impl World {
                 break;
             }
             let wo_world = -ray.ray.dir.normalize();
-            // A fixed number of requests per bounce keeps the sample sequence aligned;
-            // the light's are skipped when no light is sampled.
-            let sample_light =
-                settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some();
-            let [lx, ly, choice, u_shadow] = if sample_light {
-                sampler.next_4d()
-            } else {
-                sampler.skip();
-                [0.0; 4]
-            };
             let u_light = LightU {
                 choice,
                 point: [lx, ly],
                 roulette: u_shadow,
             };
-            // The direction takes the best stratified pair, the lobe and roulette the rest.
-            let [dx, dy, u_lobe, u_rr] = sampler.next_4d();
             // A varied hair material builds its BSDF per hit; the shading point borrows it.
             let varied_bsdf;
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
@@ -325,7 +349,7 @@ impl World {
                 break;
             };
             beta *= s.weight;
-            if events + 1 >= settings.rr_depth {
+            if !roulette_at_hit && events + 1 >= settings.rr_depth {
                 let survive = settings.roulette.survival(beta);
                 if u_rr >= survive {
                     break;

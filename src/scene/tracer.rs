@@ -233,8 +233,19 @@ impl Tracer {
     }
 
     pub fn intersect_spawned(&self, s: &SpawnedRay) -> Option<Hit> {
-        let hit = self.scene.intersect(&s.ray, s.exclude.as_ref())?;
-        self.record(&s.ray, &hit)
+        let hit = self.find_spawned(s)?;
+        self.record_spawned(s, &hit)
+    }
+
+    /// The closest hit of `s` as Embree reports it: a path may end there, by roulette,
+    /// without paying for the hit record.
+    pub fn find_spawned(&self, s: &SpawnedRay) -> Option<RayHit> {
+        self.scene.intersect(&s.ray, s.exclude.as_ref())
+    }
+
+    /// The full hit record of `hit`, which `find_spawned(s)` returned.
+    pub fn record_spawned(&self, s: &SpawnedRay, hit: &RayHit) -> Option<Hit> {
+        self.record(&s.ray, hit)
     }
 
     pub fn occluded_spawned(&self, s: &SpawnedRay) -> bool {

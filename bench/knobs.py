@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
-"""What the hair fidelity knobs (deep_bounce_depth, lobe_cull) cost and buy on the bench
-scenes, measured with the CLI: for each scene, a reference of the exact settings at 8x
-the scene's spp (a seed no timed render uses), then REPEATS rounds in which every
+"""What the hair fidelity knobs (deep_bounce_depth, lobe_cull) and the shadow-ray
+roulette's light_threshold cost and buy on the bench scenes, measured with the CLI: for
+each scene, a reference of the exact settings at 8x the scene's spp (a seed no timed render uses), then REPEATS rounds in which every
 variant renders the scene as written at its spp (seed = round), the variants
 interleaved so that a load change on a shared machine touches them alike. Prints a
 Markdown table of medians: path-tracing seconds, the process's CPU time relative to the
@@ -39,6 +39,10 @@ VARIANTS = {
     "deep_bounce_depth 16": ["--deep-bounce-depth", "16"],
     "lobe_cull 0.01": ["--lobe-cull", "0.01"],
     "lobe_cull 0.1": ["--lobe-cull", "0.1"],
+    # The shadow-ray roulette around its default (0.03): unbiased, so only speed and noise.
+    "light_threshold 0": ["--light-threshold", "0"],
+    "light_threshold 0.01": ["--light-threshold", "0.01"],
+    "light_threshold 0.1": ["--light-threshold", "0.1"],
 }
 REFERENCE_SEED = "1000003"
 

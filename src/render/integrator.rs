@@ -390,10 +390,9 @@ impl World {
     /// Emission met by a ray: lights at infinity when it escapes, rect lights nearer than
     /// its hit.
     fn emission(&self, org: Vec3, dir: Vec3, t_hit: f32, came: Came, strategy: Strategy) -> Vec3 {
-        let dir_n = dir.normalize();
         let mut sum = Vec3::ZERO;
         for (i, light) in self.lights.iter().enumerate() {
-            let Some(e) = emitted(light, org, dir, dir_n, t_hit) else {
+            let Some(e) = emitted(light, org, dir, t_hit) else {
                 continue;
             };
             // A light never chosen for next-event estimation is found only this way.
@@ -415,11 +414,11 @@ impl World {
     /// Whether the ray (org, dir) may meet, at any distance, a light that next-event
     /// estimation samples: the cases where [`Self::emission`] needs the BSDF's pdf.
     fn sampled_light_along(&self, org: Vec3, dir: Vec3) -> bool {
-        let dir_n = dir.normalize();
-        self.lights.iter().enumerate().any(|(i, light)| {
-            self.choice_pdf(i) > 0.0
-                && emitted(light, org, dir, dir_n, f32::INFINITY).is_some_and(|e| e.pdf > 0.0)
-        })
+        self.light_choice.is_some()
+            && self.lights.iter().enumerate().any(|(i, light)| {
+                self.choice_pdf(i) > 0.0
+                    && emitted(light, org, dir, f32::INFINITY).is_some_and(|e| e.pdf > 0.0)
+            })
     }
 
     fn choice_pdf(&self, light: usize) -> f32 {
@@ -509,15 +508,15 @@ enum Came {
     Bsdf { pdf: Option<f32> },
 }
 
-/// What `light` emits toward `org` along (dir, its unit dir_n) if the ray reaches it: a
-/// light at infinity when the ray's hit is at infinity, a rect when it is nearer.
-fn emitted(light: &Light, org: Vec3, dir: Vec3, dir_n: Vec3, t_hit: f32) -> Option<LightEval> {
+/// What `light` emits toward `org` along `dir` if the ray reaches it: a light at infinity
+/// when the ray's hit is at infinity, a rect when it is nearer.
+fn emitted(light: &Light, org: Vec3, dir: Vec3, t_hit: f32) -> Option<LightEval> {
     let reached = if light.is_infinite() {
         t_hit == f32::INFINITY
     } else {
         light.intersect(org, dir).is_some_and(|t| t < t_hit)
     };
-    reached.then(|| light.eval_li(org, dir_n)).flatten()
+    reached.then(|| light.eval_li(org, dir.normalize())).flatten()
 }
 
 /// A direction drawn at a vertex: in world and local frames, with its path weight.

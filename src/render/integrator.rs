@@ -516,7 +516,9 @@ fn emitted(light: &Light, org: Vec3, dir: Vec3, t_hit: f32) -> Option<LightEval>
     } else {
         light.intersect(org, dir).is_some_and(|t| t < t_hit)
     };
-    reached.then(|| light.eval_li(org, dir.normalize())).flatten()
+    reached
+        .then(|| light.eval_li(org, dir.normalize()))
+        .flatten()
 }
 
 /// A direction drawn at a vertex: in world and local frames, with its path weight.

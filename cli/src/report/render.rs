@@ -61,7 +61,9 @@ const KNOBS: &[Knob] = &[
     }),
     knob("lobe_cull 0.01", |v| render(v, |r| r.lobe_cull = 0.01)),
     knob("lobe_cull 0.1", |v| render(v, |r| r.lobe_cull = 0.1)),
-    knob("light_threshold 0", |v| render(v, |r| r.light_threshold = 0.0)),
+    knob("light_threshold 0", |v| {
+        render(v, |r| r.light_threshold = 0.0)
+    }),
 ];
 
 /// An edit of the `[render]` settings.

@@ -41,6 +41,9 @@ pub struct Curves {
     vertices: SharedBuffer<[f32; 4]>,
     indices: SharedBuffer<u32>,
     strands: StrandIndex,
+    /// Linear curves laid over a Catmull-Rom control-point buffer
+    /// ([`Curves::catmull_rom_polyline`]): their hits take the Catmull-Rom tangent.
+    catmull_rom_tangents: bool,
 }
 
 /// Where a primitive sits in its strand.
@@ -245,6 +248,7 @@ impl Curves {
             vertices: SharedBuffer::new(vertices),
             indices: SharedBuffer::new(indices),
             strands: strand_index,
+            catmull_rom_tangents: false,
         })
     }
 
@@ -302,6 +306,7 @@ impl Curves {
             vertices,
             indices: SharedBuffer::new(indices),
             strands: StrandIndex::new(segments.into_iter(), colors)?,
+            catmull_rom_tangents: false,
         })
     }
 
@@ -353,6 +358,32 @@ impl Curves {
     pub fn with_shape(mut self, shape: CurveShape) -> Self {
         self.shape = shape;
         self
+    }
+
+    /// Catmull-Rom curves as flat linear ribbons through their own points (a Catmull-Rom
+    /// curve passes through them), on the same control-point buffer: segment k's piece
+    /// starts one point later, past the root's phantom. Hits still take the curve's
+    /// tangent ([`Self::catmull_rom_tangents`]), so only the position moves, by the curve's
+    /// distance from its chord. Other bases come back as they are, flat.
+    pub fn catmull_rom_polyline(self) -> Curves {
+        if self.basis != CurveBasis::CatmullRom {
+            return self.with_shape(CurveShape::Flat);
+        }
+        let mut indices = Vec::with_capacity(self.indices().len() + padding_for::<u32>());
+        indices.extend(self.indices().iter().map(|&i| i + 1));
+        Curves {
+            basis: CurveBasis::Linear,
+            shape: CurveShape::Flat,
+            indices: SharedBuffer::new(indices),
+            catmull_rom_tangents: true,
+            ..self
+        }
+    }
+
+    /// Whether these are [`Self::catmull_rom_polyline`]s: segment `prim`, from
+    /// `indices()[prim]`, has the Catmull-Rom control points one before to two after it.
+    pub fn catmull_rom_tangents(&self) -> bool {
+        self.catmull_rom_tangents
     }
 
     pub fn basis(&self) -> CurveBasis {

@@ -8,8 +8,15 @@
 //! a round one. On the bench scenes the ribbons' images differ from the tubes' by under a
 //! third of a bench render's own noise (RMSE at equal samples 2-4% higher; README, "Curve
 //! shapes").
+//!
+//! A thin Catmull-Rom strand whose curve stays within [`POLYLINE_PIXELS`] of a pixel of its polyline
+//! is traced as flat linear ribbons through its own points (a Catmull-Rom curve passes
+//! through them), shaded with the curve's tangent: Embree's flat Catmull-Rom ribbons are
+//! intersected piece by piece as it goes, which costs the demo 1.25x the time.
 
-use crate::embree::CurveShape;
+use glam::Vec3;
+
+use crate::embree::{CurveBasis, CurveShape};
 use crate::error::Result;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -60,25 +67,97 @@ pub fn thin_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bool> 
         .collect()
 }
 
+/// How far, in pixels, a thin Catmull-Rom strand's curve may stray from its polyline for
+/// the polyline to be traced instead ([`straight_strands`]).
+pub const POLYLINE_PIXELS: f32 = 0.05;
+
+/// One flag per strand of Catmull-Rom `curves` (all false for other bases): whether every
+/// segment's curve, at a quarter, half and three quarters of it, lies within
+/// [`POLYLINE_PIXELS`] of a pixel of its chord, seen from `camera`'s eye. (A bent segment
+/// strays most at its middle, an S-shaped one near its quarters.)
+pub fn straight_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bool> {
+    let strands = curves.strands().strand_count();
+    if curves.basis() != CurveBasis::CatmullRom {
+        return vec![false; strands];
+    }
+    let (eye, spread) = (camera.eye(), camera.pixel_spread(height));
+    let xyz = |q: &[f32; 4]| Vec3::new(q[0], q[1], q[2]);
+    (0..strands)
+        .map(|s| {
+            curves.strand_points(s).windows(4).all(|w| {
+                let p = [&w[0], &w[1], &w[2], &w[3]].map(xyz);
+                chord_stray(p) <= POLYLINE_PIXELS * spread * eye.distance(0.5 * (p[1] + p[2]))
+            })
+        })
+        .collect()
+}
+
+/// The largest distance, at u = 1/4, 1/2 and 3/4, between the Catmull-Rom segment of
+/// control points `p` (from p[1] to p[2]) and its chord.
+fn chord_stray([p0, p1, p2, p3]: [Vec3; 4]) -> f32 {
+    [0.25f32, 0.5, 0.75]
+        .map(|u| {
+            let curve = p1
+                + 0.5
+                    * u
+                    * ((p2 - p0)
+                        + u * ((2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3)
+                            + u * (-p0 + 3.0 * p1 - 3.0 * p2 + p3)));
+            curve.distance(p1.lerp(p2, u))
+        })
+        .into_iter()
+        .fold(0.0, f32::max)
+}
+
+/// How one strand of an `auto` groom is traced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Part {
+    Round,
+    Flat,
+    /// A thin Catmull-Rom strand whose curve stays close to its polyline: flat linear
+    /// ribbons through its points ([`Curves::catmull_rom_polyline`]), which Embree traces
+    /// faster than its own flat Catmull-Rom ribbons, with a smaller BVH.
+    Polyline,
+}
+
+impl Part {
+    /// `curves` traced as this part.
+    fn shape(self, curves: Curves) -> Curves {
+        match self {
+            Part::Round => curves.with_shape(CurveShape::Round),
+            Part::Flat => curves.with_shape(CurveShape::Flat),
+            Part::Polyline => curves.catmull_rom_polyline(),
+        }
+    }
+}
+
 /// `curves` (built round) as the geometries an `auto` groom is traced with: its thick
-/// strands round, its thin ones flat ([`thin_strands`]), without a copy when all are one
-/// or the other.
+/// strands round, its thin ones flat ([`thin_strands`]), the thin Catmull-Rom ones that
+/// [`straight_strands`] passes as polylines; without a copy when all are one kind.
 pub fn share_out(curves: Curves, camera: &Camera, height: u32) -> Result<Vec<Curves>> {
     let thin = thin_strands(&curves, camera, height);
-    if thin.iter().all(|&t| t) {
-        return Ok(vec![curves.with_shape(CurveShape::Flat)]);
+    let straight = straight_strands(&curves, camera, height);
+    let parts: Vec<Part> = thin
+        .iter()
+        .zip(&straight)
+        .map(|(&thin, &straight)| match (thin, straight) {
+            (false, _) => Part::Round,
+            (true, false) => Part::Flat,
+            (true, true) => Part::Polyline,
+        })
+        .collect();
+    let first = parts.first().copied().unwrap_or(Part::Flat);
+    if parts.iter().all(|&p| p == first) {
+        return Ok(vec![first.shape(curves)]);
     }
-    if !thin.iter().any(|&t| t) {
-        return Ok(vec![curves.with_shape(CurveShape::Round)]);
+    let mut out = Vec::new();
+    for part in [Part::Round, Part::Flat, Part::Polyline] {
+        let keep: Vec<bool> = parts.iter().map(|&p| p == part).collect();
+        if let Some(subset) = curves.subset(&keep, CurveShape::Round)? {
+            out.push(part.shape(subset));
+        }
     }
-    let thick: Vec<bool> = thin.iter().map(|&t| !t).collect();
-    Ok([
-        curves.subset(&thick, CurveShape::Round)?,
-        curves.subset(&thin, CurveShape::Flat)?,
-    ]
-    .into_iter()
-    .flatten()
-    .collect())
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -130,5 +209,62 @@ mod tests {
         let parts = share_out(near_and_far(), &camera(), 100).unwrap();
         let ids = |p: &Curves| p.strands().locate(0).unwrap().id;
         assert_eq!((ids(&parts[0]), ids(&parts[1])), (0, 1));
+    }
+
+    /// Two thin Catmull-Rom strands at distance 1 from the camera, 0.1 long in 4 segments:
+    /// one straight, one zig-zagging by 0.01 (a tenth of its own length).
+    fn straight_and_bent() -> Curves {
+        let (straight, bent): (Vec<[f32; 4]>, Vec<[f32; 4]>) = (0..5)
+            .map(|i| {
+                let y = 0.025 * i as f32;
+                let x = if i % 2 == 1 { 0.01 } else { 0.0 };
+                ([0.0, y, -1.0, 1e-4], [0.05 + x, y, -1.0, 1e-4])
+            })
+            .unzip();
+        let strands = crate::scene::Strands {
+            points: straight
+                .iter()
+                .chain(&bent)
+                .map(|p| [p[0], p[1], p[2]])
+                .collect(),
+            radii: vec![1e-4; 10],
+            counts: vec![5, 5],
+            colors: None,
+        };
+        Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Round).unwrap()
+    }
+
+    #[test]
+    fn thin_catmull_rom_strands_close_to_their_polyline_are_traced_as_it() {
+        let c = straight_and_bent();
+        // Pixel side at distance 1: 0.536 / height. The bent strand's curve strays up to
+        // about 0.002 from its chords: under 1/20 of a pixel at height 10, far over it
+        // at 500.
+        assert_eq!(straight_strands(&c, &camera(), 10), [true, true]);
+        assert_eq!(straight_strands(&c, &camera(), 500), [true, false]);
+        assert_eq!(
+            straight_strands(&near_and_far(), &camera(), 10),
+            [false, false]
+        );
+        let parts = share_out(c.clone(), &camera(), 500).unwrap();
+        let kinds: Vec<_> = parts
+            .iter()
+            .map(|p| (p.basis(), p.shape(), p.catmull_rom_tangents()))
+            .collect();
+        assert_eq!(
+            kinds,
+            [
+                (CurveBasis::CatmullRom, CurveShape::Flat, false),
+                (CurveBasis::Linear, CurveShape::Flat, true),
+            ]
+        );
+        let ids = |p: &Curves| p.strands().locate(0).unwrap().id;
+        assert_eq!((ids(&parts[0]), ids(&parts[1])), (1, 0));
+        // The polyline runs through the strand's own points.
+        assert_eq!(parts[1].strand_points(0), &c.strand_points(0)[1..6]);
+        // Only thin strands: at height 5000 both are a pixel wide or more.
+        let whole = share_out(c, &camera(), 5000).unwrap();
+        assert_eq!(whole.len(), 1);
+        assert_eq!(whole[0].shape(), CurveShape::Round);
     }
 }

@@ -6,13 +6,24 @@ use std::path::Path;
 use std::sync::Arc;
 
 use hairtrace::description::SceneDescription;
-use hairtrace::embree::{CurveShape, Device, Geometry};
+use hairtrace::embree::{CurveBasis, CurveShape, Device, Geometry};
 use hairtrace::render::renderer::RenderOutput;
 use hairtrace::render::{Aovs, NoProgress};
 
 /// A fur ball of `strands` brown strands with per-strand variation, in a uniform sky,
 /// seen from `distance` at `size` x `size` pixels.
 fn fur_ball(shape: &str, seed: u64, distance: f32, size: u32, spp: u32) -> SceneDescription {
+    fur_ball_of("linear", shape, seed, distance, size, spp)
+}
+
+fn fur_ball_of(
+    basis: &str,
+    shape: &str,
+    seed: u64,
+    distance: f32,
+    size: u32,
+    spp: u32,
+) -> SceneDescription {
     let text = format!(
         r#"
 [render]
@@ -35,7 +46,7 @@ roughness_variation = 0.5
 
 [[groom]]
 procedural = "fur_ball"
-basis = "linear"
+basis = "{basis}"
 shape = "{shape}"
 material = "brown"
 
@@ -62,13 +73,37 @@ fn rmse(a: &[f32], b: &[f32]) -> f64 {
 }
 
 fn curve_shapes(d: &SceneDescription) -> Vec<CurveShape> {
+    curve_kinds(d).into_iter().map(|(_, shape)| shape).collect()
+}
+
+fn curve_kinds(d: &SceneDescription) -> Vec<(CurveBasis, CurveShape)> {
     let built = d.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
     (built.world.tracer.scene().geometries().iter())
         .filter_map(|g| match g {
-            Geometry::Curves(c) => Some(c.shape()),
+            Geometry::Curves(c) => Some((c.basis(), c.shape())),
             _ => None,
         })
         .collect()
+}
+
+/// Renders `groom(shape, seed, spp)` round twice and auto once, and checks that auto differs
+/// from a round render by no more than two round renders differ (their noise alone): a
+/// systematic difference of the ribbons would add to it.
+fn assert_auto_matches_round(groom: impl Fn(&str, u64, u32) -> SceneDescription) {
+    let spp = 256;
+    let reference = render(&groom("round", 1, spp), Aovs::default());
+    let round = render(&groom("round", 2, spp), Aovs::default());
+    let auto = render(&groom("auto", 3, spp), Aovs::default());
+    let noise = rmse(round.film.rgb(), reference.film.rgb());
+    let auto_error = rmse(auto.film.rgb(), reference.film.rgb());
+    // 1.15x leaves room for noise, not for a bias of 0.5 noise.
+    assert!(
+        auto_error < 1.15 * noise,
+        "auto differs from round by {auto_error}, round from round by {noise}"
+    );
+    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
+    let (m_auto, m_ref) = (mean(auto.film.rgb()), mean(reference.film.rgb()));
+    assert!((m_auto - m_ref).abs() < 2e-3 * m_ref, "{m_auto} vs {m_ref}");
 }
 
 #[test]
@@ -78,21 +113,26 @@ fn auto_ribbons_give_the_image_of_round_tubes_within_noise() {
         curve_shapes(&fur_ball("auto", 0, 5.2, 48, 1)),
         [CurveShape::Flat]
     );
-    let spp = 256;
-    let reference = render(&fur_ball("round", 1, 5.2, 48, spp), Aovs::default());
-    let round = render(&fur_ball("round", 2, 5.2, 48, spp), Aovs::default());
-    let auto = render(&fur_ball("auto", 3, 5.2, 48, spp), Aovs::default());
-    let noise = rmse(round.film.rgb(), reference.film.rgb());
-    let auto_error = rmse(auto.film.rgb(), reference.film.rgb());
-    // Two independent round renders differ by their noise alone; a systematic difference of
-    // the ribbons would add to it. 1.15x leaves room for noise, not for a bias of 0.5 noise.
+    assert_auto_matches_round(|shape, seed, spp| fur_ball(shape, seed, 5.2, 48, spp));
+}
+
+/// `auto` traces the thin Catmull-Rom strands that stay within `ribbons::POLYLINE_PIXELS` of a
+/// pixel of their polylines as linear ribbons through their points; the image is the
+/// round Catmull-Rom tubes' within their noise.
+#[test]
+fn auto_catmull_rom_polylines_give_the_image_of_round_tubes_within_noise() {
+    let groom = |shape: &str, seed, spp| fur_ball_of("catmull_rom", shape, seed, 5.2, 48, spp);
+    // Every strand is a ribbon, most of them polylines (the most bent stay Catmull-Rom).
+    let kinds = curve_kinds(&groom("auto", 0, 1));
     assert!(
-        auto_error < 1.15 * noise,
-        "auto differs from round by {auto_error}, round from round by {noise}"
+        kinds.iter().all(|&(_, shape)| shape == CurveShape::Flat),
+        "{kinds:?}"
     );
-    let mean = |v: &[f32]| v.iter().map(|&x| f64::from(x)).sum::<f64>() / v.len() as f64;
-    let (m_auto, m_ref) = (mean(auto.film.rgb()), mean(reference.film.rgb()));
-    assert!((m_auto - m_ref).abs() < 2e-3 * m_ref, "{m_auto} vs {m_ref}");
+    assert!(
+        kinds.contains(&(CurveBasis::Linear, CurveShape::Flat)),
+        "{kinds:?}"
+    );
+    assert_auto_matches_round(groom);
 }
 
 #[test]

@@ -28,6 +28,8 @@
 
 use std::ops::Range;
 
+use glam::Vec3;
+
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer, padding_for};
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
@@ -435,6 +437,18 @@ impl Curves {
 }
 
 /// Embree indexes control points with u32.
+/// The uniform Catmull-Rom segment of control points `p`, from p[1] to p[2], as the cubic
+/// p[1] + c1 u + c2 u^2 + c3 u^3: returns [c1, c2, c3]. What the polylines of thin strands
+/// are checked against (`ribbons::straight_strands`) and take their tangents from
+/// (`tracer`).
+pub(crate) fn catmull_rom_coefficients([p0, p1, p2, p3]: [Vec3; 4]) -> [Vec3; 3] {
+    [
+        0.5 * (p2 - p0),
+        0.5 * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3),
+        0.5 * (-p0 + 3.0 * p1 - 3.0 * p2 + p3),
+    ]
+}
+
 fn check_vertex_count(n: usize) -> Result<()> {
     if n > u32::MAX as usize {
         return Err(invalid_arg!(

@@ -9,17 +9,17 @@
 //! third of a bench render's own noise (RMSE at equal samples 2-4% higher; README, "Curve
 //! shapes").
 //!
-//! A thin Catmull-Rom strand whose curve stays within [`POLYLINE_PIXELS`] of a pixel of its polyline
-//! is traced as flat linear ribbons through its own points (a Catmull-Rom curve passes
-//! through them), shaded with the curve's tangent: Embree's flat Catmull-Rom ribbons are
-//! intersected piece by piece as it goes, which costs the demo 1.25x the time.
+//! A thin Catmull-Rom strand whose curve stays within [`POLYLINE_PIXELS`] of a pixel of
+//! its polyline is traced as flat linear ribbons through its own points (a Catmull-Rom
+//! curve passes through them), shaded with the curve's tangent: Embree's flat Catmull-Rom
+//! ribbons are intersected piece by piece as it goes, which costs the demo 1.25x the time.
 
 use glam::Vec3;
 
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::Result;
 use crate::scene::camera::Camera;
-use crate::scene::curves::Curves;
+use crate::scene::curves::{Curves, catmull_rom_coefficients};
 
 /// How a groom's strands are given to Embree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -81,11 +81,10 @@ pub fn straight_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bo
         return vec![false; strands];
     }
     let (eye, spread) = (camera.eye(), camera.pixel_spread(height));
-    let xyz = |q: &[f32; 4]| Vec3::new(q[0], q[1], q[2]);
     (0..strands)
         .map(|s| {
             curves.strand_points(s).windows(4).all(|w| {
-                let p = [&w[0], &w[1], &w[2], &w[3]].map(xyz);
+                let p: [Vec3; 4] = std::array::from_fn(|k| Vec3::from_slice(&w[k][..3]));
                 chord_stray(p) <= POLYLINE_PIXELS * spread * eye.distance(0.5 * (p[1] + p[2]))
             })
         })
@@ -94,17 +93,10 @@ pub fn straight_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bo
 
 /// The largest distance, at u = 1/4, 1/2 and 3/4, between the Catmull-Rom segment of
 /// control points `p` (from p[1] to p[2]) and its chord.
-fn chord_stray([p0, p1, p2, p3]: [Vec3; 4]) -> f32 {
+fn chord_stray(p: [Vec3; 4]) -> f32 {
+    let [c1, c2, c3] = catmull_rom_coefficients(p);
     [0.25f32, 0.5, 0.75]
-        .map(|u| {
-            let curve = p1
-                + 0.5
-                    * u
-                    * ((p2 - p0)
-                        + u * ((2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3)
-                            + u * (-p0 + 3.0 * p1 - 3.0 * p2 + p3)));
-            curve.distance(p1.lerp(p2, u))
-        })
+        .map(|u| (p[1] + u * (c1 + u * (c2 + u * c3))).distance(p[1].lerp(p[2], u)))
         .into_iter()
         .fold(0.0, f32::max)
 }

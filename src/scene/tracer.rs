@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::curves::{Curves, StrandIndex, StrandSegment};
+use super::curves::{Curves, StrandIndex, StrandSegment, catmull_rom_coefficients};
 use super::hit::{HairHit, Hit, SurfaceHit, hair_frame};
 use super::mesh::Mesh;
 use super::stages::{NoStages, Stage, StageRunner};
@@ -425,18 +425,15 @@ fn catmull_rom_derivative(geom: &CurveGeometry, prim: u32, u: f32) -> Option<Vec
     let first = *geom.indices().get(prim as usize)? as usize;
     let v = geom.vertices();
     let p = |i: usize| v.get(i).map(|q| Vec3::from_slice(&q[..3]));
-    let (p0, p1, p2, p3) = (
+    let points = [
         p(first.checked_sub(1)?)?,
         p(first)?,
         p(first + 1)?,
         p(first + 2)?,
-    );
+    ];
+    let [c1, c2, c3] = catmull_rom_coefficients(points);
     let u = u.clamp(0.0, 1.0);
-    Some(
-        0.5 * ((p2 - p0)
-            + 2.0 * u * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3)
-            + 3.0 * u * u * (-p0 + 3.0 * p1 - 3.0 * p2 + p3)),
-    )
+    Some(c1 + u * (2.0 * c2 + 3.0 * u * c3))
 }
 
 /// The curve tangent at the hit: the segment direction for linear curves, the derivative

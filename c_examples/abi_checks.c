@@ -271,7 +271,7 @@ int main(void) {
     ROW(ht_render(scene, &s, rgb, 12), BAD, "filter = 5");
     s.filter = HT_FILTER_TENT;
     s.filter_radius = nan;
-    ROW(ht_render(scene, &s, rgb, 12), BAD, "radius NaN");
+    ROW(ht_render(scene, &s, rgb, 12), BAD, "filter_radius = NaN");
     s.filter_radius = 1.0f;
     s.width = 0;
     ROW(ht_render(scene, &s, rgb, 0), BAD, "width = 0");

@@ -135,6 +135,15 @@ typedef struct HtHairPrepared HtHairPrepared;
 typedef struct HtScene HtScene;
 #endif
 
+#if defined(HT_RENDER)
+/**
+ * Render settings (every one has a default), read and written by name. Create with
+ * `ht_settings_new`, release with `ht_settings_free`. A handle may be read by any number
+ * of threads at once, but not while one of them sets it.
+ */
+typedef struct HtSettings HtSettings;
+#endif
+
 /**
  * Parameters of the hair BSDF (Chiang et al. 2016), all checked, never clamped:
  * - `sigma_a`: absorption per unit fibre *radius* (so independent of the fibre's size),
@@ -394,6 +403,10 @@ typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
 
 #if defined(HT_RENDER)
 /**
+ * Deprecated (ABI 6, the last to have it): use `HtSettings` with `ht_settings_set`,
+ * `ht_scene_build_with` and `ht_render_with`, whose settings are named and never change
+ * the ABI's layout (settings added since, such as `isa`, are only there).
+ *
  * What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
  * the fields you need.
  */
@@ -456,7 +469,7 @@ typedef struct HtRenderSettings {
      * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
      * per event and far less noisy on light hair, but biased (light hair comes out
      * brighter), so off by default. 0 (the default): the exact model at every event.
-     * Otherwise in [1, max_depth]; max_depth changes nothing. README, "Speed against
+     * Otherwise in [1, max_depth]; max_depth changes nothing. docs/measurements.md, "Speed against
      * error", has what it costs and buys. (ABI 5.)
      */
     uint32_t deep_bounce_depth;
@@ -464,7 +477,7 @@ typedef struct HtRenderSettings {
      * Hair lobes whose attenuation (largest channel) is below this fraction of the total
      * are dropped from evaluation and sampling (the strongest lobe is always kept); in
      * [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
-     * measured, saves no time: off by default (README, "Speed against error"). (ABI 5.)
+     * measured, saves no time: off by default (docs/measurements.md, "Speed against error"). (ABI 5.)
      */
     float lobe_cull;
     /**
@@ -472,7 +485,7 @@ typedef struct HtRenderSettings {
      * (largest channel, in the image's units) is below this value traces its shadow ray
      * with probability contribution / threshold and is reweighted by the inverse. Unbiased;
      * finite and >= 0, 0 traces every shadow ray. Default 0.03, chosen on the bench
-     * scenes (README, "Render efficiency"). (ABI 6.)
+     * scenes (docs/measurements.md, "Render efficiency"). (ABI 6.)
      */
     float light_threshold;
 } HtRenderSettings;
@@ -533,7 +546,7 @@ typedef bool (*HtBuildProgressFn)(double fraction, void *user);
 /**
  * Per strand, at each render: a ribbon where the strand is at most one pixel wide from
  * the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
- * tubes, at an error within the noise of a render (README, "Curve shapes"). A render
+ * tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A render
  * with another camera or image height than the last one builds the scene's BVH again.
  */
 #define HT_CURVE_AUTO 2
@@ -1336,6 +1349,80 @@ enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
+ * Creates settings holding every default into `*out` (640 x 480, 16 samples per pixel,
+ * seed 0, every core, the full frame, a tent filter of radius 1, the exact hair BSDF,
+ * shadow-ray roulette below 0.03: docs/settings.md lists them all).
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`out` NULL); `HT_ERR_INVALID_ARG` (`out` misaligned).
+ *
+ * # Safety
+ * `out` is NULL or writable.
+ */
+enum HtStatus ht_settings_new(struct HtSettings **out);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Releases settings (NULL: nothing to do; returns HT_OK).
+ *
+ * # Safety
+ * `settings` is NULL or a live handle from `ht_settings_new`, not used after this call.
+ */
+enum HtStatus ht_settings_free(struct HtSettings *settings);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Sets the setting `key` from the text `value`, as a scene file's `[render]` table and the
+ * command line's `--set key=value` do: integers and numbers in decimal ("64", "0.03"),
+ * choices by name ("box"), a crop as "x0,y0,x1,y1", and "none" for an optional setting
+ * left unset. Checks that need other settings (a crop inside the frame) are made when the
+ * settings are used.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (any argument NULL); `HT_ERR_INVALID_ARG` (an unknown key,
+ * or a value out of the setting's range: the message names the key and the range, and
+ * the settings are left unchanged).
+ *
+ * # Safety
+ * `settings` is NULL or a live handle that no other thread uses during the call; `key`
+ * and `value` are NULL or NUL-terminated strings.
+ */
+enum HtStatus ht_settings_set(struct HtSettings *settings, const char *key, const char *value);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Writes the value of `key` as text (the form `ht_settings_set` reads), NUL-terminated,
+ * into `buf` of `buf_len` bytes, and its length without the NUL into `*len` (may be NULL).
+ * With `buf` NULL (and `buf_len` 0) only `*len` is written: call once to size the buffer.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`settings` or `key` NULL, or both `buf` and `len`);
+ * `HT_ERR_INVALID_ARG` (an unknown key, or `buf_len` too small: nothing is written to
+ * `buf` then, and `*len` says what it needs).
+ *
+ * # Safety
+ * `settings` is NULL or a live handle; `key` is NULL or NUL-terminated; `buf` is NULL or
+ * `buf_len` writable bytes; `len` is NULL or writable.
+ */
+enum HtStatus ht_settings_get(const struct HtSettings *settings,
+                              const char *key,
+                              char *buf,
+                              size_t buf_len,
+                              size_t *len);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * The name of setting number `index` (0, 1, ... in the order of docs/settings.md), or NULL
+ * past the last: how a host lists every setting. Static storage.
+ */
+const char *ht_settings_key(size_t index);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Deprecated with `HtRenderSettings`: use `ht_settings_new`.
+ *
  * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
  * crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
  * deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
@@ -1345,6 +1432,8 @@ struct HtRenderSettings ht_render_settings_default(void);
 
 #if defined(HT_RENDER)
 /**
+ * Deprecated with `HtRenderSettings`: use `ht_scene_build_with`.
+ *
  * Builds now what `ht_render` with `settings` would build first: the Embree scene (and,
  * for `HT_CURVE_AUTO` curves, their shapes for this camera and image height), telling
  * `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom takes tens
@@ -1368,6 +1457,23 @@ enum HtStatus ht_scene_build(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
+ * As `ht_scene_build` (deprecated), with settings by name.
+ *
+ * Statuses: as `ht_scene_build`.
+ *
+ * # Safety
+ * As `ht_scene_build`; `settings` is NULL or a live handle from `ht_settings_new`.
+ */
+enum HtStatus ht_scene_build_with(struct HtScene *scene,
+                                  const struct HtSettings *settings,
+                                  HtBuildProgressFn progress,
+                                  void *user);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Deprecated with `HtRenderSettings`: use `ht_render_with`.
+ *
  * Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
  * `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
  * owned by the host. `ht_render_aovs` without AOVs.
@@ -1391,6 +1497,8 @@ enum HtStatus ht_render(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
+ * Deprecated with `HtRenderSettings`: use `ht_render_with`.
+ *
  * As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
  * and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
  * `pixel_count` is the crop window's pixel count (width * height without a crop), and
@@ -1422,6 +1530,30 @@ enum HtStatus ht_render(struct HtScene *scene,
  */
 enum HtStatus ht_render_aovs(struct HtScene *scene,
                              const struct HtRenderSettings *settings,
+                             float *rgb,
+                             size_t rgb_len,
+                             float *albedo,
+                             float *depth,
+                             float *strand_id,
+                             size_t pixel_count);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * As `ht_render_aovs` (deprecated), with settings by name and the progress callback
+ * (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
+ * may be NULL (not wanted).
+ *
+ * Statuses: as `ht_render_aovs`.
+ *
+ * # Safety
+ * As `ht_render_aovs`; `settings` is NULL or a live handle from `ht_settings_new`, not
+ * set during the call.
+ */
+enum HtStatus ht_render_with(struct HtScene *scene,
+                             const struct HtSettings *settings,
+                             HtProgressFn progress,
+                             void *user,
                              float *rgb,
                              size_t rgb_len,
                              float *albedo,

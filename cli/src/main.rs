@@ -5,23 +5,27 @@
 //! `convert` takes grooms between .hair and USD.
 
 mod report;
+mod settings;
 
 use clap::{Args, Parser, Subcommand};
 use glam::Vec3;
-use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
+use hairtrace::bsdf::{
+    DEFAULT_EUMELANIN, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset,
+};
 use hairtrace::description::convert::{self, ConvertOptions, ConvertSource};
 use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{
     self, BuiltScene, MaterialDesc, SceneDescription, has_extension, usd,
 };
-use hairtrace::embree::{CurveBasis, Isa};
+use hairtrace::embree::CurveBasis;
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::material::HairColor;
 use hairtrace::scene::{GroomShape, Stage, StageProgress, Thickness, info_report, read_hair_file};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
+use settings::SettingArgs;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -63,6 +67,10 @@ enum Command {
     /// Convert grooms between .hair and USD BasisCurves: IN is a .hair file, a USD file, or
     /// a scene file (.toml: its grooms in world space); OUT is .hair or .usda.
     Convert(ConvertArgs),
+    /// List every render setting (name, values, default, doc) as a Markdown table: what a
+    /// scene's [render] table, `render --NAME`/`--set NAME=VALUE` and the C ABI's
+    /// `ht_settings_set` take.
+    Settings,
 }
 
 #[derive(Args)]
@@ -132,66 +140,15 @@ struct RenderArgs {
     /// A built-in scene instead of a file: furball (the default), furnace, scalp.
     #[arg(long, conflicts_with = "scene")]
     demo: Option<String>,
-    /// Samples per pixel.
-    #[arg(long)]
-    spp: Option<u32>,
-    #[arg(long)]
-    width: Option<u32>,
-    #[arg(long)]
-    height: Option<u32>,
-    #[arg(long)]
-    seed: Option<u64>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
-    /// Pin Embree's kernels to one instruction set (sse2, avx, avx2, avx512) so that
-    /// crop pieces rendered on different CPUs assemble bit for bit (default: the widest
-    /// this CPU runs).
-    #[arg(long, value_parser = Isa::named)]
-    isa: Option<Isa>,
-    /// Longest path, in scattering events.
-    #[arg(long)]
-    max_depth: Option<u32>,
-    /// Russian roulette may end paths after this many scattering events (default 2).
-    #[arg(long)]
-    rr_depth: Option<u32>,
-    /// Russian roulette survival: sqrt (of the path throughput, the default) or
-    /// throughput.
-    #[arg(long, value_parser = ["sqrt", "throughput"])]
-    roulette: Option<String>,
-    /// Past this many scattering events, hair scatters through one merged lobe (the same
-    /// energy, no azimuthal highlights): less noise on light hair, at a bias (default:
-    /// exact at every event).
-    #[arg(long, value_name = "N")]
-    deep_bounce_depth: Option<u32>,
-    /// Drop hair lobes whose attenuation is below this fraction of the total, in [0, 1)
-    /// (default 0: none).
-    #[arg(long, value_name = "T")]
-    lobe_cull: Option<f32>,
-    /// Shadow-ray roulette: a light sample contributing less than this to a pixel traces
-    /// its shadow ray with probability contribution / threshold (unbiased; 0: every
-    /// shadow ray; default 0.03).
-    #[arg(long, value_name = "T")]
-    light_threshold: Option<f32>,
     /// Curve shape of every groom, over the scene's: auto (the default: a ribbon facing the
     /// ray where a strand is at most a pixel wide, a tube elsewhere), round or flat.
     #[arg(long, value_parser = ["auto", "round", "flat"])]
     shape: Option<String>,
-    /// Pixel filter: tent (the default) or box (one pixel).
-    #[arg(long, value_parser = ["tent", "box"])]
-    filter: Option<String>,
-    /// The tent filter's half-width in pixels (default 1).
-    #[arg(long)]
-    filter_radius: Option<f32>,
     /// Also write the render's figures (seconds of path tracing, scene build seconds,
     /// seconds of each stage: read, curves, bvh, render; camera samples, rays) to this
     /// JSON file: what benchmarks read.
     #[arg(long, value_name = "FILE.json")]
     stats: Option<PathBuf>,
-    /// Render only the pixels x0..x1, y0..y1 (ends exclusive) of the full frame, exactly
-    /// as the full render has them: a farm can split a frame and reassemble the pieces.
-    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = parse_list::<u32, 4>)]
-    crop: Option<[u32; 4]>,
     /// The hair's absorption preset, for a bare .hair groom: red_brown, light_brown,
     /// dark_brown, black, white (default: brown from melanin).
     #[arg(long, value_parser = parse_preset)]
@@ -199,6 +156,8 @@ struct RenderArgs {
     /// Output image.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    settings: SettingArgs,
     /// Also write these AOVs, each to OUT's name with `.albedo`, `.depth` or `.strand`
     /// before the extension: albedo (RGB), depth (camera distance), strand (strand id).
     #[arg(long, value_delimiter = ',', value_parser = ["albedo", "depth", "strand"])]
@@ -217,7 +176,7 @@ struct InfoArgs {
 #[derive(Args)]
 struct LobesArgs {
     /// Eumelanin concentration (about 0.3 blonde, 1.3 brown, 8 black).
-    #[arg(long, default_value_t = 1.3)]
+    #[arg(long, default_value_t = DEFAULT_EUMELANIN)]
     eumelanin: f32,
     /// Pheomelanin concentration (red).
     #[arg(long, default_value_t = 0.0)]
@@ -230,16 +189,16 @@ struct LobesArgs {
     #[arg(long, value_parser = parse_preset, conflicts_with_all = ["eumelanin", "pheomelanin", "color"])]
     preset: Option<[f32; 3]>,
     /// Longitudinal roughness, [0.01, 1].
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = HairParams::default().beta_m)]
     beta_m: f32,
     /// Azimuthal roughness, [0.01, 1].
-    #[arg(long, default_value_t = 0.3)]
+    #[arg(long, default_value_t = HairParams::default().beta_n)]
     beta_n: f32,
     /// Cuticle tilt in degrees.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = HairParams::default().alpha)]
     alpha: f32,
     /// Index of refraction.
-    #[arg(long, default_value_t = 1.55)]
+    #[arg(long, default_value_t = HairParams::default().eta)]
     eta: f32,
 }
 
@@ -436,28 +395,8 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         }
     }
     // Overrides go into the description, so that the camera's aspect follows the size.
-    let r = &mut description.render;
-    r.spp = args.spp.unwrap_or(r.spp);
-    r.width = args.width.unwrap_or(r.width);
-    r.height = args.height.unwrap_or(r.height);
-    r.seed = args.seed.unwrap_or(r.seed);
-    r.threads = args.threads.or(r.threads);
-    if let Some(isa) = args.isa {
-        r.isa = Some(isa.name().to_owned());
-    }
-    r.max_depth = args.max_depth.unwrap_or(r.max_depth);
-    r.crop = args.crop.or(r.crop);
-    r.rr_depth = args.rr_depth.unwrap_or(r.rr_depth);
-    if let Some(roulette) = &args.roulette {
-        r.roulette.clone_from(roulette);
-    }
-    r.deep_bounce_depth = args.deep_bounce_depth.or(r.deep_bounce_depth);
-    r.lobe_cull = args.lobe_cull.unwrap_or(r.lobe_cull);
-    r.light_threshold = args.light_threshold.unwrap_or(r.light_threshold);
-    if let Some(filter) = &args.filter {
-        r.filter.clone_from(filter);
-    }
-    r.filter_radius = args.filter_radius.or(r.filter_radius);
+    args.settings.apply(&mut description.render)?;
+    let r = &description.render;
     let build_start = std::time::Instant::now();
     let device = Arc::new(r.device()?);
     let bars = StageBars::default();
@@ -689,6 +628,10 @@ fn main() -> ExitCode {
             peers: a.peers.clone(),
         }),
         Command::Convert(a) => convert_groom(a),
+        Command::Settings => {
+            print!("{}", settings::markdown());
+            Ok(())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

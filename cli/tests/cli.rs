@@ -524,6 +524,15 @@ fn render_takes_the_fidelity_knobs() {
             .pixels
     };
     let exact = image("cli_exact.exr", &[]);
+    // A flag and `--set` are the same setting.
+    assert_eq!(
+        image("cli_set.exr", &["--set", "deep_bounce_depth=4"]),
+        exact
+    );
+    assert_eq!(
+        image("cli_set_cull.exr", &["--set", "lobe_cull=0.2"]),
+        image("cli_flag_cull.exr", &["--lobe-cull", "0.2"])
+    );
     assert_eq!(image("cli_deep4.exr", &["--deep-bounce-depth", "4"]), exact);
     assert_ne!(image("cli_deep1.exr", &["--deep-bounce-depth", "1"]), exact);
     assert_ne!(image("cli_cull.exr", &["--lobe-cull", "0.2"]), exact);
@@ -537,9 +546,34 @@ fn render_takes_the_fidelity_knobs() {
         ("--deep-bounce-depth", "0", "deep_bounce_depth = 0"),
         ("--lobe-cull", "1", "lobe_cull = 1"),
         ("--light-threshold", "inf", "light_threshold = inf"),
+        ("--set", "spp=0", "spp = 0: must be >= 1"),
+        ("--set", "spp", "NAME=VALUE"),
+        (
+            "--set",
+            "sample_count=4",
+            "sample_count: not a render setting",
+        ),
     ] {
         let mut args: Vec<&str> = common.to_vec();
         args.extend([knob, value, "-o", out.as_str()]);
         assert_one_line_error(&hairtrace(&args), needle);
     }
+}
+
+/// docs/settings.md holds the schema exactly as `hairtrace settings` prints it, so the
+/// documentation cannot drift from the code.
+#[test]
+fn the_settings_doc_is_the_schema() {
+    let o = hairtrace(&["settings"]);
+    assert!(o.status.success(), "{o:?}");
+    let table = stdout(&o);
+    assert!(table.contains("| `light_threshold` |"), "{table}");
+    let doc = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/settings.md"),
+    )
+    .unwrap();
+    assert!(
+        doc.contains(&table),
+        "docs/settings.md lacks the table `hairtrace settings` prints; paste it in:\n{table}"
+    );
 }

@@ -12,7 +12,7 @@
 //! code eight inputs at a time.
 //!
 //! A point may also evaluate less than the whole model ([`Lobes`]): the renderer's two
-//! fidelity knobs, lobe culling and the merged lobe of deep bounces (README, "Speed
+//! fidelity knobs, lobe culling and the merged lobe of deep bounces (docs/measurements.md, "Speed
 //! against error", has what each costs and buys).
 
 use super::azimuthal::{TrimmedLogistic, azimuthal_scale};

@@ -16,7 +16,7 @@ pub use diffuse::DiffusePoint;
 pub(crate) use hair::OwnedPoint;
 pub use hair::{HairBsdf, HairPoint, Lobes};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
-pub use params::HairParams;
+pub use params::{DEFAULT_EUMELANIN, HairParams};
 
 use glam::Vec3;
 

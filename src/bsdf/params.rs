@@ -21,7 +21,7 @@ pub struct HairParams {
 }
 
 /// Eumelanin concentration of the default (brown) hair.
-pub(crate) const DEFAULT_EUMELANIN: f32 = 1.3;
+pub const DEFAULT_EUMELANIN: f32 = 1.3;
 
 impl Default for HairParams {
     /// Brown hair (eumelanin 1.3), eta 1.55, beta_m = beta_n = 0.3, alpha = 2 degrees.

@@ -33,7 +33,7 @@ pub const HT_CURVE_ROUND: HtCurveShape = 0;
 pub const HT_CURVE_FLAT: HtCurveShape = 1;
 /// Per strand, at each render: a ribbon where the strand is at most one pixel wide from
 /// the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
-/// tubes, at an error within the noise of a render (README, "Curve shapes"). A render
+/// tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A render
 /// with another camera or image height than the last one builds the scene's BVH again.
 pub const HT_CURVE_AUTO: HtCurveShape = 2;
 

@@ -19,7 +19,12 @@ pub mod lights;
 pub mod materials;
 #[cfg(all(test, feature = "render"))]
 mod scene_tests;
-// After `scene`, so that the header declares scenes before the render that takes them.
+#[cfg(feature = "render")]
+pub mod settings;
+#[cfg(all(test, feature = "render"))]
+mod settings_tests;
+// After `scene` and `settings`, so that the header declares them before the render that
+// takes them.
 #[cfg(feature = "render")]
 pub mod render;
 #[cfg(all(test, feature = "render"))]
@@ -320,13 +325,18 @@ pub(crate) fn read_vec3(ptr: *const f32, name: &str) -> Result<Vec3, Failure> {
     Ok(v)
 }
 
+/// Reads a NUL-terminated UTF-8 string.
+pub(crate) fn read_str<'a>(ptr: *const c_char, name: &str) -> Result<&'a str, Failure> {
+    // SAFETY: non-NULL (checked); the host promises a NUL-terminated string that outlives
+    // the call.
+    let c = unsafe { CStr::from_ptr(non_null(ptr, name)?) };
+    Ok(c.to_str()
+        .map_err(|_| invalid_arg!("{name} {c:?} is not valid UTF-8"))?)
+}
+
 /// Reads a NUL-terminated UTF-8 path.
 pub(crate) fn read_path(ptr: *const c_char, name: &str) -> Result<PathBuf, Failure> {
-    // SAFETY: non-NULL (checked); the host promises a NUL-terminated string.
-    let c = unsafe { CStr::from_ptr(non_null(ptr, name)?) };
-    let s = c
-        .to_str()
-        .map_err(|_| invalid_arg!("{name} {c:?} is not valid UTF-8"))?;
+    let s = read_str(ptr, name)?;
     if s.is_empty() {
         return Err(invalid_arg!("{name} is empty").into());
     }

@@ -1,16 +1,16 @@
 //! Rendering a scene into the host's buffer, and writing images, through the C ABI.
 
 use super::scene::{HtScene, scene_mut};
+use super::settings::{HtSettings, read_settings};
 use super::{
     Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
     non_null_mut, read_host, read_path,
 };
 use crate::error::invalid_arg;
 use crate::image::{WriteOptions, write_image};
-use crate::render::integrator::PathSettings;
 use crate::render::renderer::render;
-use crate::render::settings::RenderSettings;
-use crate::render::{Aovs, NoProgress, PixelFilter, Progress, RenderStatus};
+use crate::render::settings::{Filter, PathSettings, RenderSettings};
+use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
 use crate::scene::stages::{NoStages, Stage, StageProgress};
 use std::ffi::{c_char, c_void};
 use std::ptr::null_mut;
@@ -35,6 +35,10 @@ pub const HT_FILTER_TENT: HtPixelFilter = 0;
 /// The one-pixel box.
 pub const HT_FILTER_BOX: HtPixelFilter = 1;
 
+/// Deprecated (ABI 6, the last to have it): use `HtSettings` with `ht_settings_set`,
+/// `ht_scene_build_with` and `ht_render_with`, whose settings are named and never change
+/// the ABI's layout (settings added since, such as `isa`, are only there).
+///
 /// What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
 /// the fields you need.
 #[repr(C)]
@@ -77,22 +81,24 @@ pub struct HtRenderSettings {
     /// (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
     /// per event and far less noisy on light hair, but biased (light hair comes out
     /// brighter), so off by default. 0 (the default): the exact model at every event.
-    /// Otherwise in [1, max_depth]; max_depth changes nothing. README, "Speed against
+    /// Otherwise in [1, max_depth]; max_depth changes nothing. docs/measurements.md, "Speed against
     /// error", has what it costs and buys. (ABI 5.)
     pub deep_bounce_depth: u32,
     /// Hair lobes whose attenuation (largest channel) is below this fraction of the total
     /// are dropped from evaluation and sampling (the strongest lobe is always kept); in
     /// [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
-    /// measured, saves no time: off by default (README, "Speed against error"). (ABI 5.)
+    /// measured, saves no time: off by default (docs/measurements.md, "Speed against error"). (ABI 5.)
     pub lobe_cull: f32,
     /// Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
     /// (largest channel, in the image's units) is below this value traces its shadow ray
     /// with probability contribution / threshold and is reweighted by the inverse. Unbiased;
     /// finite and >= 0, 0 traces every shadow ray. Default 0.03, chosen on the bench
-    /// scenes (README, "Render efficiency"). (ABI 6.)
+    /// scenes (docs/measurements.md, "Render efficiency"). (ABI 6.)
     pub light_threshold: f32,
 }
 
+/// Deprecated with `HtRenderSettings`: use `ht_settings_new`.
+///
 /// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
 /// crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
 /// deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
@@ -112,7 +118,7 @@ pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
         crop_x1,
         crop_y1,
         filter: HT_FILTER_TENT,
-        filter_radius: d.filter.name().1.unwrap_or(1.0),
+        filter_radius: d.filter_radius,
         progress: None,
         progress_user: null_mut(),
         deep_bounce_depth: d.path.deep_bounce_depth.unwrap_or(0),
@@ -126,8 +132,8 @@ impl HtRenderSettings {
     pub(super) fn to_rust(self) -> crate::Result<RenderSettings> {
         let crop = [self.crop_x0, self.crop_y0, self.crop_x1, self.crop_y1];
         let filter = match self.filter {
-            HT_FILTER_TENT => PixelFilter::tent(self.filter_radius)?,
-            HT_FILTER_BOX => PixelFilter::BOX,
+            HT_FILTER_TENT => Filter::Tent,
+            HT_FILTER_BOX => Filter::Box,
             other => {
                 return Err(invalid_arg!(
                     "filter = {other}: must be HT_FILTER_TENT (0) or HT_FILTER_BOX (1)"
@@ -142,6 +148,11 @@ impl HtRenderSettings {
             threads: (self.threads > 0).then_some(self.threads as usize),
             crop: (crop != [0; 4]).then_some(crop),
             filter,
+            // The box ignores the radius, so a host may leave any value there.
+            filter_radius: match filter {
+                Filter::Tent => self.filter_radius,
+                Filter::Box => RenderSettings::default().filter_radius,
+            },
             path: PathSettings {
                 max_depth: self.max_depth,
                 deep_bounce_depth: (self.deep_bounce_depth > 0).then_some(self.deep_bounce_depth),
@@ -149,6 +160,7 @@ impl HtRenderSettings {
                 light_threshold: self.light_threshold,
                 ..PathSettings::default()
             },
+            ..RenderSettings::default()
         })
     }
 }
@@ -194,6 +206,8 @@ impl StageProgress for HostBuildProgress {
     }
 }
 
+/// Deprecated with `HtRenderSettings`: use `ht_scene_build_with`.
+///
 /// Builds now what `ht_render` with `settings` would build first: the Embree scene (and,
 /// for `HT_CURVE_AUTO` curves, their shapes for this camera and image height), telling
 /// `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom takes tens
@@ -216,22 +230,49 @@ pub unsafe extern "C" fn ht_scene_build(
     user: *mut c_void,
 ) -> HtStatus {
     boundary(|| {
-        let scene = scene_mut(scene)?;
         let settings = read_host(settings, "settings")?.to_rust()?;
         settings.validate()?;
-        let host;
-        let sink: &dyn StageProgress = match progress {
-            Some(callback) => {
-                host = HostBuildProgress { callback, user };
-                &host
-            }
-            None => &NoStages,
-        };
-        scene.prepare(settings.width, settings.height, sink)?;
-        Ok(())
+        build(scene, &settings, progress, user)
     })
 }
 
+/// As `ht_scene_build` (deprecated), with settings by name.
+///
+/// Statuses: as `ht_scene_build`.
+///
+/// # Safety
+/// As `ht_scene_build`; `settings` is NULL or a live handle from `ht_settings_new`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_build_with(
+    scene: *mut HtScene,
+    settings: *const HtSettings,
+    progress: HtBuildProgressFn,
+    user: *mut c_void,
+) -> HtStatus {
+    boundary(|| build(scene, &read_settings(settings)?, progress, user))
+}
+
+fn build(
+    scene: *mut HtScene,
+    settings: &RenderSettings,
+    progress: HtBuildProgressFn,
+    user: *mut c_void,
+) -> Result<(), Failure> {
+    let scene = scene_mut(scene)?;
+    let host;
+    let sink: &dyn StageProgress = match progress {
+        Some(callback) => {
+            host = HostBuildProgress { callback, user };
+            &host
+        }
+        None => &NoStages,
+    };
+    scene.prepare(settings.width, settings.height, sink)?;
+    Ok(())
+}
+
+/// Deprecated with `HtRenderSettings`: use `ht_render_with`.
+///
 /// Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
 /// `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
 /// owned by the host. `ht_render_aovs` without AOVs.
@@ -270,6 +311,8 @@ pub unsafe extern "C" fn ht_render(
     }
 }
 
+/// Deprecated with `HtRenderSettings`: use `ht_render_with`.
+///
 /// As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
 /// and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
 /// `pixel_count` is the crop window's pixel count (width * height without a crop), and
@@ -311,50 +354,9 @@ pub unsafe extern "C" fn ht_render_aovs(
     pixel_count: usize,
 ) -> HtStatus {
     boundary(|| {
-        let scene = scene_mut(scene)?;
         let s = read_host(settings, "settings")?;
-        let settings_ptr = settings;
-        let settings = s.to_rust()?;
-        settings.validate()?;
-        // The crop window's size (the full frame without one).
-        let [x0, y0, x1, y1] = settings.window();
-        let (w, h) = (x1 - x0, y1 - y0);
-        // At most 2^15 x 2^15 x 3 (validated above): no overflow.
-        let pixels = w as usize * h as usize;
-        let want = 3 * pixels;
-        if rgb_len != want {
-            return Err(invalid_arg!("rgb_len = {rgb_len}: must be 3 * {w} * {h} = {want}").into());
-        }
-        let rgb = host_slice_mut(non_null_mut(rgb, "rgb")?, rgb_len, "rgb")?;
-        if pixel_count != pixels {
-            return Err(
-                invalid_arg!("pixel_count = {pixel_count}: must be {w} * {h} = {pixels}").into(),
-            );
-        }
-        let albedo = optional_slice(albedo, 3 * pixels, "albedo")?;
-        let depth = optional_slice(depth, pixels, "depth")?;
-        let strand_id = optional_slice(strand_id, pixels, "strand_id")?;
-        let span = |name, b: &Option<&mut [f32]>| {
-            b.as_ref()
-                .map_or(Span::of(name, std::ptr::null::<f32>(), 0), |b| {
-                    Span::of(name, b.as_ptr(), b.len())
-                })
-        };
-        check_disjoint(
-            &[
-                Span::of("rgb", rgb.as_ptr(), rgb.len()),
-                span("albedo", &albedo),
-                span("depth", &depth),
-                span("strand_id", &strand_id),
-            ],
-            &[Span::of("settings", settings_ptr, 1)],
-        )?;
-        let aovs = Aovs {
-            albedo: albedo.is_some(),
-            depth: depth.is_some(),
-            strand_id: strand_id.is_some(),
-        };
-        let (world, camera) = scene.prepare(s.width, s.height, &NoStages)?;
+        let rust = s.to_rust()?;
+        rust.validate()?;
         let host;
         let progress: &dyn Progress = match s.progress {
             Some(callback) => {
@@ -366,26 +368,154 @@ pub unsafe extern "C" fn ht_render_aovs(
             }
             None => &NoProgress,
         };
-        let out = render(world, &camera, &settings, aovs, progress)?;
-        let film = &out.film;
-        rgb.copy_from_slice(film.rgb());
-        for (host, aov) in [
-            (albedo, film.albedo()),
-            (depth, film.depth()),
-            (strand_id, film.strand_id()),
-        ] {
-            if let (Some(host), Some(aov)) = (host, aov) {
-                host.copy_from_slice(aov);
-            }
-        }
-        match out.status {
-            RenderStatus::Complete => Ok(()),
-            RenderStatus::Cancelled => Err(Failure(
-                HtStatus::HT_ERR_CANCELLED,
-                "render cancelled by the progress callback".into(),
-            )),
-        }
+        let buffers = HostBuffers {
+            rgb,
+            rgb_len,
+            albedo,
+            depth,
+            strand_id,
+            pixel_count,
+        };
+        render_into(
+            scene,
+            &rust,
+            Span::of("settings", settings, 1),
+            progress,
+            buffers,
+        )
     })
+}
+
+/// As `ht_render_aovs` (deprecated), with settings by name and the progress callback
+/// (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
+/// may be NULL (not wanted).
+///
+/// Statuses: as `ht_render_aovs`.
+///
+/// # Safety
+/// As `ht_render_aovs`; `settings` is NULL or a live handle from `ht_settings_new`, not
+/// set during the call.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)] // the C signature: one argument per buffer
+pub unsafe extern "C" fn ht_render_with(
+    scene: *mut HtScene,
+    settings: *const HtSettings,
+    progress: HtProgressFn,
+    user: *mut c_void,
+    rgb: *mut f32,
+    rgb_len: usize,
+    albedo: *mut f32,
+    depth: *mut f32,
+    strand_id: *mut f32,
+    pixel_count: usize,
+) -> HtStatus {
+    boundary(|| {
+        let rust = read_settings(settings)?;
+        let host;
+        let sink: &dyn Progress = match progress {
+            Some(callback) => {
+                host = HostProgress { callback, user };
+                &host
+            }
+            None => &NoProgress,
+        };
+        let buffers = HostBuffers {
+            rgb,
+            rgb_len,
+            albedo,
+            depth,
+            strand_id,
+            pixel_count,
+        };
+        render_into(
+            scene,
+            &rust,
+            Span::of("settings", settings, 1),
+            sink,
+            buffers,
+        )
+    })
+}
+
+/// The buffers a host lends a render, unchecked.
+struct HostBuffers {
+    rgb: *mut f32,
+    rgb_len: usize,
+    albedo: *mut f32,
+    depth: *mut f32,
+    strand_id: *mut f32,
+    pixel_count: usize,
+}
+
+/// Checks the host's buffers against `settings` (valid), renders and copies the film out.
+fn render_into(
+    scene: *mut HtScene,
+    settings: &RenderSettings,
+    settings_span: Span,
+    progress: &dyn Progress,
+    b: HostBuffers,
+) -> Result<(), Failure> {
+    let scene = scene_mut(scene)?;
+    // The crop window's size (the full frame without one).
+    let [x0, y0, x1, y1] = settings.window();
+    let (w, h) = (x1 - x0, y1 - y0);
+    // At most 2^15 x 2^15 x 3 (validated): no overflow.
+    let pixels = w as usize * h as usize;
+    let want = 3 * pixels;
+    let rgb_len = b.rgb_len;
+    if rgb_len != want {
+        return Err(invalid_arg!("rgb_len = {rgb_len}: must be 3 * {w} * {h} = {want}").into());
+    }
+    let rgb = host_slice_mut(non_null_mut(b.rgb, "rgb")?, rgb_len, "rgb")?;
+    let pixel_count = b.pixel_count;
+    if pixel_count != pixels {
+        return Err(
+            invalid_arg!("pixel_count = {pixel_count}: must be {w} * {h} = {pixels}").into(),
+        );
+    }
+    let albedo = optional_slice(b.albedo, 3 * pixels, "albedo")?;
+    let depth = optional_slice(b.depth, pixels, "depth")?;
+    let strand_id = optional_slice(b.strand_id, pixels, "strand_id")?;
+    let span = |name, b: &Option<&mut [f32]>| {
+        b.as_ref()
+            .map_or(Span::of(name, std::ptr::null::<f32>(), 0), |b| {
+                Span::of(name, b.as_ptr(), b.len())
+            })
+    };
+    check_disjoint(
+        &[
+            Span::of("rgb", rgb.as_ptr(), rgb.len()),
+            span("albedo", &albedo),
+            span("depth", &depth),
+            span("strand_id", &strand_id),
+        ],
+        &[settings_span],
+    )?;
+    let aovs = Aovs {
+        albedo: albedo.is_some(),
+        depth: depth.is_some(),
+        strand_id: strand_id.is_some(),
+    };
+    let (world, camera) = scene.prepare(settings.width, settings.height, &NoStages)?;
+    let out = render(world, &camera, settings, aovs, progress)?;
+    let film = &out.film;
+    rgb.copy_from_slice(film.rgb());
+    for (host, aov) in [
+        (albedo, film.albedo()),
+        (depth, film.depth()),
+        (strand_id, film.strand_id()),
+    ] {
+        if let (Some(host), Some(aov)) = (host, aov) {
+            host.copy_from_slice(aov);
+        }
+    }
+    match out.status {
+        RenderStatus::Complete => Ok(()),
+        RenderStatus::Cancelled => Err(Failure(
+            HtStatus::HT_ERR_CANCELLED,
+            "render cancelled by the progress callback".into(),
+        )),
+    }
 }
 
 /// An AOV buffer of `len` floats the host lends, or None where it passed NULL (not

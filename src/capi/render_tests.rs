@@ -8,10 +8,11 @@ use crate::capi::scene::*;
 use crate::capi::scene_tests::{Handles, fails, last_error, small_fur, xyzr, xyzr_desc};
 use crate::embree::{CurveBasis, CurveShape, Device, Geometry, SceneOptions};
 use crate::image::read_image;
-use crate::render::integrator::{PathSettings, World};
+use crate::render::integrator::World;
 use crate::render::renderer::render;
+use crate::render::settings::PathSettings;
 use crate::render::settings::RenderSettings;
-use crate::render::{Aovs, NoProgress, PixelFilter};
+use crate::render::{Aovs, NoProgress};
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::envmap::Environment;
@@ -83,7 +84,7 @@ pub(super) fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>
 }
 
 /// Renders through `ht_render_aovs` with every AOV: rgb, albedo, depth, strand id.
-fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
+pub(super) fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
     unsafe {
         let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
         let pixels = ((x1 - x0) * (y1 - y0)) as usize;
@@ -150,7 +151,7 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
     let (status, box_rgb) = render_c(&h, &boxed);
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
     let rust_box = RenderSettings {
-        filter: PixelFilter::BOX,
+        filter: crate::render::settings::Filter::Box,
         ..rust
     };
     let out = render(&world, &camera, &rust_box, Aovs::default(), &NoProgress).unwrap();
@@ -506,7 +507,11 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             filter_radius: f32::NAN,
             ..s
         };
-        fails(ht_render(h.scene, &radius, ptr, len), INVALID, "radius NaN");
+        fails(
+            ht_render(h.scene, &radius, ptr, len),
+            INVALID,
+            "filter_radius = NaN",
+        );
         let deep = HtRenderSettings {
             max_depth: 4,
             deep_bounce_depth: 5,
@@ -515,7 +520,7 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
         fails(
             ht_render(h.scene, &deep, ptr, len),
             INVALID,
-            "deep_bounce_depth = 5: must be in [1, max_depth = 4]",
+            "deep_bounce_depth = 5: must be at most max_depth = 4",
         );
         let cull = HtRenderSettings {
             lobe_cull: 1.0,
@@ -565,15 +570,15 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             "pixel_count = 64: must be 4 * 3 = 12",
         );
         let outside = HtRenderSettings { crop_x1: 9, ..crop };
-        fails(aovs(&outside, 36, 12), INVALID, "crop = [2, 1, 9, 4]");
+        fails(aovs(&outside, 36, 12), INVALID, "crop = 2,1,9,4");
         let reversed = HtRenderSettings { crop_x0: 6, ..crop };
-        fails(aovs(&reversed, 36, 12), INVALID, "crop = [6, 1, 6, 4]");
+        fails(aovs(&reversed, 36, 12), INVALID, "crop = 6,1,6,4");
         // Only all four zero mean the full frame.
         let partial = HtRenderSettings { crop_x1: 4, ..s };
         fails(
             ht_render(h.scene, &partial, ptr, len),
             INVALID,
-            "crop = [0, 0, 4, 0]",
+            "crop = 0,0,4,0",
         );
         assert!(
             rgb.iter().all(|v| *v == 0.0),
@@ -665,7 +670,10 @@ fn the_default_settings_are_the_rust_defaults() {
     assert_eq!((d.threads, d.max_depth), (0, r.path.max_depth));
     let rust = d.to_rust().unwrap();
     assert_eq!(rust.crop, None, "the full frame");
-    assert_eq!(rust.filter, r.filter);
+    assert_eq!(
+        (rust.filter, rust.filter_radius),
+        (r.filter, r.filter_radius)
+    );
     assert_eq!(rust.path, r.path, "no deep-bounce lobe, no lobe culling");
     assert!(d.progress.is_none() && d.progress_user.is_null());
 }

@@ -50,10 +50,8 @@ impl SceneDescription {
         device: Arc<Device>,
         progress: &dyn StageProgress,
     ) -> Result<BuiltScene> {
-        let settings = self
-            .render
-            .settings()
-            .map_err(|e| self.error("render", e))?;
+        let settings = self.render;
+        settings.validate().map_err(|e| self.error("render", e))?;
         let mut prepared = BTreeMap::new();
         for (name, m) in &self.materials {
             let material = m

@@ -5,9 +5,10 @@ use std::path::Path;
 
 use super::{
     EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc, MeshSource,
-    RenderDesc, SceneDescription, Transform,
+    SceneDescription, Transform,
 };
 use crate::error::{Error, Result, invalid_arg};
+use crate::render::settings::RenderSettings;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::hair_file::Thickness;
 use crate::scene::material::{HairColor, HairMaterial};
@@ -135,10 +136,7 @@ fn furnace_demo() -> SceneDescription {
         ..HairMaterial::default()
     };
     SceneDescription {
-        render: RenderDesc {
-            max_depth: 256,
-            ..RenderDesc::default()
-        },
+        render: RenderSettings::default(),
         materials: BTreeMap::from([
             ("white_hair".to_string(), MaterialDesc::Hair(white_hair)),
             (

@@ -12,11 +12,12 @@ use toml::Spanned;
 use super::usd::is_usd_path;
 use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
-    MeshSource, RenderDesc, SceneDescription, Transform,
+    MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::sigma_a_preset;
 use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
+use crate::render::settings::RenderSettings;
 use crate::scene::GroomShape;
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
 use crate::scene::hair_file::Thickness;
@@ -54,8 +55,21 @@ impl SceneDescription {
         let grooms = convert(&source, "groom", raw.groom, |g| g.into_desc(base_dir))?;
         let meshes = convert(&source, "mesh", raw.mesh, |m| m.into_desc(base_dir))?;
         let lights = convert(&source, "light", raw.light, |l| l.into_desc(base_dir))?;
+        let mut render = RenderSettings::default();
+        for (key, value) in &raw.render {
+            let at = source.position(key.span());
+            let text = setting_text(value.get_ref()).ok_or_else(|| {
+                invalid_arg!(
+                    "{at}: render.{}: must be a number, a string or an array of them",
+                    key.get_ref()
+                )
+            })?;
+            render
+                .set(key.get_ref(), &text)
+                .map_err(|e| invalid_arg!("{at}: render.{}", e.detail()))?;
+        }
         Ok(SceneDescription {
-            render: raw.render,
+            render,
             camera: raw.camera,
             materials,
             grooms,
@@ -66,6 +80,26 @@ impl SceneDescription {
     }
 }
 
+/// A `[render]` value as the text [`RenderSettings::set`] reads: `crop = [0, 0, 8, 8]` is
+/// `0,0,8,8`.
+fn setting_text(value: &toml::Value) -> Option<String> {
+    match value {
+        toml::Value::String(s) => Some(s.clone()),
+        toml::Value::Integer(i) => Some(i.to_string()),
+        toml::Value::Float(f) => Some(f.to_string()),
+        toml::Value::Boolean(b) => Some(b.to_string()),
+        toml::Value::Array(items) => items
+            .iter()
+            .map(|v| match v {
+                toml::Value::Array(_) => None,
+                v => setting_text(v),
+            })
+            .collect::<Option<Vec<_>>>()
+            .map(|v| v.join(",")),
+        _ => None,
+    }
+}
+
 // Entries are not internally tagged serde enums because those lose the position of every
 // error inside them.
 
@@ -73,7 +107,7 @@ impl SceneDescription {
 #[serde(deny_unknown_fields)]
 struct RawScene {
     #[serde(default)]
-    render: RenderDesc,
+    render: BTreeMap<Spanned<String>, Spanned<toml::Value>>,
     #[serde(default)]
     camera: CameraDesc,
     #[serde(default)]

@@ -6,23 +6,12 @@
 //! # The file format
 //!
 //! ```toml
-//! [render]                 # every key optional; defaults from RenderSettings::default()
+//! [render]                 # any render setting (RenderSettings::schema, docs/settings.md)
 //! width = 640
-//! height = 480
 //! spp = 16
-//! seed = 0
 //! threads = 2              # absent: all cores
-//! isa = "avx2"             # pin Embree's kernels (sse2, avx, avx2, avx512); absent: the CPU's widest
-//! max_depth = 256
-//! rr_depth = 2            # Russian roulette after this many events
-//! roulette = "sqrt"        # survival sqrt(throughput), or "throughput"
-//! clamp_indirect = 10.0    # absent: no clamping
-//! deep_bounce_depth = 4    # hair past 4 events: one merged lobe (absent: exact throughout)
-//! lobe_cull = 0.01         # drop hair lobes below 1% of the attenuation (default 0: none)
-//! light_threshold = 0.03   # shadow-ray roulette below this contribution (default; 0: every ray)
 //! crop = [0, 0, 320, 240]  # [x0, y0, x1, y1) of the full frame
 //! filter = "tent"          # or "box" (one pixel)
-//! filter_radius = 1.0      # the tent's half-width in pixels
 //!
 //! [camera]                 # optional: without eye and target, an automatic camera frames
 //! eye = [0, 1, 5]          # the grooms (or, with no groom, the meshes other than ground
@@ -110,12 +99,12 @@ use std::path::PathBuf;
 
 use serde::Deserialize;
 
-use crate::embree::{CurveBasis, Device, Isa};
+use crate::embree::CurveBasis;
 use crate::error::Result;
-use crate::render::integrator::{PathSettings, Roulette, World};
+use crate::render::integrator::World;
 use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
-use crate::render::{Aovs, PixelFilter, Progress};
+use crate::render::{Aovs, Progress};
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::groom::{FurBall, ScalpPatch};
@@ -130,7 +119,8 @@ pub use demos::{DEMOS, demo, quick_look};
 /// settings after it: the camera's aspect follows `render.width / render.height`.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SceneDescription {
-    pub render: RenderDesc,
+    /// The `[render]` table.
+    pub render: RenderSettings,
     pub camera: CameraDesc,
     pub materials: BTreeMap<String, MaterialDesc>,
     pub grooms: Vec<GroomDesc>,
@@ -138,93 +128,6 @@ pub struct SceneDescription {
     pub lights: Vec<LightDesc>,
     /// What error messages call this description: the scene file's path, or "demo NAME".
     pub origin: String,
-}
-
-/// The `[render]` table: [`RenderSettings`] with its path settings flattened.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct RenderDesc {
-    pub width: u32,
-    pub height: u32,
-    pub spp: u32,
-    pub seed: u64,
-    pub threads: Option<usize>,
-    /// Embree's kernels pinned to this instruction set (see [`Isa`]); `None`: the widest
-    /// the CPU runs.
-    pub isa: Option<String>,
-    pub max_depth: u32,
-    pub rr_depth: u32,
-    /// "sqrt" (the default) or "throughput": see [`Roulette`].
-    pub roulette: String,
-    pub clamp_indirect: Option<f32>,
-    /// Past this many events a hair BSDF is one merged lobe; None: exact at every event.
-    pub deep_bounce_depth: Option<u32>,
-    /// Hair lobes below this fraction of the attenuation are dropped; 0: none.
-    pub lobe_cull: f32,
-    /// Shadow-ray roulette below this contribution; 0: every shadow ray.
-    pub light_threshold: f32,
-    pub crop: Option<[u32; 4]>,
-    /// "tent" (the default) or "box".
-    pub filter: String,
-    /// The tent's half-width in pixels (default 1).
-    pub filter_radius: Option<f32>,
-}
-
-impl Default for RenderDesc {
-    fn default() -> Self {
-        let s = RenderSettings::default();
-        RenderDesc {
-            width: s.width,
-            height: s.height,
-            spp: s.spp,
-            seed: s.seed,
-            threads: s.threads,
-            isa: None,
-            max_depth: s.path.max_depth,
-            rr_depth: s.path.rr_depth,
-            roulette: s.path.roulette.name().to_string(),
-            clamp_indirect: s.path.clamp_indirect,
-            deep_bounce_depth: s.path.deep_bounce_depth,
-            lobe_cull: s.path.lobe_cull,
-            light_threshold: s.path.light_threshold,
-            crop: s.crop,
-            filter: s.filter.name().0.to_string(),
-            filter_radius: None,
-        }
-    }
-}
-
-impl RenderDesc {
-    /// The Embree device these settings ask for: their thread count and pinned ISA.
-    pub fn device(&self) -> Result<Device> {
-        let isa = self.isa.as_deref().map(Isa::named).transpose()?;
-        Device::pinned(self.threads, isa)
-    }
-
-    /// The validated settings.
-    pub fn settings(&self) -> Result<RenderSettings> {
-        let settings = RenderSettings {
-            width: self.width,
-            height: self.height,
-            spp: self.spp,
-            seed: self.seed,
-            threads: self.threads,
-            crop: self.crop,
-            filter: PixelFilter::named(&self.filter, self.filter_radius)?,
-            path: PathSettings {
-                max_depth: self.max_depth,
-                rr_depth: self.rr_depth,
-                roulette: Roulette::named(&self.roulette)?,
-                clamp_indirect: self.clamp_indirect,
-                deep_bounce_depth: self.deep_bounce_depth,
-                lobe_cull: self.lobe_cull,
-                light_threshold: self.light_threshold,
-                ..PathSettings::default()
-            },
-        };
-        settings.validate()?;
-        Ok(settings)
-    }
 }
 
 /// The `[camera]` table.

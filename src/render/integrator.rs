@@ -3,12 +3,13 @@
 //!
 //! Light hair keeps energy through very many bounces, so the depth cap is high and paths
 //! end mostly by Russian roulette on their throughput, which is unbiased. Which rays are
-//! traced where was chosen by measurement (README, "Render efficiency").
+//! traced where was chosen by measurement (docs/measurements.md, "Render efficiency").
 
 use glam::Vec3;
 
 use super::film::FirstHit;
 use super::sampler::PixelSampler;
+use super::settings::{PathSettings, Roulette, Strategy};
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
 use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, Lobes, LocalBsdf};
@@ -20,60 +21,13 @@ use crate::scene::hit::{HairHit, Hit, SurfaceHit};
 use crate::scene::light::{Light, LightEval};
 use crate::scene::material::Material;
 use crate::scene::tracer::{SpawnedRay, Tracer};
-use crate::validate::positive;
-
-/// How a path's light is gathered. `Mis` is the renderer; the two others exist so that
-/// tests can show MIS is unbiased (all three converge to the same image).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Strategy {
-    #[default]
-    Mis,
-    /// Next-event estimation only: emission found by BSDF sampling is ignored, except
-    /// what the camera sees directly and lights that next-event estimation never samples
-    /// (a uniform environment: see `Light::needs_light_sampling`).
-    LightOnly,
-    /// BSDF sampling only: no shadow rays.
-    BsdfOnly,
-}
-
-/// How Russian roulette turns a path's throughput into its chance to go on. Both are
-/// unbiased (a surviving path is reweighted by 1 / survival); they differ in where they
-/// spend rays. Measured on the bench scenes (README, "Render efficiency").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Roulette {
-    /// Survival = min(1, sqrt(max channel of the throughput)): a dim path lives longer
-    /// than its throughput alone says, which keeps long chains through light hair.
-    #[default]
-    SqrtThroughput,
-    /// Survival = min(1, max channel of the throughput) (pbrt's rule): fewer rays per
-    /// sample, more variance per ray.
-    Throughput,
-}
 
 impl Roulette {
-    /// The rule named `name`: "sqrt" or "throughput".
-    pub fn named(name: &str) -> Result<Self> {
-        match name {
-            "sqrt" => Ok(Roulette::SqrtThroughput),
-            "throughput" => Ok(Roulette::Throughput),
-            _ => Err(invalid_arg!(
-                "unknown roulette {name:?} (choose sqrt or throughput)"
-            )),
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Roulette::SqrtThroughput => "sqrt",
-            Roulette::Throughput => "throughput",
-        }
-    }
-
     /// The probability that a path goes on when it is decided at a hit, before the
     /// vertex is shaded (where no light is sampled: `World::radiance`): the square of
     /// [`Self::survival`], which also stands in for the attenuation of the vertex it has
     /// not seen. Measured on the uniform-sky fur ball: as many rays and the same error as
-    /// the rule after the vertex, in 9% less time (README, "Render efficiency").
+    /// the rule after the vertex, in 9% less time (docs/measurements.md, "Render efficiency").
     pub fn survival_at_hit(self, beta: Vec3) -> f32 {
         let s = self.survival(beta);
         s * s
@@ -91,101 +45,10 @@ impl Roulette {
     }
 }
 
-/// Path settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PathSettings {
-    /// Longest path, in scattering events. 256 keeps a white fur ball's furnace above
-    /// 0.9999 (white fibres scatter for hundreds of bounces); Russian roulette ends most
-    /// paths far earlier.
-    pub max_depth: u32,
-    /// Russian roulette may end a path after this many events (1: after the first).
-    /// The default, 2, always traces the ray that leaves the first hit: on the bench
-    /// scenes that is 1.2-1.25x more efficient than 1 and than 3 (README, "Render
-    /// efficiency"), because the first bounce carries most of the image's light. Where
-    /// no light is sampled, roulette decides at the hits after the first instead, before
-    /// they are shaded ([`Roulette::survival_at_hit`]): 1 then acts as 2.
-    pub rr_depth: u32,
-    pub roulette: Roulette,
-    /// Upper bound on the luminance of any one contribution of indirect light (two or
-    /// more scattering events; biased, reduces fireflies); None = off, the default.
-    pub clamp_indirect: Option<f32>,
-    pub strategy: Strategy,
-    /// Past this many scattering events a hair BSDF is its merged lobe ([`Lobes::Merged`]:
-    /// the same energy, no azimuthal structure: less noise on light hair, at a bias);
-    /// None = the exact model at every event, the default (README, "Speed against
-    /// error": what it costs and buys). In [1, max_depth]; max_depth leaves every event
-    /// exact.
-    pub deep_bounce_depth: Option<u32>,
-    /// Hair lobes whose attenuation is below this fraction of the total are dropped
-    /// ([`Lobes::Culled`]); 0 = off, the default. In [0, 1).
-    pub lobe_cull: f32,
-    /// Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
-    /// (path throughput included, largest channel) is below this value has its shadow ray
-    /// traced with probability contribution / threshold, and is reweighted by the inverse:
-    /// unbiased, and most of the shadow rays of hair carry almost nothing (narrow lobes,
-    /// dim deep paths). In the image's units; 0 traces every shadow ray. The default was
-    /// chosen on the bench scenes (README, "Render efficiency").
-    pub light_threshold: f32,
-}
-
 /// The least probability with which shadow-ray roulette traces a shadow ray.
 const MIN_SHADOW_SURVIVAL: f32 = 1.0 / 1_048_576.0;
 
-/// [`PathSettings::light_threshold`]'s default.
-pub const DEFAULT_LIGHT_THRESHOLD: f32 = 0.03;
-
-impl Default for PathSettings {
-    fn default() -> Self {
-        PathSettings {
-            max_depth: 256,
-            rr_depth: 2,
-            roulette: Roulette::default(),
-            clamp_indirect: None,
-            strategy: Strategy::Mis,
-            deep_bounce_depth: None,
-            lobe_cull: 0.0,
-            light_threshold: DEFAULT_LIGHT_THRESHOLD,
-        }
-    }
-}
-
 impl PathSettings {
-    pub fn validate(&self) -> Result<()> {
-        if self.max_depth == 0 {
-            return Err(invalid_arg!("max_depth = 0: must be at least 1"));
-        }
-        if self.rr_depth == 0 {
-            return Err(invalid_arg!(
-                "rr_depth = 0: must be at least 1 (roulette decides after an event)"
-            ));
-        }
-        if let Some(c) = self.clamp_indirect {
-            positive("clamp_indirect", c)?;
-        }
-        if let Some(n) = self.deep_bounce_depth {
-            if n == 0 || n > self.max_depth {
-                return Err(invalid_arg!(
-                    "deep_bounce_depth = {n}: must be in [1, max_depth = {}] (unset, or 0 \
-                     in C, for the exact BSDF at every event)",
-                    self.max_depth
-                ));
-            }
-        }
-        if !(self.light_threshold.is_finite() && self.light_threshold >= 0.0) {
-            return Err(invalid_arg!(
-                "light_threshold = {}: must be finite and >= 0 (0: every shadow ray)",
-                self.light_threshold
-            ));
-        }
-        if !(0.0..1.0).contains(&self.lobe_cull) {
-            return Err(invalid_arg!(
-                "lobe_cull = {}: must be in [0, 1) (0: every lobe)",
-                self.lobe_cull
-            ));
-        }
-        Ok(())
-    }
-
     /// The hair lobes a vertex evaluates after `events` scattering events.
     fn lobes(&self, events: u32) -> Lobes {
         if self.deep_bounce_depth.is_some_and(|n| events >= n) {
@@ -362,7 +225,7 @@ impl World {
             let mis = settings.strategy == Strategy::Mis
                 && self.sampled_light_along(ray.ray.org, ray.ray.dir);
             came = Came::Bsdf {
-                pdf: mis.then(|| shading.pdf(s.local)),
+                pdf: if mis { shading.pdf(s.local) } else { 0.0 },
             };
         }
         (l, first, rays)
@@ -402,9 +265,10 @@ impl World {
                 _ if light_pdf == 0.0 => 1.0,
                 (_, Strategy::LightOnly) => 0.0,
                 // `sampled_light_along` saw this light, so the pdf is there.
-                (Came::Bsdf { pdf }, Strategy::Mis) => {
-                    pdf.map_or(1.0, |pdf| power_heuristic(1.0, pdf, 1.0, light_pdf))
+                (Came::Bsdf { pdf }, Strategy::Mis) if pdf > 0.0 => {
+                    power_heuristic(1.0, pdf, 1.0, light_pdf)
                 }
+                (Came::Bsdf { .. }, Strategy::Mis) => 1.0,
             };
             sum += e.radiance * weight;
         }
@@ -504,8 +368,10 @@ enum Came {
     /// From the camera: emission is seen with full weight.
     Camera,
     /// By BSDF sampling. `pdf` is its density, for MIS, where the ray may meet a light
-    /// that next-event estimation samples; None elsewhere.
-    Bsdf { pdf: Option<f32> },
+    /// that next-event estimation samples; 0 elsewhere (a sampled direction's density is
+    /// never 0). A plain number rather than an Option, whose unset payload memcheck sees
+    /// as read when the compiler merges the match's branches.
+    Bsdf { pdf: f32 },
 }
 
 /// What `light` emits toward `org` along `dir` if the ray reaches it: a light at infinity

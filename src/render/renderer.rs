@@ -44,7 +44,7 @@ pub fn render(
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
     let mut film = Film::new(settings.width, settings.height, crop, aovs)?;
-    let filter = settings.filter;
+    let filter = settings.pixel_filter()?;
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),

@@ -1,75 +1,545 @@
-//! What a render is asked to do: image size, samples, seed, threads, crop window, paths.
+//! Every render setting, declared once: name, type, default, range and doc in one line of
+//! `settings!` below. The TOML `[render]` table, the command line (`--NAME VALUE` and
+//! `--set NAME=VALUE`) and the C ABI (`ht_settings_set(settings, "NAME", "VALUE")`) all read
+//! settings by name through [`RenderSettings::set`], so a new setting is one line here plus
+//! its use, and never changes the C ABI's layout.
+//!
+//! Every surface speaks text: `set` parses it with the setting's type ([`Value`]) and checks
+//! the declared [`Range`], and errors name the key and the range.
+
+use std::fmt;
 
 use super::film::PixelFilter;
-use super::integrator::PathSettings;
-use crate::error::{Result, invalid_arg};
+use crate::embree::{Device, Isa};
+use crate::error::{Error, Result, invalid_arg};
 
-/// Settings of one render. The image depends only on these and the scene: never on the
-/// thread count or the order tiles finish in.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    /// Samples per pixel.
-    pub spp: u32,
-    pub seed: u64,
-    /// Worker threads; None = all cores.
-    pub threads: Option<usize>,
-    /// Pixels [x0, x1) x [y0, y1) of the full frame to render; None = all. A crop renders
-    /// exactly the pixels the full frame has there, so pieces assemble bit for bit.
-    pub crop: Option<[u32; 4]>,
-    /// Where in and around its pixel each sample lands (validated when built).
-    pub filter: PixelFilter,
-    pub path: PathSettings,
+/// A value a setting can hold, read from and written as text.
+pub trait Value: Sized {
+    /// What the text must be, for help and errors ("an integer", "sqrt or throughput").
+    fn kind() -> String;
+    fn parse(text: &str) -> Option<Self>;
+    fn show(&self) -> String;
+    /// The number a [`Range`] checks; None where there is none (a name, unset).
+    fn number(&self) -> Option<f64> {
+        None
+    }
 }
 
-impl Default for RenderSettings {
-    fn default() -> Self {
-        RenderSettings {
-            width: 640,
-            height: 480,
-            spp: 16,
-            seed: 0,
-            threads: None,
-            crop: None,
-            filter: PixelFilter::default(),
-            path: PathSettings::default(),
+macro_rules! numeric_value {
+    ($($t:ty => $kind:literal),*) => {$(
+        impl Value for $t {
+            fn kind() -> String {
+                $kind.into()
+            }
+            fn parse(text: &str) -> Option<Self> {
+                text.trim().parse().ok()
+            }
+            fn show(&self) -> String {
+                self.to_string()
+            }
+            fn number(&self) -> Option<f64> {
+                Some(*self as f64)
+            }
+        }
+    )*};
+}
+numeric_value!(u32 => "an integer", u64 => "an integer", usize => "an integer");
+
+impl Value for f32 {
+    fn kind() -> String {
+        "a number".into()
+    }
+    fn parse(text: &str) -> Option<Self> {
+        // NaN and infinities are never a setting.
+        text.trim().parse().ok().filter(|v: &f32| v.is_finite())
+    }
+    fn show(&self) -> String {
+        self.to_string()
+    }
+    fn number(&self) -> Option<f64> {
+        Some(f64::from(*self))
+    }
+}
+
+/// Unset is written `none`.
+impl<T: Value> Value for Option<T> {
+    fn kind() -> String {
+        format!("{} or none", T::kind())
+    }
+    fn parse(text: &str) -> Option<Self> {
+        match text.trim() {
+            "none" => Some(None),
+            t => T::parse(t).map(Some),
         }
     }
+    fn show(&self) -> String {
+        self.as_ref().map_or("none".into(), T::show)
+    }
+    fn number(&self) -> Option<f64> {
+        self.as_ref().and_then(T::number)
+    }
+}
+
+/// A pixel window `x0,y0,x1,y1`.
+impl Value for [u32; 4] {
+    fn kind() -> String {
+        "x0,y0,x1,y1".into()
+    }
+    fn parse(text: &str) -> Option<Self> {
+        let v: Vec<u32> = text
+            .split(',')
+            .map(|x| x.trim().parse().ok())
+            .collect::<Option<_>>()?;
+        v.try_into().ok()
+    }
+    fn show(&self) -> String {
+        self.map(|v| v.to_string()).join(",")
+    }
+}
+
+/// A setting's choices, each by its name.
+macro_rules! named_value {
+    ($t:ty { $($variant:ident = $name:literal),* $(,)? }) => {
+        impl Value for $t {
+            fn kind() -> String {
+                [$($name),*].join(" | ")
+            }
+            fn parse(text: &str) -> Option<Self> {
+                match text.trim() {
+                    $($name => Some(<$t>::$variant),)*
+                    _ => None,
+                }
+            }
+            fn show(&self) -> String {
+                match self {
+                    $(<$t>::$variant => $name.into(),)*
+                }
+            }
+        }
+    };
+}
+named_value!(Roulette { SqrtThroughput = "sqrt", Throughput = "throughput" });
+named_value!(Strategy { Mis = "mis", LightOnly = "light", BsdfOnly = "bsdf" });
+named_value!(Filter { Tent = "tent", Box = "box" });
+named_value!(Isa { Sse2 = "sse2", Avx = "avx", Avx2 = "avx2", Avx512 = "avx512" });
+
+/// The values a numeric setting may take.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Range {
+    Any,
+    /// `>= a`
+    AtLeast(f64),
+    /// `> a`
+    Above(f64),
+    /// `[a, b]`
+    Closed(f64, f64),
+    /// `[a, b)`
+    ClosedOpen(f64, f64),
+    /// `(a, b]`
+    OpenClosed(f64, f64),
+}
+
+impl Range {
+    fn holds(self, x: f64) -> bool {
+        match self {
+            Range::Any => true,
+            Range::AtLeast(a) => x >= a,
+            Range::Above(a) => x > a,
+            Range::Closed(a, b) => (a..=b).contains(&x),
+            Range::ClosedOpen(a, b) => (a..b).contains(&x),
+            Range::OpenClosed(a, b) => x > a && x <= b,
+        }
+    }
+}
+
+impl fmt::Display for Range {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Range::Any => write!(f, "any"),
+            Range::AtLeast(a) => write!(f, ">= {a}"),
+            Range::Above(a) => write!(f, "> {a}"),
+            Range::Closed(a, b) => write!(f, "[{a}, {b}]"),
+            Range::ClosedOpen(a, b) => write!(f, "[{a}, {b})"),
+            Range::OpenClosed(a, b) => write!(f, "({a}, {b}]"),
+        }
+    }
+}
+
+/// One setting of the schema: what help, docs and the C ABI list.
+pub struct Setting {
+    pub name: &'static str,
+    /// The doc comment's lines.
+    doc: &'static [&'static str],
+    pub range: Range,
+    kind: fn() -> String,
+    default: fn() -> String,
+    get: fn(&RenderSettings) -> String,
+    set: fn(&mut RenderSettings, &str) -> std::result::Result<(), String>,
+    check: fn(&RenderSettings) -> std::result::Result<(), String>,
+}
+
+impl Setting {
+    /// The doc comment as one paragraph.
+    pub fn doc(&self) -> String {
+        self.doc
+            .iter()
+            .map(|l| l.trim())
+            .collect::<Vec<_>>()
+            .join(" ")
+    }
+    /// What its text must be: "an integer", "sqrt | throughput", ...
+    pub fn kind(&self) -> String {
+        (self.kind)()
+    }
+    /// The default, as text.
+    pub fn default_text(&self) -> String {
+        (self.default)()
+    }
+    /// Where `range` says more than `kind`: "an integer, >= 1".
+    pub fn allowed(&self) -> String {
+        match self.range {
+            Range::Any => self.kind(),
+            r => format!("{}, {r}", self.kind()),
+        }
+    }
+}
+
+/// `value` parsed as a `T` within `range`, or what is wrong with it.
+fn parsed<T: Value>(text: &str, range: Range) -> std::result::Result<T, String> {
+    let v = T::parse(text).ok_or_else(|| format!("must be {}", T::kind()))?;
+    within(&v, range)?;
+    Ok(v)
+}
+
+fn within<T: Value>(v: &T, range: Range) -> std::result::Result<(), String> {
+    match v.number() {
+        // Fields set directly (the Rust API, the C struct) may hold NaN or infinities.
+        Some(x) if !x.is_finite() => Err(format!("must be finite, {range}")),
+        Some(x) if !range.holds(x) => Err(format!("must be {range}")),
+        _ => Ok(()),
+    }
+}
+
+macro_rules! settings {
+    (
+        $(#[$rmeta:meta])*
+        pub struct RenderSettings {
+            $( $(#[doc = $rdoc:literal])* $rname:ident : $rty:ty = $rdefault:expr, $rrange:expr; )*
+        }
+        $(#[$pmeta:meta])*
+        pub struct PathSettings {
+            $( $(#[doc = $pdoc:literal])* $pname:ident : $pty:ty = $pdefault:expr, $prange:expr; )*
+        }
+    ) => {
+        $(#[$rmeta])*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub struct RenderSettings {
+            $( $(#[doc = $rdoc])* pub $rname: $rty, )*
+            /// How paths are traced.
+            pub path: PathSettings,
+        }
+
+        $(#[$pmeta])*
+        #[derive(Debug, Clone, Copy, PartialEq)]
+        pub struct PathSettings {
+            $( $(#[doc = $pdoc])* pub $pname: $pty, )*
+        }
+
+        impl Default for RenderSettings {
+            fn default() -> Self {
+                RenderSettings { $($rname: $rdefault,)* path: PathSettings::default() }
+            }
+        }
+
+        impl Default for PathSettings {
+            fn default() -> Self {
+                PathSettings { $($pname: $pdefault,)* }
+            }
+        }
+
+        /// The schema, in declaration order.
+        static SETTINGS: &[Setting] = &[
+            $(Setting {
+                name: stringify!($rname),
+                doc: &[$($rdoc),*],
+                range: $rrange,
+                kind: <$rty as Value>::kind,
+                default: || Value::show(&RenderSettings::default().$rname),
+                get: |s| Value::show(&s.$rname),
+                set: |s, t| Ok(s.$rname = parsed(t, $rrange)?),
+                check: |s| within(&s.$rname, $rrange),
+            },)*
+            $(Setting {
+                name: stringify!($pname),
+                doc: &[$($pdoc),*],
+                range: $prange,
+                kind: <$pty as Value>::kind,
+                default: || Value::show(&PathSettings::default().$pname),
+                get: |s| Value::show(&s.path.$pname),
+                set: |s, t| Ok(s.path.$pname = parsed(t, $prange)?),
+                check: |s| within(&s.path.$pname, $prange),
+            },)*
+        ];
+    };
+}
+
+settings! {
+    /// Settings of one render. The image depends only on these and the scene: never on the
+    /// thread count or the order tiles finish in. Read and written by name with
+    /// [`RenderSettings::set`] and [`RenderSettings::get`]; [`RenderSettings::schema`] lists
+    /// them.
+    pub struct RenderSettings {
+        /// Image width in pixels.
+        width: u32 = 640, Range::Closed(1.0, MAX_SIDE as f64);
+        /// Image height in pixels.
+        height: u32 = 480, Range::Closed(1.0, MAX_SIDE as f64);
+        /// Samples per pixel.
+        spp: u32 = 16, Range::AtLeast(1.0);
+        /// The image depends only on the scene, the settings and this seed.
+        seed: u64 = 0, Range::Any;
+        /// Worker threads; none: one per hardware thread.
+        threads: Option<usize> = None, Range::AtLeast(1.0);
+        /// Pin Embree's kernels to one instruction set, so that crops rendered on different
+        /// CPUs assemble bit for bit (docs/farm.md); none: the widest this CPU runs.
+        isa: Option<Isa> = None, Range::Any;
+        /// Render only the pixels [x0, x1) x [y0, y1) of the full frame, exactly as the full
+        /// render has them; none: the full frame.
+        crop: Option<[u32; 4]> = None, Range::Any;
+        /// Pixel filter: tent (thin strands alias under a box) or box (one pixel, as
+        /// renderers that use it).
+        filter: Filter = Filter::Tent, Range::Any;
+        /// The tent's half-width in pixels (the box ignores it).
+        filter_radius: f32 = 1.0, Range::OpenClosed(0.0, 8.0);
+    }
+
+    /// How paths are traced and ended, and the hair BSDF's fidelity knobs.
+    pub struct PathSettings {
+        /// Longest path, in scattering events. 256 keeps a white fur ball's furnace above
+        /// 0.9999 (white fibres scatter for hundreds of bounces); Russian roulette ends most
+        /// paths far earlier.
+        max_depth: u32 = 256, Range::AtLeast(1.0);
+        /// Russian roulette may end a path after this many events. 2 always traces the ray
+        /// that leaves the first hit: 1.2-1.25x more efficient than 1 or 3 on the bench
+        /// scenes.
+        rr_depth: u32 = 2, Range::AtLeast(1.0);
+        /// Russian roulette's survival: sqrt (of the path throughput's largest channel:
+        /// keeps long chains through light hair) or throughput (pbrt's rule).
+        roulette: Roulette = Roulette::SqrtThroughput, Range::Any;
+        /// Upper bound on the luminance of one contribution of indirect light (biased, cuts
+        /// fireflies); none: no clamping.
+        clamp_indirect: Option<f32> = None, Range::Above(0.0);
+        /// How light is gathered: mis (the renderer), light or bsdf (one strategy alone,
+        /// which tests use to show that MIS is unbiased).
+        strategy: Strategy = Strategy::Mis, Range::Any;
+        /// Past this many scattering events a hair BSDF is one merged lobe (the same
+        /// energy, no azimuthal highlights: less noise on light hair, at a bias); none: the
+        /// exact model at every event. At most max_depth.
+        deep_bounce_depth: Option<u32> = None, Range::AtLeast(1.0);
+        /// Hair lobes whose attenuation is below this fraction of the total are dropped;
+        /// 0: every lobe. Measured to save no time on the bench scenes.
+        lobe_cull: f32 = 0.0, Range::ClosedOpen(0.0, 1.0);
+        /// Shadow-ray roulette: a light sample contributing less than this to the pixel
+        /// (largest channel) traces its shadow ray with probability contribution /
+        /// threshold, reweighted (unbiased); 0: every shadow ray.
+        light_threshold: f32 = 0.03, Range::AtLeast(0.0);
+    }
+}
+
+/// How Russian roulette turns a path's throughput into its chance to go on. Both are
+/// unbiased (a surviving path is reweighted by 1 / survival); they differ in where they
+/// spend rays.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Roulette {
+    /// Survival = min(1, sqrt(max channel of the throughput)): a dim path lives longer
+    /// than its throughput alone says, which keeps long chains through light hair.
+    SqrtThroughput,
+    /// Survival = min(1, max channel of the throughput) (pbrt's rule): fewer rays per
+    /// sample, more variance per ray.
+    Throughput,
+}
+
+/// How a path's light is gathered. `Mis` is the renderer; the two others exist so that
+/// tests can show MIS is unbiased (all three converge to the same image).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strategy {
+    Mis,
+    /// Next-event estimation only: emission found by BSDF sampling is ignored, except
+    /// what the camera sees directly and lights that next-event estimation never samples
+    /// (a uniform environment: see `Light::needs_light_sampling`).
+    LightOnly,
+    /// BSDF sampling only: no shadow rays.
+    BsdfOnly,
+}
+
+/// The pixel filter's kind (its radius is `filter_radius`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    Tent,
+    Box,
 }
 
 /// Largest accepted image side, so that a typo cannot ask for terabytes.
 pub(crate) const MAX_SIDE: u32 = 1 << 15;
 
 impl RenderSettings {
+    /// Every setting, in declaration order.
+    pub fn schema() -> &'static [Setting] {
+        SETTINGS
+    }
+
+    fn setting(key: &str) -> Result<&'static Setting> {
+        SETTINGS.iter().find(|s| s.name == key).ok_or_else(|| {
+            invalid_arg!(
+                "{key}: not a render setting (the settings: {})",
+                SETTINGS
+                    .iter()
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        })
+    }
+
+    /// Sets `key` from its text (`"16"`, `"box"`, `"none"`, `"0,0,64,48"`), checked against
+    /// the setting's type and range; an error names the key and what it allows. Checks
+    /// across settings (a crop inside the frame) wait for [`Self::validate`].
+    pub fn set(&mut self, key: &str, value: &str) -> Result<()> {
+        let s = Self::setting(key)?;
+        (s.set)(self, value).map_err(|why| Error::InvalidArg(format!("{key} = {value}: {why}")))
+    }
+
+    /// The value of `key`, as [`Self::set`] reads it.
+    pub fn get(&self, key: &str) -> Result<String> {
+        Ok((Self::setting(key)?.get)(self))
+    }
+
+    /// Checks every setting's range and the rules between settings.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in [("width", self.width), ("height", self.height)] {
-            if v == 0 || v > MAX_SIDE {
-                return Err(invalid_arg!("{name} = {v}: must be in [1, {MAX_SIDE}]"));
-            }
-        }
-        if self.spp == 0 {
-            return Err(invalid_arg!("spp = 0: must be at least 1"));
-        }
-        if self.threads == Some(0) {
-            return Err(invalid_arg!(
-                "threads = 0: must be at least 1 (or unset for all cores)"
-            ));
+        for s in SETTINGS {
+            (s.check)(self).map_err(|why| {
+                Error::InvalidArg(format!("{} = {}: {why}", s.name, (s.get)(self)))
+            })?;
         }
         if let Some([x0, y0, x1, y1]) = self.crop {
             if !(x0 < x1 && y0 < y1 && x1 <= self.width && y1 <= self.height) {
                 return Err(invalid_arg!(
-                    "crop = [{x0}, {y0}, {x1}, {y1}]: must satisfy x0 < x1 <= width ({}) and y0 < y1 <= height ({})",
+                    "crop = {x0},{y0},{x1},{y1}: must satisfy x0 < x1 <= width ({}) and y0 < y1 \
+                     <= height ({})",
                     self.width,
                     self.height
                 ));
             }
         }
-        self.path.validate()
+        if let Some(n) = self.path.deep_bounce_depth {
+            if n > self.path.max_depth {
+                return Err(invalid_arg!(
+                    "deep_bounce_depth = {n}: must be at most max_depth = {} (none: the exact \
+                     BSDF at every event)",
+                    self.path.max_depth
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The crop window, or the full frame.
     pub fn window(&self) -> [u32; 4] {
         self.crop.unwrap_or([0, 0, self.width, self.height])
+    }
+
+    /// Where in and around its pixel each sample lands.
+    pub fn pixel_filter(&self) -> Result<PixelFilter> {
+        match self.filter {
+            Filter::Tent => PixelFilter::tent(self.filter_radius),
+            Filter::Box => Ok(PixelFilter::BOX),
+        }
+    }
+
+    /// The Embree device these settings ask for: their thread count and pinned ISA.
+    pub fn device(&self) -> Result<Device> {
+        Device::pinned(self.threads, self.isa)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_setting_round_trips_its_default_through_text() {
+        let d = RenderSettings::default();
+        for s in RenderSettings::schema() {
+            let mut r = RenderSettings::default();
+            r.set(s.name, &s.default_text()).unwrap();
+            assert_eq!(r, d, "{}", s.name);
+            assert_eq!(r.get(s.name).unwrap(), s.default_text());
+            assert!(!s.doc().is_empty(), "{} has no doc", s.name);
+        }
+        d.validate().unwrap();
+    }
+
+    #[test]
+    fn set_reaches_the_field_and_refuses_what_the_schema_refuses() {
+        let mut r = RenderSettings::default();
+        r.set("spp", "64").unwrap();
+        r.set("roulette", "throughput").unwrap();
+        r.set("crop", "0,0,32,16").unwrap();
+        r.set("clamp_indirect", "10").unwrap();
+        r.set("isa", "sse2").unwrap();
+        assert_eq!(
+            (r.spp, r.path.roulette, r.crop, r.path.clamp_indirect, r.isa),
+            (
+                64,
+                Roulette::Throughput,
+                Some([0, 0, 32, 16]),
+                Some(10.0),
+                Some(Isa::Sse2)
+            )
+        );
+        for (key, value, says) in [
+            ("spp", "0", "spp = 0: must be >= 1"),
+            ("spp", "1.5", "must be an integer"),
+            ("width", "40000", "must be [1, 32768]"),
+            ("lobe_cull", "1", "must be [0, 1)"),
+            ("light_threshold", "NaN", "must be a number"),
+            ("light_threshold", "inf", "must be a number"),
+            ("clamp_indirect", "0", "must be > 0"),
+            ("roulette", "cube", "must be sqrt | throughput"),
+            ("filter_radius", "0", "must be (0, 8]"),
+            ("sp", "4", "sp: not a render setting"),
+        ] {
+            let before = r;
+            let e = r.set(key, value).unwrap_err().to_string();
+            assert!(e.contains(says), "{key} = {value}: {e}");
+            assert_eq!(r, before, "a refused value must change nothing");
+        }
+    }
+
+    #[test]
+    fn validate_checks_ranges_of_fields_set_directly_and_rules_between_settings() {
+        let mut r = RenderSettings::default();
+        r.path.lobe_cull = 1.0;
+        assert!(
+            r.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("lobe_cull = 1")
+        );
+        let r = RenderSettings {
+            crop: Some([0, 0, 641, 10]),
+            ..RenderSettings::default()
+        };
+        assert!(r.validate().unwrap_err().to_string().contains("crop"));
+        let mut r = RenderSettings::default();
+        r.path.max_depth = 4;
+        r.path.deep_bounce_depth = Some(5);
+        assert!(
+            r.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("at most max_depth")
+        );
+        r.path.deep_bounce_depth = Some(4);
+        r.validate().unwrap();
     }
 }

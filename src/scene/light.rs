@@ -148,7 +148,7 @@ impl Light {
     /// environment: its radiance is the same from every direction, so the BSDF-sampled
     /// ray a path traces anyway estimates it with the BSDF's own importance, and a shadow
     /// ray toward a uniformly drawn direction would double the rays for little gain
-    /// (measured: README, "Render efficiency").
+    /// (measured: docs/measurements.md, "Render efficiency").
     pub(crate) fn needs_light_sampling(&self) -> bool {
         !matches!(self, Light::Environment(env) if env.is_uniform())
     }

@@ -6,7 +6,7 @@
 //! (by up to a radius) and at end caps and joints, differences that a strand thinner than a
 //! pixel hides inside the pixel. A flat linear curve costs Embree 1.5-1.8x less per ray than
 //! a round one. On the bench scenes the ribbons' images differ from the tubes' by under a
-//! third of a bench render's own noise (RMSE at equal samples 2-4% higher; README, "Curve
+//! third of a bench render's own noise (RMSE at equal samples 2-4% higher; docs/measurements.md, "Curve
 //! shapes").
 //!
 //! A thin Catmull-Rom strand whose curve stays within [`POLYLINE_PIXELS`] of a pixel of

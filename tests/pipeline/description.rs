@@ -14,7 +14,7 @@ use hairtrace::description::{
 };
 use hairtrace::embree::{CurveBasis, Device};
 use hairtrace::render::PixelFilter;
-use hairtrace::render::integrator::Roulette;
+use hairtrace::render::settings::Roulette;
 use hairtrace::scene::GroomShape;
 use hairtrace::scene::material::HairColor;
 use hairtrace::scene::{FurBall, HairStyle, Thickness, write_hair_file};
@@ -163,7 +163,7 @@ fn every_demo_builds() {
 #[test]
 fn furnace_demo_is_a_furnace() {
     let desc = demo("furnace").unwrap();
-    assert_eq!(desc.render.max_depth, 256);
+    assert_eq!(desc.render.path.max_depth, 256);
     assert_eq!(
         desc.lights,
         vec![LightDesc::Environment {
@@ -203,7 +203,7 @@ fn cli_style_overrides_reach_the_settings() {
     desc.render.spp = 3;
     desc.render.width = 64;
     desc.render.height = 32;
-    desc.render.max_depth = 12;
+    desc.render.path.max_depth = 12;
     let built = desc.build(device()).unwrap();
     assert_eq!(built.settings.spp, 3);
     assert_eq!((built.settings.width, built.settings.height), (64, 32));
@@ -389,22 +389,22 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
         "[render]\nfilter = \"box\"\nroulette = \"throughput\"\nrr_depth = 3\n{BASE}"
     ))
     .unwrap();
-    let s = d.render.settings().unwrap();
-    assert_eq!(s.filter, PixelFilter::BOX);
+    let s = d.render;
+    assert_eq!(s.pixel_filter().unwrap(), PixelFilter::BOX);
     assert_eq!(
         (s.path.roulette, s.path.rr_depth),
         (Roulette::Throughput, 3)
     );
     let d = parse(&format!("[render]\nfilter_radius = 2\n{BASE}")).unwrap();
     assert_eq!(
-        d.render.settings().unwrap().filter,
+        d.render.pixel_filter().unwrap(),
         PixelFilter::tent(2.0).unwrap()
     );
     let d = parse(&format!(
         "[render]\ndeep_bounce_depth = 3\nlobe_cull = 0.05\nlight_threshold = 0\n{BASE}"
     ))
     .unwrap();
-    let s = d.render.settings().unwrap();
+    let s = d.render;
     assert_eq!(
         (
             s.path.deep_bounce_depth,
@@ -415,8 +415,8 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
     );
     // The defaults: a tent of one pixel, roulette on sqrt(throughput) after two events,
     // the exact hair BSDF at every event.
-    let s = parse(BASE).unwrap().render.settings().unwrap();
-    assert_eq!(s.filter, PixelFilter::default());
+    let s = parse(BASE).unwrap().render;
+    assert_eq!(s.pixel_filter().unwrap(), PixelFilter::default());
     assert_eq!(
         (s.path.roulette, s.path.rr_depth),
         (Roulette::SqrtThroughput, 2)
@@ -427,32 +427,34 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
     for (keys, expect) in [
         (
             "filter = \"gauss\"",
-            &["render", "\"gauss\"", "box or tent"][..],
+            &["test.toml:2:1", "render.filter = gauss", "tent | box"][..],
         ),
-        (
-            "filter = \"box\"\nfilter_radius = 2",
-            &["render", "filter_radius = 2"],
-        ),
-        ("filter_radius = 0", &["render", "radius 0"]),
+        ("filter_radius = 0", &["render.filter_radius = 0", "(0, 8]"]),
         (
             "roulette = \"maybe\"",
-            &["render", "\"maybe\"", "sqrt or throughput"],
+            &["render.roulette = maybe", "sqrt | throughput"],
         ),
-        ("rr_depth = 0", &["render", "rr_depth = 0"]),
+        ("rr_depth = 0", &["render.rr_depth = 0", ">= 1"]),
+        ("deep_bounce_depth = 0", &["render.deep_bounce_depth = 0"]),
+        ("lobe_cull = 1.5", &["render.lobe_cull = 1.5", "[0, 1)"]),
         (
-            "deep_bounce_depth = 0",
-            &["render", "deep_bounce_depth = 0"],
+            "light_threshold = -1",
+            &["render.light_threshold = -1", ">= 0"],
         ),
-        (
-            "max_depth = 4\ndeep_bounce_depth = 5",
-            &["render", "deep_bounce_depth = 5", "max_depth = 4"],
-        ),
-        ("lobe_cull = 1.5", &["render", "lobe_cull = 1.5"]),
-        ("light_threshold = -1", &["render", "light_threshold = -1"]),
+        ("spp = \"many\"", &["render.spp = many", "an integer"]),
+        ("crop = [1, 2]", &["render.crop = 1,2", "x0,y0,x1,y1"]),
     ] {
-        let e = build_error(&format!("[render]\n{keys}\n{BASE}")).to_string();
+        let e = parse_error(&format!("[render]\n{keys}\n{BASE}"));
         assert_contains(&e, expect);
     }
+    // Rules between settings are checked when the scene is built.
+    let e = build_error(&format!(
+        "[render]\nmax_depth = 4\ndeep_bounce_depth = 5\n{BASE}"
+    ));
+    assert_contains(
+        &e.to_string(),
+        &["render", "deep_bounce_depth = 5", "max_depth = 4"],
+    );
 }
 
 /// The peer benchmark's scenes are scene files like any other: they parse, build and
@@ -483,8 +485,8 @@ fn bad_values_name_their_entry() {
     let e = build_error(&BASE.replace("radiance = [1, 1, 1]", "radiance = [-1, 1, 1]")).to_string();
     assert_contains(&e, &["test.toml: light[0]", "radiance", "-1"]);
 
-    let e = build_error(&format!("[render]\nwidth = 0\n{BASE}")).to_string();
-    assert_contains(&e, &["test.toml: render", "width = 0"]);
+    let e = parse_error(&format!("[render]\nwidth = 0\n{BASE}"));
+    assert_contains(&e, &["test.toml:2:1: render", "width = 0"]);
 
     let e = build_error(&BASE.replace("strands = 50", "strands = 0")).to_string();
     assert_contains(&e, &["groom[0]", "strands"]);

@@ -178,7 +178,10 @@ fn the_fixture_reads_into_pbrts_numbers() {
     assert_eq!(c.target, Some([0.0, 1.0, 5.0]));
     assert_eq!((c.up, c.fov_deg), ([0.0, 1.0, 0.0], 30.0));
     let r = &d.render;
-    assert_eq!((r.width, r.height, r.spp, r.max_depth), (64, 48, 4, 16));
+    assert_eq!(
+        (r.width, r.height, r.spp, r.path.max_depth),
+        (64, 48, 4, 16)
+    );
     assert_eq!(s.film_filename.as_deref(), Some(Path::new("hair.exr")));
     assert_eq!(d.meshes.len(), 1);
 }

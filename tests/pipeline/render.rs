@@ -3,9 +3,9 @@
 
 use glam::Vec3;
 use hairtrace::embree::{CurveBasis, CurveShape, Device, SceneOptions};
-use hairtrace::render::integrator::{PathSettings, Strategy, World};
+use hairtrace::render::integrator::World;
 use hairtrace::render::renderer::render;
-use hairtrace::render::settings::RenderSettings;
+use hairtrace::render::settings::{PathSettings, RenderSettings, Strategy};
 use hairtrace::render::{Aovs, NoProgress, RenderStatus};
 use hairtrace::scene::FurBall;
 use hairtrace::scene::camera::Camera;
@@ -408,7 +408,7 @@ fn fidelity_settings_out_of_range_are_refused() {
                 deep_bounce_depth: Some(9),
                 ..path
             },
-            "deep_bounce_depth = 9: must be in [1, max_depth = 8]",
+            "deep_bounce_depth = 9: must be at most max_depth = 8",
         ),
         (
             PathSettings {
@@ -422,7 +422,7 @@ fn fidelity_settings_out_of_range_are_refused() {
                 lobe_cull: 1.0,
                 ..path
             },
-            "lobe_cull = 1: must be in [0, 1)",
+            "lobe_cull = 1: must be [0, 1)",
         ),
         (
             PathSettings {
@@ -432,7 +432,7 @@ fn fidelity_settings_out_of_range_are_refused() {
             "lobe_cull = NaN",
         ),
     ] {
-        let e = bad.validate().unwrap_err().to_string();
+        let e = settings(bad).validate().unwrap_err().to_string();
         assert!(e.contains(words), "{e}");
     }
     let fine = PathSettings {
@@ -440,5 +440,13 @@ fn fidelity_settings_out_of_range_are_refused() {
         lobe_cull: 0.5,
         ..path
     };
-    fine.validate().unwrap();
+    settings(fine).validate().unwrap();
+}
+
+/// Default render settings with these path settings.
+fn settings(path: PathSettings) -> RenderSettings {
+    RenderSettings {
+        path,
+        ..RenderSettings::default()
+    }
 }

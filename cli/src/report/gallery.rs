@@ -7,7 +7,6 @@ use super::{Context, bench_scene};
 use hairtrace::bsdf::sigma_a_preset;
 use hairtrace::description::MaterialDesc;
 use hairtrace::image::{Image, srgb_encode};
-use hairtrace::render::integrator::Strategy;
 use hairtrace::scene::material::{HairColor, HairMaterial};
 use hairtrace::{Error, Result};
 use plotters::prelude::*;
@@ -119,11 +118,7 @@ fn render_tile(ctx: &Context, look: Look) -> Result<Image> {
             look.apply(hair)?;
         }
     }
-    let (image, _, _) = Built::new(&Variant {
-        desc,
-        strategy: Strategy::Mis,
-    })?
-    .render(spp, 1)?;
+    let (image, _, _) = Built::new(&Variant { desc })?.render(spp, 1)?;
     Ok(image)
 }
 

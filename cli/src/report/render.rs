@@ -5,20 +5,18 @@
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
 use super::{Context, bench_scene, median};
-use hairtrace::description::{GroomSource, RenderDesc, SceneDescription};
+use hairtrace::description::{GroomSource, SceneDescription};
 use hairtrace::embree::CurveBasis;
 use hairtrace::image::{Image, compare};
-use hairtrace::render::integrator::Strategy;
+use hairtrace::render::settings::Filter;
 use hairtrace::scene::GroomShape;
 use hairtrace::{Aovs, NoProgress, Result};
 use std::sync::Arc;
 
-/// What a knob changes: the scene description, and the integrator's strategy (which is
-/// not a scene-file setting).
+/// What a knob changes: the scene description.
 #[derive(Clone, PartialEq)]
 pub struct Variant {
     pub desc: SceneDescription,
-    pub strategy: Strategy,
 }
 
 /// A named change to the reference settings. An edit that fails means the knob does not
@@ -40,36 +38,25 @@ const KNOBS: &[Knob] = &[
     knob("shape auto", |v| set_shape(v, GroomShape::Auto)),
     knob("basis linear", |v| set_basis(v, CurveBasis::Linear)),
     knob("basis bspline", |v| set_basis(v, CurveBasis::BSpline)),
-    knob("strategy light", |v| set_strategy(v, Strategy::LightOnly)),
-    knob("strategy bsdf", |v| set_strategy(v, Strategy::BsdfOnly)),
-    knob("rr_depth 1", |v| render(v, |r| r.rr_depth = 1)),
-    knob("rr_depth 8", |v| render(v, |r| r.rr_depth = 8)),
-    knob("roulette throughput", |v| {
-        render(v, |r| r.roulette = "throughput".into())
-    }),
-    knob("max_depth 16", |v| render(v, |r| r.max_depth = 16)),
-    knob("max_depth 4", |v| render(v, |r| r.max_depth = 4)),
-    knob("filter tent", |v| render(v, |r| r.filter = "tent".into())),
-    knob("deep_bounce_depth 1", |v| {
-        render(v, |r| r.deep_bounce_depth = Some(1))
-    }),
-    knob("deep_bounce_depth 2", |v| {
-        render(v, |r| r.deep_bounce_depth = Some(2))
-    }),
-    knob("deep_bounce_depth 4", |v| {
-        render(v, |r| r.deep_bounce_depth = Some(4))
-    }),
-    knob("lobe_cull 0.01", |v| render(v, |r| r.lobe_cull = 0.01)),
-    knob("lobe_cull 0.1", |v| render(v, |r| r.lobe_cull = 0.1)),
-    knob("light_threshold 0", |v| {
-        render(v, |r| r.light_threshold = 0.0)
-    }),
+    knob("strategy light", |v| set(v, "strategy", "light")),
+    knob("strategy bsdf", |v| set(v, "strategy", "bsdf")),
+    knob("rr_depth 1", |v| set(v, "rr_depth", "1")),
+    knob("rr_depth 8", |v| set(v, "rr_depth", "8")),
+    knob("roulette throughput", |v| set(v, "roulette", "throughput")),
+    knob("max_depth 16", |v| set(v, "max_depth", "16")),
+    knob("max_depth 4", |v| set(v, "max_depth", "4")),
+    knob("filter tent", |v| set(v, "filter", "tent")),
+    knob("deep_bounce_depth 1", |v| set(v, "deep_bounce_depth", "1")),
+    knob("deep_bounce_depth 2", |v| set(v, "deep_bounce_depth", "2")),
+    knob("deep_bounce_depth 4", |v| set(v, "deep_bounce_depth", "4")),
+    knob("lobe_cull 0.01", |v| set(v, "lobe_cull", "0.01")),
+    knob("lobe_cull 0.1", |v| set(v, "lobe_cull", "0.1")),
+    knob("light_threshold 0", |v| set(v, "light_threshold", "0")),
 ];
 
-/// An edit of the `[render]` settings.
-fn render(v: &mut Variant, edit: fn(&mut RenderDesc)) -> Result<()> {
-    edit(&mut v.desc.render);
-    Ok(())
+/// A render setting, by name.
+fn set(v: &mut Variant, key: &str, value: &str) -> Result<()> {
+    v.desc.render.set(key, value)
 }
 
 fn set_shape(v: &mut Variant, shape: GroomShape) -> Result<()> {
@@ -79,11 +66,6 @@ fn set_shape(v: &mut Variant, shape: GroomShape) -> Result<()> {
 
 fn set_basis(v: &mut Variant, basis: CurveBasis) -> Result<()> {
     v.desc.grooms.iter_mut().for_each(|g| g.basis = basis);
-    Ok(())
-}
-
-fn set_strategy(v: &mut Variant, strategy: Strategy) -> Result<()> {
-    v.strategy = strategy;
     Ok(())
 }
 
@@ -137,17 +119,13 @@ fn reference_variant(ctx: &Context, name: &str) -> Result<Variant> {
     desc.grooms
         .iter_mut()
         .for_each(|g| g.shape = GroomShape::Round);
-    desc.render.filter = "box".into();
-    desc.render.filter_radius = None;
+    desc.render.filter = Filter::Box;
     if ctx.quick {
         desc.render.width = (desc.render.width / 4).max(16);
         desc.render.height = (desc.render.height / 4).max(16);
         fewer_strands(&mut desc, 10);
     }
-    Ok(Variant {
-        desc,
-        strategy: Strategy::Mis,
-    })
+    Ok(Variant { desc })
 }
 
 /// Divides the strand count of every procedural groom by `factor` (quick runs).
@@ -167,9 +145,7 @@ pub struct Built(hairtrace::BuiltScene);
 impl Built {
     pub fn new(v: &Variant) -> Result<Built> {
         let device = Arc::new(v.desc.render.device()?);
-        let mut built = v.desc.build(device)?;
-        built.settings.path.strategy = v.strategy;
-        Ok(Built(built))
+        Ok(Built(v.desc.build(device)?))
     }
 
     /// The image (RGB, linear) and the path-tracing seconds and rays per camera sample.

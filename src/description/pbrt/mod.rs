@@ -149,7 +149,7 @@ impl PbrtScene {
         let _ = writeln!(
             s,
             "film: {} x {}, {} spp, max depth {}",
-            d.render.width, d.render.height, d.render.spp, d.render.max_depth
+            d.render.width, d.render.height, d.render.spp, d.render.path.max_depth
         );
         for w in &self.warnings {
             let _ = writeln!(s, "warning: {w}");

@@ -14,10 +14,11 @@ use super::materials::{DEFAULT_REFLECTANCE, Material, material};
 use super::params::{Color, Params, Warning, read_params};
 use super::shapes::{Grooms, mesh};
 use crate::description::{
-    CameraDesc, EnvironmentSource, LightDesc, MaterialDesc, MeshDesc, RenderDesc, SceneDescription,
+    CameraDesc, EnvironmentSource, LightDesc, MaterialDesc, MeshDesc, SceneDescription,
 };
 use crate::error::{Error, Result, invalid_arg};
 use crate::image::read_image;
+use crate::render::settings::{PathSettings, RenderSettings};
 
 /// Includes deeper than this are refused (a cycle is refused at once).
 pub(super) const MAX_INCLUDE_DEPTH: usize = 32;
@@ -590,12 +591,15 @@ impl Reader {
             })
             .collect();
         Ok(SceneDescription {
-            render: RenderDesc {
+            render: RenderSettings {
                 width,
                 height,
                 spp: self.spp,
-                max_depth: self.max_depth,
-                ..RenderDesc::default()
+                path: PathSettings {
+                    max_depth: self.max_depth,
+                    ..PathSettings::default()
+                },
+                ..RenderSettings::default()
             },
             camera,
             materials,

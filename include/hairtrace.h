@@ -366,8 +366,8 @@ typedef struct HtHairVariation {
      */
     float tip_absorption;
     /**
-     * 1: take the absorption from the curves' per-point colours where they have them;
-     * 0: ignore them. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
+     * 1: take the absorption from the curves where they give one (their per-point colours,
+     * or the melanin of a USD file's strands, taken as it is); 0: ignore it. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
      * than a `bool`, so that no byte the host stores here is undefined behaviour.
      */
     uint8_t use_vertex_colors;

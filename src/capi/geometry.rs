@@ -372,10 +372,9 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let path = read_path(path, "path")?;
         scene.check_material(material_id, true)?;
         let shape = curve_shape(shape)?;
-        let beta_n = scene.hair_beta_n(material_id);
         let grooms = read_usd_file(&path)?;
         let curves = (grooms.curves.iter())
-            .map(|c| c.curves(shape.built(), 1.0, |p| p, beta_n))
+            .map(|c| c.curves(shape.built(), 1.0, |p| p))
             .collect::<Result<Vec<_>>>()?;
         let first = u32::try_from(scene.geometries.len())
             .map_err(|_| invalid_arg!("too many geometries"))?;

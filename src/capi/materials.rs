@@ -20,8 +20,8 @@ pub struct HtHairVariation {
     pub roughness_variation: f32,
     /// Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
     pub tip_absorption: f32,
-    /// 1: take the absorption from the curves' per-point colours where they have them;
-    /// 0: ignore them. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
+    /// 1: take the absorption from the curves where they give one (their per-point colours,
+    /// or the melanin of a USD file's strands, taken as it is); 0: ignore it. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
     /// than a `bool`, so that no byte the host stores here is undefined behaviour.
     pub use_vertex_colors: u8,
     /// Seed of the per-strand random choices.

@@ -12,7 +12,7 @@ use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::light::Light;
-use crate::scene::material::{HairMaterial, Material};
+use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::ribbons::{self, GroomShape};
 use crate::scene::stages::{NoStages, StageProgress, StageRunner};
@@ -94,14 +94,6 @@ impl HtScene {
             )
         })?;
         material.check_suits(&format!("material_id = {id}"), on_curves)
-    }
-
-    /// The azimuthal roughness of hair material `id` (the default for any other).
-    pub(super) fn hair_beta_n(&self, id: u32) -> f32 {
-        match self.materials.get(id as usize) {
-            Some(Material::Hair(h)) => h.material().beta_n,
-            _ => HairMaterial::default().beta_n,
-        }
     }
 
     pub(super) fn add_geometry(&mut self, shape: Shape, material: u32) -> Result<u32> {

@@ -10,6 +10,7 @@ use crate::capi::bsdf::ht_hair_params_default;
 use crate::capi::ht_last_error;
 use crate::embree::{MemoryMonitor, padding_for};
 use crate::scene::NoStages;
+use crate::scene::material::HairColor;
 use crate::scene::{FurBall, write_hair_file};
 use crate::scene::{Strands, Thickness};
 use std::ffi::CStr;
@@ -503,8 +504,8 @@ fn geometry_from_buffers_and_files_gets_consecutive_ids() {
         };
         assert_eq!((c.vertices(), c.indices()), (&xyzr[..], &[0u32, 4, 5][..]));
         assert_eq!(
-            c.strands().color(&c.strands().locate(2).unwrap(), 1.0),
-            Some([0.5; 3])
+            c.strands().absorption(&c.strands().locate(2).unwrap(), 1.0),
+            Some(HairColor::Color([0.5; 3]))
         );
         xyzr_desc.basis = HT_CURVE_BEZIER;
         fails(

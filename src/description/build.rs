@@ -19,7 +19,7 @@ use crate::scene::curves::Curves;
 use crate::scene::envmap::Environment;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
-use crate::scene::material::{HairMaterial, Material};
+use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
@@ -93,12 +93,8 @@ impl SceneDescription {
         let mut built = Vec::new();
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
-            let beta_n = match self.materials.get(&g.material) {
-                Some(MaterialDesc::Hair(h)) => h.beta_n,
-                _ => HairMaterial::default().beta_n,
-            };
             let curves = g
-                .curves(&mut stages, (i, grooms, reads), &mut hair_bounds, beta_n)
+                .curves(&mut stages, (i, grooms, reads), &mut hair_bounds)
                 .map_err(|e| self.error(&at, e))?;
             built.extend(curves.into_iter().map(|c| (i, c)));
         }
@@ -240,14 +236,12 @@ impl GroomDesc {
     /// The Embree curves of the groom, `part` = (index, grooms, files to read) of the
     /// build's stages: one geometry, or one per BasisCurves prim of a USD file (laid out by
     /// the prim's own basis and wrap, placed by the entry's transform). Adds the points,
-    /// widened by their radii, to `framed`. `beta_n` is the material's (melanin primvars
-    /// become colours for it).
+    /// widened by their radii, to `framed`.
     fn curves(
         &self,
         stages: &mut StageRunner,
         (i, grooms, reads): (usize, usize, usize),
         framed: &mut Bounds,
-        beta_n: f32,
     ) -> Result<Vec<Curves>> {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
@@ -271,7 +265,7 @@ impl GroomDesc {
                 }
                 stages.run(Stage::Curves, (i, grooms), |_| {
                     (file.curves.iter())
-                        .map(|c| c.curves(self.shape.built(), radius_factor, place, beta_n))
+                        .map(|c| c.curves(self.shape.built(), radius_factor, place))
                         .collect()
                 })
             }

@@ -197,7 +197,7 @@ impl World {
             let varied_bsdf;
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
                 (Hit::Hair(h), Some(Material::Hair(m))) => {
-                    varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.color);
+                    varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
                     Shading::hair(h, &varied_bsdf, wo_world, settings.lobes(events))
                 }
                 (Hit::Surface(s), Some(Material::Diffuse(d))) => Shading::diffuse(s, *d, wo_world),
@@ -234,7 +234,7 @@ impl World {
     fn first_hit(&self, hit: &Hit) -> FirstHit {
         let (albedo, strand) = match (hit, self.materials.get(hit.geom_id() as usize)) {
             (Hit::Hair(h), Some(Material::Hair(m))) => {
-                let p = m.params_at(h.strand.id, h.s, h.color);
+                let p = m.params_at(h.strand.id, h.s, h.absorption);
                 (
                     Vec3::from_array(color_from_sigma_a(p.sigma_a, p.beta_n)),
                     Some(h.strand.id),

@@ -24,15 +24,19 @@
 //! Either way, attributes survive to the hit through [`StrandIndex`]: the strand of a
 //! primitive (a prefix table of segment counts, 4 bytes per strand rather than 4 per
 //! segment), the position s along the strand (root 0, tip 1, uniform in the segment
-//! parameter) and an optional colour per polyline point, interpolated linearly.
+//! parameter) and the groom's optional absorption: a colour per polyline point,
+//! interpolated linearly, or a melanin pair per strand ([`Curves::with_melanin`]), kept as
+//! given so that the material converts it once, at the hit.
 
 use std::ops::Range;
 
 use glam::Vec3;
 
+use crate::bsdf::sigma_a_from_melanin;
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer, padding_for};
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
+use crate::scene::material::HairColor;
 use crate::validate;
 
 /// Curves ready for Embree: control points, index buffer and strand table.
@@ -77,19 +81,28 @@ impl StrandSegment {
 }
 
 /// Per-strand data kept next to the Embree geometry: which strand a primitive belongs to,
-/// and the optional colours.
+/// and the groom's optional absorption.
 #[derive(Debug, Clone, PartialEq)]
 pub struct StrandIndex {
     /// First segment of each strand, plus the total at the end.
     segment_starts: Vec<u32>,
-    /// Linear RGB at each polyline point (segments + 1 per strand), strand after strand.
-    colors: Option<Vec<[f32; 3]>>,
+    absorption: Option<GroomAbsorption>,
     /// Each strand's number in the groom it came from, when it is not its index here.
     ids: Option<Vec<u32>>,
     /// The strand of every [`COARSE`]-th segment: a lookup narrows to the strands of one
     /// block (one or two, usually) before searching, instead of searching all of them,
     /// which cost a cache miss per step on large grooms (5% of a fur ball's render).
     coarse: Vec<u32>,
+}
+
+/// A groom's absorption as its source said it.
+#[derive(Debug, Clone, PartialEq)]
+enum GroomAbsorption {
+    /// Linear RGB reflectance at each polyline point (segments + 1 per strand), strand
+    /// after strand.
+    Colors(Vec<[f32; 3]>),
+    /// (eumelanin, pheomelanin) of each strand.
+    Melanin(Vec<[f32; 2]>),
 }
 
 /// Segments per block of [`StrandIndex::coarse`]: 1/8 byte per segment.
@@ -114,14 +127,8 @@ impl StrandIndex {
             }
             coarse.push(strand as u32);
         }
-        let index = StrandIndex {
-            segment_starts,
-            colors,
-            ids: None,
-            coarse,
-        };
-        if let Some(c) = &index.colors {
-            let knots = total as usize + index.strand_count();
+        if let Some(c) = &colors {
+            let knots = total as usize + segment_starts.len() - 1;
             if c.len() != knots {
                 return Err(invalid_arg!(
                     "{} colours for {knots} strand points (segments + 1 per strand)",
@@ -130,7 +137,12 @@ impl StrandIndex {
             }
             validate::colors(c)?;
         }
-        Ok(index)
+        Ok(StrandIndex {
+            segment_starts,
+            absorption: colors.map(GroomAbsorption::Colors),
+            ids: None,
+            coarse,
+        })
     }
 
     pub fn strand_count(&self) -> usize {
@@ -164,20 +176,37 @@ impl StrandIndex {
         })
     }
 
-    /// The colour at parameter u of segment `at`, if the curves have colours.
-    pub fn color(&self, at: &StrandSegment, u: f32) -> Option<[f32; 3]> {
-        let colors = self.colors.as_ref()?;
-        // Each strand has one more point than segments: skip one per strand before it.
-        let k = (at.first_prim + at.strand + at.segment) as usize;
-        let (a, b) = (colors.get(k)?, colors.get(k + 1)?);
-        let u = u.clamp(0.0, 1.0);
-        Some(std::array::from_fn(|c| a[c] + (b[c] - a[c]) * u))
+    /// The groom's absorption at parameter u of segment `at`, if it gives one: the colour
+    /// there (interpolated between the segment's ends) or the strand's melanin.
+    pub fn absorption(&self, at: &StrandSegment, u: f32) -> Option<HairColor> {
+        match self.absorption.as_ref()? {
+            GroomAbsorption::Colors(colors) => {
+                // Each strand has one more point than segments: skip one per strand before.
+                let k = (at.first_prim + at.strand + at.segment) as usize;
+                let (a, b) = (colors.get(k)?, colors.get(k + 1)?);
+                let u = u.clamp(0.0, 1.0);
+                Some(HairColor::Color(std::array::from_fn(|c| {
+                    a[c] + (b[c] - a[c]) * u
+                })))
+            }
+            GroomAbsorption::Melanin(m) => {
+                let [eumelanin, pheomelanin] = *m.get(at.strand as usize)?;
+                Some(HairColor::Melanin {
+                    eumelanin,
+                    pheomelanin,
+                })
+            }
+        }
     }
 
     /// Heap bytes of the table.
     pub fn heap_bytes(&self) -> usize {
         self.segment_starts.capacity() * 4
-            + self.colors.as_ref().map_or(0, |c| c.capacity() * 12)
+            + match &self.absorption {
+                Some(GroomAbsorption::Colors(c)) => c.capacity() * 12,
+                Some(GroomAbsorption::Melanin(m)) => m.capacity() * 8,
+                None => 0,
+            }
             + self.ids.as_ref().map_or(0, |i| i.capacity() * 4)
             + self.coarse.capacity() * 4
     }
@@ -326,23 +355,32 @@ impl Curves {
             ));
         }
         let (mut vertices, mut counts, mut ids) = (Vec::new(), Vec::new(), Vec::new());
-        let mut colors = self.strands.colors.as_ref().map(|_| Vec::new());
+        let (mut colors, mut melanin) = (Vec::new(), Vec::new());
         for (s, _) in keep.iter().enumerate().filter(|(_, k)| **k) {
             let (a, b) = (starts[s] as usize, starts[s + 1] as usize);
             let points = self.strand_points(s);
             counts.push(points.len() as u32);
             vertices.extend_from_slice(points);
             ids.push(self.strands.ids.as_ref().map_or(s as u32, |i| i[s]));
-            if let (Some(out), Some(all)) = (&mut colors, &self.strands.colors) {
+            match &self.strands.absorption {
                 // Segments + 1 colours per strand: s strands' extra ones come before.
-                out.extend_from_slice(&all[a + s..b + s + 1]);
+                Some(GroomAbsorption::Colors(all)) => {
+                    colors.extend_from_slice(&all[a + s..b + s + 1]);
+                }
+                Some(GroomAbsorption::Melanin(all)) => melanin.push(all[s]),
+                None => {}
             }
         }
         if counts.is_empty() {
             return Ok(None);
         }
         vertices.reserve_exact(padding_for::<[f32; 4]>());
+        let colors =
+            matches!(self.strands.absorption, Some(GroomAbsorption::Colors(_))).then_some(colors);
         let mut part = Curves::from_control_points(vertices, &counts, colors, self.basis, shape)?;
+        if matches!(self.strands.absorption, Some(GroomAbsorption::Melanin(_))) {
+            part = part.with_melanin(melanin)?;
+        }
         part.strands.ids = Some(ids);
         Ok(Some(part))
     }
@@ -354,6 +392,31 @@ impl Curves {
         let start = first[starts[s] as usize] as usize;
         let end = first[starts[s + 1] as usize - 1] as usize + self.basis.points_per_segment();
         &self.vertices()[start..end]
+    }
+
+    /// The same curves with one (eumelanin, pheomelanin) pair per strand as the groom's
+    /// absorption: a hair material with `use_vertex_colors` takes each strand's sigma_a
+    /// from it as [`sigma_a_from_melanin`] gives it, with no colour in between. Each value
+    /// must be finite and >= 0, and the curves must have no colours.
+    pub fn with_melanin(mut self, melanin: Vec<[f32; 2]>) -> Result<Self> {
+        if matches!(self.strands.absorption, Some(GroomAbsorption::Colors(_))) {
+            return Err(invalid_arg!(
+                "the curves have colours: give colours or melanin, not both"
+            ));
+        }
+        let strands = self.strands.strand_count();
+        if melanin.len() != strands {
+            return Err(invalid_arg!(
+                "{} melanin pairs for {strands} strands",
+                melanin.len()
+            ));
+        }
+        for (i, &[eumelanin, pheomelanin]) in melanin.iter().enumerate() {
+            sigma_a_from_melanin(eumelanin, pheomelanin)
+                .map_err(|e| e.context(format!("strand {i}")))?;
+        }
+        self.strands.absorption = Some(GroomAbsorption::Melanin(melanin));
+        Ok(self)
     }
 
     /// The same curves drawn with `shape`.
@@ -514,49 +577,70 @@ mod tests {
     }
 
     #[test]
-    fn a_subset_keeps_its_strands_numbers_points_and_colours() {
+    fn a_subset_keeps_its_strands_numbers_points_colours_and_melanin() {
         let s = strands();
+        let plain = Strands {
+            colors: None,
+            ..strands()
+        };
+        let melanin = |b| {
+            Curves::from_strands(&plain, b, CurveShape::Round)
+                .unwrap()
+                .with_melanin(vec![[8.0, 0.0], [0.5, 1.5]])
+                .unwrap()
+        };
         for basis in CurveBasis::ALL {
-            let whole = Curves::from_strands(&s, basis, CurveShape::Round).unwrap();
-            for keep in [[true, false], [false, true], [true, true]] {
-                let part = whole.subset(&keep, CurveShape::Flat).unwrap().unwrap();
-                assert_eq!(part.shape(), CurveShape::Flat);
-                let kept: Vec<usize> = (0..2).filter(|&k| keep[k]).collect();
-                assert_eq!(part.strands().strand_count(), kept.len(), "{basis:?}");
-                for (local, &s) in kept.iter().enumerate() {
-                    assert_eq!(part.strand_points(local), whole.strand_points(s));
-                    let first = whole.strands().segment_starts[s];
-                    let local_first = part.strands().segment_starts[local];
-                    for seg in 0..whole.strands().locate(first).unwrap().segments {
-                        let (a, b) = (
-                            whole.strands().locate(first + seg).unwrap(),
-                            part.strands().locate(local_first + seg).unwrap(),
-                        );
-                        assert_eq!(
-                            (b.id, b.segment, b.segments),
-                            (s as u32, a.segment, a.segments)
-                        );
-                        for u in [0.0, 0.3, 1.0] {
-                            assert_eq!(whole.strands().color(&a, u), part.strands().color(&b, u));
-                        }
+            for whole in [
+                Curves::from_strands(&s, basis, CurveShape::Round).unwrap(),
+                melanin(basis),
+            ] {
+                subset_of(&whole);
+            }
+        }
+    }
+
+    fn subset_of(whole: &Curves) {
+        let basis = whole.basis();
+        for keep in [[true, false], [false, true], [true, true]] {
+            let part = whole.subset(&keep, CurveShape::Flat).unwrap().unwrap();
+            assert_eq!(part.shape(), CurveShape::Flat);
+            let kept: Vec<usize> = (0..2).filter(|&k| keep[k]).collect();
+            assert_eq!(part.strands().strand_count(), kept.len(), "{basis:?}");
+            for (local, &s) in kept.iter().enumerate() {
+                assert_eq!(part.strand_points(local), whole.strand_points(s));
+                let first = whole.strands().segment_starts[s];
+                let local_first = part.strands().segment_starts[local];
+                for seg in 0..whole.strands().locate(first).unwrap().segments {
+                    let (a, b) = (
+                        whole.strands().locate(first + seg).unwrap(),
+                        part.strands().locate(local_first + seg).unwrap(),
+                    );
+                    assert_eq!(
+                        (b.id, b.segment, b.segments),
+                        (s as u32, a.segment, a.segments)
+                    );
+                    for u in [0.0, 0.3, 1.0] {
+                        let at = |c: &Curves, s| c.strands().absorption(s, u);
+                        assert!(at(whole, &a).is_some());
+                        assert_eq!(at(whole, &a), at(&part, &b));
                     }
                 }
-                // A subset of a subset still names the strands of the whole.
-                if kept.len() == 2 {
-                    let again = part
-                        .subset(&[false, true], CurveShape::Round)
-                        .unwrap()
-                        .unwrap();
-                    assert_eq!(again.strands().locate(0).unwrap().id, 1);
-                }
             }
-            assert_eq!(
-                whole.subset(&[false, false], CurveShape::Flat).unwrap(),
-                None
-            );
-            let e = whole.subset(&[true], CurveShape::Flat).unwrap_err();
-            assert!(e.to_string().contains("1 flags for 2 strands"), "{e}");
+            // A subset of a subset still names the strands of the whole.
+            if kept.len() == 2 {
+                let again = part
+                    .subset(&[false, true], CurveShape::Round)
+                    .unwrap()
+                    .unwrap();
+                assert_eq!(again.strands().locate(0).unwrap().id, 1);
+            }
         }
+        assert_eq!(
+            whole.subset(&[false, false], CurveShape::Flat).unwrap(),
+            None
+        );
+        let e = whole.subset(&[true], CurveShape::Flat).unwrap_err();
+        assert!(e.to_string().contains("1 flags for 2 strands"), "{e}");
     }
 
     #[test]
@@ -601,15 +685,57 @@ mod tests {
             }
         );
         assert_eq!(at.s(0.5), 0.75);
-        assert_eq!(idx.color(&at, 0.5), Some([0.0, 0.5, 0.5]));
+        assert_eq!(
+            idx.absorption(&at, 0.5),
+            Some(HairColor::Color([0.0, 0.5, 0.5]))
+        );
         let at = idx.locate(2).unwrap();
         assert_eq!(
             (at.strand, at.segment, at.s(0.0), at.s(1.0)),
             (1, 0, 0.0, 1.0)
         );
-        assert_eq!(idx.color(&at, 0.25), Some([0.75; 3]));
+        assert_eq!(idx.absorption(&at, 0.25), Some(HairColor::Color([0.75; 3])));
         assert_eq!(idx.locate(3), None);
         assert_eq!(idx.locate(2).unwrap().prims(), 2..3);
+    }
+
+    /// Melanin stays one pair per strand, as given, and bad pairs are refused by strand.
+    #[test]
+    fn melanin_is_kept_per_strand() {
+        let plain = Strands {
+            colors: None,
+            ..strands()
+        };
+        let c = Curves::from_strands(&plain, CurveBasis::BSpline, CurveShape::Round).unwrap();
+        let m = c
+            .clone()
+            .with_melanin(vec![[8.0, 0.0], [0.5, 1.5]])
+            .unwrap();
+        let idx = m.strands();
+        for (prim, want) in [(0, [8.0, 0.0]), (1, [8.0, 0.0]), (2, [0.5, 1.5])] {
+            let at = idx.locate(prim).unwrap();
+            for u in [0.0, 1.0] {
+                assert_eq!(
+                    idx.absorption(&at, u),
+                    Some(HairColor::Melanin {
+                        eumelanin: want[0],
+                        pheomelanin: want[1]
+                    })
+                );
+            }
+        }
+        for (melanin, want) in [
+            (vec![[1.0, 0.0]], "1 melanin pairs for 2 strands"),
+            (vec![[1.0, 0.0], [0.0, -1.0]], "strand 1: pheomelanin"),
+            (vec![[f32::NAN, 0.0], [1.0, 0.0]], "strand 0: eumelanin"),
+            (vec![[f32::MAX, 0.0], [1.0, 0.0]], "overflows"),
+        ] {
+            let e = c.clone().with_melanin(melanin).unwrap_err().to_string();
+            assert!(e.contains(want), "{e}");
+        }
+        let coloured = Curves::from_strands(&strands(), CurveBasis::Linear, CurveShape::Round);
+        let e = coloured.unwrap().with_melanin(vec![[1.0, 0.0]; 2]);
+        assert!(e.unwrap_err().to_string().contains("not both"));
     }
 
     #[test]

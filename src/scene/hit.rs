@@ -9,6 +9,7 @@
 use glam::Vec3;
 
 use super::curves::StrandSegment;
+use super::material::HairColor;
 use crate::embree::CurveShape;
 use crate::math::Frame;
 use crate::math::frame::hair_frame_offset;
@@ -65,8 +66,9 @@ pub struct HairHit {
     pub strand: StrandSegment,
     /// Position along the strand: root 0, tip 1.
     pub s: f32,
-    /// Interpolated per-point colour, when the curves have one.
-    pub color: Option<[f32; 3]>,
+    /// The groom's absorption here, when it gives one
+    /// ([`super::curves::StrandIndex::absorption`]).
+    pub absorption: Option<HairColor>,
 }
 
 /// A hit on a triangle mesh.

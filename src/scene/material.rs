@@ -41,6 +41,21 @@ pub enum HairColor {
     Color([f32; 3]),
 }
 
+impl HairColor {
+    /// The absorption it says, for a fibre of azimuthal roughness `beta_n` (which only a
+    /// colour needs).
+    pub fn sigma_a(self, beta_n: f32) -> Result<[f32; 3]> {
+        match self {
+            HairColor::SigmaA(s) => Ok(s),
+            HairColor::Melanin {
+                eumelanin,
+                pheomelanin,
+            } => sigma_a_from_melanin(eumelanin, pheomelanin),
+            HairColor::Color(c) => sigma_a_from_color(c, beta_n),
+        }
+    }
+}
+
 /// A hair material: the BSDF parameters plus how they vary over the groom. Variation is
 /// deterministic: it depends only on the seed, the strand id and the position along it.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,7 +75,8 @@ pub struct HairMaterial {
     /// Absorption at the tip relative to the root, > 0 (below 1: lighter tips), varied
     /// linearly along the strand.
     pub tip_absorption: f32,
-    /// Take the absorption from the groom's per-vertex colours where it has them.
+    /// Take the absorption from the groom where it gives one, in place of `color`: its
+    /// per-point colours (inverted at `beta_n`) or its per-strand melanin (as it is).
     pub use_vertex_colors: bool,
     pub seed: u64,
 }
@@ -94,16 +110,8 @@ pub struct PreparedHair {
 
 impl HairMaterial {
     fn base_params(&self) -> Result<HairParams> {
-        let sigma_a = match self.color {
-            HairColor::SigmaA(s) => s,
-            HairColor::Melanin {
-                eumelanin,
-                pheomelanin,
-            } => sigma_a_from_melanin(eumelanin, pheomelanin)?,
-            HairColor::Color(c) => sigma_a_from_color(c, self.beta_n)?,
-        };
         let params = HairParams {
-            sigma_a,
+            sigma_a: self.color.sigma_a(self.beta_n)?,
             eta: self.eta,
             beta_m: self.beta_m,
             beta_n: self.beta_n,
@@ -143,34 +151,27 @@ impl HairMaterial {
 }
 
 impl PreparedHair {
-    /// The material it was prepared from.
-    pub(crate) fn material(&self) -> &HairMaterial {
-        &self.material
-    }
-
-    /// Every hit shares one BSDF: nothing varies per strand, along strands or by colour.
+    /// Every hit shares one BSDF: nothing varies per strand, along strands or by the
+    /// groom's absorption.
     pub(crate) fn is_uniform(&self) -> bool {
         self.uniform.is_some()
     }
 
-    /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's colour
-    /// at the hit when it has one.
-    pub(crate) fn params_at(
-        &self,
-        strand: u32,
-        s: f32,
-        vertex_color: Option<[f32; 3]>,
-    ) -> HairParams {
+    /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's
+    /// absorption at the hit when it gives one ([`crate::scene::curves::StrandIndex::absorption`]).
+    pub(crate) fn params_at(&self, strand: u32, s: f32, groom: Option<HairColor>) -> HairParams {
         let m = &self.material;
         let mut p = self.base;
-        if let (true, Some(c)) = (
-            m.use_vertex_colors,
-            vertex_color.filter(|c| c.iter().all(|v| v.is_finite())),
-        ) {
-            // Colours are validated into [0, 1]; black, which no finite absorption makes,
-            // is taken as 1e-4 (documented with the colours of the C ABI and scene files).
-            let c = c.map(|v| v.max(1e-4));
-            p.sigma_a = sigma_a_from_color(c, p.beta_n).unwrap_or(p.sigma_a);
+        if let (true, Some(a)) = (m.use_vertex_colors, groom) {
+            let a = match a {
+                // Colours are validated into [0, 1]; black, which no finite absorption
+                // makes, is taken as 1e-4 (documented with the colours of the C ABI and
+                // scene files).
+                HairColor::Color(c) => HairColor::Color(c.map(|v| v.max(1e-4))),
+                other => other,
+            };
+            // The groom's values were validated with it: the fallback is never taken.
+            p.sigma_a = a.sigma_a(p.beta_n).unwrap_or(p.sigma_a);
         }
         let [ua, ur] = strand_uniforms(m.seed, strand);
         let absorption = (1.0 + m.absorption_variation * (2.0 * ua - 1.0))
@@ -187,13 +188,13 @@ impl PreparedHair {
         &self,
         strand: u32,
         s: f32,
-        vertex_color: Option<[f32; 3]>,
+        groom: Option<HairColor>,
     ) -> std::borrow::Cow<'_, HairBsdf> {
         match &self.uniform {
             Some(b) => std::borrow::Cow::Borrowed(b),
             // The parameters are valid by construction (clamped into range).
             None => std::borrow::Cow::Owned(
-                HairBsdf::new(&self.params_at(strand, s, vertex_color))
+                HairBsdf::new(&self.params_at(strand, s, groom))
                     .expect("varied parameters stay in range"),
             ),
         }
@@ -248,6 +249,41 @@ mod tests {
         }
     }
 
+    /// A groom's melanin is its absorption exactly, whatever beta_n, even for black hair
+    /// (eumelanin 8), which no colour above 1e-4 can say; a colour is inverted at beta_n.
+    /// Without `use_vertex_colors` the material's own absorption stays.
+    #[test]
+    fn groom_melanin_is_its_absorption_exactly() {
+        let black = HairColor::Melanin {
+            eumelanin: 8.0,
+            pheomelanin: 0.0,
+        };
+        let want = sigma_a_from_melanin(8.0, 0.0).unwrap();
+        for beta_n in [0.1, 0.3, 0.9] {
+            let m = HairMaterial {
+                beta_n,
+                use_vertex_colors: true,
+                ..HairMaterial::default()
+            };
+            let p = m.prepare().unwrap();
+            assert_eq!(p.params_at(4, 0.6, Some(black)).sigma_a, want);
+            let c = [0.2, 0.3, 0.4];
+            assert_eq!(
+                p.params_at(4, 0.6, Some(HairColor::Color(c))).sigma_a,
+                sigma_a_from_color(c, beta_n).unwrap()
+            );
+            let own = HairMaterial {
+                use_vertex_colors: false,
+                ..m
+            };
+            let own = own.prepare().unwrap();
+            assert_eq!(
+                own.params_at(4, 0.6, Some(black)),
+                p.params_at(4, 0.6, None)
+            );
+        }
+    }
+
     #[test]
     fn vertex_colours_and_bad_values() {
         let m = HairMaterial {
@@ -255,7 +291,7 @@ mod tests {
             ..HairMaterial::default()
         };
         let p = m.prepare().unwrap();
-        let white = p.params_at(0, 0.3, Some([1.0, 1.0, 1.0]));
+        let white = p.params_at(0, 0.3, Some(HairColor::Color([1.0; 3])));
         assert_eq!(white.sigma_a, [0.0; 3]);
         assert_eq!(
             p.params_at(0, 0.3, None).sigma_a,

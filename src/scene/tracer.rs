@@ -377,7 +377,7 @@ fn hair_hit(
         v: hit.v,
         strand: at,
         s: at.s(u),
-        color: strands.color(&at, u),
+        absorption: strands.absorption(&at, u),
     })
 }
 

@@ -25,15 +25,9 @@ fn layer(module: &str) -> usize {
         .unwrap_or_else(|| panic!("module {module:?} is in no layer: add it to LAYERS"))
 }
 
-/// Every library source file as (module path, (source without its unit tests, lines of the
-/// whole file)).
-fn modules() -> BTreeMap<String, (String, usize)> {
-    sources("src")
-}
-
-/// [`modules`] for the source folder `dir` of the workspace.
-fn sources(dir: &str) -> BTreeMap<String, (String, usize)> {
-    fn walk(dir: &Path, root: &Path, out: &mut BTreeMap<String, (String, usize)>) {
+/// Every library source file as (module path, source without its unit tests).
+fn modules() -> BTreeMap<String, String> {
+    fn walk(dir: &Path, root: &Path, out: &mut BTreeMap<String, String>) {
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
             if path.is_dir() {
@@ -48,16 +42,15 @@ fn sources(dir: &str) -> BTreeMap<String, (String, usize)> {
                     parts.pop();
                 }
                 let text = std::fs::read_to_string(&path).unwrap();
-                let lines = text.lines().count();
                 let code = match text.find("#[cfg(test)]\nmod tests") {
                     Some(i) => text[..i].to_string(),
                     None => text,
                 };
-                out.insert(parts.join("::"), (code, lines));
+                out.insert(parts.join("::"), code);
             }
         }
     }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut out = BTreeMap::new();
     walk(&root, &root, &mut out);
     out
@@ -130,7 +123,7 @@ fn layers_go_one_way_and_files_form_no_cycle() {
     let modules = modules();
     let known: BTreeSet<String> = modules.keys().cloned().collect();
     let mut uses: BTreeMap<&str, BTreeSet<String>> = BTreeMap::new();
-    for (module, (code, _)) in &modules {
+    for (module, code) in &modules {
         for path in named_paths(code) {
             if let Some(target) = resolve(module, &path, &known) {
                 // A file's own module and its parents (re-exports) are not dependencies.
@@ -184,20 +177,4 @@ fn the_scan_sees_what_it_must() {
         Some("math")
     );
     assert_eq!(layer("description::peer"), 5);
-}
-
-/// Rooms stay small enough to read: no source file of the library or the command line
-/// (cli/src) over about 800 lines.
-#[test]
-fn no_source_file_is_over_800_lines() {
-    let cli = sources("cli/src")
-        .into_iter()
-        .map(|(module, file)| (format!("cli: {module}"), file));
-    let long: Vec<String> = modules()
-        .into_iter()
-        .chain(cli)
-        .filter(|(_, (_, n))| *n > 800)
-        .map(|(module, (_, n))| format!("{module}: {n} lines"))
-        .collect();
-    assert!(long.is_empty(), "split these: {}", long.join(", "));
 }

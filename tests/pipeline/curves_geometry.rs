@@ -13,6 +13,7 @@ use hairtrace::embree::{CurveBasis, CurveShape, Device, Geometry, Ray, SceneOpti
 use hairtrace::scene::Strands;
 use hairtrace::scene::curves::Curves;
 use hairtrace::scene::hit::{HairHit, Hit};
+use hairtrace::scene::material::HairColor;
 use hairtrace::scene::tracer::{Tracer, TracerBuilder};
 use hairtrace::{HairBsdf, HairParams};
 
@@ -536,7 +537,9 @@ fn strand_attributes_reach_the_hit() {
         let hit = hair(tracer.intersect(&Ray::new(Vec3::new(1.5, 0.0, 2.0), -Vec3::Z))).unwrap();
         assert_eq!((hit.strand.strand, hit.strand.segment), (1, 1), "{basis:?}");
         assert!((hit.s - 0.5).abs() < 1e-3, "{basis:?}: s = {}", hit.s);
-        let c = hit.color.unwrap();
+        let Some(HairColor::Color(c)) = hit.absorption else {
+            panic!("{basis:?}: no colour at the hit")
+        };
         assert!(
             (c[1] - 0.5).abs() < 1e-3 && c[0] == 1.0 && c[2] == 0.0,
             "{c:?}"

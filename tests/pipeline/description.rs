@@ -9,8 +9,7 @@ use hairtrace::Error;
 use hairtrace::bsdf::SIGMA_A_PRESETS;
 use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{
-    DEMOS, EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource, SceneDescription,
-    demo, quick_look,
+    DEMOS, GroomSource, LightDesc, MaterialDesc, SceneDescription, demo, quick_look,
 };
 use hairtrace::embree::{CurveBasis, Device};
 use hairtrace::render::PixelFilter;
@@ -158,43 +157,6 @@ fn every_demo_builds() {
     }
     let e = demo("furry").unwrap_err().to_string();
     assert_contains(&e, &["furry", "furball, furnace, scalp"]);
-}
-
-#[test]
-fn furnace_demo_is_a_furnace() {
-    let desc = demo("furnace").unwrap();
-    assert_eq!(desc.render.path.max_depth, 256);
-    assert_eq!(
-        desc.lights,
-        vec![LightDesc::Environment {
-            source: EnvironmentSource::Uniform([1.0; 3]),
-            rotation_deg: 0.0,
-            scale: 1.0
-        }]
-    );
-    let hair = desc.materials.values().find_map(|m| match m {
-        MaterialDesc::Hair(h) => Some(h),
-        MaterialDesc::Diffuse { .. } => None,
-    });
-    let hair = hair.unwrap();
-    assert_eq!(hair.color, HairColor::SigmaA([0.0; 3]));
-    assert_eq!((hair.beta_m, hair.beta_n), (0.3, 0.3));
-    assert!(
-        desc.materials
-            .values()
-            .any(|m| *m == MaterialDesc::Diffuse { albedo: [1.0; 3] })
-    );
-    let GroomSource::FurBall(fur) = &desc.grooms[0].source else {
-        panic!("not a fur ball")
-    };
-    assert_eq!(
-        desc.meshes[0].source,
-        MeshSource::Sphere {
-            centre: [0.0; 3],
-            radius: fur.radius
-        }
-    );
-    assert_eq!(desc.camera.eye, None, "the furnace is framed automatically");
 }
 
 #[test]

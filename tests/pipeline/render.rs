@@ -305,23 +305,68 @@ fn renders_are_deterministic_across_threads_and_crops() {
     }
 }
 
-/// `--demo furnace`: white fur around a white diffuse sphere under a uniform environment
-/// of radiance 1. Every pixel's expected value is 1; the image mean must be within 1%.
+/// `--demo furnace` is a furnace: white fur around a white sphere, under a uniform
+/// environment of radiance 1 and no other light, so that every pixel's expected value is 1
+/// whatever the geometry. Three things show it, each of which a change to the demo would
+/// break:
+/// - a pixel whose samples all escape is exactly 1 (the environment is 1 in every direction
+///   the camera sees, and nothing else emits);
+/// - every first hit reports an albedo of exactly 1 (every material is white), so that a
+///   pixel's albedo is the fraction of its samples that hit: a multiple of 1/spp;
+/// - pixels that see the groom or the sphere average 1 within 4 standard errors (nothing
+///   absorbs, nothing else emits), plus [`SPHERE_LEAK`].
 #[test]
-fn furnace_demo_renders_to_one() {
+fn furnace_demo_is_a_furnace() {
     let mut d = hairtrace::description::demo("furnace").unwrap();
-    d.render.width = 48;
-    d.render.height = 36;
+    d.render.width = 96;
+    d.render.height = 72;
     d.render.spp = 8;
+    let spp = d.render.spp as f32;
     let device = Arc::new(Device::new(Some(2)).unwrap());
     let built = d.build(device).unwrap();
-    let out = built.render(Aovs::default(), &NoProgress).unwrap();
-    let rgb = out.film.rgb();
-    assert!(rgb.iter().all(|v| v.is_finite()));
-    let m = mean(rgb);
-    println!("furnace demo mean {m:.5} ({} rays)", out.stats.rays);
-    assert!((m - 1.0).abs() < 0.01, "furnace demo mean {m}");
+    let aovs = Aovs {
+        albedo: true,
+        ..Aovs::default()
+    };
+    let out = built.render(aovs, &NoProgress).unwrap();
+    let albedo = out.film.albedo().unwrap();
+    let mut seen = Vec::new();
+    for (i, (rgb, a)) in out.film.rgb().chunks(3).zip(albedo.chunks(3)).enumerate() {
+        let hits = a[0] * spp;
+        assert!(
+            a.iter().all(|&c| c == a[0]) && (hits - hits.round()).abs() < 1e-4,
+            "pixel {i}: albedo {a:?} is not a count of white hits out of {spp}"
+        );
+        if hits.round() == 0.0 {
+            assert_eq!(rgb, [1.0; 3], "pixel {i} sees only the environment");
+        } else {
+            // One value per pixel: the channels of a white furnace are the same estimate.
+            seen.push(rgb.iter().map(|&v| f64::from(v)).sum::<f64>() / 3.0);
+        }
+    }
+    let (n, pixels) = (seen.len() as f64, (albedo.len() / 3) as f64);
+    assert!(
+        n > 0.1 * pixels && n < 0.9 * pixels,
+        "{n} of {pixels} pixels see the groom: the check needs both sky and groom"
+    );
+    let m = seen.iter().sum::<f64>() / n;
+    let se = (seen.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (n - 1.0) / n).sqrt();
+    println!(
+        "furnace demo: groom pixels' mean {m:.5} ± {se:.5} ({} rays)",
+        out.stats.rays
+    );
+    assert!(
+        (m - 1.0).abs() < 4.0 * se + SPHERE_LEAK,
+        "furnace demo: groom pixels' mean {m} ± {se}"
+    );
 }
+
+/// What the furnace demo's tessellated sphere loses: a diffuse bounce about a smoothed
+/// normal can leave below the facet, into the closed white sphere, and never come out.
+/// Measured 0.9987 ± 0.0007 for the sphere alone, and 0.9986 ± 0.0004 for the demo's
+/// groom pixels here. Before the sphere sat inside the roots the demo lost ten times that
+/// (0.9907 ± 0.0011 here), which this test refuses.
+const SPHERE_LEAK: f64 = 2e-3;
 
 /// A white fur ball (3000 strands) in a white furnace with these path settings: the mean
 /// of the image and its standard error (every pixel's expected value is 1 when energy is

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use hairtrace::Error;
-use hairtrace::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
 use hairtrace::description::usd::{UsdGrooms, read_usd_file};
 use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::embree::{CurveShape, Device};
 use hairtrace::render::NO_STRAND;
+use hairtrace::scene::material::HairColor;
 use hairtrace::{Aovs, NoProgress};
 use serde_json::Value;
 
@@ -365,29 +365,25 @@ fn scene_files_refuse_hair_keys_on_usd_grooms() {
     assert_eq!(desc.grooms[0].radius_scale, 2.0);
 }
 
-/// `primvars:melanin` (eumelanin per curve) becomes a strand colour that the renderer's
-/// colour-to-absorption fit, at the material's beta_n, turns back into the melanin's sigma_a.
+/// `primvars:melanin` (eumelanin per curve) reaches each strand as melanin, as authored:
+/// no colour and no beta_n in between.
 #[test]
 fn melanin_primvar_gives_each_strand_its_absorption() {
     let grooms = read_usd_file(&fixtures().join("all_bases.usdc")).unwrap();
     let c = grooms.curves.iter().find(|c| c.melanin.is_some()).unwrap();
     assert_eq!(c.melanin.as_deref(), Some(&[0.3f32, 1.5][..]));
-    for beta_n in [0.3f32, 0.8] {
-        let curves = c.curves(CurveShape::Round, 1.0, |p| p, beta_n).unwrap();
-        let idx = curves.strands();
-        // Segment 0 is in strand 0 (4 points: 1 segment), the last in strand 1.
-        let last = curves.indices().len() as u32 - 1;
-        for (prim, melanin) in [(0, 0.3f32), (last, 1.5)] {
-            let color = idx.color(&idx.locate(prim).unwrap(), 0.5).unwrap();
-            let got = sigma_a_from_color(color, beta_n).unwrap();
-            let want = sigma_a_from_melanin(melanin, 0.0).unwrap();
-            for k in 0..3 {
-                assert!(
-                    (got[k] - want[k]).abs() < 1e-4 * (1.0 + want[k]),
-                    "{got:?} {want:?}"
-                );
-            }
-        }
+    let curves = c.curves(CurveShape::Round, 1.0, |p| p).unwrap();
+    let idx = curves.strands();
+    // Segment 0 is in strand 0 (4 points: 1 segment), the last in strand 1.
+    let last = curves.indices().len() as u32 - 1;
+    for (prim, eumelanin) in [(0, 0.3f32), (last, 1.5)] {
+        assert_eq!(
+            idx.absorption(&idx.locate(prim).unwrap(), 0.5),
+            Some(HairColor::Melanin {
+                eumelanin,
+                pheomelanin: 0.0
+            })
+        );
     }
     let ok = "int[] curveVertexCounts = [2, 2]\npoint3f[] points = [(0,0,0),(0,1,0),(1,0,0),(1,1,0)]\nfloat[] widths = [0.1] (interpolation = \"constant\")\nuniform token type = \"linear\"";
     for (name, primvar, want) in [
@@ -413,4 +409,63 @@ fn melanin_primvar_gives_each_strand_its_absorption() {
         );
         assert!(m.contains(want), "{name}: {m}");
     }
+}
+
+/// Black hair from USD renders as black hair: a groom whose `primvars:melanin` is 8 (a
+/// material with `use_vertex_colors`) gives, bit for bit, the image and albedo of the same
+/// curves without the primvar under a material of `melanin = [8, 0]`. Through a colour
+/// (inverted at beta_n, darker than 1e-4 in blue) it came out far lighter.
+#[test]
+fn black_usd_melanin_renders_as_the_material_melanin() {
+    let dir = std::env::temp_dir().join(format!("hairtrace-usd-black-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let prim = |primvar: &str| {
+        curves_prim(&format!(
+            "int[] curveVertexCounts = [4, 4, 4]\n\
+             point3f[] points = [(-0.4,-1,0),(-0.3,0,0.1),(-0.4,1,0),(-0.3,2,0), \
+             (0,-1,0),(0.1,0,-0.1),(0,1,0),(0.1,2,0), (0.4,-1,0),(0.3,0,0),(0.4,1,0.1),(0.3,2,0)]\n\
+             float[] widths = [0.2] (interpolation = \"constant\")\n\
+             uniform token type = \"cubic\"\nuniform token basis = \"catmullRom\"\n{primvar}"
+        ))
+    };
+    std::fs::write(
+        dir.join("black.usda"),
+        prim("float[] primvars:melanin = [8]"),
+    )
+    .unwrap();
+    std::fs::write(dir.join("plain.usda"), prim("")).unwrap();
+    let device = Arc::new(Device::new(Some(1)).unwrap());
+    let render = |file: &str, material: &str| {
+        let toml = format!(
+            "[render]\nwidth = 24\nheight = 24\nspp = 2\n\
+             [materials.h]\ntype = \"hair\"\n{material}\n\
+             [[groom]]\nfile = \"{file}\"\nmaterial = \"h\"\n\
+             [[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n\
+             [[light]]\ntype = \"distant\"\ndirection = [0, 0, -1]\nirradiance = [3, 3, 3]\n"
+        );
+        let desc = SceneDescription::from_toml(&toml, &dir, "black.toml").unwrap();
+        let aovs = Aovs {
+            albedo: true,
+            ..Aovs::default()
+        };
+        let out = desc
+            .build(device.clone())
+            .unwrap()
+            .render(aovs, &NoProgress)
+            .unwrap();
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        (bits(out.film.rgb()), bits(out.film.albedo().unwrap()))
+    };
+    let material = render("plain.usda", "melanin = [8, 0]\nbeta_n = 0.4");
+    let groom = render(
+        "black.usda",
+        "color = [0.9, 0.8, 0.7]\nbeta_n = 0.4\nuse_vertex_colors = true",
+    );
+    assert!(
+        material == groom,
+        "the groom's melanin 8 is not the material's"
+    );
+    // The groom's melanin is what decides: the material's own colour is another image.
+    let own = render("black.usda", "color = [0.9, 0.8, 0.7]\nbeta_n = 0.4");
+    assert!(own != groom, "the groom's melanin changed nothing");
 }

@@ -14,7 +14,6 @@ use std::path::Path;
 
 use openusd::usd::{PrimPredicate, Stage};
 
-use crate::bsdf::{sigma_a_from_color, sigma_a_from_melanin};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::curves::Curves;
@@ -67,47 +66,31 @@ pub struct UsdCurves {
 
 impl UsdCurves {
     /// The Embree curves of this prim, radii multiplied by `radius_scale` and every point
-    /// mapped by `point` (a scene's placement of the groom). `beta_n` is the material's
-    /// azimuthal roughness: melanin becomes the strand colour that the renderer's
-    /// colour-to-absorption fit at that roughness turns back into the melanin's absorption.
+    /// mapped by `point` (a scene's placement of the groom). Colours and melanin go with
+    /// the strands as authored: the material converts them at each hit.
     pub fn curves(
         &self,
         shape: CurveShape,
         radius_scale: f32,
         point: impl Fn([f32; 3]) -> [f32; 3],
-        beta_n: f32,
     ) -> Result<Curves> {
-        let colors = match &self.melanin {
-            Some(m) => Some(self.melanin_colors(m, beta_n)?),
-            None => self.colors.clone(),
-        };
-        Curves::from_control_points(
+        let curves = Curves::from_control_points(
             super::placed(&self.control, point, radius_scale),
             &self.control_counts,
-            colors,
+            self.colors.clone(),
             self.layout.basis,
             shape,
-        )
-        .map_err(|e| e.context(&self.path))
+        );
+        let curves = match &self.melanin {
+            // The primvar is eumelanin alone.
+            Some(m) => curves.and_then(|c| c.with_melanin(m.iter().map(|&e| [e, 0.0]).collect())),
+            None => curves,
+        };
+        curves.map_err(|e| e.context(&self.path))
     }
 
     pub fn basis(&self) -> CurveBasis {
         self.layout.basis
-    }
-
-    /// One colour per segment end from each curve's eumelanin: the inverse of
-    /// [`sigma_a_from_color`] at `beta_n` applied to [`sigma_a_from_melanin`].
-    fn melanin_colors(&self, melanin: &[f32], beta_n: f32) -> Result<Vec<[f32; 3]>> {
-        // sigma_a_from_color(c) = (ln c / d)^2, so d follows from c = 1/e: sigma_a = 1/d^2.
-        let d = 1.0 / f64::from(sigma_a_from_color([(-1.0f32).exp(); 3], beta_n)?[0]).sqrt();
-        let mut out = Vec::new();
-        for (&m, &n) in melanin.iter().zip(&self.control_counts) {
-            let sigma_a = sigma_a_from_melanin(m, 0.0)?;
-            let c = sigma_a.map(|s| (-f64::from(s).sqrt() * d).exp() as f32);
-            let segments = self.layout.basis.segments_for(n as usize).unwrap_or(0);
-            out.extend(std::iter::repeat_n(c, segments + 1));
-        }
-        Ok(out)
     }
 }
 

@@ -1319,6 +1319,28 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
+ * Gives hair material `material_id` new parameters and variation (as
+ * `ht_scene_add_hair_material_varied` takes them), without a new build: the next render
+ * is the one of a scene built with them. `variation` may be NULL: no variation.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `params` NULL); `HT_ERR_INVALID_ARG` (a value
+ * out of range as for `ht_scene_add_hair_material_varied`, no material `material_id`, a
+ * diffuse material, or a `beta_n` other than the one a USD groom's melanin colours were
+ * derived at, for a material with `use_vertex_colors`: add the groom again instead).
+ * On failure the material is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `params` and
+ * `variation` are NULL or readable.
+ */
+enum HtStatus ht_scene_set_hair_material(struct HtScene *scene,
+                                         uint32_t material_id,
+                                         const struct HtHairParams *params,
+                                         const struct HtHairVariation *variation);
+#endif
+
+#if defined(HT_RENDER)
+/**
  * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;
  * writes its id.
  *
@@ -1332,6 +1354,24 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
 enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
                                             const float *albedo,
                                             uint32_t *material_id);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Gives diffuse material `material_id` a new `albedo` (3 floats, linear RGB, each in
+ * [0, 1]), without a new build: the next render is the one of a scene built with it.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `albedo` NULL); `HT_ERR_INVALID_ARG` (a channel
+ * NaN or outside [0, 1], a misaligned pointer, no material `material_id`, a hair
+ * material). On failure the material is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `albedo` is NULL or
+ * points to 3 readable floats.
+ */
+enum HtStatus ht_scene_set_diffuse_material(struct HtScene *scene,
+                                            uint32_t material_id,
+                                            const float *albedo);
 #endif
 
 #if defined(HT_RENDER)

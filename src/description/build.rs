@@ -7,7 +7,7 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3};
 
 use super::{
-    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
+    BuiltScene, CameraDesc, EnvironmentSource, GeometrySource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
     MeshDesc, MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
@@ -16,7 +16,9 @@ use crate::error::{Error, Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
+use crate::scene::detail_view::DetailView;
 use crate::scene::envmap::Environment;
+use crate::scene::framing::Framing;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
 use crate::scene::material::{HairMaterial, Material};
@@ -87,10 +89,11 @@ impl SceneDescription {
 
         let mut stages = StageRunner::new(progress);
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
-        let mut hair_bounds = Bounds::EMPTY;
+        let mut framing = Framing::default();
         let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
         // One material per geometry: a USD groom adds one geometry per BasisCurves prim.
         let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
+        let mut sources = Vec::with_capacity(materials.capacity());
         // Curves wait for the camera: an `auto` groom's shapes depend on it.
         let mut built = Vec::new();
         for (i, g) in self.grooms.iter().enumerate() {
@@ -100,11 +103,10 @@ impl SceneDescription {
                 _ => HairMaterial::default().beta_n,
             };
             let curves = g
-                .curves(&mut stages, (i, grooms, reads), &mut hair_bounds, beta_n)
+                .curves(&mut stages, (i, grooms, reads), &mut framing, beta_n)
                 .map_err(|e| self.error(&at, e))?;
             built.extend(curves.into_iter().map(|c| (i, c)));
         }
-        let mut prop_bounds = Bounds::EMPTY;
         let mut meshes = Vec::with_capacity(self.meshes.len());
         for (i, m) in self.meshes.iter().enumerate() {
             let at = format!("mesh[{i}]");
@@ -114,35 +116,41 @@ impl SceneDescription {
             // A ground quad is the stage, not the subject: framing it would shrink the
             // subject to a speck.
             if !matches!(m.source, MeshSource::Ground { .. }) {
-                for p in &mesh.positions {
-                    prop_bounds.add(Vec3::from_array(*p), 0.0);
-                }
+                framing.add_mesh(&mesh.positions);
             }
             meshes.push(mesh);
         }
         // A scene without grooms (or meshes) still goes through every stage.
         stages.report(Stage::Read, 1.0)?;
         stages.report(Stage::Curves, 1.0)?;
-        let framed = if hair_bounds.is_empty() {
-            prop_bounds
-        } else {
-            hair_bounds
-        };
         let aspect = settings.width as f32 / settings.height as f32;
         let camera = self
             .camera
-            .build(framed, aspect)
+            .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
-        for (i, curves) in built {
+        let view = DetailView::new(camera, settings.height);
+        for (i, (curves, colors_beta_n)) in built {
             let at = format!("groom[{i}]");
-            let parts = match self.grooms[i].shape {
-                GroomShape::Auto => ribbons::share_out(curves, &camera, settings.height)
-                    .map_err(|e| self.error(&at, e))?,
-                _ => vec![curves],
+            let groom = &self.grooms[i];
+            let auto = groom.shape == GroomShape::Auto;
+            let parts = if auto {
+                ribbons::share_out(curves, &camera, settings.height)
+                    .map_err(|e| self.error(&at, e))?
+            } else {
+                vec![curves]
             };
             for part in parts {
-                tracer.add_curves(part).map_err(|e| self.error(&at, e))?;
+                let added = if auto {
+                    tracer.add_view_curves(part, view)
+                } else {
+                    tracer.add_curves(part)
+                };
+                added.map_err(|e| self.error(&at, e))?;
                 materials.push(groom_materials[i].clone());
+                sources.push(GeometrySource {
+                    material: groom.material.clone(),
+                    colors_beta_n,
+                });
             }
         }
         // Geometry ids follow `materials`: the grooms' geometries, then the meshes.
@@ -150,6 +158,10 @@ impl SceneDescription {
             tracer
                 .add_mesh(mesh)
                 .map_err(|e| self.error(&format!("mesh[{i}]"), e))?;
+            sources.push(GeometrySource {
+                material: self.meshes[i].material.clone(),
+                colors_beta_n: None,
+            });
         }
         materials.extend(mesh_materials);
         let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
@@ -159,6 +171,7 @@ impl SceneDescription {
             camera,
             settings,
             stages: stages.times(),
+            sources,
         })
     }
 
@@ -191,7 +204,8 @@ impl SceneDescription {
 }
 
 impl MaterialDesc {
-    fn prepare(&self) -> Result<Material> {
+    /// The material, every value checked.
+    pub(super) fn prepare(&self) -> Result<Material> {
         Ok(match self {
             MaterialDesc::Hair(h) => Material::Hair(Box::new(h.prepare()?)),
             MaterialDesc::Diffuse { albedo } => {
@@ -241,16 +255,16 @@ impl GroomDesc {
 
     /// The Embree curves of the groom, `part` = (index, grooms, files to read) of the
     /// build's stages: one geometry, or one per BasisCurves prim of a USD file (laid out by
-    /// the prim's own basis and wrap, placed by the entry's transform). Adds the points,
-    /// widened by their radii, to `framed`. `beta_n` is the material's (melanin primvars
-    /// become colours for it).
+    /// the prim's own basis and wrap, placed by the entry's transform), each with the
+    /// `beta_n` its colours were derived at, if they come from melanin. Adds the groom to
+    /// `framing`. `beta_n` is the material's (melanin primvars become colours for it).
     fn curves(
         &self,
         stages: &mut StageRunner,
         (i, grooms, reads): (usize, usize, usize),
-        framed: &mut Bounds,
+        framing: &mut Framing,
         beta_n: f32,
-    ) -> Result<Vec<Curves>> {
+    ) -> Result<Vec<(Curves, Option<f32>)>> {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
         let radius_factor = self.transform.scale * self.radius_scale;
@@ -259,21 +273,15 @@ impl GroomDesc {
             GroomSource::File { path, .. } if is_usd_path(path) => {
                 let file = stages.run(Stage::Read, (i, reads), |_| read_usd_file(path))?;
                 for c in &file.curves {
-                    let (lo, hi) = c.bounds;
-                    let r = c.radius_range.1 * radius_factor;
-                    for corner in 0..8 {
-                        let p =
-                            std::array::from_fn(
-                                |k| {
-                                    if corner >> k & 1 == 1 { hi[k] } else { lo[k] }
-                                },
-                            );
-                        framed.add(Vec3::from_array(place(p)), r);
-                    }
+                    c.frame(framing, radius_factor, place);
                 }
                 stages.run(Stage::Curves, (i, grooms), |_| {
                     (file.curves.iter())
-                        .map(|c| c.curves(self.shape.built(), radius_factor, place, beta_n))
+                        .map(|c| {
+                            let curves =
+                                c.curves(self.shape.built(), radius_factor, place, beta_n)?;
+                            Ok((curves, c.colors_beta_n(beta_n)))
+                        })
                         .collect()
                 })
             }
@@ -289,20 +297,16 @@ impl GroomDesc {
                         self.shape.built(),
                     )
                 })?;
-                for p in curves.vertices() {
-                    framed.add(Vec3::new(p[0], p[1], p[2]), p[3]);
-                }
-                Ok(vec![curves])
+                framing.add_control_points(curves.vertices());
+                Ok(vec![(curves, None)])
             }
             _ => {
                 let strands = stages.run(Stage::Read, (i, reads), |_| self.strands())?;
-                for (p, r) in strands.points.iter().zip(&strands.radii) {
-                    framed.add(Vec3::from_array(*p), *r);
-                }
+                framing.add_strands(&strands);
                 let curves = stages.run(Stage::Curves, (i, grooms), |_| {
                     Curves::from_strands(&strands, self.basis, self.shape.built())
                 })?;
-                Ok(vec![curves])
+                Ok(vec![(curves, None)])
             }
         }
     }
@@ -417,25 +421,25 @@ impl LightDesc {
 }
 
 impl CameraDesc {
-    /// The camera for an image of `aspect`, framing `framed` when no eye and target are
+    /// The camera for an image of `aspect`, framing `framing` when no eye and target are
     /// given.
-    fn build(&self, framed: Bounds, aspect: f32) -> Result<Camera> {
+    fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
         let (camera, target) = match (self.eye, self.target) {
             (Some(eye), Some(target)) => {
                 let (eye, target) = (Vec3::from_array(eye), Vec3::from_array(target));
                 let up = Vec3::from_array(self.up);
                 (Camera::new(eye, target, up, self.fov_deg, aspect)?, target)
             }
-            (None, None) if framed.is_empty() => {
-                return Err(invalid_arg!(
-                    "nothing to frame (no groom and no mesh but ground quads): give `eye` \
-                     and `target`"
-                ));
+            (None, None) => {
+                let camera = framing.camera(aspect, self.fov_deg).ok_or_else(|| {
+                    invalid_arg!(
+                        "nothing to frame (no groom and no mesh but ground quads): give \
+                         `eye` and `target`"
+                    )
+                })??;
+                let (lo, hi) = framing.bounds().expect("framed above");
+                (camera, (lo + hi) / 2.0)
             }
-            (None, None) => (
-                Camera::frame_bounds(framed.lo, framed.hi, aspect, self.fov_deg)?,
-                (framed.lo + framed.hi) / 2.0,
-            ),
             _ => {
                 return Err(invalid_arg!(
                     "give both `eye` and `target`, or neither for an automatic camera"
@@ -446,29 +450,5 @@ impl CameraDesc {
             .focus_distance
             .unwrap_or_else(|| camera.eye().distance(target));
         camera.with_thin_lens(self.aperture_radius, focus)
-    }
-}
-
-/// An axis-aligned box grown point by point.
-#[derive(Debug, Clone, Copy)]
-struct Bounds {
-    lo: Vec3,
-    hi: Vec3,
-}
-
-impl Bounds {
-    const EMPTY: Bounds = Bounds {
-        lo: Vec3::INFINITY,
-        hi: Vec3::NEG_INFINITY,
-    };
-
-    /// Grows the box to hold a ball of `radius` around `p`.
-    fn add(&mut self, p: Vec3, radius: f32) {
-        self.lo = self.lo.min(p - radius);
-        self.hi = self.hi.max(p + radius);
-    }
-
-    fn is_empty(&self) -> bool {
-        self.lo.cmpgt(self.hi).any()
     }
 }

@@ -30,6 +30,27 @@ impl Material {
     }
 }
 
+impl Material {
+    /// Checks that the material may shade curves whose colours were derived from melanin
+    /// at azimuthal roughness `colors_beta_n` (a USD groom's melanin primvar; None for any
+    /// other colours): a hair material that reads vertex colours must keep that roughness,
+    /// for which alone the colours give the melanin's absorption back.
+    pub fn check_colors_at(&self, what: &str, colors_beta_n: Option<f32>) -> Result<()> {
+        match (self, colors_beta_n) {
+            (Material::Hair(h), Some(b))
+                if h.material().use_vertex_colors && h.material().beta_n != b =>
+            {
+                Err(invalid_arg!(
+                    "{what}: beta_n = {}, but the groom's colours were derived from its \
+                     melanin at beta_n = {b}: add the groom again to change beta_n",
+                    h.material().beta_n
+                ))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
 /// Where a hair material's absorption comes from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum HairColor {

@@ -28,6 +28,8 @@ mod render_tests;
 pub mod shutdown;
 #[cfg(all(test, feature = "render"))]
 mod soundness_tests;
+#[cfg(all(test, feature = "render"))]
+mod edit_tests;
 
 pub use bsdf::HtHairParams;
 

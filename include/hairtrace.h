@@ -531,10 +531,11 @@ typedef bool (*HtBuildProgressFn)(double fraction, void *user);
 
 #if defined(HT_RENDER)
 /**
- * Per strand, at each render: a ribbon where the strand is at most one pixel wide from
- * the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
- * tubes, at an error within the noise of a render (README, "Curve shapes"). A render
- * with another camera or image height than the last one builds the scene's BVH again.
+ * Per strand, at a build: a ribbon where the strand is at most one pixel wide from the
+ * camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
+ * tubes, at an error within the noise of a render (README, "Curve shapes"). A later
+ * render keeps the build while no pixel is smaller where the strands are than at that
+ * build (farther, a wider view, fewer pixels); a nearer or finer view builds again.
  */
 #define HT_CURVE_AUTO 2
 #endif
@@ -984,8 +985,10 @@ enum HtStatus ht_scene_free(struct HtScene *scene);
  * every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
  * giving the image's upward direction (finite, not zero, not parallel to the view), with
  * a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
- * `(target - eye) x up`. Replaces any earlier camera. Without one, renders frame the
- * scene's bounds from the front (+z), a little to the right and above.
+ * `(target - eye) x up`. Replaces any earlier camera, without a new build unless
+ * `HT_CURVE_AUTO` curves need other shapes for it. Without one, renders frame the
+ * geometry as added (the hair's points widened by their radii, else the meshes) from the
+ * front (+z), a little to the right and above, as a scene file without a camera does.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
  * `HT_ERR_INVALID_ARG` (a value out of range, `eye == target`, `up` along the view, a
@@ -1413,10 +1416,11 @@ enum HtStatus ht_scene_build(struct HtScene *scene,
  * owned by the host. `ht_render_aovs` without AOVs.
  *
  * The first render builds the Embree scene (its time is part of the call, silent:
- * `ht_scene_build` reports it); later ones reuse it until geometry is added. Blocks until the image is done, on worker threads of
- * its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
- * pixels finished before the callback said stop and 0 elsewhere; on other errors it is
- * left untouched.
+ * `ht_scene_build` reports it); later ones reuse it until geometry is added, or until
+ * a view needs other shapes for `HT_CURVE_AUTO` curves. Blocks until the image is done,
+ * on worker threads of its own that are joined before it returns. On `HT_ERR_CANCELLED`,
+ * `rgb` holds the pixels finished before the callback said stop and 0 elsewhere; on other
+ * errors it is left untouched.
  *
  * Statuses: as `ht_render_aovs`.
  *

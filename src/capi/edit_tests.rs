@@ -50,16 +50,23 @@ impl Setup {
         let h = Handles::new();
         unsafe {
             let (mut hair, mut wall) = (0, 0);
-            let s = ht_scene_add_hair_material_varied(h.scene, &self.hair, &self.variation, &mut hair);
+            let s =
+                ht_scene_add_hair_material_varied(h.scene, &self.hair, &self.variation, &mut hair);
             assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
             let albedo = self.albedo.as_ptr();
-            assert_eq!(ht_scene_add_diffuse_material(h.scene, albedo, &mut wall), HtStatus::HT_OK);
+            assert_eq!(
+                ht_scene_add_diffuse_material(h.scene, albedo, &mut wall),
+                HtStatus::HT_OK
+            );
             let fur = small_fur();
             let desc = HtCurves {
                 shape: HT_CURVE_AUTO,
                 ..curves_desc(&fur)
             };
-            assert_eq!(ht_scene_add_curves(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
+            assert_eq!(
+                ht_scene_add_curves(h.scene, &desc, hair, &mut 0),
+                HtStatus::HT_OK
+            );
             assert_eq!(h.add_triangle(wall), HtStatus::HT_OK);
             light(&h, false);
         }
@@ -88,7 +95,10 @@ impl Setup {
             let s = ht_scene_set_camera(h.scene, eye, target.as_ptr(), up.as_ptr(), 40.0);
             assert_eq!(s, HtStatus::HT_OK);
             if let Some((radius, focus)) = self.lens {
-                assert_eq!(ht_scene_set_thin_lens(h.scene, radius, focus), HtStatus::HT_OK);
+                assert_eq!(
+                    ht_scene_set_thin_lens(h.scene, radius, focus),
+                    HtStatus::HT_OK
+                );
             }
         }
     }
@@ -140,7 +150,10 @@ fn edits_keep_the_build_and_render_as_a_fresh_build() {
         assert_eq!(builds(&h), 1, "step {i} built the BVH again");
         assert!(bits(&edited) != bits(&image), "step {i} changed nothing");
         let fresh = step.build();
-        assert!(bits(&render_c(&fresh, &s).1) == bits(&edited), "step {i}: not the fresh image");
+        assert!(
+            bits(&render_c(&fresh, &s).1) == bits(&edited),
+            "step {i}: not the fresh image"
+        );
         (before, image) = (*step, edited);
     }
 }
@@ -156,27 +169,73 @@ fn bad_material_edits_are_refused_and_change_nothing() {
     let v = ht_hair_variation_default();
     unsafe {
         use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
-        fails(ht_scene_set_hair_material(null_mut(), 0, &p, &v), NULL, "scene");
-        fails(ht_scene_set_hair_material(h.scene, 0, null(), &v), NULL, "params");
-        fails(ht_scene_set_hair_material(h.scene, 2, &p, &v), INVALID, "material_id = 2");
-        fails(ht_scene_set_hair_material(h.scene, 1, &p, &v), INVALID, "diffuse");
+        fails(
+            ht_scene_set_hair_material(null_mut(), 0, &p, &v),
+            NULL,
+            "scene",
+        );
+        fails(
+            ht_scene_set_hair_material(h.scene, 0, null(), &v),
+            NULL,
+            "params",
+        );
+        fails(
+            ht_scene_set_hair_material(h.scene, 2, &p, &v),
+            INVALID,
+            "material_id = 2",
+        );
+        fails(
+            ht_scene_set_hair_material(h.scene, 1, &p, &v),
+            INVALID,
+            "diffuse",
+        );
         let bad = HtHairParams { beta_n: 2.0, ..p };
-        fails(ht_scene_set_hair_material(h.scene, 0, &bad, &v), INVALID, "beta_n");
+        fails(
+            ht_scene_set_hair_material(h.scene, 0, &bad, &v),
+            INVALID,
+            "beta_n",
+        );
         let bad = HtHairVariation {
             use_vertex_colors: 2,
             ..v
         };
-        fails(ht_scene_set_hair_material(h.scene, 0, &p, &bad), INVALID, "use_vertex_colors");
+        fails(
+            ht_scene_set_hair_material(h.scene, 0, &p, &bad),
+            INVALID,
+            "use_vertex_colors",
+        );
         let grey = [0.5f32; 3];
-        fails(ht_scene_set_diffuse_material(null_mut(), 1, grey.as_ptr()), NULL, "scene");
-        fails(ht_scene_set_diffuse_material(h.scene, 1, null()), NULL, "albedo");
-        fails(ht_scene_set_diffuse_material(h.scene, 0, grey.as_ptr()), INVALID, "hair");
+        fails(
+            ht_scene_set_diffuse_material(null_mut(), 1, grey.as_ptr()),
+            NULL,
+            "scene",
+        );
+        fails(
+            ht_scene_set_diffuse_material(h.scene, 1, null()),
+            NULL,
+            "albedo",
+        );
+        fails(
+            ht_scene_set_diffuse_material(h.scene, 0, grey.as_ptr()),
+            INVALID,
+            "hair",
+        );
         let bright = [1.5f32, 0.5, 0.5];
-        fails(ht_scene_set_diffuse_material(h.scene, 1, bright.as_ptr()), INVALID, "1.5");
+        fails(
+            ht_scene_set_diffuse_material(h.scene, 1, bright.as_ptr()),
+            INVALID,
+            "1.5",
+        );
         // NULL variation: none, the same as the default.
-        assert_eq!(ht_scene_set_hair_material(h.scene, 0, &p, null()), HtStatus::HT_OK);
+        assert_eq!(
+            ht_scene_set_hair_material(h.scene, 0, &p, null()),
+            HtStatus::HT_OK
+        );
     }
-    assert!(bits(&render_c(&h, &s).1) == bits(&before), "a refused edit changed the image");
+    assert!(
+        bits(&render_c(&h, &s).1) == bits(&before),
+        "a refused edit changed the image"
+    );
     assert_eq!(builds(&h), 1);
 }
 
@@ -192,7 +251,12 @@ fn melanin_colours_keep_their_beta_n() {
     unsafe {
         let s = ht_scene_add_usd_file(h.scene, path.as_ptr(), 0, hair, &mut first, &mut count);
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        assert!(h.scene().geometries.iter().any(|g| g.colors_beta_n.is_some()));
+        assert!(
+            h.scene()
+                .geometries
+                .iter()
+                .any(|g| g.colors_beta_n.is_some())
+        );
         let p = ht_hair_params_default();
         let colours = HtHairVariation {
             use_vertex_colors: 1,
@@ -202,9 +266,17 @@ fn melanin_colours_keep_their_beta_n() {
         let s = ht_scene_set_hair_material(h.scene, hair, &rougher, &colours);
         fails(s, HtStatus::HT_ERR_INVALID_ARG, "melanin at beta_n = 0.3");
         let s = ht_scene_set_hair_material(h.scene, hair, &rougher, &ht_hair_variation_default());
-        assert_eq!(s, HtStatus::HT_OK, "without vertex colours: {}", last_error());
+        assert_eq!(
+            s,
+            HtStatus::HT_OK,
+            "without vertex colours: {}",
+            last_error()
+        );
         let darker = HtHairParams { eta: 1.6, ..p };
-        assert_eq!(ht_scene_set_hair_material(h.scene, hair, &darker, &colours), HtStatus::HT_OK);
+        assert_eq!(
+            ht_scene_set_hair_material(h.scene, hair, &darker, &colours),
+            HtStatus::HT_OK
+        );
     }
 }
 
@@ -220,7 +292,10 @@ fn a_host_without_a_camera_builds_once() {
             shape,
             ..curves_desc(&fur)
         };
-        assert_eq!(unsafe { ht_scene_add_curves(h.scene, &desc, hair, &mut 0) }, HtStatus::HT_OK);
+        assert_eq!(
+            unsafe { ht_scene_add_curves(h.scene, &desc, hair, &mut 0) },
+            HtStatus::HT_OK
+        );
         light(&h, false);
         let s = settings(24);
         let status = unsafe { ht_scene_build(h.scene, &s, None, null_mut()) };
@@ -251,12 +326,20 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
     d.render.spp = 4;
     d.render.seed = 3;
     d.render.threads = Some(2);
-    d.materials.insert("hair".into(), MaterialDesc::Hair(HairMaterial::default()));
-    d.materials.insert("floor".into(), MaterialDesc::Diffuse { albedo: [0.6; 3] });
+    d.materials
+        .insert("hair".into(), MaterialDesc::Hair(HairMaterial::default()));
+    d.materials
+        .insert("floor".into(), MaterialDesc::Diffuse { albedo: [0.6; 3] });
     let mut groom = GroomDesc::new(GroomSource::FurBall(fur.clone()), "hair");
     groom.shape = GroomShape::Auto;
     d.grooms.push(groom);
-    d.meshes.push(MeshDesc::new(MeshSource::Ground { y: ground_y, half_size: half }, "floor"));
+    d.meshes.push(MeshDesc::new(
+        MeshSource::Ground {
+            y: ground_y,
+            half_size: half,
+        },
+        "floor",
+    ));
     d.lights.push(LightDesc::Distant {
         direction: sun.0,
         irradiance: sun.1,
@@ -276,16 +359,31 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
             ..curves_desc(&strands)
         };
         assert_eq!(desc.basis, HT_CURVE_BSPLINE);
-        assert_eq!(GroomDesc::new(GroomSource::FurBall(fur), "").basis, CurveBasis::BSpline);
-        assert_eq!(ht_scene_add_curves(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
+        assert_eq!(
+            GroomDesc::new(GroomSource::FurBall(fur), "").basis,
+            CurveBasis::BSpline
+        );
+        assert_eq!(
+            ht_scene_add_curves(h.scene, &desc, hair, &mut 0),
+            HtStatus::HT_OK
+        );
         let ground = crate::scene::shapes::ground(ground_y, half).unwrap();
-        let (p, t) = (ground.positions.as_ptr().cast(), ground.triangles.as_ptr().cast());
-        let normals = ground.normals.as_ref().map_or(null(), |n| n.as_ptr().cast());
+        let (p, t) = (
+            ground.positions.as_ptr().cast(),
+            ground.triangles.as_ptr().cast(),
+        );
+        let normals = ground
+            .normals
+            .as_ref()
+            .map_or(null(), |n| n.as_ptr().cast());
         let (v, n) = (ground.positions.len(), ground.triangles.len());
         let s = ht_scene_add_mesh(h.scene, v, p, normals, n, t, floor, &mut 0);
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
         let (dir, irradiance) = (sun.0.as_ptr(), sun.1.as_ptr());
-        assert_eq!(ht_scene_add_distant_light(h.scene, dir, irradiance, sun.2), HtStatus::HT_OK);
+        assert_eq!(
+            ht_scene_add_distant_light(h.scene, dir, irradiance, sun.2),
+            HtStatus::HT_OK
+        );
     }
     let s = HtRenderSettings {
         width: 40,
@@ -297,7 +395,14 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
     };
     let (status, rgb) = render_c(&h, &s);
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    let (_, camera) = scene_mut(h.scene).ok().unwrap().prepare(40, 30, &crate::scene::NoStages).unwrap();
+    let (_, camera) = scene_mut(h.scene)
+        .ok()
+        .unwrap()
+        .prepare(40, 30, &crate::scene::NoStages)
+        .unwrap();
     assert_eq!(camera.eye(), built.camera.eye());
-    assert!(bits(&rgb) == bits(toml.film.rgb()), "the C image is not the description's");
+    assert!(
+        bits(&rgb) == bits(toml.film.rgb()),
+        "the C image is not the description's"
+    );
 }

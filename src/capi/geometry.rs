@@ -32,10 +32,11 @@ pub type HtCurveShape = u32;
 pub const HT_CURVE_ROUND: HtCurveShape = 0;
 /// A ribbon facing the ray: faster, approximate up close.
 pub const HT_CURVE_FLAT: HtCurveShape = 1;
-/// Per strand, at each render: a ribbon where the strand is at most one pixel wide from
-/// the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
-/// tubes, at an error within the noise of a render (README, "Curve shapes"). A render
-/// with another camera or image height than the last one builds the scene's BVH again.
+/// Per strand, at a build: a ribbon where the strand is at most one pixel wide from the
+/// camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
+/// tubes, at an error within the noise of a render (README, "Curve shapes"). A later
+/// render keeps the build while no pixel is smaller where the strands are than at that
+/// build (farther, a wider view, fewer pixels); a nearer or finer view builds again.
 pub const HT_CURVE_AUTO: HtCurveShape = 2;
 
 /// Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays

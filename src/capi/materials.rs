@@ -138,10 +138,9 @@ fn hair_material(
             0 => false,
             1 => true,
             other => {
-                return Err(invalid_arg!(
-                    "variation->use_vertex_colors = {other}: must be 0 or 1"
-                )
-                .into());
+                return Err(
+                    invalid_arg!("variation->use_vertex_colors = {other}: must be 0 or 1").into(),
+                );
             }
         },
         seed: v.seed,

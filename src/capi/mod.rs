@@ -20,6 +20,8 @@ pub mod materials;
 #[cfg(all(test, feature = "render"))]
 mod scene_tests;
 // After `scene`, so that the header declares scenes before the render that takes them.
+#[cfg(all(test, feature = "render"))]
+mod edit_tests;
 #[cfg(feature = "render")]
 pub mod render;
 #[cfg(all(test, feature = "render"))]
@@ -28,8 +30,6 @@ mod render_tests;
 pub mod shutdown;
 #[cfg(all(test, feature = "render"))]
 mod soundness_tests;
-#[cfg(all(test, feature = "render"))]
-mod edit_tests;
 
 pub use bsdf::HtHairParams;
 

@@ -137,7 +137,11 @@ impl HtScene {
         let what = format!("material_id = {id}");
         let old = self.material(id)?;
         if std::mem::discriminant(old) != std::mem::discriminant(&material) {
-            let kind = if matches!(old, Material::Hair(_)) { "hair" } else { "diffuse" };
+            let kind = if matches!(old, Material::Hair(_)) {
+                "hair"
+            } else {
+                "diffuse"
+            };
             return Err(invalid_arg!(
                 "{what} is a {kind} material, and a material keeps its kind: add a new one"
             ));
@@ -400,8 +404,10 @@ pub unsafe extern "C" fn ht_scene_free(scene: *mut HtScene) -> HtStatus {
 /// every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
 /// giving the image's upward direction (finite, not zero, not parallel to the view), with
 /// a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
-/// `(target - eye) x up`. Replaces any earlier camera. Without one, renders frame the
-/// scene's bounds from the front (+z), a little to the right and above.
+/// `(target - eye) x up`. Replaces any earlier camera, without a new build unless
+/// `HT_CURVE_AUTO` curves need other shapes for it. Without one, renders frame the
+/// geometry as added (the hair's points widened by their radii, else the meshes) from the
+/// front (+z), a little to the right and above, as a scene file without a camera does.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
 /// `HT_ERR_INVALID_ARG` (a value out of range, `eye == target`, `up` along the view, a

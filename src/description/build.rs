@@ -7,8 +7,8 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3};
 
 use super::{
-    BuiltScene, CameraDesc, EnvironmentSource, GeometrySource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
-    MeshDesc, MeshSource, SceneDescription, Transform,
+    BuiltScene, CameraDesc, EnvironmentSource, GeometrySource, GroomDesc, GroomSource, LightDesc,
+    MaterialDesc, MeshDesc, MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device, SceneOptions};

@@ -434,7 +434,9 @@ impl BuiltScene {
             .map(|(g, _)| g as u32)
             .collect();
         if users.is_empty() {
-            return Err(invalid_arg!("no geometry of the scene uses a material named {name:?}"));
+            return Err(invalid_arg!(
+                "no geometry of the scene uses a material named {name:?}"
+            ));
         }
         let what = format!("material {name:?}");
         for &g in &users {

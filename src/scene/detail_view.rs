@@ -100,12 +100,12 @@ impl ViewDependent {
         let Some(built) = &self.view else {
             return true;
         };
-        self.geometries.iter().all(|&id| {
-            match scene.geometries().get(id as usize) {
+        self.geometries
+            .iter()
+            .all(|&id| match scene.geometries().get(id as usize) {
                 Some(Geometry::Curves(c)) => built.holds_for(new, c.vertices()),
                 _ => true,
-            }
-        })
+            })
     }
 }
 
@@ -114,7 +114,10 @@ mod tests {
     use super::*;
 
     fn view(eye: Vec3, fov: f32, height: u32) -> DetailView {
-        DetailView::new(Camera::new(eye, Vec3::ZERO, Vec3::Y, fov, 1.0).unwrap(), height)
+        DetailView::new(
+            Camera::new(eye, Vec3::ZERO, Vec3::Y, fov, 1.0).unwrap(),
+            height,
+        )
     }
 
     #[test]

@@ -117,7 +117,12 @@ fn edits_of_a_built_scene_render_as_a_fresh_build_without_one() {
     check(&built, with_rect, "a light");
     // Farther: every strand stays a ribbon, so the shapes hold and a fresh build agrees.
     built.camera = camera(5.0);
-    assert!(built.world.tracer.serves(&DetailView::new(built.camera, 32)));
+    assert!(
+        built
+            .world
+            .tracer
+            .serves(&DetailView::new(built.camera, 32))
+    );
     check(&built, scene(5.0, red, blue, true), "a farther camera");
 
     // Nearer and with more pixels, strands are wider than the build assumed: refused.
@@ -142,9 +147,18 @@ fn bad_edits_are_refused_and_change_nothing() {
     let hair = MaterialDesc::Hair(HairMaterial::default());
     let floor = MaterialDesc::Diffuse { albedo: [0.1; 3] };
     let refused = |e: Error, words: &str| assert!(e.to_string().contains(words), "{e}");
-    refused(built.set_material("nothing", &hair).unwrap_err(), "\"nothing\"");
-    refused(built.set_material("brown", &floor).unwrap_err(), "curves need a hair material");
-    refused(built.set_material("floor", &hair).unwrap_err(), "meshes need a diffuse material");
+    refused(
+        built.set_material("nothing", &hair).unwrap_err(),
+        "\"nothing\"",
+    );
+    refused(
+        built.set_material("brown", &floor).unwrap_err(),
+        "curves need a hair material",
+    );
+    refused(
+        built.set_material("floor", &hair).unwrap_err(),
+        "meshes need a diffuse material",
+    );
     let bright = MaterialDesc::Diffuse { albedo: [2.0; 3] };
     assert!(built.set_material("floor", &bright).is_err());
     refused(built.set_lights(&[]).unwrap_err(), "no lights");

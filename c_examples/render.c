@@ -208,6 +208,19 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     printf("crop %d %d same %d hits %d\n", CROP_W, CROP_H, same, hits);
     if (check(ht_image_write(out, WIDTH, HEIGHT, 3, b->rgb, WIDTH * HEIGHT * 3), "ht_image_write")) return 1;
     printf("wrote %s\n", out);
+
+    /* Darker hair on the built scene: no new build, the next render uses it at once. */
+    if (check(ht_hair_sigma_a_from_melanin(3.0f, 0.2f, hair.sigma_a), "sigma_a")) return 1;
+    if (check(ht_scene_set_hair_material(scene, hair_id, &hair, &variation), "set hair"))
+        return 1;
+    float darker[CROP_W * CROP_H * 3];
+    if (check(ht_render(scene, &settings, darker, CROP_W * CROP_H * 3), "ht_render")) return 1;
+    double before = 0.0, after = 0.0;
+    for (int i = 0; i < CROP_W * CROP_H * 3; i++) {
+        before += crop[i];
+        after += darker[i];
+    }
+    printf("darker hair %d\n", after < before);
     return 0;
 }
 

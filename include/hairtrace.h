@@ -544,10 +544,11 @@ typedef bool (*HtBuildProgressFn)(double fraction, void *user);
 
 #if defined(HT_RENDER)
 /**
- * Per strand, at each render: a ribbon where the strand is at most one pixel wide from
- * the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
- * tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A render
- * with another camera or image height than the last one builds the scene's BVH again.
+ * Per strand, at a build: a ribbon where the strand is at most one pixel wide from the
+ * camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
+ * tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A later
+ * render keeps the build while no pixel is smaller where the strands are than at that
+ * build (farther, a wider view, fewer pixels); a nearer or finer view builds again.
  */
 #define HT_CURVE_AUTO 2
 #endif
@@ -997,8 +998,10 @@ enum HtStatus ht_scene_free(struct HtScene *scene);
  * every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
  * giving the image's upward direction (finite, not zero, not parallel to the view), with
  * a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
- * `(target - eye) x up`. Replaces any earlier camera. Without one, renders frame the
- * scene's bounds from the front (+z), a little to the right and above.
+ * `(target - eye) x up`. Replaces any earlier camera, without a new build unless
+ * `HT_CURVE_AUTO` curves need other shapes for it. Without one, renders frame the
+ * geometry as added (the hair's points widened by their radii, else the meshes) from the
+ * front (+z), a little to the right and above, as a scene file without a camera does.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
  * `HT_ERR_INVALID_ARG` (a value out of range, `eye == target`, `up` along the view, a
@@ -1332,6 +1335,28 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
 
 #if defined(HT_RENDER)
 /**
+ * Gives hair material `material_id` new parameters and variation (as
+ * `ht_scene_add_hair_material_varied` takes them), without a new build: the next render
+ * is the one of a scene built with them. `variation` may be NULL: no variation.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `params` NULL); `HT_ERR_INVALID_ARG` (a value
+ * out of range as for `ht_scene_add_hair_material_varied`, no material `material_id`, a
+ * diffuse material, or a `beta_n` other than the one a USD groom's melanin colours were
+ * derived at, for a material with `use_vertex_colors`: add the groom again instead).
+ * On failure the material is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `params` and
+ * `variation` are NULL or readable.
+ */
+enum HtStatus ht_scene_set_hair_material(struct HtScene *scene,
+                                         uint32_t material_id,
+                                         const struct HtHairParams *params,
+                                         const struct HtHairVariation *variation);
+#endif
+
+#if defined(HT_RENDER)
+/**
  * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;
  * writes its id.
  *
@@ -1345,6 +1370,24 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
 enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
                                             const float *albedo,
                                             uint32_t *material_id);
+#endif
+
+#if defined(HT_RENDER)
+/**
+ * Gives diffuse material `material_id` a new `albedo` (3 floats, linear RGB, each in
+ * [0, 1]), without a new build: the next render is the one of a scene built with it.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `albedo` NULL); `HT_ERR_INVALID_ARG` (a channel
+ * NaN or outside [0, 1], a misaligned pointer, no material `material_id`, a hair
+ * material). On failure the material is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `albedo` is NULL or
+ * points to 3 readable floats.
+ */
+enum HtStatus ht_scene_set_diffuse_material(struct HtScene *scene,
+                                            uint32_t material_id,
+                                            const float *albedo);
 #endif
 
 #if defined(HT_RENDER)
@@ -1479,10 +1522,11 @@ enum HtStatus ht_scene_build_with(struct HtScene *scene,
  * owned by the host. `ht_render_aovs` without AOVs.
  *
  * The first render builds the Embree scene (its time is part of the call, silent:
- * `ht_scene_build` reports it); later ones reuse it until geometry is added. Blocks until the image is done, on worker threads of
- * its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
- * pixels finished before the callback said stop and 0 elsewhere; on other errors it is
- * left untouched.
+ * `ht_scene_build` reports it); later ones reuse it until geometry is added, or until
+ * a view needs other shapes for `HT_CURVE_AUTO` curves. Blocks until the image is done,
+ * on worker threads of its own that are joined before it returns. On `HT_ERR_CANCELLED`,
+ * `rgb` holds the pixels finished before the callback said stop and 0 elsewhere; on other
+ * errors it is left untouched.
  *
  * Statuses: as `ht_render_aovs`.
  *

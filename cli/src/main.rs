@@ -405,6 +405,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         camera,
         settings,
         stages,
+        ..
     } = description.build_with(device, &bars)?;
     bars.finish();
     let build_seconds = build_start.elapsed().as_secs_f64();

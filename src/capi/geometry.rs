@@ -8,6 +8,7 @@ use crate::embree::{CurveBasis, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::scene::GroomShape;
 use crate::scene::curves::Curves;
+use crate::scene::framing::Framing;
 use crate::scene::mesh::Mesh;
 use crate::scene::{Strands, Thickness, read_hair_file};
 use std::ffi::c_char;
@@ -31,10 +32,11 @@ pub type HtCurveShape = u32;
 pub const HT_CURVE_ROUND: HtCurveShape = 0;
 /// A ribbon facing the ray: faster, approximate up close.
 pub const HT_CURVE_FLAT: HtCurveShape = 1;
-/// Per strand, at each render: a ribbon where the strand is at most one pixel wide from
-/// the camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
-/// tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A render
-/// with another camera or image height than the last one builds the scene's BVH again.
+/// Per strand, at a build: a ribbon where the strand is at most one pixel wide from the
+/// camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
+/// tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A later
+/// render keeps the build while no pixel is smaller where the strands are than at that
+/// build (farther, a wider view, fewer pixels); a nearer or finer view builds again.
 pub const HT_CURVE_AUTO: HtCurveShape = 2;
 
 /// Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
@@ -194,7 +196,8 @@ pub unsafe extern "C" fn ht_scene_add_curves(
             colors,
         };
         let curves = Curves::from_strands(&strands, basis, shape.built())?;
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
+        let frame = |f: &mut Framing| f.add_strands(&strands);
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
     })
 }
 
@@ -298,7 +301,8 @@ fn add_curves_xyzr(
         };
         let curves =
             Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
+        let frame = |f: &mut Framing| f.add_control_points(points);
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
     })
 }
 
@@ -335,7 +339,8 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
         };
         let strands = read_hair_file(&path, thickness)?;
         let curves = Curves::from_strands(&strands, basis, shape.built())?;
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id)?)
+        let frame = |f: &mut Framing| f.add_strands(&strands);
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
     })
 }
 
@@ -379,8 +384,9 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let first = u32::try_from(scene.geometries.len())
             .map_err(|_| invalid_arg!("too many geometries"))?;
         let count = u32::try_from(curves.len()).map_err(|_| invalid_arg!("too many prims"))?;
-        for c in curves {
-            scene.add_geometry(Shape::curves(c, shape), material_id)?;
+        for (c, prim) in curves.into_iter().zip(&grooms.curves) {
+            let frame = |f: &mut Framing| prim.frame(f, 1.0, |p| p);
+            scene.add_geometry(Shape::curves(c, shape), material_id, frame)?;
         }
         // SAFETY: non-NULL (checked), the host's uint32_t.
         unsafe { count_out.write(count) };
@@ -430,7 +436,7 @@ pub unsafe extern "C" fn ht_scene_add_mesh(
             .transpose()?;
         let triangles: &[[u32; 3]] = host_slice(indices.cast(), triangle_count, "indices")?;
         let mesh = Mesh::new(positions, triangles.to_vec(), normals)?;
-        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id)?)
+        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id, |_| ())?)
     })
 }
 
@@ -456,6 +462,6 @@ pub unsafe extern "C" fn ht_scene_add_mesh_file(
         let path = read_path(path, "path")?;
         scene.check_material(material_id, false)?;
         let mesh = Mesh::load(&path)?;
-        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id)?)
+        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id, |_| ())?)
     })
 }

@@ -1,9 +1,10 @@
 //! Materials through the C ABI: hair from parameters (optionally varied over the groom)
-//! and diffuse surfaces, each returning the id that geometries name.
+//! and diffuse surfaces, each returning the id that geometries name; their parameters
+//! can be changed later without a new build.
 
 use super::bsdf::HtHairParams;
-use super::scene::{HtScene, add_with_id};
-use super::{Failure, HtStatus, read_host, read_vec3};
+use super::scene::{HtScene, add_with_id, scene_mut};
+use super::{Failure, HtStatus, boundary, read_host, read_vec3};
 use crate::bsdf::diffuse::Diffuse;
 use crate::error::invalid_arg;
 use crate::scene::material::{HairColor, HairMaterial, Material};
@@ -79,32 +80,72 @@ pub unsafe extern "C" fn ht_scene_add_hair_material_varied(
     material_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, material_id, "material_id", |scene| {
-        let p = read_host(params, "params")?;
-        let v = read_host(variation, "variation")?;
-        let material = HairMaterial {
-            color: HairColor::SigmaA(p.sigma_a),
-            eta: p.eta,
-            beta_m: p.beta_m,
-            beta_n: p.beta_n,
-            alpha: p.alpha,
-            absorption_variation: v.absorption_variation,
-            roughness_variation: v.roughness_variation,
-            tip_absorption: v.tip_absorption,
-            use_vertex_colors: match v.use_vertex_colors {
-                0 => false,
-                1 => true,
-                other => {
-                    return Err(invalid_arg!(
-                        "variation->use_vertex_colors = {other}: must be 0 or 1"
-                    )
-                    .into());
-                }
-            },
-            seed: v.seed,
-        };
-        let prepared = material.prepare()?;
-        push_material(scene, Material::Hair(Box::new(prepared)))
+        let material = hair_material(params, variation)?;
+        push_material(scene, material)
     })
+}
+
+/// Gives hair material `material_id` new parameters and variation (as
+/// `ht_scene_add_hair_material_varied` takes them), without a new build: the next render
+/// is the one of a scene built with them. `variation` may be NULL: no variation.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene` or `params` NULL); `HT_ERR_INVALID_ARG` (a value
+/// out of range as for `ht_scene_add_hair_material_varied`, no material `material_id`, a
+/// diffuse material, or a `beta_n` other than the one a USD groom's melanin colours were
+/// derived at, for a material with `use_vertex_colors`: add the groom again instead).
+/// On failure the material is unchanged.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `params` and
+/// `variation` are NULL or readable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_set_hair_material(
+    scene: *mut HtScene,
+    material_id: u32,
+    params: *const HtHairParams,
+    variation: *const HtHairVariation,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        let none = ht_hair_variation_default();
+        let variation = if variation.is_null() {
+            &raw const none
+        } else {
+            variation
+        };
+        let material = hair_material(params, variation)?;
+        Ok(scene.set_material(material_id, material)?)
+    })
+}
+
+/// The hair material of the host's parameters and variation, checked and prepared.
+fn hair_material(
+    params: *const HtHairParams,
+    variation: *const HtHairVariation,
+) -> std::result::Result<Material, Failure> {
+    let p = read_host(params, "params")?;
+    let v = read_host(variation, "variation")?;
+    let material = HairMaterial {
+        color: HairColor::SigmaA(p.sigma_a),
+        eta: p.eta,
+        beta_m: p.beta_m,
+        beta_n: p.beta_n,
+        alpha: p.alpha,
+        absorption_variation: v.absorption_variation,
+        roughness_variation: v.roughness_variation,
+        tip_absorption: v.tip_absorption,
+        use_vertex_colors: match v.use_vertex_colors {
+            0 => false,
+            1 => true,
+            other => {
+                return Err(
+                    invalid_arg!("variation->use_vertex_colors = {other}: must be 0 or 1").into(),
+                );
+            }
+        },
+        seed: v.seed,
+    };
+    Ok(Material::Hair(Box::new(material.prepare()?)))
 }
 
 /// Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;
@@ -125,6 +166,29 @@ pub unsafe extern "C" fn ht_scene_add_diffuse_material(
     add_with_id(scene, material_id, "material_id", |scene| {
         let diffuse = Diffuse::new(read_vec3(albedo, "albedo")?)?;
         push_material(scene, Material::Diffuse(diffuse))
+    })
+}
+
+/// Gives diffuse material `material_id` a new `albedo` (3 floats, linear RGB, each in
+/// [0, 1]), without a new build: the next render is the one of a scene built with it.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene` or `albedo` NULL); `HT_ERR_INVALID_ARG` (a channel
+/// NaN or outside [0, 1], a misaligned pointer, no material `material_id`, a hair
+/// material). On failure the material is unchanged.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `albedo` is NULL or
+/// points to 3 readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_set_diffuse_material(
+    scene: *mut HtScene,
+    material_id: u32,
+    albedo: *const f32,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        let diffuse = Diffuse::new(read_vec3(albedo, "albedo")?)?;
+        Ok(scene.set_material(material_id, Material::Diffuse(diffuse))?)
     })
 }
 

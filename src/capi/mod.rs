@@ -23,6 +23,8 @@ mod scene_tests;
 pub mod settings;
 #[cfg(all(test, feature = "render"))]
 mod settings_tests;
+#[cfg(all(test, feature = "render"))]
+mod edit_tests;
 // After `scene` and `settings`, so that the header declares them before the render that
 // takes them.
 #[cfg(feature = "render")]

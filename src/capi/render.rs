@@ -278,10 +278,11 @@ fn build(
 /// owned by the host. `ht_render_aovs` without AOVs.
 ///
 /// The first render builds the Embree scene (its time is part of the call, silent:
-/// `ht_scene_build` reports it); later ones reuse it until geometry is added. Blocks until the image is done, on worker threads of
-/// its own that are joined before it returns. On `HT_ERR_CANCELLED`, `rgb` holds the
-/// pixels finished before the callback said stop and 0 elsewhere; on other errors it is
-/// left untouched.
+/// `ht_scene_build` reports it); later ones reuse it until geometry is added, or until
+/// a view needs other shapes for `HT_CURVE_AUTO` curves. Blocks until the image is done,
+/// on worker threads of its own that are joined before it returns. On `HT_ERR_CANCELLED`,
+/// `rgb` holds the pixels finished before the callback said stop and 0 elsewhere; on other
+/// errors it is left untouched.
 ///
 /// Statuses: as `ht_render_aovs`.
 ///

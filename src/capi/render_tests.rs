@@ -694,10 +694,10 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
         light(&h, true);
         h
     });
+    // The shapes of the last build (the scene's own camera and height keep it).
     let shapes = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
-        let height = scene.built_for.map_or(1, |v| v.1);
-        let (world, _) = scene.prepare(1, height, &NoStages).unwrap();
+        let world = scene.world.as_ref().expect("built");
         (world.tracer.scene().geometries().iter())
             .map(|g| match g {
                 Geometry::Curves(c) => c.shape(),
@@ -705,6 +705,7 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
             })
             .collect::<Vec<_>>()
     };
+    let builds = |h: &Handles| h.scene().device.builds();
     // Roots 0.008 wide, 3 to 5 units from an eye with a 40-degree view: a pixel wide at
     // 273 to 455 pixels of image height. At 32 every strand is a ribbon; at 1000 every
     // strand a tube (a 16-pixel crop keeps that render small); at 350, both.
@@ -728,15 +729,19 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     let auto_small = image(&auto, &small);
     assert_eq!(shapes(&auto), [CurveShape::Flat]);
     assert_eq!(auto_small, image(&flat, &small));
+    // More pixels make strands wider: built again, partly round, then all round.
+    let (status, _) = render_c(&auto, &settings(350));
+    assert_eq!(status, HtStatus::HT_OK);
+    assert_eq!(shapes(&auto), [CurveShape::Round, CurveShape::Flat]);
     let auto_tall = image(&auto, &tall);
     assert_eq!(shapes(&auto), [CurveShape::Round]);
     assert_eq!(auto_tall, image(&round, &tall));
     assert!(auto_tall.iter().any(|&v| f32::from_bits(v) > 0.0));
-    // Back to the first view: built again, the same pixels.
-    assert_eq!(image(&auto, &small), auto_small);
-    let (status, _) = render_c(&auto, &settings(350));
-    assert_eq!(status, HtStatus::HT_OK);
-    assert_eq!(shapes(&auto), [CurveShape::Round, CurveShape::Flat]);
+    assert_eq!(builds(&auto), 3);
+    // Back to the small view, whose pixels are larger: the tubes stay, with no build.
+    assert_eq!(image(&auto, &small), image(&round, &small));
+    assert_eq!(shapes(&auto), [CurveShape::Round]);
+    assert_eq!(builds(&auto), 3);
 }
 
 unsafe extern "C" fn record_build(fraction: f64, user: *mut c_void) -> bool {

@@ -3,7 +3,8 @@
 //!
 //! The scene keeps what the host added (curves already converted for Embree) and builds
 //! the Embree scene on the first render, then reuses it: adding geometry rebuilds it on
-//! the next render, adding a light only re-weights the lights.
+//! the next render; adding a light, changing a material's parameters and a camera for
+//! which the `auto` curves' shapes still hold keep it.
 
 use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
 use crate::embree::{Device, Isa, SceneOptions};
@@ -11,11 +12,13 @@ use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
+use crate::scene::detail_view::DetailView;
+use crate::scene::framing::Framing;
 use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::ribbons::{self, GroomShape};
-use crate::scene::stages::{NoStages, StageProgress, StageRunner};
+use crate::scene::stages::{StageProgress, StageRunner};
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::validate::{length, non_negative, positive};
 use std::ffi::c_char;
@@ -45,15 +48,15 @@ pub struct HtScene {
     /// Aperture radius and focus distance of a thin lens, validated; kept apart from the
     /// camera so that either may be set first, and the framing camera gets it too.
     pub(super) lens: Option<(f32, f32)>,
+    /// What a render without a camera frames, grown as geometry is added.
+    pub(super) framing: Framing,
     /// The last build; None until the first render and after geometry is added.
     pub(super) world: Option<World>,
+    /// The index in `geometries` of each Embree geometry of `world` (`auto` curves may
+    /// make several).
+    pub(super) built_from: Vec<usize>,
     /// Lights were added since `world` was built.
     pub(super) lights_changed: bool,
-    /// The view the `auto` curves of `world` were shared out for.
-    pub(super) built_for: Option<View>,
-    /// The bounds of the geometry as added (`auto` curves round), which frame a scene
-    /// with `auto` curves and no camera.
-    pub(super) added_bounds: Option<Bounds>,
 }
 
 pub(super) enum Shape {
@@ -79,83 +82,122 @@ pub(super) struct Geometry {
     pub(super) material: u32,
 }
 
-/// What an `auto` groom's shapes were chosen for: the camera and the image height.
-type View = (Camera, u32);
-/// Lower and upper corners of a box.
-type Bounds = ([f32; 3], [f32; 3]);
-
 impl HtScene {
     /// The material `id` for a geometry; hair goes on curves, diffuse on meshes.
     pub(super) fn check_material(&self, id: u32, on_curves: bool) -> Result<()> {
-        let material = self.materials.get(id as usize).ok_or_else(|| {
+        self.material(id)?
+            .check_suits(&format!("material_id = {id}"), on_curves)
+    }
+
+    fn material(&self, id: u32) -> Result<&Material> {
+        self.materials.get(id as usize).ok_or_else(|| {
             invalid_arg!(
                 "material_id = {id}: the scene has {} materials",
                 self.materials.len()
             )
-        })?;
-        material.check_suits(&format!("material_id = {id}"), on_curves)
+        })
     }
 
-    pub(super) fn add_geometry(&mut self, shape: Shape, material: u32) -> Result<u32> {
+    /// Adds a geometry; the next render builds again. A mesh is framed by its vertices,
+    /// curves by what `frame_curves` adds from the points the host gave (`Framing`).
+    pub(super) fn add_geometry(
+        &mut self,
+        shape: Shape,
+        material: u32,
+        frame_curves: impl FnOnce(&mut Framing),
+    ) -> Result<u32> {
         let id = u32::try_from(self.geometries.len())
             .map_err(|_| invalid_arg!("too many geometries"))?;
-        self.geometries.push(Geometry { shape, material });
-        (self.world, self.built_for, self.added_bounds) = (None, None, None);
+        match &shape {
+            Shape::Mesh(m) => self.framing.add_mesh(&m.positions),
+            Shape::Curves(_) | Shape::AutoCurves(_) => frame_curves(&mut self.framing),
+        }
+        self.geometries.push(Geometry {
+            shape,
+            material,
+        });
+        self.world = None;
         Ok(id)
     }
 
-    fn has_auto_curves(&self) -> bool {
-        (self.geometries.iter()).any(|g| matches!(g.shape, Shape::AutoCurves(_)))
+    /// Gives material `id` new parameters, of the same kind (hair or diffuse), without a
+    /// new build: the built world's geometries that use it take it at once.
+    pub(super) fn set_material(&mut self, id: u32, material: Material) -> Result<()> {
+        let what = format!("material_id = {id}");
+        let old = self.material(id)?;
+        if std::mem::discriminant(old) != std::mem::discriminant(&material) {
+            let kind = if matches!(old, Material::Hair(_)) {
+                "hair"
+            } else {
+                "diffuse"
+            };
+            return Err(invalid_arg!(
+                "{what} is a {kind} material, and a material keeps its kind: add a new one"
+            ));
+        }
+        if let Some(world) = &mut self.world {
+            for (embree_id, &g) in self.built_from.iter().enumerate() {
+                if self.geometries[g].material == id {
+                    world.set_material(embree_id as u32, material.clone())?;
+                }
+            }
+        }
+        self.materials[id as usize] = material;
+        Ok(())
     }
 
-    /// The Embree scene and one material per Embree geometry; `auto` curves are shared out
-    /// for `view`, or stay round without one.
+    /// The Embree scene, one material per Embree geometry and the geometry each came from;
+    /// `auto` curves are shared out for `view`.
     fn build_tracer(
         &self,
-        view: Option<&View>,
+        view: &DetailView,
         progress: &dyn StageProgress,
-    ) -> Result<(Tracer, Vec<Material>)> {
+    ) -> Result<(Tracer, Vec<Material>, Vec<usize>)> {
         let mut builder = TracerBuilder::new(self.device.clone(), SceneOptions::default())?;
         let mut materials = Vec::with_capacity(self.geometries.len());
-        for g in &self.geometries {
-            // Embree geometries made of this one (two for auto curves split by shape).
-            let added = match (&g.shape, view) {
-                (Shape::Mesh(m), _) => {
+        let mut built_from = Vec::with_capacity(self.geometries.len());
+        for (i, g) in self.geometries.iter().enumerate() {
+            // Embree geometries made of this one (several for auto curves split by shape).
+            let added = match &g.shape {
+                Shape::Mesh(m) => {
                     builder.add_mesh(m.clone())?;
                     1
                 }
-                (Shape::AutoCurves(c), Some((camera, height))) => {
-                    let parts = ribbons::share_out(c.clone(), camera, *height)?;
+                Shape::AutoCurves(c) => {
+                    let parts = ribbons::share_out(c.clone(), &view.camera, view.height)?;
                     let n = parts.len();
                     for part in parts {
-                        builder.add_curves(part)?;
+                        builder.add_view_curves(part, *view)?;
                     }
                     n
                 }
-                (Shape::Curves(c) | Shape::AutoCurves(c), _) => {
+                Shape::Curves(c) => {
                     builder.add_curves(c.clone())?;
                     1
                 }
             };
             let material = &self.materials[g.material as usize];
             materials.extend(std::iter::repeat_n(material.clone(), added));
+            built_from.extend(std::iter::repeat_n(i, added));
         }
-        Ok((builder.build_with(&StageRunner::new(progress))?, materials))
+        let tracer = builder.build_with(&StageRunner::new(progress))?;
+        Ok((tracer, materials, built_from))
     }
 
-    /// The host's camera, or one framing `bounds` (the geometry's; needed only without a
-    /// camera), for an image of `aspect` (width over height), with the host's lens.
-    fn camera(&self, aspect: f32, bounds: Option<Bounds>) -> Result<Camera> {
-        let camera = match (self.camera, bounds) {
-            (Some(c), _) => c.with_aspect(aspect)?,
-            (None, Some((lo, hi))) if !self.geometries.is_empty() => {
-                Camera::frame_bounds(lo.into(), hi.into(), aspect, Camera::DEFAULT_FOV_Y_DEG)?
-            }
-            (None, _) => {
-                return Err(invalid_arg!(
-                    "the scene has no geometry to frame: set a camera with ht_scene_set_camera"
-                ));
-            }
+    /// The host's camera, or the one that frames the geometry as added, for an image of
+    /// `aspect` (width over height), with the host's lens.
+    fn camera(&self, aspect: f32) -> Result<Camera> {
+        let camera = match self.camera {
+            Some(c) => c.with_aspect(aspect)?,
+            None => self
+                .framing
+                .camera(aspect, Camera::DEFAULT_FOV_Y_DEG)
+                .ok_or_else(|| {
+                    invalid_arg!(
+                        "the scene has no geometry to frame: set a camera with \
+                         ht_scene_set_camera"
+                    )
+                })??,
         };
         match self.lens {
             Some((aperture_radius, focus_distance)) => {
@@ -166,9 +208,10 @@ impl HtScene {
     }
 
     /// The world to render, built or updated as needed (the BVH build reporting to
-    /// `progress`), and the camera for an image of `width` x `height` pixels. `auto` curves
-    /// make the build depend on the camera and the height: a render with another view
-    /// builds again.
+    /// `progress`), and the camera for an image of `width` x `height` pixels. One build
+    /// at most: the automatic camera is framed without one. A build is kept while nothing
+    /// was added and the view still suits its `auto` curves' shapes (`Tracer::serves`);
+    /// new lights are weighed again on it.
     pub(crate) fn prepare(
         &mut self,
         width: u32,
@@ -180,44 +223,22 @@ impl HtScene {
                 "the scene has no light: add an environment, distant or rect light"
             ));
         }
-        let aspect = width as f32 / height as f32;
-        // `auto` curves are shared out for the view, which is framed on the curves as
-        // added (round), so that it never depends on the shapes it picks.
-        let view = if self.has_auto_curves() {
-            let bounds = match (self.camera, self.added_bounds) {
-                (Some(_), _) => None,
-                (None, Some(b)) => Some(b),
-                (None, None) => {
-                    let (tracer, _) = self.build_tracer(None, &NoStages)?;
-                    Some(*self.added_bounds.insert(tracer.scene().bounds()))
-                }
-            };
-            let view = (self.camera(aspect, bounds)?, height);
-            if self.built_for != Some(view) {
-                self.world = None;
-            }
-            Some(view)
-        } else {
-            None
-        };
-        if self.world.is_none() || self.lights_changed {
-            let (tracer, materials) = match self.world.take() {
-                Some(world) => world.into_geometry(),
-                None => {
-                    let built = self.build_tracer(view.as_ref(), progress)?;
-                    self.built_for = view;
-                    built
-                }
-            };
-            self.world = Some(World::new(tracer, materials, self.lights.clone())?);
-            self.lights_changed = false;
+        let camera = self.camera(width as f32 / height as f32)?;
+        let view = DetailView::new(camera, height);
+        if (self.world.as_ref()).is_some_and(|w| !w.tracer.serves(&view)) {
+            self.world = None;
         }
-        let world = self.world.as_ref().expect("built above");
-        let camera = match view {
-            Some((camera, _)) => camera,
-            None => self.camera(aspect, Some(world.tracer.scene().bounds()))?,
-        };
-        Ok((world, camera))
+        match &mut self.world {
+            Some(world) if self.lights_changed => world.set_lights(self.lights.clone())?,
+            Some(_) => {}
+            None => {
+                let (tracer, materials, built_from) = self.build_tracer(&view, progress)?;
+                self.world = Some(World::new(tracer, materials, self.lights.clone())?);
+                self.built_from = built_from;
+            }
+        }
+        self.lights_changed = false;
+        Ok((self.world.as_ref().expect("built above"), camera))
     }
 }
 
@@ -339,10 +360,10 @@ pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut Ht
             lights: Vec::new(),
             camera: None,
             lens: None,
+            framing: Framing::default(),
             world: None,
+            built_from: Vec::new(),
             lights_changed: false,
-            built_for: None,
-            added_bounds: None,
         });
         // SAFETY: non-NULL (checked), the host's HtScene*.
         unsafe { out.write(Box::into_raw(scene)) };
@@ -369,8 +390,10 @@ pub unsafe extern "C" fn ht_scene_free(scene: *mut HtScene) -> HtStatus {
 /// every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
 /// giving the image's upward direction (finite, not zero, not parallel to the view), with
 /// a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
-/// `(target - eye) x up`. Replaces any earlier camera. Without one, renders frame the
-/// scene's bounds from the front (+z), a little to the right and above.
+/// `(target - eye) x up`. Replaces any earlier camera, without a new build unless
+/// `HT_CURVE_AUTO` curves need other shapes for it. Without one, renders frame the
+/// geometry as added (the hair's points widened by their radii, else the meshes) from the
+/// front (+z), a little to the right and above, as a scene file without a camera does.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
 /// `HT_ERR_INVALID_ARG` (a value out of range, `eye == target`, `up` along the view, a

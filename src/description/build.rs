@@ -7,8 +7,8 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3};
 
 use super::{
-    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
-    MeshDesc, MeshSource, SceneDescription, Transform,
+    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc,
+    MaterialDesc, MeshDesc, MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device, SceneOptions};
@@ -16,7 +16,9 @@ use crate::error::{Error, Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
+use crate::scene::detail_view::DetailView;
 use crate::scene::envmap::Environment;
+use crate::scene::framing::Framing;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
 use crate::scene::material::Material;
@@ -85,20 +87,20 @@ impl SceneDescription {
 
         let mut stages = StageRunner::new(progress);
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
-        let mut hair_bounds = Bounds::EMPTY;
+        let mut framing = Framing::default();
         let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
         // One material per geometry: a USD groom adds one geometry per BasisCurves prim.
         let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
+        let mut sources = Vec::with_capacity(materials.capacity());
         // Curves wait for the camera: an `auto` groom's shapes depend on it.
         let mut built = Vec::new();
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
             let curves = g
-                .curves(&mut stages, (i, grooms, reads), &mut hair_bounds)
+                .curves(&mut stages, (i, grooms, reads), &mut framing)
                 .map_err(|e| self.error(&at, e))?;
             built.extend(curves.into_iter().map(|c| (i, c)));
         }
-        let mut prop_bounds = Bounds::EMPTY;
         let mut meshes = Vec::with_capacity(self.meshes.len());
         for (i, m) in self.meshes.iter().enumerate() {
             let at = format!("mesh[{i}]");
@@ -108,35 +110,38 @@ impl SceneDescription {
             // A ground quad is the stage, not the subject: framing it would shrink the
             // subject to a speck.
             if !matches!(m.source, MeshSource::Ground { .. }) {
-                for p in &mesh.positions {
-                    prop_bounds.add(Vec3::from_array(*p), 0.0);
-                }
+                framing.add_mesh(&mesh.positions);
             }
             meshes.push(mesh);
         }
         // A scene without grooms (or meshes) still goes through every stage.
         stages.report(Stage::Read, 1.0)?;
         stages.report(Stage::Curves, 1.0)?;
-        let framed = if hair_bounds.is_empty() {
-            prop_bounds
-        } else {
-            hair_bounds
-        };
         let aspect = settings.width as f32 / settings.height as f32;
         let camera = self
             .camera
-            .build(framed, aspect)
+            .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
+        let view = DetailView::new(camera, settings.height);
         for (i, curves) in built {
             let at = format!("groom[{i}]");
-            let parts = match self.grooms[i].shape {
-                GroomShape::Auto => ribbons::share_out(curves, &camera, settings.height)
-                    .map_err(|e| self.error(&at, e))?,
-                _ => vec![curves],
+            let groom = &self.grooms[i];
+            let auto = groom.shape == GroomShape::Auto;
+            let parts = if auto {
+                ribbons::share_out(curves, &camera, settings.height)
+                    .map_err(|e| self.error(&at, e))?
+            } else {
+                vec![curves]
             };
             for part in parts {
-                tracer.add_curves(part).map_err(|e| self.error(&at, e))?;
+                let added = if auto {
+                    tracer.add_view_curves(part, view)
+                } else {
+                    tracer.add_curves(part)
+                };
+                added.map_err(|e| self.error(&at, e))?;
                 materials.push(groom_materials[i].clone());
+                sources.push(groom.material.clone());
             }
         }
         // Geometry ids follow `materials`: the grooms' geometries, then the meshes.
@@ -144,6 +149,7 @@ impl SceneDescription {
             tracer
                 .add_mesh(mesh)
                 .map_err(|e| self.error(&format!("mesh[{i}]"), e))?;
+            sources.push(self.meshes[i].material.clone());
         }
         materials.extend(mesh_materials);
         let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
@@ -153,6 +159,7 @@ impl SceneDescription {
             camera,
             settings,
             stages: stages.times(),
+            sources,
         })
     }
 
@@ -185,7 +192,8 @@ impl SceneDescription {
 }
 
 impl MaterialDesc {
-    fn prepare(&self) -> Result<Material> {
+    /// The material, every value checked.
+    pub(super) fn prepare(&self) -> Result<Material> {
         Ok(match self {
             MaterialDesc::Hair(h) => Material::Hair(Box::new(h.prepare()?)),
             MaterialDesc::Diffuse { albedo } => {
@@ -235,13 +243,13 @@ impl GroomDesc {
 
     /// The Embree curves of the groom, `part` = (index, grooms, files to read) of the
     /// build's stages: one geometry, or one per BasisCurves prim of a USD file (laid out by
-    /// the prim's own basis and wrap, placed by the entry's transform). Adds the points,
-    /// widened by their radii, to `framed`.
+    /// the prim's own basis and wrap, placed by the entry's transform). Adds the groom to
+    /// `framing`.
     fn curves(
         &self,
         stages: &mut StageRunner,
         (i, grooms, reads): (usize, usize, usize),
-        framed: &mut Bounds,
+        framing: &mut Framing,
     ) -> Result<Vec<Curves>> {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
@@ -251,17 +259,7 @@ impl GroomDesc {
             GroomSource::File { path, .. } if is_usd_path(path) => {
                 let file = stages.run(Stage::Read, (i, reads), |_| read_usd_file(path))?;
                 for c in &file.curves {
-                    let (lo, hi) = c.bounds;
-                    let r = c.radius_range.1 * radius_factor;
-                    for corner in 0..8 {
-                        let p =
-                            std::array::from_fn(
-                                |k| {
-                                    if corner >> k & 1 == 1 { hi[k] } else { lo[k] }
-                                },
-                            );
-                        framed.add(Vec3::from_array(place(p)), r);
-                    }
+                    c.frame(framing, radius_factor, place);
                 }
                 stages.run(Stage::Curves, (i, grooms), |_| {
                     (file.curves.iter())
@@ -281,16 +279,12 @@ impl GroomDesc {
                         self.shape.built(),
                     )
                 })?;
-                for p in curves.vertices() {
-                    framed.add(Vec3::new(p[0], p[1], p[2]), p[3]);
-                }
+                framing.add_control_points(curves.vertices());
                 Ok(vec![curves])
             }
             _ => {
                 let strands = stages.run(Stage::Read, (i, reads), |_| self.strands())?;
-                for (p, r) in strands.points.iter().zip(&strands.radii) {
-                    framed.add(Vec3::from_array(*p), *r);
-                }
+                framing.add_strands(&strands);
                 let curves = stages.run(Stage::Curves, (i, grooms), |_| {
                     Curves::from_strands(&strands, self.basis, self.shape.built())
                 })?;
@@ -409,25 +403,25 @@ impl LightDesc {
 }
 
 impl CameraDesc {
-    /// The camera for an image of `aspect`, framing `framed` when no eye and target are
+    /// The camera for an image of `aspect`, framing `framing` when no eye and target are
     /// given.
-    fn build(&self, framed: Bounds, aspect: f32) -> Result<Camera> {
+    fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
         let (camera, target) = match (self.eye, self.target) {
             (Some(eye), Some(target)) => {
                 let (eye, target) = (Vec3::from_array(eye), Vec3::from_array(target));
                 let up = Vec3::from_array(self.up);
                 (Camera::new(eye, target, up, self.fov_deg, aspect)?, target)
             }
-            (None, None) if framed.is_empty() => {
-                return Err(invalid_arg!(
-                    "nothing to frame (no groom and no mesh but ground quads): give `eye` \
-                     and `target`"
-                ));
+            (None, None) => {
+                let camera = framing.camera(aspect, self.fov_deg).ok_or_else(|| {
+                    invalid_arg!(
+                        "nothing to frame (no groom and no mesh but ground quads): give \
+                         `eye` and `target`"
+                    )
+                })??;
+                let (lo, hi) = framing.bounds().expect("framed above");
+                (camera, (lo + hi) / 2.0)
             }
-            (None, None) => (
-                Camera::frame_bounds(framed.lo, framed.hi, aspect, self.fov_deg)?,
-                (framed.lo + framed.hi) / 2.0,
-            ),
             _ => {
                 return Err(invalid_arg!(
                     "give both `eye` and `target`, or neither for an automatic camera"
@@ -438,29 +432,5 @@ impl CameraDesc {
             .focus_distance
             .unwrap_or_else(|| camera.eye().distance(target));
         camera.with_thin_lens(self.aperture_radius, focus)
-    }
-}
-
-/// An axis-aligned box grown point by point.
-#[derive(Debug, Clone, Copy)]
-struct Bounds {
-    lo: Vec3,
-    hi: Vec3,
-}
-
-impl Bounds {
-    const EMPTY: Bounds = Bounds {
-        lo: Vec3::INFINITY,
-        hi: Vec3::NEG_INFINITY,
-    };
-
-    /// Grows the box to hold a ball of `radius` around `p`.
-    fn add(&mut self, p: Vec3, radius: f32) {
-        self.lo = self.lo.min(p - radius);
-        self.hi = self.hi.max(p + radius);
-    }
-
-    fn is_empty(&self) -> bool {
-        self.lo.cmpgt(self.hi).any()
     }
 }

@@ -100,7 +100,7 @@ use std::path::PathBuf;
 use serde::Deserialize;
 
 use crate::embree::CurveBasis;
-use crate::error::Result;
+use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
@@ -296,18 +296,60 @@ pub(crate) fn placed(
         .collect()
 }
 
-/// What a render needs, built from a description.
+/// What a render needs, built from a description. Materials and lights can be changed
+/// on it without a new build ([`BuiltScene::set_material`], [`BuiltScene::set_lights`]),
+/// and so can the camera and the settings, as long as the curves' view-dependent shapes
+/// still hold for them (`world.tracer.serves(...)`; a render checks it).
 pub struct BuiltScene {
     pub world: World,
     pub camera: Camera,
     pub settings: RenderSettings,
     /// Seconds each build stage took.
     pub stages: StageTimes,
+    /// The name of each geometry's material, by geometry id.
+    sources: Vec<String>,
 }
 
 impl BuiltScene {
     /// Renders the scene as built, its film and AOVs as `aovs` asks.
     pub fn render(&self, aovs: Aovs, progress: &dyn Progress) -> Result<RenderOutput> {
         renderer::render(&self.world, &self.camera, &self.settings, aovs, progress)
+    }
+
+    /// Gives the material `name` new parameters on every geometry that uses it, without a
+    /// new build: the next render is the one of the description built with `material`.
+    /// Refused (nothing changed) when no geometry uses `name` or when the material does not
+    /// suit its geometries.
+    pub fn set_material(&mut self, name: &str, material: &MaterialDesc) -> Result<()> {
+        let prepared = material.prepare()?;
+        let users: Vec<u32> = (self.sources.iter().enumerate())
+            .filter(|(_, s)| *s == name)
+            .map(|(g, _)| g as u32)
+            .collect();
+        if users.is_empty() {
+            return Err(invalid_arg!(
+                "no geometry of the scene uses a material named {name:?}"
+            ));
+        }
+        let what = format!("material {name:?}");
+        for &g in &users {
+            let on_curves = self.world.tracer.strands(g).is_some();
+            prepared.check_suits(&what, on_curves)?;
+        }
+        for g in users {
+            self.world.set_material(g, prepared.clone())?;
+        }
+        Ok(())
+    }
+
+    /// Replaces the lights without a new build.
+    pub fn set_lights(&mut self, lights: &[LightDesc]) -> Result<()> {
+        let lights = (lights.iter().enumerate())
+            .map(|(i, l)| l.build().map_err(|e| e.context(format!("light[{i}]"))))
+            .collect::<Result<Vec<_>>>()?;
+        if lights.is_empty() {
+            return Err(invalid_arg!("no lights: give at least one"));
+        }
+        self.world.set_lights(lights)
     }
 }

@@ -3,6 +3,7 @@
 use std::ffi::{CStr, CString, c_char, c_void};
 use std::ptr::NonNull;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use super::{Isa, abi_check, sys};
 use crate::error::invalid_arg;
@@ -19,6 +20,8 @@ pub struct Device {
     /// Boxed so that its address, handed to Embree as the callback's user pointer, stays
     /// fixed when the `Device` moves.
     last_error: Box<ErrorSlot>,
+    /// BVH builds started on this device ([`Device::builds`]).
+    builds: AtomicU64,
 }
 
 /// The last error Embree reported: code and message. A mutex because Embree calls the
@@ -105,7 +108,11 @@ impl Device {
                 std::ptr::from_ref::<ErrorSlot>(&last_error) as *mut c_void,
             );
         }
-        let device = Device { raw, last_error };
+        let device = Device {
+            raw,
+            last_error,
+            builds: AtomicU64::new(0),
+        };
         abi_check::verify_once(device.raw())?;
         Ok(device)
     }
@@ -114,6 +121,17 @@ impl Device {
     /// code that keeps Embree objects beyond that must retain the device itself.
     pub fn raw(&self) -> sys::RTCDevice {
         self.raw.as_ptr()
+    }
+
+    /// How many scenes this device has started to build (commits, finished or not): what
+    /// tells a host, and the tests, that an edit was applied without a BVH build.
+    pub fn builds(&self) -> u64 {
+        self.builds.load(Ordering::Relaxed)
+    }
+
+    /// Counts one more build (by [`super::SceneBuilder::commit`]).
+    pub(super) fn count_build(&self) {
+        self.builds.fetch_add(1, Ordering::Relaxed);
     }
 
     /// Reports, and clears, the last error Embree recorded on this device (from any

@@ -101,6 +101,7 @@ impl SceneBuilder {
     /// The monitor's signature is the same in Embree 3 and 4.
     pub(crate) fn commit(self, progress: &BuildMonitor<'_>) -> Result<Scene> {
         let scene = self.raw.0.as_ptr();
+        self.device.count_build();
         let user = (&raw const progress).cast_mut().cast::<std::ffi::c_void>();
         // SAFETY: live scene; `user` points at `progress`, which outlives the commit, and
         // the monitor is removed before this function returns.

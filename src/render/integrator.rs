@@ -72,11 +72,6 @@ pub struct World {
 }
 
 impl World {
-    /// The tracer and the materials, to build another world on them (other lights).
-    pub(crate) fn into_geometry(self) -> (Tracer, Vec<Material>) {
-        (self.tracer, self.materials)
-    }
-
     /// `materials[g]` shades geometry id g of the tracer.
     pub fn new(tracer: Tracer, materials: Vec<Material>, lights: Vec<Light>) -> Result<Self> {
         let geometries = tracer.scene().geometries().len();
@@ -86,7 +81,37 @@ impl World {
                 materials.len()
             ));
         }
-        let (lo, hi) = tracer.scene().bounds();
+        let mut world = World {
+            tracer,
+            materials,
+            lights: Vec::new(),
+            light_choice: None,
+            light_prob: Vec::new(),
+        };
+        world.set_lights(lights)?;
+        Ok(world)
+    }
+
+    /// Replaces the material of geometry `geometry` (hair on curves, diffuse on meshes),
+    /// keeping the build: a world shades by reading its materials at each hit, so the
+    /// next render is the one a world built with this material would give.
+    pub fn set_material(&mut self, geometry: u32, material: Material) -> Result<()> {
+        let slot = self.materials.get_mut(geometry as usize).ok_or_else(|| {
+            invalid_arg!(
+                "geometry {geometry}: the world has {} geometries",
+                self.tracer.scene().geometries().len()
+            )
+        })?;
+        let on_curves = self.tracer.strands(geometry).is_some();
+        material.check_suits(&format!("the material for geometry {geometry}"), on_curves)?;
+        *slot = material;
+        Ok(())
+    }
+
+    /// Replaces the lights, keeping the build, and weighs them again for next-event
+    /// estimation (by power over the scene's bounds, as [`World::new`] does).
+    pub fn set_lights(&mut self, lights: Vec<Light>) -> Result<()> {
+        let (lo, hi) = self.tracer.scene().bounds();
         let radius = 0.5 * (Vec3::from_array(hi) - Vec3::from_array(lo)).length();
         let radius = if radius.is_finite() && radius > 0.0 {
             radius
@@ -106,7 +131,7 @@ impl World {
             })
             .collect();
         let total: f32 = power.iter().sum();
-        let (light_choice, light_prob) = if total > 0.0 && total.is_finite() {
+        (self.light_choice, self.light_prob) = if total > 0.0 && total.is_finite() {
             (
                 Some(Distribution1D::new(&power)?),
                 power.iter().map(|p| p / total).collect(),
@@ -114,13 +139,8 @@ impl World {
         } else {
             (None, vec![0.0; lights.len()])
         };
-        Ok(World {
-            tracer,
-            materials,
-            lights,
-            light_choice,
-            light_prob,
-        })
+        self.lights = lights;
+        Ok(())
     }
 
     /// Radiance arriving along the camera ray (org, dir), what its first hit reports for

@@ -9,8 +9,9 @@ use super::progress::Progress;
 use super::sampler::PixelSampler;
 use super::settings::RenderSettings;
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
-use crate::error::Result;
+use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
+use crate::scene::detail_view::DetailView;
 
 /// A finished (or cancelled) render and what it cost.
 #[derive(Debug)]
@@ -31,7 +32,9 @@ pub struct RenderStats {
 
 /// Renders `world` through `camera`. Each sample's numbers depend only on the seed, the
 /// full-frame pixel and the sample index, so the image is the same for any thread count,
-/// tile order or crop.
+/// tile order or crop. A world whose curves were shaped for a view (the `auto` shape)
+/// renders only the views for which those shapes hold ([`crate::scene::tracer::Tracer::serves`]);
+/// any other is refused, to be built again for it.
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -40,6 +43,15 @@ pub fn render(
     progress: &dyn Progress,
 ) -> Result<RenderOutput> {
     settings.validate()?;
+    if !world
+        .tracer
+        .serves(&DetailView::new(*camera, settings.height))
+    {
+        return Err(invalid_arg!(
+            "the scene's curves were shaped for a view that saw them smaller (from farther, \
+             or with fewer pixels): build the scene again for this camera and image height"
+        ));
+    }
     let crop = settings
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });

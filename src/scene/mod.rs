@@ -5,7 +5,9 @@
 
 pub mod camera;
 pub mod curves;
+pub mod detail_view;
 pub mod envmap;
+pub mod framing;
 pub(crate) mod groom;
 pub mod hair_file;
 pub mod hit;

@@ -7,6 +7,7 @@ use std::sync::Arc;
 use glam::Vec3;
 
 use super::curves::{Curves, StrandIndex, StrandSegment, catmull_rom_coefficients};
+use super::detail_view::{DetailView, ViewDependent};
 use super::hit::{HairHit, Hit, SurfaceHit, hair_frame};
 use super::mesh::Mesh;
 use super::stages::{NoStages, Stage, StageRunner};
@@ -85,6 +86,7 @@ enum Table {
 pub struct TracerBuilder {
     scene: SceneBuilder,
     tables: Vec<Table>,
+    view: ViewDependent,
 }
 
 impl TracerBuilder {
@@ -92,6 +94,7 @@ impl TracerBuilder {
         Ok(TracerBuilder {
             scene: SceneBuilder::new(device, options)?,
             tables: Vec::new(),
+            view: ViewDependent::default(),
         })
     }
 
@@ -112,6 +115,14 @@ impl TracerBuilder {
             strands,
             catmull_rom_tangents,
         });
+        Ok(id)
+    }
+
+    /// Adds curves whose detail was chosen for `view`, one per scene ([`Tracer::serves`]).
+    pub fn add_view_curves(&mut self, curves: Curves, view: DetailView) -> Result<u32> {
+        self.view.check(&view)?;
+        let id = self.add_curves(curves)?;
+        self.view.push(id, view);
         Ok(id)
     }
 
@@ -143,6 +154,7 @@ impl TracerBuilder {
                 .scene
                 .commit(&|fraction| stages.forward(Stage::Bvh, fraction))?,
             tables: self.tables,
+            view: self.view,
         })
     }
 }
@@ -153,11 +165,22 @@ impl TracerBuilder {
 pub struct Tracer {
     scene: Scene,
     tables: Vec<Table>,
+    view: ViewDependent,
 }
 
 impl Tracer {
     pub fn scene(&self) -> &Scene {
         &self.scene
+    }
+
+    /// Whether `view` may render this scene as built ([`ViewDependent::holds_for`]).
+    pub fn serves(&self, view: &DetailView) -> bool {
+        self.view.holds_for(&self.scene, view)
+    }
+
+    /// The view-dependent curves and the view they were made for.
+    pub fn view_dependent(&self) -> &ViewDependent {
+        &self.view
     }
 
     /// The strand table of curves `geom_id`.

@@ -9,6 +9,7 @@ mod camera_film;
 mod convert;
 mod curves_geometry;
 mod description;
+mod edits;
 mod farm;
 mod groom;
 mod hair_file;

@@ -17,6 +17,7 @@ use openusd::usd::{PrimPredicate, Stage};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::curves::Curves;
+use crate::scene::framing::Framing;
 
 pub use layout::{Interpolation, Layout, Wrap};
 pub use write::{CurvesToWrite, ROOT_PRIM, StageUnits, write_usd_file};
@@ -91,6 +92,22 @@ impl UsdCurves {
 
     pub fn basis(&self) -> CurveBasis {
         self.layout.basis
+    }
+
+    /// Adds the prim to `framing` as a scene frames it: the corners of its authored bounds,
+    /// mapped by `point`, each widened by its largest radius times `radius_scale`.
+    pub fn frame(
+        &self,
+        framing: &mut Framing,
+        radius_scale: f32,
+        point: impl Fn([f32; 3]) -> [f32; 3],
+    ) {
+        let (lo, hi) = self.bounds;
+        let r = self.radius_range.1 * radius_scale;
+        for corner in 0..8 {
+            let p = std::array::from_fn(|k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] });
+            framing.add_hair_point(point(p).into(), r);
+        }
     }
 }
 

@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod curves;
 pub mod envmap;
+pub mod footprint;
 pub(crate) mod groom;
 pub mod hair_file;
 pub mod hit;

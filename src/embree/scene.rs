@@ -26,9 +26,9 @@ pub struct SceneOptions {
     pub compact: bool,
 }
 
-/// Compact by default: on the 10^6-strand scalp it builds with 18% less CPU time and 43%
-/// less peak memory, and traces as fast (docs/large-grooms.md); it is what lets 10^7
-/// strands fit on a 24 GiB machine.
+/// Compact by default: on the bench scalp it builds with 20% less CPU time and 43% less
+/// peak memory (docs/large-grooms.md); it is what lets 10^7 strands fit on a 24 GiB
+/// machine.
 pub const DEFAULT_COMPACT: bool = true;
 
 impl Default for SceneOptions {

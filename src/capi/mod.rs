@@ -11,6 +11,8 @@ pub mod prepared;
 #[cfg(feature = "render")]
 pub mod scene;
 // Scenes first: the header declares them before the calls that fill them.
+#[cfg(all(test, feature = "render"))]
+mod edit_tests;
 #[cfg(feature = "render")]
 pub mod geometry;
 #[cfg(feature = "render")]
@@ -23,8 +25,6 @@ mod scene_tests;
 pub mod settings;
 #[cfg(all(test, feature = "render"))]
 mod settings_tests;
-#[cfg(all(test, feature = "render"))]
-mod edit_tests;
 // After `scene` and `settings`, so that the header declares them before the render that
 // takes them.
 #[cfg(feature = "render")]

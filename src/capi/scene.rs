@@ -112,10 +112,7 @@ impl HtScene {
             Shape::Mesh(m) => self.framing.add_mesh(&m.positions),
             Shape::Curves(_) | Shape::AutoCurves(_) => frame_curves(&mut self.framing),
         }
-        self.geometries.push(Geometry {
-            shape,
-            material,
-        });
+        self.geometries.push(Geometry { shape, material });
         self.world = None;
         Ok(id)
     }

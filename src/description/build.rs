@@ -7,8 +7,8 @@ use std::sync::Arc;
 use glam::{Mat3, Vec3};
 
 use super::{
-    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc,
-    MaterialDesc, MeshDesc, MeshSource, SceneDescription, Transform,
+    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
+    MeshDesc, MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device, SceneOptions};
@@ -18,6 +18,7 @@ use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
 use crate::scene::envmap::Environment;
+use crate::scene::footprint::{self, CurvesSize, available_bytes};
 use crate::scene::framing::Framing;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
@@ -85,6 +86,8 @@ impl SceneDescription {
             .map(|(i, l)| l.build().map_err(|e| self.error(&format!("light[{i}]"), e)))
             .collect::<Result<Vec<_>>>()?;
 
+        self.check_memory(available_bytes())?;
+
         let mut stages = StageRunner::new(progress);
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
         let mut framing = Framing::default();
@@ -123,6 +126,7 @@ impl SceneDescription {
             .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
         let view = DetailView::new(camera, settings.height);
+        let mut sizes = Vec::new();
         for (i, curves) in built {
             let at = format!("groom[{i}]");
             let groom = &self.grooms[i];
@@ -134,6 +138,7 @@ impl SceneDescription {
                 vec![curves]
             };
             for part in parts {
+                sizes.push(CurvesSize::of(&part));
                 let added = if auto {
                     tracer.add_view_curves(part, view)
                 } else {
@@ -152,6 +157,9 @@ impl SceneDescription {
             sources.push(self.meshes[i].material.clone());
         }
         materials.extend(mesh_materials);
+        // What is built so far is held already: only Embree's part is still to come.
+        let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum();
+        footprint::check_fits(&sizes, bvh, "more for the BVH build", available_bytes())?;
         let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
         let world = World::new(tracer, materials, lights)?;
         Ok(BuiltScene {
@@ -161,6 +169,36 @@ impl SceneDescription {
             stages: stages.times(),
             sources,
         })
+    }
+
+    /// Refuses the description when its procedural grooms, whose sizes are known before
+    /// anything is made, would need more than `available` bytes at their peak (see
+    /// [`footprint`]); grooms from files are checked once read, before the BVH build.
+    pub(crate) fn check_memory(&self, available: Option<u64>) -> Result<()> {
+        let (mut sizes, mut conversion) = (Vec::new(), 0);
+        for g in &self.grooms {
+            let (strands, segments) = match &g.source {
+                GroomSource::FurBall(f) => (f.strands, f.segments),
+                GroomSource::Scalp(s) => (s.strands, s.segments),
+                _ => continue,
+            };
+            let (strands, segments) = (strands as u64, u64::from(segments));
+            let size = CurvesSize::polylines(strands, segments, g.basis, g.shape.built());
+            // An `auto` groom shared out between shapes is copied once more.
+            let copies = if g.shape == GroomShape::Auto { 2 } else { 1 };
+            let points = strands.saturating_mul(segments + 1);
+            conversion = u64::max(
+                conversion,
+                footprint::conversion_bytes(points, strands, &size, copies),
+            );
+            sizes.push(size);
+        }
+        if sizes.is_empty() {
+            return Ok(());
+        }
+        let needed = footprint::build_bytes(&sizes).max(conversion);
+        footprint::check_fits(&sizes, needed, "at their peak", available)
+            .map_err(|e| e.context(&self.origin))
     }
 
     /// The prepared material `name`, if it exists and suits the geometry.
@@ -432,5 +470,76 @@ impl CameraDesc {
             .focus_distance
             .unwrap_or_else(|| camera.eye().distance(target));
         camera.with_thin_lens(self.aperture_radius, focus)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    /// A scalp of `strands` x 16 segments of `basis`, shape `shape`.
+    fn scalp(strands: usize, basis: &str, shape: &str) -> SceneDescription {
+        let text = format!(
+            "[materials.h]\ntype = \"hair\"\nmelanin = [0.5, 0]\n[[groom]]\nprocedural = \"scalp\"\nmaterial = \"h\"\n\
+             basis = \"{basis}\"\nshape = \"{shape}\"\n[groom.params]\nstrands = {strands}\n\
+             segments = 16\n[[light]]\ntype = \"environment\"\nradiance = [1, 1, 1]\n"
+        );
+        SceneDescription::from_toml(&text, Path::new("."), "scalp.toml").unwrap()
+    }
+
+    const GIB: u64 = 1 << 30;
+
+    #[test]
+    fn a_groom_past_the_available_memory_is_refused_with_its_size() {
+        let big = scalp(10_000_000, "catmull_rom", "round");
+        let e = big.check_memory(Some(4 * GIB)).unwrap_err();
+        let message = e.to_string();
+        for part in [
+            "scalp.toml",
+            "10000000 strands x 16 segments, catmull_rom round",
+            "4.0 GiB are available",
+        ] {
+            assert!(message.contains(part), "{message:?} lacks {part:?}");
+        }
+        // The figure it names is the estimate's.
+        let needed = footprint::build_bytes(&[CurvesSize::polylines(
+            10_000_000,
+            16,
+            CurveBasis::CatmullRom,
+            crate::embree::CurveShape::Round,
+        )]);
+        let gib = format!("{:.1} GiB of memory", needed as f64 / GIB as f64);
+        assert!(message.contains(&gib), "{message:?} lacks {gib:?}");
+        // The same groom fits where there is room, and so does a small one here.
+        big.check_memory(Some(needed + GIB)).unwrap();
+        scalp(1000, "catmull_rom", "round")
+            .check_memory(Some(4 * GIB))
+            .unwrap();
+        // Without a figure for the available memory, nothing is refused.
+        big.check_memory(None).unwrap();
+    }
+
+    #[test]
+    fn the_estimate_grows_with_the_basis_and_the_auto_copy() {
+        let at = |basis, shape| {
+            scalp(10_000_000, basis, shape)
+                .check_memory(Some(GIB))
+                .unwrap_err()
+                .to_string()
+        };
+        let gib = |m: String| -> f64 {
+            let i = m.find(" GiB of memory").unwrap();
+            let start = m[..i].rfind(' ').unwrap() + 1;
+            m[start..i].parse().unwrap()
+        };
+        let linear = gib(at("linear", "round"));
+        let cubic = gib(at("catmull_rom", "round"));
+        let bezier = gib(at("bezier", "round"));
+        assert!(
+            linear < cubic && cubic < bezier,
+            "{linear} {cubic} {bezier}"
+        );
+        assert!(at("bspline", "auto").contains("bspline round"));
     }
 }

@@ -1,0 +1,163 @@
+//! How much memory a groom needs at the peak of its build, estimated from its size alone,
+//! so that a groom that cannot fit is refused before the build with what it needs, rather
+//! than killed by the kernel part way through a build of many minutes.
+//!
+//! The estimate adds, per geometry ([`CurvesSize`]), the buffers hairtrace hands Embree
+//! (exact, from the layouts of `curves.rs`) and Embree's peak during the BVH build (a
+//! per-segment figure measured on the bench scalp: its primitive references, nodes and
+//! leaves; see docs/large-grooms.md), plus what the process needs besides. A groom made
+//! here (procedural, or read from a `.hair` file) also briefly holds its polylines next to
+//! its converted copy; [`conversion_bytes`] is that moment. Level of detail changes only
+//! the sizes it passes in: fewer segments, a cheaper basis or shape per part.
+
+use crate::embree::{CurveBasis, CurveShape};
+use crate::error::{Result, invalid_arg};
+use crate::scene::curves::Curves;
+
+/// Bytes a process holding a scene needs besides its grooms (code, Embree's thread pool,
+/// meshes, film), measured as the peak of a render of a 1-strand scalp.
+pub const BASE_BYTES: u64 = 140 << 20;
+
+/// The size of one curve geometry: what its memory depends on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CurvesSize {
+    pub strands: u64,
+    /// Curve segments (Embree primitives), all strands together.
+    pub segments: u64,
+    /// Control points Embree reads.
+    pub control_points: u64,
+    pub basis: CurveBasis,
+    pub shape: CurveShape,
+}
+
+impl CurvesSize {
+    /// `strands` polylines of `segments` segments each, laid out for `basis` as
+    /// [`Curves::from_strands`] lays them out.
+    pub fn polylines(strands: u64, segments: u64, basis: CurveBasis, shape: CurveShape) -> Self {
+        let per_strand = match basis {
+            CurveBasis::Linear => segments + 1,
+            CurveBasis::BSpline | CurveBasis::CatmullRom => segments + 3,
+            CurveBasis::Bezier => 3 * segments + 1,
+        };
+        CurvesSize {
+            strands,
+            segments: strands.saturating_mul(segments),
+            control_points: strands.saturating_mul(per_strand),
+            basis,
+            shape,
+        }
+    }
+
+    /// The size of curves already built.
+    pub fn of(curves: &Curves) -> Self {
+        CurvesSize {
+            strands: curves.strands().strand_count() as u64,
+            segments: curves.indices().len() as u64,
+            control_points: curves.vertices().len() as u64,
+            basis: curves.basis(),
+            shape: curves.shape(),
+        }
+    }
+
+    /// Bytes of the buffers hairtrace keeps for these curves: float4 control points, one
+    /// u32 index per segment, the strand table (a u32 per strand and per 32 segments).
+    pub fn curve_bytes(&self) -> u64 {
+        let points = self.control_points.saturating_mul(16);
+        let segments = self.segments.saturating_mul(4) + self.segments / 8;
+        points
+            .saturating_add(segments)
+            .saturating_add(self.strands.saturating_mul(4))
+    }
+
+    /// Bytes Embree holds at the peak of the BVH build over these curves.
+    pub fn bvh_bytes(&self) -> u64 {
+        self.segments
+            .saturating_mul(bvh_bytes_per_segment(self.basis))
+    }
+
+    /// "1000000 strands x 16 segments, catmull_rom round".
+    fn describe(&self) -> String {
+        let per = self.segments.checked_div(self.strands).unwrap_or(0);
+        let basis = match self.basis {
+            CurveBasis::Linear => "linear",
+            CurveBasis::Bezier => "bezier",
+            CurveBasis::BSpline => "bspline",
+            CurveBasis::CatmullRom => "catmull_rom",
+        };
+        let shape = match self.shape {
+            CurveShape::Round => "round",
+            CurveShape::Flat => "flat",
+        };
+        format!("{} strands x {per} segments, {basis} {shape}", self.strands)
+    }
+}
+
+/// Embree's peak bytes per curve segment during a build of a compact scene (what
+/// `SceneBuilder` makes): 32-byte primitive references, then the BVH of index leaves, both
+/// alive at the end of the build. Cubic and linear leaves differ; round and flat share them.
+fn bvh_bytes_per_segment(basis: CurveBasis) -> u64 {
+    match basis {
+        CurveBasis::Linear => 35,
+        _ => 40,
+    }
+}
+
+/// Peak bytes of a scene whose curves are `parts`, at its BVH build.
+pub fn build_bytes(parts: &[CurvesSize]) -> u64 {
+    parts.iter().fold(BASE_BYTES, |sum, p| {
+        sum.saturating_add(p.curve_bytes())
+            .saturating_add(p.bvh_bytes())
+    })
+}
+
+/// Peak bytes while polylines of `points` points (xyz and radius, 16 bytes each) and
+/// `strands` strands are converted into `copies` copies of `part`: all are alive.
+pub fn conversion_bytes(points: u64, strands: u64, part: &CurvesSize, copies: u64) -> u64 {
+    BASE_BYTES
+        .saturating_add(points.saturating_mul(16))
+        .saturating_add(strands.saturating_mul(4))
+        .saturating_add(part.curve_bytes().saturating_mul(copies))
+}
+
+/// Bytes this process may still take before the system runs out: Linux's `MemAvailable`,
+/// capped by the memory cgroup's limit when there is one. `None` when not known (then
+/// nothing is refused).
+pub fn available_bytes() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib = |text: &str, key: &str| {
+        text.lines()
+            .find_map(|l| l.strip_prefix(key))
+            .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+    };
+    let mut available = kib(&meminfo, "MemAvailable:")?.saturating_mul(1024);
+    let read = |f: &str| std::fs::read_to_string(format!("/sys/fs/cgroup/{f}")).ok();
+    if let (Some(max), Some(current)) = (read("memory.max"), read("memory.current"))
+        && let (Ok(max), Ok(current)) = (max.trim().parse::<u64>(), current.trim().parse::<u64>())
+    {
+        available = available.min(max.saturating_sub(current));
+    }
+    Some(available)
+}
+
+/// Refuses `parts` when `needed` bytes (one of the estimates above), needed `when`, exceed
+/// `available` (from [`available_bytes`]), naming their sizes, what they need and what
+/// there is.
+pub fn check_fits(
+    parts: &[CurvesSize],
+    needed: u64,
+    when: &str,
+    available: Option<u64>,
+) -> Result<()> {
+    let Some(available) = available.filter(|&a| needed > a) else {
+        return Ok(());
+    };
+    let gib = |b: u64| b as f64 / f64::from(1u32 << 30);
+    let sizes: Vec<String> = parts.iter().map(CurvesSize::describe).collect();
+    Err(invalid_arg!(
+        "{} need about {:.1} GiB of memory {when}, and {:.1} GiB are available: use fewer \
+         strands or segments, or the linear basis",
+        sizes.join(" + "),
+        gib(needed),
+        gib(available)
+    ))
+}

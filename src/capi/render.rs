@@ -358,32 +358,9 @@ pub unsafe extern "C" fn ht_render_aovs(
         let s = read_host(settings, "settings")?;
         let rust = s.to_rust()?;
         rust.validate()?;
-        let host;
-        let progress: &dyn Progress = match s.progress {
-            Some(callback) => {
-                host = HostProgress {
-                    callback,
-                    user: s.progress_user,
-                };
-                &host
-            }
-            None => &NoProgress,
-        };
-        let buffers = HostBuffers {
-            rgb,
-            rgb_len,
-            albedo,
-            depth,
-            strand_id,
-            pixel_count,
-        };
-        render_into(
-            scene,
-            &rust,
-            Span::of("settings", settings, 1),
-            progress,
-            buffers,
-        )
+        let span = Span::of("settings", settings, 1);
+        let buffers = (rgb, rgb_len, albedo, depth, strand_id, pixel_count);
+        render_into(scene, &rust, span, s.progress, s.progress_user, buffers)
     })
 }
 
@@ -412,50 +389,34 @@ pub unsafe extern "C" fn ht_render_with(
 ) -> HtStatus {
     boundary(|| {
         let rust = read_settings(settings)?;
-        let host;
-        let sink: &dyn Progress = match progress {
-            Some(callback) => {
-                host = HostProgress { callback, user };
-                &host
-            }
-            None => &NoProgress,
-        };
-        let buffers = HostBuffers {
-            rgb,
-            rgb_len,
-            albedo,
-            depth,
-            strand_id,
-            pixel_count,
-        };
-        render_into(
-            scene,
-            &rust,
-            Span::of("settings", settings, 1),
-            sink,
-            buffers,
-        )
+        let span = Span::of("settings", settings, 1);
+        let buffers = (rgb, rgb_len, albedo, depth, strand_id, pixel_count);
+        render_into(scene, &rust, span, progress, user, buffers)
     })
 }
 
-/// The buffers a host lends a render, unchecked.
-struct HostBuffers {
-    rgb: *mut f32,
-    rgb_len: usize,
-    albedo: *mut f32,
-    depth: *mut f32,
-    strand_id: *mut f32,
-    pixel_count: usize,
-}
+/// The buffers a host lends a render, unchecked: rgb and its length, the albedo, depth and
+/// strand-id AOVs (each may be NULL) and the pixel count.
+type HostBuffers = (*mut f32, usize, *mut f32, *mut f32, *mut f32, usize);
 
-/// Checks the host's buffers against `settings` (valid), renders and copies the film out.
+/// Checks the host's buffers against `settings` (valid), renders, telling `progress`
+/// (may be NULL), and copies the film out.
 fn render_into(
     scene: *mut HtScene,
     settings: &RenderSettings,
     settings_span: Span,
-    progress: &dyn Progress,
-    b: HostBuffers,
+    progress: HtProgressFn,
+    user: *mut c_void,
+    (rgb, rgb_len, albedo, depth, strand_id, pixel_count): HostBuffers,
 ) -> Result<(), Failure> {
+    let host;
+    let progress: &dyn Progress = match progress {
+        Some(callback) => {
+            host = HostProgress { callback, user };
+            &host
+        }
+        None => &NoProgress,
+    };
     let scene = scene_mut(scene)?;
     // The crop window's size (the full frame without one).
     let [x0, y0, x1, y1] = settings.window();
@@ -463,20 +424,18 @@ fn render_into(
     // At most 2^15 x 2^15 x 3 (validated): no overflow.
     let pixels = w as usize * h as usize;
     let want = 3 * pixels;
-    let rgb_len = b.rgb_len;
     if rgb_len != want {
         return Err(invalid_arg!("rgb_len = {rgb_len}: must be 3 * {w} * {h} = {want}").into());
     }
-    let rgb = host_slice_mut(non_null_mut(b.rgb, "rgb")?, rgb_len, "rgb")?;
-    let pixel_count = b.pixel_count;
+    let rgb = host_slice_mut(non_null_mut(rgb, "rgb")?, rgb_len, "rgb")?;
     if pixel_count != pixels {
         return Err(
             invalid_arg!("pixel_count = {pixel_count}: must be {w} * {h} = {pixels}").into(),
         );
     }
-    let albedo = optional_slice(b.albedo, 3 * pixels, "albedo")?;
-    let depth = optional_slice(b.depth, pixels, "depth")?;
-    let strand_id = optional_slice(b.strand_id, pixels, "strand_id")?;
+    let albedo = optional_slice(albedo, 3 * pixels, "albedo")?;
+    let depth = optional_slice(depth, pixels, "depth")?;
+    let strand_id = optional_slice(strand_id, pixels, "strand_id")?;
     let span = |name, b: &Option<&mut [f32]>| {
         b.as_ref()
             .map_or(Span::of(name, std::ptr::null::<f32>(), 0), |b| {

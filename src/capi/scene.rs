@@ -12,6 +12,7 @@ use crate::render::integrator::World;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::light::Light;
+use crate::scene::lod::DEFAULT_LOD_PIXELS;
 use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
 use crate::scene::ribbons::{self, GroomShape};
@@ -133,7 +134,7 @@ impl HtScene {
                     1
                 }
                 (Shape::AutoCurves(c), Some((camera, height))) => {
-                    let parts = ribbons::share_out(c.clone(), camera, *height)?;
+                    let parts = ribbons::share_out(c.clone(), camera, *height, DEFAULT_LOD_PIXELS)?;
                     let n = parts.len();
                     for part in parts {
                         builder.add_curves(part)?;

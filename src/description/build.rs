@@ -19,6 +19,7 @@ use crate::scene::curves::Curves;
 use crate::scene::envmap::Environment;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
+use crate::scene::lod::DEFAULT_LOD_PIXELS;
 use crate::scene::material::{HairMaterial, Material};
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
@@ -136,8 +137,10 @@ impl SceneDescription {
         for (i, curves) in built {
             let at = format!("groom[{i}]");
             let parts = match self.grooms[i].shape {
-                GroomShape::Auto => ribbons::share_out(curves, &camera, settings.height)
-                    .map_err(|e| self.error(&at, e))?,
+                GroomShape::Auto => {
+                    ribbons::share_out(curves, &camera, settings.height, DEFAULT_LOD_PIXELS)
+                        .map_err(|e| self.error(&at, e))?
+                }
                 _ => vec![curves],
             };
             for part in parts {

@@ -15,6 +15,7 @@ use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
 use crate::scene::framing::Framing;
 use crate::scene::light::Light;
+use crate::scene::lod::DEFAULT_LOD_PIXELS;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::ribbons::{self, GroomShape};
@@ -161,7 +162,12 @@ impl HtScene {
                     1
                 }
                 Shape::AutoCurves(c) => {
-                    let parts = ribbons::share_out(c.clone(), &view.camera, view.height)?;
+                    let parts = ribbons::share_out(
+                        c.clone(),
+                        &view.camera,
+                        view.height,
+                        DEFAULT_LOD_PIXELS,
+                    )?;
                     let n = parts.len();
                     for part in parts {
                         builder.add_view_curves(part, *view)?;

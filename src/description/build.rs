@@ -22,6 +22,7 @@ use crate::scene::footprint::{self, CurvesSize, available_bytes};
 use crate::scene::framing::Framing;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
+use crate::scene::lod::DEFAULT_LOD_PIXELS;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
@@ -132,7 +133,7 @@ impl SceneDescription {
             let groom = &self.grooms[i];
             let auto = groom.shape == GroomShape::Auto;
             let parts = if auto {
-                ribbons::share_out(curves, &camera, settings.height)
+                ribbons::share_out(curves, &camera, settings.height, DEFAULT_LOD_PIXELS)
                     .map_err(|e| self.error(&at, e))?
             } else {
                 vec![curves]

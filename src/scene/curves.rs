@@ -27,10 +27,15 @@
 //! parameter) and the groom's optional absorption: a colour per polyline point,
 //! interpolated linearly, or a melanin pair per strand ([`Curves::with_melanin`]), kept as
 //! given so that the material converts it once, at the hit.
+//!
+//! [`Curves::polylines`] lays flat linear ribbons over points sampled on other curves (the
+//! level of detail of `lod.rs`); [`TrueCurves`] keeps those curves, so that the ribbons'
+//! hits take the true curve's tangent, position along the strand and colour.
 
 use std::ops::Range;
+use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use crate::bsdf::sigma_a_from_melanin;
 use crate::embree::{CurveBasis, CurveShape, SharedBuffer, padding_for};
@@ -47,9 +52,8 @@ pub struct Curves {
     vertices: SharedBuffer<[f32; 4]>,
     indices: SharedBuffer<u32>,
     strands: StrandIndex,
-    /// Linear curves laid over a Catmull-Rom control-point buffer
-    /// ([`Curves::catmull_rom_polyline`]): their hits take the Catmull-Rom tangent.
-    catmull_rom_tangents: bool,
+    /// The curves these [`Curves::polylines`] stand for.
+    truth: Option<Arc<TrueCurves>>,
 }
 
 /// Where a primitive sits in its strand.
@@ -176,6 +180,12 @@ impl StrandIndex {
         })
     }
 
+    /// The first segment of strand `strand`.
+    pub fn first_segment(&self, strand: usize) -> Option<StrandSegment> {
+        self.locate(*self.segment_starts.get(strand)?)
+            .filter(|at| at.strand as usize == strand)
+    }
+
     /// The groom's absorption at parameter u of segment `at`, if it gives one: the colour
     /// there (interpolated between the segment's ends) or the strand's melanin.
     pub fn absorption(&self, at: &StrandSegment, u: f32) -> Option<HairColor> {
@@ -279,7 +289,7 @@ impl Curves {
             vertices: SharedBuffer::new(vertices),
             indices: SharedBuffer::new(indices),
             strands: strand_index,
-            catmull_rom_tangents: false,
+            truth: None,
         })
     }
 
@@ -337,7 +347,7 @@ impl Curves {
             vertices,
             indices: SharedBuffer::new(indices),
             strands: StrandIndex::new(segments.into_iter(), colors)?,
-            catmull_rom_tangents: false,
+            truth: None,
         })
     }
 
@@ -425,30 +435,52 @@ impl Curves {
         self
     }
 
-    /// Catmull-Rom curves as flat linear ribbons through their own points (a Catmull-Rom
-    /// curve passes through them), on the same control-point buffer: segment k's piece
-    /// starts one point later, past the root's phantom. Hits still take the curve's
-    /// tangent ([`Self::catmull_rom_tangents`]), so only the position moves, by the curve's
-    /// distance from its chord. Other bases come back as they are, flat.
-    pub fn catmull_rom_polyline(self) -> Curves {
-        if self.basis != CurveBasis::CatmullRom {
-            return self.with_shape(CurveShape::Flat);
+    /// Flat linear ribbons through `points`, `counts[i]` of them for strand i of `truth`,
+    /// each on the curve of `truth` at the parameter `params` gives it (segment index plus
+    /// u, from the root; one per point). Their hits take the strand numbers, tangent,
+    /// position along the strand and colours of `truth` ([`Self::truth`]).
+    pub(crate) fn polylines(
+        truth: Curves,
+        points: Vec<[f32; 4]>,
+        counts: &[u32],
+        params: Vec<f32>,
+    ) -> Result<Curves> {
+        if counts.len() != truth.strands.strand_count() || params.len() != points.len() {
+            return Err(invalid_arg!(
+                "{} polylines of {} points with {} parameters for {} strands",
+                counts.len(),
+                points.len(),
+                params.len(),
+                truth.strands.strand_count()
+            ));
         }
-        let mut indices = Vec::with_capacity(self.indices().len() + padding_for::<u32>());
-        indices.extend(self.indices().iter().map(|&i| i + 1));
-        Curves {
-            basis: CurveBasis::Linear,
-            shape: CurveShape::Flat,
-            indices: SharedBuffer::new(indices),
-            catmull_rom_tangents: true,
-            ..self
-        }
+        let mut lines = Curves::from_control_points(
+            points,
+            counts,
+            None,
+            CurveBasis::Linear,
+            CurveShape::Flat,
+        )?;
+        lines.strands.ids = truth.strands.ids.clone();
+        lines.truth = Some(Arc::new(TrueCurves {
+            curves: truth,
+            params,
+        }));
+        Ok(lines)
     }
 
-    /// Whether these are [`Self::catmull_rom_polyline`]s: segment `prim`, from
-    /// `indices()[prim]`, has the Catmull-Rom control points one before to two after it.
-    pub fn catmull_rom_tangents(&self) -> bool {
-        self.catmull_rom_tangents
+    /// The curves these [`Self::polylines`] stand for, if they are polylines.
+    pub fn truth(&self) -> Option<&Arc<TrueCurves>> {
+        self.truth.as_ref()
+    }
+
+    /// The polynomial of segment `prim`.
+    pub(crate) fn segment_curve(&self, prim: u32) -> Option<SegmentCurve> {
+        let first = *self.indices().get(prim as usize)? as usize;
+        let points = self
+            .vertices()
+            .get(first..first + self.basis.points_per_segment())?;
+        Some(SegmentCurve::new(self.basis, points))
     }
 
     pub fn basis(&self) -> CurveBasis {
@@ -476,7 +508,10 @@ impl Curves {
     /// Heap bytes of everything hairtrace keeps for these curves (shared control points are
     /// their owner's, not counted).
     pub fn heap_bytes(&self) -> usize {
-        self.vertices.heap_bytes() + self.indices.heap_bytes() + self.strands.heap_bytes()
+        self.vertices.heap_bytes()
+            + self.indices.heap_bytes()
+            + self.strands.heap_bytes()
+            + self.truth.as_ref().map_or(0, |t| t.heap_bytes())
     }
 
     /// Splits into the Embree buffers and the table that stays with the scene.
@@ -488,6 +523,7 @@ impl Curves {
         SharedBuffer<[f32; 4]>,
         SharedBuffer<u32>,
         StrandIndex,
+        Option<Arc<TrueCurves>>,
     ) {
         (
             self.basis,
@@ -495,23 +531,125 @@ impl Curves {
             self.vertices,
             self.indices,
             self.strands,
+            self.truth,
         )
     }
 }
 
-/// Embree indexes control points with u32.
-/// The uniform Catmull-Rom segment of control points `p`, from p[1] to p[2], as the cubic
-/// p[1] + c1 u + c2 u^2 + c3 u^3: returns [c1, c2, c3]. What the polylines of thin strands
-/// are checked against (`ribbons::straight_strands`) and take their tangents from
-/// (`tracer`).
-pub(crate) fn catmull_rom_coefficients([p0, p1, p2, p3]: [Vec3; 4]) -> [Vec3; 3] {
-    [
-        0.5 * (p2 - p0),
-        0.5 * (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3),
-        0.5 * (-p0 + 3.0 * p1 - 3.0 * p2 + p3),
-    ]
+/// The curves that [`Curves::polylines`] stand for, and where each polyline point lies on
+/// them.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrueCurves {
+    curves: Curves,
+    /// The curve parameter (segment index plus u, from the root) of each polyline point.
+    params: Vec<f32>,
 }
 
+impl TrueCurves {
+    pub fn curves(&self) -> &Curves {
+        &self.curves
+    }
+
+    /// The curve parameter of each polyline point.
+    pub fn params(&self) -> &[f32] {
+        &self.params
+    }
+
+    /// The segment of the true curve, and its parameter, at parameter `u` of the polyline
+    /// piece of strand `strand` that starts at polyline point `first`: the piece's
+    /// parameter mapped linearly onto the curve's between its two points.
+    pub fn locate(&self, strand: u32, first: u32, u: f32) -> Option<(StrandSegment, f32)> {
+        let first = first as usize;
+        let (a, b) = (*self.params.get(first)?, *self.params.get(first + 1)?);
+        let t = a + u.clamp(0.0, 1.0) * (b - a);
+        let starts = &self.curves.strands.segment_starts;
+        let (start, end) = (
+            *starts.get(strand as usize)?,
+            *starts.get(strand as usize + 1)?,
+        );
+        let segment = (t.max(0.0) as u32).min(end.checked_sub(start + 1)?);
+        let at = self.curves.strands.locate(start + segment)?;
+        Some((at, (t - segment as f32).clamp(0.0, 1.0)))
+    }
+
+    /// The true curve's derivative at parameter `u` of segment `at`.
+    pub fn derivative(&self, at: &StrandSegment, u: f32) -> Option<Vec3> {
+        let curve = self.curves.segment_curve(at.first_prim + at.segment)?;
+        Some(curve.derivative(u).truncate())
+    }
+
+    /// The true curve's colour at parameter `u` of segment `at`, if it has colours.
+    pub fn absorption(&self, at: &StrandSegment, u: f32) -> Option<HairColor> {
+        self.curves.strands.absorption(at, u)
+    }
+
+    pub fn heap_bytes(&self) -> usize {
+        self.curves.heap_bytes() + self.params.capacity() * 4
+    }
+}
+
+/// One curve segment as the cubic c0 + c1 u + c2 u^2 + c3 u^3 in (x, y, z, radius), for
+/// every basis from one table of coefficients ([`power_basis`]): what the level of detail
+/// samples and its hits take their tangents from. (Embree evaluates the same curves.)
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SegmentCurve([Vec4; 4]);
+
+impl SegmentCurve {
+    /// The segment of `basis` read from `points` (as many as one segment reads).
+    pub(crate) fn new(basis: CurveBasis, points: &[[f32; 4]]) -> Self {
+        let m = power_basis(basis);
+        SegmentCurve(std::array::from_fn(|k| {
+            (points.iter().zip(m[k]))
+                .map(|(p, w)| w * Vec4::from_array(*p))
+                .sum()
+        }))
+    }
+
+    /// Point (x, y, z) and radius (w) at `u`.
+    pub(crate) fn at(&self, u: f32) -> Vec4 {
+        let [c0, c1, c2, c3] = self.0;
+        c0 + u * (c1 + u * (c2 + u * c3))
+    }
+
+    /// Derivative with respect to `u`.
+    pub(crate) fn derivative(&self, u: f32) -> Vec4 {
+        let [_, c1, c2, c3] = self.0;
+        c1 + u * (2.0 * c2 + 3.0 * u * c3)
+    }
+}
+
+/// Row k holds the weights of the control points in the coefficient of u^k of a segment.
+fn power_basis(basis: CurveBasis) -> [[f32; 4]; 4] {
+    const SIXTH: f32 = 1.0 / 6.0;
+    match basis {
+        CurveBasis::Linear => [
+            [1.0, 0.0, 0.0, 0.0],
+            [-1.0, 1.0, 0.0, 0.0],
+            [0.0; 4],
+            [0.0; 4],
+        ],
+        CurveBasis::Bezier => [
+            [1.0, 0.0, 0.0, 0.0],
+            [-3.0, 3.0, 0.0, 0.0],
+            [3.0, -6.0, 3.0, 0.0],
+            [-1.0, 3.0, -3.0, 1.0],
+        ],
+        CurveBasis::BSpline => [
+            [SIXTH, 4.0 * SIXTH, SIXTH, 0.0],
+            [-0.5, 0.0, 0.5, 0.0],
+            [0.5, -1.0, 0.5, 0.0],
+            [-SIXTH, 0.5, -0.5, SIXTH],
+        ],
+        CurveBasis::CatmullRom => [
+            [0.0, 1.0, 0.0, 0.0],
+            [-0.5, 0.0, 0.5, 0.0],
+            [1.0, -2.5, 2.0, -0.5],
+            [-0.5, 1.5, -1.5, 0.5],
+        ],
+    }
+}
+
+/// Embree indexes control points with u32.
 fn check_vertex_count(n: usize) -> Result<()> {
     if n > u32::MAX as usize {
         return Err(invalid_arg!(

@@ -14,6 +14,7 @@ pub mod hair_file;
 pub mod hit;
 pub mod light;
 mod light_sample;
+pub mod lod;
 pub mod material;
 pub(crate) mod mesh;
 pub mod ribbons;

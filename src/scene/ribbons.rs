@@ -9,17 +9,19 @@
 //! third of a bench render's own noise (RMSE at equal samples 2-4% higher; docs/measurements.md, "Curve
 //! shapes").
 //!
-//! A thin Catmull-Rom strand whose curve stays within [`POLYLINE_PIXELS`] of a pixel of
-//! its polyline is traced as flat linear ribbons through its own points (a Catmull-Rom
-//! curve passes through them), shaded with the curve's tangent: Embree's flat Catmull-Rom
-//! ribbons are intersected piece by piece as it goes, which costs the demo 1.25x the time.
+//! With a level of detail (`lod_pixels` > 0), the thin strands of every basis are traced
+//! as flat linear ribbons through points on their curves, as few as keep the curve within
+//! `lod_pixels` of them (`lod.rs`), shaded with the curve's tangent: Embree builds and
+//! traces linear ribbons faster than cubic ones, and Catmull-Rom and Bezier curves are
+//! converted to B-splines in its build.
 
 use glam::Vec3;
 
-use crate::embree::{CurveBasis, CurveShape};
+use crate::embree::CurveShape;
 use crate::error::Result;
 use crate::scene::camera::Camera;
-use crate::scene::curves::{Curves, catmull_rom_coefficients};
+use crate::scene::curves::Curves;
+use crate::scene::lod;
 
 /// How a groom's strands are given to Embree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -62,43 +64,9 @@ pub fn thin_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bool> 
             curves
                 .strand_points(s)
                 .iter()
-                .all(|&[x, y, z, r]| 2.0 * r <= spread * eye.distance(glam::Vec3::new(x, y, z)))
+                .all(|&[x, y, z, r]| 2.0 * r <= spread * eye.distance(Vec3::new(x, y, z)))
         })
         .collect()
-}
-
-/// How far, in pixels, a thin Catmull-Rom strand's curve may stray from its polyline for
-/// the polyline to be traced instead ([`straight_strands`]).
-pub const POLYLINE_PIXELS: f32 = 0.05;
-
-/// One flag per strand of Catmull-Rom `curves` (all false for other bases): whether every
-/// segment's curve, at a quarter, half and three quarters of it, lies within
-/// [`POLYLINE_PIXELS`] of a pixel of its chord, seen from `camera`'s eye. (A bent segment
-/// strays most at its middle, an S-shaped one near its quarters.)
-pub fn straight_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bool> {
-    let strands = curves.strands().strand_count();
-    if curves.basis() != CurveBasis::CatmullRom {
-        return vec![false; strands];
-    }
-    let (eye, spread) = (camera.eye(), camera.pixel_spread(height));
-    (0..strands)
-        .map(|s| {
-            curves.strand_points(s).windows(4).all(|w| {
-                let p: [Vec3; 4] = std::array::from_fn(|k| Vec3::from_slice(&w[k][..3]));
-                chord_stray(p) <= POLYLINE_PIXELS * spread * eye.distance(0.5 * (p[1] + p[2]))
-            })
-        })
-        .collect()
-}
-
-/// The largest distance, at u = 1/4, 1/2 and 3/4, between the Catmull-Rom segment of
-/// control points `p` (from p[1] to p[2]) and its chord.
-fn chord_stray(p: [Vec3; 4]) -> f32 {
-    let [c1, c2, c3] = catmull_rom_coefficients(p);
-    [0.25f32, 0.5, 0.75]
-        .map(|u| (p[1] + u * (c1 + u * (c2 + u * c3))).distance(p[1].lerp(p[2], u)))
-        .into_iter()
-        .fold(0.0, f32::max)
 }
 
 /// How one strand of an `auto` groom is traced.
@@ -106,47 +74,44 @@ fn chord_stray(p: [Vec3; 4]) -> f32 {
 enum Part {
     Round,
     Flat,
-    /// A thin Catmull-Rom strand whose curve stays close to its polyline: flat linear
-    /// ribbons through its points ([`Curves::catmull_rom_polyline`]), which Embree traces
-    /// faster than its own flat Catmull-Rom ribbons, with a smaller BVH.
+    /// A thin strand with a level of detail: flat linear ribbons through points on its
+    /// curve ([`lod::polylines`]).
     Polyline,
 }
 
-impl Part {
-    /// `curves` traced as this part.
-    fn shape(self, curves: Curves) -> Curves {
-        match self {
-            Part::Round => curves.with_shape(CurveShape::Round),
-            Part::Flat => curves.with_shape(CurveShape::Flat),
-            Part::Polyline => curves.catmull_rom_polyline(),
-        }
-    }
-}
-
 /// `curves` (built round) as the geometries an `auto` groom is traced with: its thick
-/// strands round, its thin ones flat ([`thin_strands`]), the thin Catmull-Rom ones that
-/// [`straight_strands`] passes as polylines; without a copy when all are one kind.
-pub fn share_out(curves: Curves, camera: &Camera, height: u32) -> Result<Vec<Curves>> {
-    let thin = thin_strands(&curves, camera, height);
-    let straight = straight_strands(&curves, camera, height);
-    let parts: Vec<Part> = thin
-        .iter()
-        .zip(&straight)
-        .map(|(&thin, &straight)| match (thin, straight) {
-            (false, _) => Part::Round,
-            (true, false) => Part::Flat,
-            (true, true) => Part::Polyline,
-        })
+/// strands round, its thin ones ([`thin_strands`]) flat, or with `lod_pixels` > 0 as
+/// polylines within that many pixels of their curves; without a copy when all are one
+/// kind.
+pub fn share_out(
+    curves: Curves,
+    camera: &Camera,
+    height: u32,
+    lod_pixels: f32,
+) -> Result<Vec<Curves>> {
+    lod::check_pixels(lod_pixels)?;
+    let thin_part = if lod_pixels > 0.0 {
+        Part::Polyline
+    } else {
+        Part::Flat
+    };
+    let parts: Vec<Part> = (thin_strands(&curves, camera, height).into_iter())
+        .map(|thin| if thin { thin_part } else { Part::Round })
         .collect();
+    let shape = |part, curves: Curves| match part {
+        Part::Round => Ok(curves.with_shape(CurveShape::Round)),
+        Part::Flat => Ok(curves.with_shape(CurveShape::Flat)),
+        Part::Polyline => lod::polylines(curves, camera, height, lod_pixels),
+    };
     let first = parts.first().copied().unwrap_or(Part::Flat);
     if parts.iter().all(|&p| p == first) {
-        return Ok(vec![first.shape(curves)]);
+        return Ok(vec![shape(first, curves)?]);
     }
     let mut out = Vec::new();
-    for part in [Part::Round, Part::Flat, Part::Polyline] {
+    for part in [Part::Round, thin_part] {
         let keep: Vec<bool> = parts.iter().map(|&p| p == part).collect();
         if let Some(subset) = curves.subset(&keep, CurveShape::Round)? {
-            out.push(part.shape(subset));
+            out.push(shape(part, subset)?);
         }
     }
     Ok(out)
@@ -191,35 +156,30 @@ mod tests {
 
     #[test]
     fn share_out_splits_only_a_mixed_groom() {
-        let one = |h| {
-            let parts = share_out(near_and_far(), &camera(), h).unwrap();
-            parts.iter().map(|p| p.shape()).collect::<Vec<_>>()
-        };
-        assert_eq!(one(10), [CurveShape::Flat]);
-        assert_eq!(one(5000), [CurveShape::Round]);
-        assert_eq!(one(100), [CurveShape::Round, CurveShape::Flat]);
-        let parts = share_out(near_and_far(), &camera(), 100).unwrap();
-        let ids = |p: &Curves| p.strands().locate(0).unwrap().id;
-        assert_eq!((ids(&parts[0]), ids(&parts[1])), (0, 1));
+        for lod in [0.0, 0.25] {
+            let one = |h| {
+                let parts = share_out(near_and_far(), &camera(), h, lod).unwrap();
+                parts.iter().map(|p| p.shape()).collect::<Vec<_>>()
+            };
+            assert_eq!(one(10), [CurveShape::Flat]);
+            assert_eq!(one(5000), [CurveShape::Round]);
+            assert_eq!(one(100), [CurveShape::Round, CurveShape::Flat]);
+            let parts = share_out(near_and_far(), &camera(), 100, lod).unwrap();
+            let ids = |p: &Curves| p.strands().locate(0).unwrap().id;
+            assert_eq!((ids(&parts[0]), ids(&parts[1])), (0, 1));
+        }
     }
 
-    /// Two thin Catmull-Rom strands at distance 1 from the camera, 0.1 long in 4 segments:
-    /// one straight, one zig-zagging by 0.01 (a tenth of its own length).
-    fn straight_and_bent() -> Curves {
-        let (straight, bent): (Vec<[f32; 4]>, Vec<[f32; 4]>) = (0..5)
-            .map(|i| {
-                let y = 0.025 * i as f32;
-                let x = if i % 2 == 1 { 0.01 } else { 0.0 };
-                ([0.0, y, -1.0, 1e-4], [0.05 + x, y, -1.0, 1e-4])
-            })
-            .unzip();
+    /// Two Catmull-Rom strands of radius 1e-4 in 4 segments: one at distance 1 from the
+    /// camera, one at distance 100.
+    fn catmull_rom_near_and_far() -> Curves {
+        let points: Vec<[f32; 3]> = [-1.0f32, -100.0]
+            .iter()
+            .flat_map(|&z| (0..5).map(move |i| [0.01 * (i % 2) as f32, 0.025 * i as f32, z]))
+            .collect();
         let strands = crate::scene::Strands {
-            points: straight
-                .iter()
-                .chain(&bent)
-                .map(|p| [p[0], p[1], p[2]])
-                .collect(),
-            radii: vec![1e-4; 10],
+            radii: vec![1e-4; points.len()],
+            points,
             counts: vec![5, 5],
             colors: None,
         };
@@ -227,36 +187,29 @@ mod tests {
     }
 
     #[test]
-    fn thin_catmull_rom_strands_close_to_their_polyline_are_traced_as_it() {
-        let c = straight_and_bent();
-        // Pixel side at distance 1: 0.536 / height. The bent strand's curve strays up to
-        // about 0.002 from its chords: under 1/20 of a pixel at height 10, far over it
-        // at 500.
-        assert_eq!(straight_strands(&c, &camera(), 10), [true, true]);
-        assert_eq!(straight_strands(&c, &camera(), 500), [true, false]);
-        assert_eq!(
-            straight_strands(&near_and_far(), &camera(), 10),
-            [false, false]
+    fn a_level_of_detail_traces_the_thin_strands_as_polylines_of_their_curves() {
+        let c = catmull_rom_near_and_far();
+        let kinds = |h, lod| {
+            (share_out(c.clone(), &camera(), h, lod).unwrap().iter())
+                .map(|p| (p.basis(), p.shape(), p.truth().is_some()))
+                .collect::<Vec<_>>()
+        };
+        let (native, polyline) = (
+            (CurveBasis::CatmullRom, CurveShape::Flat, false),
+            (CurveBasis::Linear, CurveShape::Flat, true),
         );
-        let parts = share_out(c.clone(), &camera(), 500).unwrap();
-        let kinds: Vec<_> = parts
-            .iter()
-            .map(|p| (p.basis(), p.shape(), p.catmull_rom_tangents()))
-            .collect();
-        assert_eq!(
-            kinds,
-            [
-                (CurveBasis::CatmullRom, CurveShape::Flat, false),
-                (CurveBasis::Linear, CurveShape::Flat, true),
-            ]
-        );
-        let ids = |p: &Curves| p.strands().locate(0).unwrap().id;
-        assert_eq!((ids(&parts[0]), ids(&parts[1])), (1, 0));
-        // The polyline runs through the strand's own points.
-        assert_eq!(parts[1].strand_points(0), &c.strand_points(0)[1..6]);
-        // Only thin strands: at height 5000 both are a pixel wide or more.
-        let whole = share_out(c, &camera(), 5000).unwrap();
-        assert_eq!(whole.len(), 1);
-        assert_eq!(whole[0].shape(), CurveShape::Round);
+        // Pixel side 0.536 d / height; diameter 2e-4. Height 10: both thin.
+        assert_eq!(kinds(10, 0.0), [native]);
+        assert_eq!(kinds(10, 0.25), [polyline]);
+        // Height 5000: the near strand (pixel 1.07e-4) is thick and stays round.
+        let round = (CurveBasis::CatmullRom, CurveShape::Round, false);
+        assert_eq!(kinds(5000, 0.25), [round, polyline]);
+        let parts = share_out(c.clone(), &camera(), 5000, 0.25).unwrap();
+        // The polylines keep the strand's number, and their curve is the strand's.
+        assert_eq!(parts[1].strands().locate(0).unwrap().id, 1);
+        let truth = parts[1].truth().unwrap().curves();
+        assert_eq!(truth.strand_points(0), c.strand_points(1));
+        let e = share_out(c, &camera(), 10, -1.0).unwrap_err();
+        assert!(e.to_string().contains("tolerance -1"), "{e}");
     }
 }

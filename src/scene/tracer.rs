@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::curves::{Curves, StrandIndex, StrandSegment, catmull_rom_coefficients};
+use super::curves::{Curves, StrandIndex, StrandSegment, TrueCurves};
 use super::detail_view::{DetailView, ViewDependent};
 use super::hit::{HairHit, Hit, SurfaceHit, hair_frame};
 use super::mesh::Mesh;
@@ -73,8 +73,8 @@ pub struct SpawnedRay {
 enum Table {
     Curves {
         strands: StrandIndex,
-        /// The curves are [`Curves::catmull_rom_polyline`]s.
-        catmull_rom_tangents: bool,
+        /// The curves that level-of-detail polylines stand for ([`Curves::truth`]).
+        truth: Option<Arc<TrueCurves>>,
     },
     Mesh {
         normals: Option<Vec<[f32; 3]>>,
@@ -100,8 +100,7 @@ impl TracerBuilder {
 
     /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
     pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
-        let catmull_rom_tangents = curves.catmull_rom_tangents();
-        let (basis, shape, vertices, indices, strands) = curves.into_parts();
+        let (basis, shape, vertices, indices, strands, truth) = curves.into_parts();
         let geometry = CurveGeometry::new(
             self.scene.device(),
             basis,
@@ -111,10 +110,7 @@ impl TracerBuilder {
             HAIR_MASK,
         )?;
         let id = self.scene.attach(geometry)?;
-        self.tables.push(Table::Curves {
-            strands,
-            catmull_rom_tangents,
-        });
+        self.tables.push(Table::Curves { strands, truth });
         Ok(id)
     }
 
@@ -197,7 +193,9 @@ impl Tracer {
             .tables
             .iter()
             .map(|t| match t {
-                Table::Curves { strands, .. } => strands.heap_bytes(),
+                Table::Curves { strands, truth } => {
+                    strands.heap_bytes() + truth.as_ref().map_or(0, |t| t.heap_bytes())
+                }
                 Table::Mesh { normals } => normals.as_ref().map_or(0, |n| n.capacity() * 12),
             })
             .sum();
@@ -317,15 +315,9 @@ impl Tracer {
             self.scene.geometry(hit.geom_id)?,
             self.tables.get(hit.geom_id as usize)?,
         ) {
-            (
-                Geometry::Curves(geom),
-                Table::Curves {
-                    strands,
-                    catmull_rom_tangents,
-                },
-            ) => {
+            (Geometry::Curves(geom), Table::Curves { strands, truth }) => {
                 let at = strands.locate(hit.prim_id)?;
-                let hair = hair_hit(ray, hit, p, geom, strands, at, *catmull_rom_tangents)?;
+                let hair = hair_hit(ray, hit, p, geom, strands, at, truth.as_deref())?;
                 Some(Hit::Hair(hair))
             }
             (Geometry::Triangles(geom), Table::Mesh { normals }) => {
@@ -360,7 +352,7 @@ fn hair_hit(
     geom: &CurveGeometry,
     strands: &StrandIndex,
     at: StrandSegment,
-    catmull_rom_tangents: bool,
+    truth: Option<&TrueCurves>,
 ) -> Option<HairHit> {
     let flat_cubic = geom.shape() == CurveShape::Flat && geom.basis() != CurveBasis::Linear;
     let (u, c) = if flat_cubic {
@@ -369,12 +361,25 @@ fn hair_hit(
         (hit.u, geom.interpolate(hit.prim_id, hit.u)?)
     };
     let axis = Vec3::from_array(c.p);
-    let tangent = if catmull_rom_tangents {
-        catmull_rom_derivative(geom, hit.prim_id, u)
-            .filter(|d| usable(*d, c.radius))
-            .unwrap_or_else(|| tangent(geom, hit.prim_id, Vec3::ZERO, c.radius, &at))
-    } else {
-        tangent(geom, hit.prim_id, Vec3::from_array(c.dp_du), c.radius, &at)
+    // A polyline's hit takes the true curve's tangent, position and colour there.
+    let on_curve = truth.and_then(|t| {
+        let first = *geom.indices().get(hit.prim_id as usize)?;
+        let (seg, cu) = t.locate(at.strand, first, u)?;
+        Some((t.derivative(&seg, cu)?, seg.s(cu), t.absorption(&seg, cu)))
+    });
+    let (tangent, s, absorption) = match on_curve {
+        Some((d, s, absorption)) => (
+            Some(d)
+                .filter(|d| usable(*d, c.radius))
+                .unwrap_or_else(|| tangent(geom, hit.prim_id, Vec3::ZERO, c.radius, &at)),
+            s,
+            absorption,
+        ),
+        None => (
+            tangent(geom, hit.prim_id, Vec3::from_array(c.dp_du), c.radius, &at),
+            at.s(u),
+            strands.absorption(&at, u),
+        ),
     };
     // One formula for every shape: on flat cubic curves it beats Embree's v (the offset
     // across the tessellated ribbon) by two orders of magnitude on bent fibers
@@ -399,8 +404,8 @@ fn hair_hit(
         u,
         v: hit.v,
         strand: at,
-        s: at.s(u),
-        absorption: strands.absorption(&at, u),
+        s,
+        absorption,
     })
 }
 
@@ -439,24 +444,6 @@ const DEGENERATE_DERIVATIVE: f32 = 1e-6;
 /// Whether `t` can serve as a tangent at a point of radius `radius`.
 fn usable(t: Vec3, radius: f32) -> bool {
     t.is_finite() && t.length() > DEGENERATE_DERIVATIVE * radius.max(0.0)
-}
-
-/// The derivative at u of the Catmull-Rom segment that linear segment `prim` of a
-/// [`Curves::catmull_rom_polyline`] stands for: its control points are the one before
-/// the segment's first point to the one after its second (phantom points at the ends).
-fn catmull_rom_derivative(geom: &CurveGeometry, prim: u32, u: f32) -> Option<Vec3> {
-    let first = *geom.indices().get(prim as usize)? as usize;
-    let v = geom.vertices();
-    let p = |i: usize| v.get(i).map(|q| Vec3::from_slice(&q[..3]));
-    let points = [
-        p(first.checked_sub(1)?)?,
-        p(first)?,
-        p(first + 1)?,
-        p(first + 2)?,
-    ];
-    let [c1, c2, c3] = catmull_rom_coefficients(points);
-    let u = u.clamp(0.0, 1.0);
-    Some(c1 + u * (2.0 * c2 + 3.0 * u * c3))
 }
 
 /// The curve tangent at the hit: the segment direction for linear curves, the derivative
@@ -555,6 +542,7 @@ fn surface_hit(
 mod tests {
     use super::*;
     use crate::scene::Strands;
+    use crate::scene::material::HairColor;
 
     fn tracer(curves: Curves) -> Tracer {
         let device = Arc::new(Device::new(Some(1)).unwrap());
@@ -732,69 +720,95 @@ mod tests {
         assert!(t.intersect_spawned(&spawned).is_none());
     }
 
-    /// A bent strand (0.05 rad per segment) traced as ribbons through its Catmull-Rom
-    /// polyline gives the hits Embree's own flat Catmull-Rom ribbons give: the curve's
-    /// tangent within 1e-3 rad inside the pieces (their chords are up to 0.025 rad off)
-    /// and within a fifth of a segment's turn where a ray meets a joint (the piece's end,
-    /// u = 0 or 1), and h up to the curve's distance from its chord (the sagitta, here 0.03
-    /// of a radius: the polyline's h is measured from the polyline).
+    /// Two bent strands (0.05 rad per segment) with colours, as level-of-detail
+    /// polylines of the second alone, against Embree's own flat ribbons of both, every
+    /// basis: the same strand number, the true curve's tangent (within 1e-3 rad inside the
+    /// pieces, a fifth of a segment's turn where a ray meets a joint, where the chords are
+    /// up to half a piece's turn off), its position along the strand and its colour.
     #[test]
-    fn catmull_rom_polylines_shade_with_the_curves_tangent() {
+    fn polylines_shade_with_the_true_curves_tangent_position_and_colour() {
+        use crate::scene::camera::Camera;
+        use crate::scene::lod;
         const TURN: f32 = 0.05;
-        let points: Vec<[f32; 3]> = (0..9)
-            .map(|i| {
-                let a = TURN * i as f32;
-                [a.sin(), 1.0 - a.cos(), 0.0]
-            })
-            .collect();
-        let strands = Strands {
-            radii: vec![0.01; points.len()],
-            counts: vec![points.len() as u32],
-            points,
-            colors: None,
-        };
-        let curves =
-            Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Flat).unwrap();
-        let polyline = curves.clone().catmull_rom_polyline();
-        assert!(polyline.catmull_rom_tangents() && polyline.basis() == CurveBasis::Linear);
-        let (exact, fast) = (tracer(curves), tracer(polyline));
-        let (mut inside, mut joints, mut worst_h, mut worst_chord) =
-            (0.0f32, 0.0f32, 0.0f32, 0.0f32);
-        for k in 0..40 {
-            let a = 0.01 + 0.0098 * k as f32;
-            let at = Vec3::new(a.sin(), 1.0 - a.cos(), 0.0);
-            let across = 0.006 * ((k % 7) as f32 / 3.0 - 1.0);
-            let ray = Ray::new(at + Vec3::new(0.0, across, 5.0), -Vec3::Z);
-            let (Some(Hit::Hair(e)), Some(Hit::Hair(f))) =
-                (exact.intersect(&ray), fast.intersect(&ray))
-            else {
-                panic!("ray {k} missed");
-            };
-            let angle = f.frame.x.angle_between(e.frame.x);
-            if f.u > 0.0 && f.u < 1.0 {
-                inside = inside.max(angle);
-            } else {
-                joints = joints.max(angle);
-            }
-            let curve = Vec3::new(a.cos(), a.sin(), 0.0);
-            let chord = chord(geometry(&fast), f.prim_id).normalize();
-            worst_chord = worst_chord.max(chord.angle_between(curve));
-            worst_h = worst_h.max((f.h - e.h).abs());
+        const RADIUS: f32 = 1e-3;
+        // Straight for four segments of 0.05, then bending TURN per segment.
+        let mut arc = vec![[0.0f32; 3]];
+        for i in 0..8 {
+            let (a, [x, y, _]) = (TURN * (i as f32 - 3.0).max(0.0), arc[i]);
+            arc.push([x + 0.05 * a.cos(), y + 0.05 * a.sin(), 0.0]);
         }
-        assert!(inside < 1e-3, "tangent {inside} rad from Embree's");
-        assert!(
-            joints < 0.2 * TURN,
-            "tangent {joints} rad from Embree's at a joint"
-        );
-        assert!(
-            worst_chord > 0.4 * TURN,
-            "chords only {worst_chord} rad off"
-        );
-        // Arc of radius 1 turning TURN per segment, fibre radius 0.01.
-        let sagitta = TURN * TURN / 8.0 / 0.01;
-        assert!(
-            worst_h < 1.1 * sagitta,
-            "h {worst_h} from Embree's (sagitta {sagitta})"
-        );
+        let points: Vec<[f32; 3]> = (0..18).map(|i| arc[i % 9]).collect();
+        let strands = Strands {
+            radii: vec![RADIUS; points.len()],
+            colors: Some((0..18).map(|i| [(i % 9) as f32 / 8.0, 0.2, 1.0]).collect()),
+            counts: vec![9, 9],
+            points,
+        };
+        // A pixel 4 radii wide at the strand: thin; a tolerance of a tenth of a pixel.
+        let camera = Camera::new(Vec3::new(0.2, 0.1, 5.0), -Vec3::Z, Vec3::Y, 30.0, 1.0).unwrap();
+        let height = (camera.pixel_spread(1) * 5.0 / (4.0 * RADIUS)) as u32;
+        for basis in [
+            CurveBasis::CatmullRom,
+            CurveBasis::BSpline,
+            CurveBasis::Bezier,
+        ] {
+            let curves = Curves::from_strands(&strands, basis, CurveShape::Flat).unwrap();
+            let second = curves
+                .subset(&[false, true], CurveShape::Flat)
+                .unwrap()
+                .unwrap();
+            let lines = lod::polylines(second, &camera, height, 0.1).unwrap();
+            // The straight segments are one piece: s and the colours are not the pieces'.
+            let pieces = lines.strands().segment_count();
+            assert!(pieces < 8, "{basis:?}: {pieces} pieces");
+            let (exact, fast) = (tracer(curves), tracer(lines));
+            let (mut inside, mut joints, mut worst_chord) = (0.0f32, 0.0f32, 0.0f32);
+            let (mut worst_s, mut worst_color) = (0.0f32, 0.0f32);
+            for k in 0..40 {
+                // Rays across the second strand's curve, from +z.
+                let t = 0.05 + 0.0225 * k as f32 * 8.0;
+                let prim = 8 + (t as u32).min(7);
+                let on = geometry(&exact).interpolate(prim, t.fract()).unwrap().p;
+                let across = 0.5 * RADIUS * ((k % 7) as f32 / 3.0 - 1.0);
+                let ray = Ray::new(Vec3::from_array(on) + Vec3::new(0.0, across, 5.0), -Vec3::Z);
+                let (Some(Hit::Hair(e)), Some(Hit::Hair(f))) =
+                    (exact.intersect(&ray), fast.intersect(&ray))
+                else {
+                    panic!("{basis:?}: ray {k} missed");
+                };
+                assert_eq!((e.strand.id, f.strand.id), (1, 1), "{basis:?}");
+                let angle = f.frame.x.angle_between(e.frame.x);
+                if f.u > 0.0 && f.u < 1.0 {
+                    inside = inside.max(angle);
+                } else {
+                    joints = joints.max(angle);
+                }
+                let chord = chord(geometry(&fast), f.prim_id).normalize();
+                worst_chord = worst_chord.max(chord.angle_between(e.frame.x));
+                worst_s = worst_s.max((f.s - e.s).abs());
+                let colour = |h: &HairHit| match h.absorption {
+                    Some(HairColor::Color(c)) => c,
+                    other => panic!("a colour, not {other:?}"),
+                };
+                let (ce, cf) = (colour(&e), colour(&f));
+                worst_color = worst_color.max((ce[0] - cf[0]).abs());
+            }
+            assert!(
+                inside < 1e-3,
+                "{basis:?}: tangent {inside} rad from Embree's"
+            );
+            assert!(
+                joints < 0.2 * TURN,
+                "{basis:?}: tangent {joints} rad from Embree's at a joint"
+            );
+            assert!(
+                worst_chord > 10.0 * inside.max(1e-4),
+                "{basis:?}: chords only {worst_chord} rad off"
+            );
+            // s and the colour run 1/8 per segment: 2.5e-3 is a fiftieth of a segment, about
+            // where a ray half a radius off the axis meets the ribbon rather than the tube.
+            assert!(worst_s < 2.5e-3, "{basis:?}: s {worst_s} off");
+            assert!(worst_color < 2.5e-3, "{basis:?}: colour {worst_color} off");
+        }
     }
 }

@@ -116,23 +116,21 @@ fn auto_ribbons_give_the_image_of_round_tubes_within_noise() {
     assert_auto_matches_round(|shape, seed, spp| fur_ball(shape, seed, 5.2, 48, spp));
 }
 
-/// `auto` traces the thin Catmull-Rom strands that stay within `ribbons::POLYLINE_PIXELS` of a
-/// pixel of their polylines as linear ribbons through their points; the image is the
-/// round Catmull-Rom tubes' within their noise.
+/// `auto` traces the thin strands of cubic grooms as linear ribbons through points on their
+/// curves (the level of detail, `lod::DEFAULT_LOD_PIXELS`); the image is the round
+/// tubes' within their noise.
 #[test]
-fn auto_catmull_rom_polylines_give_the_image_of_round_tubes_within_noise() {
-    let groom = |shape: &str, seed, spp| fur_ball_of("catmull_rom", shape, seed, 5.2, 48, spp);
-    // Every strand is a ribbon, most of them polylines (the most bent stay Catmull-Rom).
-    let kinds = curve_kinds(&groom("auto", 0, 1));
-    assert!(
-        kinds.iter().all(|&(_, shape)| shape == CurveShape::Flat),
-        "{kinds:?}"
-    );
-    assert!(
-        kinds.contains(&(CurveBasis::Linear, CurveShape::Flat)),
-        "{kinds:?}"
-    );
-    assert_auto_matches_round(groom);
+fn auto_level_of_detail_polylines_give_the_image_of_round_tubes_within_noise() {
+    for basis in ["catmull_rom", "bspline"] {
+        let groom = |shape: &str, seed, spp| fur_ball_of(basis, shape, seed, 5.2, 48, spp);
+        // Every strand is thin: one geometry of polylines.
+        assert_eq!(
+            curve_kinds(&groom("auto", 0, 1)),
+            [(CurveBasis::Linear, CurveShape::Flat)],
+            "{basis}"
+        );
+        assert_auto_matches_round(groom);
+    }
 }
 
 #[test]

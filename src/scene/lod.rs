@@ -1,0 +1,357 @@
+//! Level of detail from the view: a strand the camera sees thinner than a pixel is traced as
+//! flat linear ribbons through points on its true curve, as few as keep the curve within a
+//! tolerance, in pixels, of its polyline.
+//!
+//! Each strand's curve (any basis) is cut by bisection of its parameter: first at the
+//! segment ends nearest the middle, then within a segment at halves, down to
+//! [`MIN_PIECE`] of a segment. A piece is kept when a bound on the curve's distance from
+//! the piece's chord is within the tolerance at the curve's distance from the eye. The
+//! bound, on each cubic part of the piece between segment ends, is the Hermite form of the
+//! curve's offset across the chord: at most the larger end offset plus 4/27 of the two end
+//! slopes (an arc's sagitta is overestimated by a fifth). A straight strand is one piece,
+//! a wavy one gets more pieces than segments where it bends; a Catmull-Rom strand whose
+//! segments pass keeps exactly its own points.
+//!
+//! The ribbons' hits are mapped back to the curve's parameter (`TrueCurves::locate`) and
+//! take its tangent, position along the strand and colours. The image moves by the
+//! tolerance at most, inside pixels a thinner strand only grazes (docs/large-grooms.md,
+//! "Level of detail", has what each tolerance costs and changes).
+
+use glam::{Vec3, Vec4};
+use rayon::prelude::*;
+
+use crate::error::{Result, invalid_arg};
+use crate::scene::camera::Camera;
+use crate::scene::curves::{Curves, SegmentCurve};
+
+/// The default tolerance, in pixels, between a thin strand's curve and its polyline.
+pub const DEFAULT_LOD_PIXELS: f32 = 0.02;
+
+/// The shortest piece, as a fraction of a segment: a bound on the points per segment
+/// whatever the tolerance.
+const MIN_PIECE: f32 = 1.0 / 64.0;
+
+/// Strands sampled per parallel task.
+const CHUNK: usize = 4096;
+
+/// Checks a tolerance: finite and >= 0 (0: no level of detail).
+pub fn check_pixels(pixels: f32) -> Result<()> {
+    if pixels.is_finite() && pixels >= 0.0 {
+        Ok(())
+    } else {
+        Err(invalid_arg!(
+            "level-of-detail tolerance {pixels} pixels: must be finite and >= 0 (0: off)"
+        ))
+    }
+}
+
+/// `curves` as flat linear ribbons through points on their curves, within `pixels` of a
+/// pixel of an image `height` pixels tall seen from `camera`'s eye ([`Curves::polylines`]).
+pub fn polylines(curves: Curves, camera: &Camera, height: u32, pixels: f32) -> Result<Curves> {
+    check_pixels(pixels)?;
+    let sampler = Sampler {
+        eye: camera.eye(),
+        per_distance: pixels * camera.pixel_spread(height),
+    };
+    let strands = curves.strands().strand_count();
+    // Each chunk's points, parameters and counts, in strand order whatever the threads.
+    let chunks: Vec<Polylines> = (0..strands.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut out = Polylines::default();
+            for s in c * CHUNK..strands.min((c + 1) * CHUNK) {
+                sampler.strand(&curves, s, &mut out);
+            }
+            out
+        })
+        .collect();
+    let mut all = Polylines::default();
+    let total = |f: fn(&Polylines) -> usize| chunks.iter().map(f).sum::<usize>();
+    all.points.reserve_exact(total(|c| c.points.len()) + 1);
+    all.params.reserve_exact(total(|c| c.params.len()));
+    all.counts.reserve_exact(strands);
+    for chunk in chunks {
+        all.points.extend_from_slice(&chunk.points);
+        all.params.extend_from_slice(&chunk.params);
+        all.counts.extend_from_slice(&chunk.counts);
+    }
+    Curves::polylines(curves, all.points, &all.counts, all.params)
+}
+
+#[derive(Default)]
+struct Polylines {
+    points: Vec<[f32; 4]>,
+    params: Vec<f32>,
+    counts: Vec<u32>,
+}
+
+struct Sampler {
+    eye: Vec3,
+    /// The tolerance per unit of distance from the eye.
+    per_distance: f32,
+}
+
+impl Sampler {
+    /// Appends strand `s`'s polyline to `out`.
+    fn strand(&self, curves: &Curves, s: usize, out: &mut Polylines) {
+        let segments: Vec<SegmentCurve> = (curves.strands().first_segment(s))
+            .into_iter()
+            .flat_map(|first| first.prims())
+            .filter_map(|prim| curves.segment_curve(prim))
+            .collect();
+        if segments.is_empty() {
+            out.counts.push(0);
+            return;
+        }
+        let strand = Strand {
+            segments: &segments,
+            sampler: self,
+        };
+        let before = out.points.len();
+        let end = segments.len() as f32;
+        let (root, tip) = (strand.point(0.0), strand.point(end));
+        out.points.push(root.to_array());
+        out.params.push(0.0);
+        strand.refine(0.0, root, end, tip, out);
+        out.counts.push((out.points.len() - before) as u32);
+    }
+}
+
+/// One strand's segments, with the tolerance.
+struct Strand<'a> {
+    segments: &'a [SegmentCurve],
+    sampler: &'a Sampler,
+}
+
+impl Strand<'_> {
+    /// The segment holding parameter `t` (a segment end belongs to the segment it starts,
+    /// the tip to the last), and `t`'s parameter in it.
+    fn segment(&self, t: f32) -> (&SegmentCurve, f32) {
+        let j = (t as usize).min(self.segments.len() - 1);
+        (&self.segments[j], t - j as f32)
+    }
+
+    fn point(&self, t: f32) -> Vec4 {
+        let (curve, u) = self.segment(t);
+        curve.at(u)
+    }
+
+    /// Appends the points after `a` up to `b` (both on the curve, at `pa` and `pb`).
+    fn refine(&self, a: f32, pa: Vec4, b: f32, pb: Vec4, out: &mut Polylines) {
+        if b - a > MIN_PIECE && !self.fits(a, pa, b, pb) {
+            // Segment ends are whole numbers: cut at the one nearest the middle first.
+            let m = if b - a > 1.0 {
+                ((a + b) * 0.5).floor()
+            } else {
+                (a + b) * 0.5
+            };
+            let pm = self.point(m);
+            self.refine(a, pa, m, pm, out);
+            self.refine(m, pm, b, pb, out);
+            return;
+        }
+        out.points.push(pb.to_array());
+        out.params.push(b);
+    }
+
+    /// Whether the curve from `a` to `b` stays within the tolerance of the chord `pa`-`pb`.
+    fn fits(&self, a: f32, pa: Vec4, b: f32, pb: Vec4) -> bool {
+        let (p0, p1) = (pa.truncate(), pb.truncate());
+        let along = (p1 - p0).normalize_or_zero();
+        let across = |v: Vec4| {
+            let v = v.truncate();
+            (v - v.dot(along) * along).length()
+        };
+        let mut x = a;
+        while x < b {
+            let (curve, u0) = self.segment(x);
+            let u1 = u0 + (b - x).min(1.0 - u0);
+            let (c0, c1) = (curve.at(u0), curve.at(u1));
+            let span = u1 - u0;
+            let offset = across(c0 - pa).max(across(c1 - pa));
+            let slopes = span * (across(curve.derivative(u0)) + across(curve.derivative(u1)));
+            let near = self
+                .sampler
+                .eye
+                .distance(c0.truncate())
+                .min(self.sampler.eye.distance(c1.truncate()));
+            if offset + 4.0 / 27.0 * slopes > self.sampler.per_distance * near {
+                return false;
+            }
+            x += span;
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::embree::{CurveBasis, CurveShape};
+    use crate::scene::Strands;
+
+    /// A camera at the origin looking down -z: a pixel of an image 100 pixels tall is
+    /// 0.00536 wide per unit of distance.
+    fn camera() -> Camera {
+        Camera::new(Vec3::ZERO, -Vec3::Z, Vec3::Y, 30.0, 1.0).unwrap()
+    }
+
+    const HEIGHT: u32 = 100;
+
+    /// Three strands of 12 segments 2 to 3 units from the eye, seen across: straight,
+    /// gently wavy and curly (one wave, and 2.5 waves).
+    fn strands() -> Strands {
+        let mut points = Vec::new();
+        for (k, (amplitude, waves)) in [(0.0f32, 0.0f32), (0.02, 1.0), (0.05, 2.5)]
+            .into_iter()
+            .enumerate()
+        {
+            for i in 0..13 {
+                let y = i as f32 / 12.0;
+                let x = 0.3 * k as f32 + amplitude * (std::f32::consts::TAU * waves * y).sin();
+                points.push([x, y - 0.5, -2.0 - y]);
+            }
+        }
+        Strands {
+            radii: (0..points.len())
+                .map(|i| 1e-4 * (1.0 + (i % 13) as f32 / 13.0))
+                .collect(),
+            colors: Some(
+                (0..points.len())
+                    .map(|i| [(i % 13) as f32 / 12.0, 0.5, 0.0])
+                    .collect(),
+            ),
+            counts: vec![13; 3],
+            points,
+        }
+    }
+
+    /// Distance from `p` to the segment `a`-`b`.
+    fn to_segment(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+        let d = b - a;
+        let t = if d == Vec3::ZERO {
+            0.0
+        } else {
+            ((p - a).dot(d) / d.dot(d)).clamp(0.0, 1.0)
+        };
+        p.distance(a + t * d)
+    }
+
+    /// Pieces of each strand's polyline.
+    fn pieces(lines: &Curves) -> Vec<u32> {
+        (0..lines.strands().strand_count())
+            .map(|s| lines.strands().first_segment(s).unwrap().segments)
+            .collect()
+    }
+
+    /// The curve at 64 points per segment against the polyline piece its parameter falls
+    /// in: the largest distance, in pixels at the point's distance from the eye.
+    fn worst_pixels(lines: &Curves, strand: usize) -> f32 {
+        let truth = lines.truth().unwrap();
+        let curve = truth.curves();
+        let first = curve.strands().first_segment(strand).unwrap();
+        let points = lines.strand_points(strand);
+        let start = lines.indices()
+            [lines.strands().first_segment(strand).unwrap().first_prim as usize]
+            as usize;
+        let params = &truth.params()[start..start + points.len()];
+        let spread = camera().pixel_spread(HEIGHT);
+        let mut worst = 0.0f32;
+        for prim in first.prims() {
+            let seg = curve.segment_curve(prim).unwrap();
+            for k in 0..=64 {
+                let u = k as f32 / 64.0;
+                let t = (prim - first.first_prim) as f32 + u;
+                let piece = params
+                    .windows(2)
+                    .position(|w| w[0] <= t && t <= w[1])
+                    .unwrap();
+                let p = seg.at(u).truncate();
+                let [a, b] = [piece, piece + 1].map(|i| Vec3::from_slice(&points[i][..3]));
+                worst = worst.max(to_segment(p, a, b) / (spread * p.length()));
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn polylines_keep_every_curve_point_within_the_tolerance_in_fewer_pieces_where_straight() {
+        let strands = strands();
+        for basis in CurveBasis::ALL {
+            let curves = Curves::from_strands(&strands, basis, CurveShape::Round).unwrap();
+            let mut previous = vec![u32::MAX; 3];
+            for pixels in [0.02, 0.1, 0.5] {
+                let lines = polylines(curves.clone(), &camera(), HEIGHT, pixels).unwrap();
+                assert_eq!(
+                    (lines.basis(), lines.shape()),
+                    (CurveBasis::Linear, CurveShape::Flat)
+                );
+                let n = pieces(&lines);
+                for s in 0..3 {
+                    let worst = worst_pixels(&lines, s);
+                    assert!(
+                        worst <= pixels,
+                        "{basis:?} strand {s} at {pixels} px: a curve point {worst} px off"
+                    );
+                    // A looser tolerance never takes more pieces.
+                    assert!(n[s] <= previous[s], "{basis:?} {pixels} px: {n:?}");
+                    // Every point is on the curve, at its parameter.
+                    let truth = lines.truth().unwrap();
+                    let first = lines.strands().first_segment(s).unwrap();
+                    for prim in first.prims() {
+                        let i = lines.indices()[prim as usize] as usize;
+                        let (at, u) = truth.locate(s as u32, i as u32, 0.0).unwrap();
+                        let on = truth.curves().segment_curve(at.first_prim + at.segment);
+                        let p = Vec4::from_array(lines.vertices()[i]);
+                        assert!(on.unwrap().at(u).distance(p) < 1e-6, "{basis:?}");
+                    }
+                }
+                // The straight strand is one piece; the curly one needs more pieces than
+                // the wavy one (as many, when both keep every linear segment).
+                assert_eq!(n[0], 1, "{basis:?} {pixels} px");
+                assert!(n[1] < n[2] || n[1] == 12, "{basis:?} {pixels} px: {n:?}");
+                previous = n;
+            }
+            // At a fiftieth of a pixel the curly strand takes more pieces than segments.
+            let tight = polylines(curves.clone(), &camera(), HEIGHT, 0.02).unwrap();
+            if basis != CurveBasis::Linear {
+                assert!(pieces(&tight)[2] > 12, "{basis:?}: {:?}", pieces(&tight));
+            }
+        }
+    }
+
+    /// Where every segment passes, a Catmull-Rom strand's polyline is its own points (the
+    /// curve runs through them).
+    #[test]
+    fn a_catmull_rom_polyline_cut_at_segment_ends_is_the_strands_own_points() {
+        let strands = strands();
+        let curves =
+            Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Round).unwrap();
+        let lines = polylines(curves, &camera(), HEIGHT, 0.5).unwrap();
+        let truth = lines.truth().unwrap();
+        let start = 13 + 2;
+        let own = &truth.curves().vertices()[start + 1..start + 14];
+        let first = lines.indices()[lines.strands().first_segment(1).unwrap().first_prim as usize];
+        let params = &truth.params()[first as usize..];
+        let points = lines.strand_points(1);
+        let mut whole = 0;
+        for (p, &t) in points.iter().zip(params) {
+            // The tip is the last segment's end, a sum of its coefficients.
+            if t.fract() == 0.0 && t < 12.0 {
+                assert_eq!(*p, own[t as usize], "at {t}");
+                whole += 1;
+            }
+        }
+        assert!(whole >= 2, "{whole} points at segment ends");
+    }
+
+    #[test]
+    fn a_bad_tolerance_is_refused() {
+        let curves =
+            Curves::from_strands(&strands(), CurveBasis::BSpline, CurveShape::Round).unwrap();
+        for bad in [f32::NAN, -0.5, f32::INFINITY] {
+            let e = polylines(curves.clone(), &camera(), HEIGHT, bad).unwrap_err();
+            assert!(e.to_string().contains("tolerance"), "{e}");
+        }
+    }
+}

@@ -20,16 +20,22 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
+use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
 use crate::scene::curves::{Curves, SegmentCurve};
 
 /// The default tolerance, in pixels, between a thin strand's curve and its polyline.
-pub const DEFAULT_LOD_PIXELS: f32 = 0.02;
+pub const DEFAULT_LOD_PIXELS: f32 = 0.05;
 
 /// The shortest piece, as a fraction of a segment: a bound on the points per segment
 /// whatever the tolerance.
 const MIN_PIECE: f32 = 1.0 / 64.0;
+
+/// The most pieces a cubic strand's polyline may have per segment of its curve: past
+/// that, Embree builds the strand's own flat cubic ribbons faster (on the 10^6 scalp,
+/// about 3 to 5x a linear segment's build time per cubic segment) and in less memory.
+const MAX_PIECES_PER_SEGMENT: usize = 2;
 
 /// Strands sampled per parallel task.
 const CHUNK: usize = 4096;
@@ -46,8 +52,15 @@ pub fn check_pixels(pixels: f32) -> Result<()> {
 }
 
 /// `curves` as flat linear ribbons through points on their curves, within `pixels` of a
-/// pixel of an image `height` pixels tall seen from `camera`'s eye ([`Curves::polylines`]).
-pub fn polylines(curves: Curves, camera: &Camera, height: u32, pixels: f32) -> Result<Curves> {
+/// pixel of an image `height` pixels tall seen from `camera`'s eye ([`Curves::polylines`]),
+/// and, apart, the strands that would need more than [`MAX_PIECES_PER_SEGMENT`] pieces
+/// per segment, as their own flat curves. Either is `None` when it has no strand.
+pub fn polylines(
+    curves: Curves,
+    camera: &Camera,
+    height: u32,
+    pixels: f32,
+) -> Result<(Option<Curves>, Option<Curves>)> {
     check_pixels(pixels)?;
     let sampler = Sampler {
         eye: camera.eye(),
@@ -65,17 +78,57 @@ pub fn polylines(curves: Curves, camera: &Camera, height: u32, pixels: f32) -> R
             out
         })
         .collect();
+    let budget = if curves.basis() == CurveBasis::Linear {
+        usize::MAX
+    } else {
+        MAX_PIECES_PER_SEGMENT
+    };
     let mut all = Polylines::default();
     let total = |f: fn(&Polylines) -> usize| chunks.iter().map(f).sum::<usize>();
     all.points.reserve_exact(total(|c| c.points.len()) + 1);
     all.params.reserve_exact(total(|c| c.params.len()));
     all.counts.reserve_exact(strands);
+    // Strand by strand, those within the budget.
+    let mut keep = Vec::with_capacity(strands);
     for chunk in chunks {
-        all.points.extend_from_slice(&chunk.points);
-        all.params.extend_from_slice(&chunk.params);
-        all.counts.extend_from_slice(&chunk.counts);
+        let mut at = 0;
+        for (&count, &segments) in chunk.counts.iter().zip(&chunk.segments) {
+            let n = count as usize;
+            let kept = n <= budget.saturating_mul(segments as usize).saturating_add(1);
+            if kept {
+                all.points.extend_from_slice(&chunk.points[at..at + n]);
+                all.params.extend_from_slice(&chunk.params[at..at + n]);
+                all.counts.push(count);
+            }
+            keep.push(kept);
+            at += n;
+        }
     }
-    Curves::polylines(curves, all.points, &all.counts, all.params)
+    if keep.iter().all(|&k| k) {
+        return Ok((
+            Some(Curves::polylines(
+                curves,
+                all.points,
+                &all.counts,
+                all.params,
+            )?),
+            None,
+        ));
+    }
+    let native = curves.subset(
+        &keep.iter().map(|k| !k).collect::<Vec<_>>(),
+        CurveShape::Flat,
+    )?;
+    let lines = match curves.subset(&keep, CurveShape::Flat)? {
+        Some(truth) => Some(Curves::polylines(
+            truth,
+            all.points,
+            &all.counts,
+            all.params,
+        )?),
+        None => None,
+    };
+    Ok((lines, native))
 }
 
 #[derive(Default)]
@@ -83,6 +136,8 @@ struct Polylines {
     points: Vec<[f32; 4]>,
     params: Vec<f32>,
     counts: Vec<u32>,
+    /// Segments of each strand's curve.
+    segments: Vec<u32>,
 }
 
 struct Sampler {
@@ -99,6 +154,7 @@ impl Sampler {
             .flat_map(|first| first.prims())
             .filter_map(|prim| curves.segment_curve(prim))
             .collect();
+        out.segments.push(segments.len() as u32);
         if segments.is_empty() {
             out.counts.push(0);
             return;
@@ -187,7 +243,6 @@ impl Strand<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::embree::{CurveBasis, CurveShape};
     use crate::scene::Strands;
 
     /// A camera at the origin looking down -z: a pixel of an image 100 pixels tall is
@@ -198,11 +253,18 @@ mod tests {
 
     const HEIGHT: u32 = 100;
 
+    /// `curves` as polylines, every strand within its budget.
+    fn all_polylines(curves: Curves, pixels: f32) -> Curves {
+        let (lines, native) = polylines(curves, &camera(), HEIGHT, pixels).unwrap();
+        assert!(native.is_none(), "strands past their budget at {pixels} px");
+        lines.unwrap()
+    }
+
     /// Three strands of 12 segments 2 to 3 units from the eye, seen across: straight,
     /// gently wavy and curly (one wave, and 2.5 waves).
     fn strands() -> Strands {
         let mut points = Vec::new();
-        for (k, (amplitude, waves)) in [(0.0f32, 0.0f32), (0.02, 1.0), (0.05, 2.5)]
+        for (k, (amplitude, waves)) in [(0.0f32, 0.0f32), (0.02, 1.0), (0.01, 2.5)]
             .into_iter()
             .enumerate()
         {
@@ -280,8 +342,8 @@ mod tests {
         for basis in CurveBasis::ALL {
             let curves = Curves::from_strands(&strands, basis, CurveShape::Round).unwrap();
             let mut previous = vec![u32::MAX; 3];
-            for pixels in [0.02, 0.1, 0.5] {
-                let lines = polylines(curves.clone(), &camera(), HEIGHT, pixels).unwrap();
+            for pixels in [0.1, 0.25, 0.5] {
+                let lines = all_polylines(curves.clone(), pixels);
                 assert_eq!(
                     (lines.basis(), lines.shape()),
                     (CurveBasis::Linear, CurveShape::Flat)
@@ -312,10 +374,21 @@ mod tests {
                 assert!(n[1] < n[2] || n[1] == 12, "{basis:?} {pixels} px: {n:?}");
                 previous = n;
             }
-            // At a fiftieth of a pixel the curly strand takes more pieces than segments.
-            let tight = polylines(curves.clone(), &camera(), HEIGHT, 0.02).unwrap();
+            // At a thousandth, past two pieces a segment, it stays a flat curve of its own.
+            let (lines, native) = polylines(curves.clone(), &camera(), HEIGHT, 0.001).unwrap();
             if basis != CurveBasis::Linear {
-                assert!(pieces(&tight)[2] > 12, "{basis:?}: {:?}", pieces(&tight));
+                let native = native.unwrap();
+                assert_eq!((native.basis(), native.shape()), (basis, CurveShape::Flat));
+                let ids = |c: &Curves| {
+                    (0..c.strands().strand_count())
+                        .map(|s| c.strands().first_segment(s).unwrap().id)
+                        .collect::<Vec<_>>()
+                };
+                let lines = lines.unwrap();
+                assert!(pieces(&lines).iter().all(|&n| n <= 24), "{basis:?}");
+                let mut all = [ids(&lines), ids(&native)].concat();
+                all.sort();
+                assert_eq!(all, [0, 1, 2], "{basis:?}");
             }
         }
     }
@@ -327,7 +400,7 @@ mod tests {
         let strands = strands();
         let curves =
             Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Round).unwrap();
-        let lines = polylines(curves, &camera(), HEIGHT, 0.5).unwrap();
+        let lines = all_polylines(curves, 0.5);
         let truth = lines.truth().unwrap();
         let start = 13 + 2;
         let own = &truth.curves().vertices()[start + 1..start + 14];

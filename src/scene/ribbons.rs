@@ -98,20 +98,27 @@ pub fn share_out(
     let parts: Vec<Part> = (thin_strands(&curves, camera, height).into_iter())
         .map(|thin| if thin { thin_part } else { Part::Round })
         .collect();
-    let shape = |part, curves: Curves| match part {
-        Part::Round => Ok(curves.with_shape(CurveShape::Round)),
-        Part::Flat => Ok(curves.with_shape(CurveShape::Flat)),
-        Part::Polyline => lod::polylines(curves, camera, height, lod_pixels),
+    // Each part's geometries: polylines of the thin strands, and those too bent for
+    // their budget as their own flat curves.
+    let shape = |part, curves: Curves| -> Result<Vec<Curves>> {
+        Ok(match part {
+            Part::Round => vec![curves.with_shape(CurveShape::Round)],
+            Part::Flat => vec![curves.with_shape(CurveShape::Flat)],
+            Part::Polyline => {
+                let (lines, native) = lod::polylines(curves, camera, height, lod_pixels)?;
+                native.into_iter().chain(lines).collect()
+            }
+        })
     };
     let first = parts.first().copied().unwrap_or(Part::Flat);
     if parts.iter().all(|&p| p == first) {
-        return Ok(vec![shape(first, curves)?]);
+        return shape(first, curves);
     }
     let mut out = Vec::new();
     for part in [Part::Round, thin_part] {
         let keep: Vec<bool> = parts.iter().map(|&p| p == part).collect();
         if let Some(subset) = curves.subset(&keep, CurveShape::Round)? {
-            out.push(shape(part, subset)?);
+            out.extend(shape(part, subset)?);
         }
     }
     Ok(out)

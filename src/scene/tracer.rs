@@ -757,7 +757,10 @@ mod tests {
                 .subset(&[false, true], CurveShape::Flat)
                 .unwrap()
                 .unwrap();
-            let lines = lod::polylines(second, &camera, height, 0.1).unwrap();
+            let lines = lod::polylines(second, &camera, height, 0.1)
+                .unwrap()
+                .0
+                .unwrap();
             // The straight segments are one piece: s and the colours are not the pieces'.
             let pieces = lines.strands().segment_count();
             assert!(pieces < 8, "{basis:?}: {pieces} pieces");

@@ -267,7 +267,7 @@ fn build(
         }
         None => &NoStages,
     };
-    scene.prepare(settings.width, settings.height, sink)?;
+    scene.prepare(settings, sink)?;
     Ok(())
 }
 
@@ -456,7 +456,7 @@ fn render_into(
         depth: depth.is_some(),
         strand_id: strand_id.is_some(),
     };
-    let (world, camera) = scene.prepare(settings.width, settings.height, &NoStages)?;
+    let (world, camera) = scene.prepare(settings, &NoStages)?;
     let out = render(world, &camera, settings, aovs, progress)?;
     let film = &out.film;
     rgb.copy_from_slice(film.rgb());

@@ -231,7 +231,16 @@ fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
         // The points Embree reads in the shared scene's current build.
         let embree_points = || {
             let scene = scene_mut(scenes[1].scene).ok().unwrap();
-            let (world, _) = scene.prepare(1, 1, &NoStages).unwrap();
+            let (world, _) = scene
+                .prepare(
+                    &crate::render::settings::RenderSettings {
+                        width: 1,
+                        height: 1,
+                        ..Default::default()
+                    },
+                    &NoStages,
+                )
+                .unwrap();
             match world.tracer.scene().geometry(0) {
                 Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
                 _ => panic!("curves expected"),

@@ -10,12 +10,12 @@ use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
 use crate::embree::{Device, Isa, SceneOptions};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
+use crate::render::settings::RenderSettings;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
 use crate::scene::framing::Framing;
 use crate::scene::light::Light;
-use crate::scene::lod::DEFAULT_LOD_PIXELS;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::ribbons::{self, GroomShape};
@@ -162,12 +162,8 @@ impl HtScene {
                     1
                 }
                 Shape::AutoCurves(c) => {
-                    let parts = ribbons::share_out(
-                        c.clone(),
-                        &view.camera,
-                        view.height,
-                        DEFAULT_LOD_PIXELS,
-                    )?;
+                    let parts =
+                        ribbons::share_out(c.clone(), &view.camera, view.height, view.lod_pixels)?;
                     let n = parts.len();
                     for part in parts {
                         builder.add_view_curves(part, *view)?;
@@ -217,17 +213,17 @@ impl HtScene {
     /// new lights are weighed again on it.
     pub(crate) fn prepare(
         &mut self,
-        width: u32,
-        height: u32,
+        settings: &RenderSettings,
         progress: &dyn StageProgress,
     ) -> Result<(&World, Camera)> {
+        let (width, height) = (settings.width, settings.height);
         if self.lights.is_empty() {
             return Err(invalid_arg!(
                 "the scene has no light: add an environment, distant or rect light"
             ));
         }
         let camera = self.camera(width as f32 / height as f32)?;
-        let view = DetailView::new(camera, height);
+        let view = DetailView::new(camera, height, settings.lod_pixels);
         if (self.world.as_ref()).is_some_and(|w| !w.tracer.serves(&view)) {
             self.world = None;
         }

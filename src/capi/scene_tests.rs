@@ -632,7 +632,14 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
                 scene_mut(h.scene)
                     .ok()
                     .unwrap()
-                    .prepare(1, 1, &NoStages)
+                    .prepare(
+                        &crate::render::settings::RenderSettings {
+                            width: 1,
+                            height: 1,
+                            ..Default::default()
+                        },
+                        &NoStages,
+                    )
                     .unwrap();
                 (held_bytes(h.scene()), monitor.current() as usize)
             });

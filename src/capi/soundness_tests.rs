@@ -155,7 +155,16 @@ fn coordinates_embree_cannot_trace_are_refused_when_set() {
 
         // Should a ray Embree refuses ever be formed, it is a miss, not an abort.
         let scene = scene_mut(h.scene).ok().unwrap();
-        let (world, _) = scene.prepare(1, 1, &NoStages).unwrap();
+        let (world, _) = scene
+            .prepare(
+                &crate::render::settings::RenderSettings {
+                    width: 1,
+                    height: 1,
+                    ..Default::default()
+                },
+                &NoStages,
+            )
+            .unwrap();
         let bad = Ray::new(Vec3::new(1e19, 0.0, 0.0), Vec3::NEG_X);
         assert!(world.tracer.scene().intersect(&bad, None).is_none());
         let nan = Ray::new(Vec3::new(f32::NAN, 0.0, 4.0), Vec3::NEG_Z);

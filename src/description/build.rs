@@ -22,7 +22,6 @@ use crate::scene::footprint::{self, CurvesSize, available_bytes};
 use crate::scene::framing::Framing;
 use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
-use crate::scene::lod::DEFAULT_LOD_PIXELS;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
@@ -126,14 +125,14 @@ impl SceneDescription {
             .camera
             .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
-        let view = DetailView::new(camera, settings.height);
+        let view = DetailView::new(camera, settings.height, settings.lod_pixels);
         let mut sizes = Vec::new();
         for (i, curves) in built {
             let at = format!("groom[{i}]");
             let groom = &self.grooms[i];
             let auto = groom.shape == GroomShape::Auto;
             let parts = if auto {
-                ribbons::share_out(curves, &camera, settings.height, DEFAULT_LOD_PIXELS)
+                ribbons::share_out(curves, &camera, settings.height, settings.lod_pixels)
                     .map_err(|e| self.error(&at, e))?
             } else {
                 vec![curves]

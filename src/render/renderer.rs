@@ -43,10 +43,11 @@ pub fn render(
     progress: &dyn Progress,
 ) -> Result<RenderOutput> {
     settings.validate()?;
-    if !world
-        .tracer
-        .serves(&DetailView::new(*camera, settings.height))
-    {
+    if !world.tracer.serves(&DetailView::new(
+        *camera,
+        settings.height,
+        settings.lod_pixels,
+    )) {
         return Err(invalid_arg!(
             "the scene's curves were shaped for a view that saw them smaller (from farther, \
              or with fewer pixels): build the scene again for this camera and image height"

@@ -12,6 +12,7 @@ use std::fmt;
 use super::film::PixelFilter;
 use crate::embree::{Device, Isa};
 use crate::error::{Error, Result, invalid_arg};
+use crate::scene::lod::DEFAULT_LOD_PIXELS;
 
 /// A value a setting can hold, read from and written as text.
 pub trait Value: Sized {
@@ -310,6 +311,9 @@ settings! {
         filter: Filter = Filter::Tent, Range::Any;
         /// The tent's half-width in pixels (the box ignores it).
         filter_radius: f32 = 1.0, Range::OpenClosed(0.0, 8.0);
+        /// Level of detail of `auto` grooms: the largest distance, in pixels, between a thin
+        /// strand's curve and the linear ribbons traced in its place; 0: full detail.
+        lod_pixels: f32 = DEFAULT_LOD_PIXELS, Range::AtLeast(0.0);
     }
 
     /// How paths are traced and ended, and the hair BSDF's fidelity knobs.

@@ -30,11 +30,18 @@ pub const FOOTPRINT_TOLERANCE: f32 = 1e-3;
 pub struct DetailView {
     pub camera: Camera,
     pub height: u32,
+    /// The level of detail's tolerance in pixels (`lod_pixels`): a build holds only for
+    /// its own.
+    pub lod_pixels: f32,
 }
 
 impl DetailView {
-    pub fn new(camera: Camera, height: u32) -> Self {
-        DetailView { camera, height }
+    pub fn new(camera: Camera, height: u32, lod_pixels: f32) -> Self {
+        DetailView {
+            camera,
+            height,
+            lod_pixels,
+        }
     }
 
     /// The side of one pixel (at the image centre) at `p`, in world units.
@@ -47,6 +54,9 @@ impl DetailView {
     /// view's times 1 - [`FOOTPRINT_TOLERANCE`]. A lens, the aspect and the target play
     /// no part, and the same eye with pixels no smaller needs no look at the points.
     pub fn holds_for(&self, new: &DetailView, points: &[[f32; 4]]) -> bool {
+        if self.lod_pixels != new.lod_pixels {
+            return false;
+        }
         let (built, now) = (
             self.camera.pixel_spread(self.height),
             new.camera.pixel_spread(new.height),
@@ -117,6 +127,7 @@ mod tests {
         DetailView::new(
             Camera::new(eye, Vec3::ZERO, Vec3::Y, fov, 1.0).unwrap(),
             height,
+            crate::scene::lod::DEFAULT_LOD_PIXELS,
         )
     }
 
@@ -125,6 +136,12 @@ mod tests {
         let points = [[0.0, 0.0, 0.0, 0.01], [0.5, 0.0, 0.0, 0.01]];
         let built = view(Vec3::new(0.0, 0.0, 4.0), 40.0, 100);
         assert!(built.holds_for(&built, &points));
+        // Another level of detail is another build.
+        let finer = DetailView {
+            lod_pixels: built.lod_pixels / 2.0,
+            ..built
+        };
+        assert!(!built.holds_for(&finer, &points));
         // Farther, a wider field of view or fewer pixels: larger footprints.
         assert!(built.holds_for(&view(Vec3::new(0.0, 0.0, 5.0), 40.0, 100), &points));
         assert!(built.holds_for(&view(Vec3::new(0.0, 0.0, 4.0), 50.0, 100), &points));

@@ -25,6 +25,8 @@ fn scene(z: f32, brown: [f32; 3], floor: [f32; 3], rect: bool) -> SceneDescripti
     let text = format!(
         r#"
 [render]
+# Level of detail off: a farther view would cut the strands otherwise than the kept build.
+lod_pixels = 0
 width = 32
 height = 32
 spp = 4
@@ -117,12 +119,11 @@ fn edits_of_a_built_scene_render_as_a_fresh_build_without_one() {
     check(&built, with_rect, "a light");
     // Farther: every strand stays a ribbon, so the shapes hold and a fresh build agrees.
     built.camera = camera(5.0);
-    assert!(
-        built
-            .world
-            .tracer
-            .serves(&DetailView::new(built.camera, 32))
-    );
+    assert!(built.world.tracer.serves(&DetailView::new(
+        built.camera,
+        32,
+        built.settings.lod_pixels
+    )));
     check(&built, scene(5.0, red, blue, true), "a farther camera");
 
     // Nearer and with more pixels, strands are wider than the build assumed: refused.

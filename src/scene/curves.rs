@@ -515,16 +515,7 @@ impl Curves {
     }
 
     /// Splits into the Embree buffers and the table that stays with the scene.
-    pub(crate) fn into_parts(
-        self,
-    ) -> (
-        CurveBasis,
-        CurveShape,
-        SharedBuffer<[f32; 4]>,
-        SharedBuffer<u32>,
-        StrandIndex,
-        Option<Arc<TrueCurves>>,
-    ) {
+    pub(crate) fn into_parts(self) -> CurveParts {
         (
             self.basis,
             self.shape,
@@ -535,6 +526,17 @@ impl Curves {
         )
     }
 }
+
+/// What [`Curves::into_parts`] gives: basis, shape, control points, index buffer, the
+/// strand table and the true curves of a polyline.
+pub(crate) type CurveParts = (
+    CurveBasis,
+    CurveShape,
+    SharedBuffer<[f32; 4]>,
+    SharedBuffer<u32>,
+    StrandIndex,
+    Option<Arc<TrueCurves>>,
+);
 
 /// The curves that [`Curves::polylines`] stand for, and where each polyline point lies on
 /// them.

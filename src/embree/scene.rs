@@ -22,7 +22,7 @@ use crate::{Error, Result};
 pub struct SceneOptions {
     /// `RTC_SCENE_FLAG_COMPACT`: a BVH whose curve leaves index into the vertex buffers
     /// instead of copying the control points (Curve8i leaves, about 28 against 92 bytes per
-    /// segment). Default [`DEFAULT_COMPACT`].
+    /// segment). Default on.
     pub compact: bool,
 }
 

@@ -28,7 +28,7 @@
 //! interpolated linearly, or a melanin pair per strand ([`Curves::with_melanin`]), kept as
 //! given so that the material converts it once, at the hit.
 //!
-//! [`Curves::polylines`] lays flat linear ribbons over points sampled on other curves (the
+//! `Curves::polylines` lays flat linear ribbons over points sampled on other curves (the
 //! level of detail of `lod.rs`); [`TrueCurves`] keeps those curves, so that the ribbons'
 //! hits take the true curve's tangent, position along the strand and colour.
 
@@ -52,7 +52,7 @@ pub struct Curves {
     vertices: SharedBuffer<[f32; 4]>,
     indices: SharedBuffer<u32>,
     strands: StrandIndex,
-    /// The curves these [`Curves::polylines`] stand for.
+    /// The curves these `Curves::polylines` stand for.
     truth: Option<Arc<TrueCurves>>,
 }
 
@@ -469,7 +469,7 @@ impl Curves {
         Ok(lines)
     }
 
-    /// The curves these [`Self::polylines`] stand for, if they are polylines.
+    /// The curves these `Self::polylines` stand for, if they are polylines.
     pub fn truth(&self) -> Option<&Arc<TrueCurves>> {
         self.truth.as_ref()
     }
@@ -538,7 +538,7 @@ pub(crate) type CurveParts = (
     Option<Arc<TrueCurves>>,
 );
 
-/// The curves that [`Curves::polylines`] stand for, and where each polyline point lies on
+/// The curves that `Curves::polylines` stand for, and where each polyline point lies on
 /// them.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrueCurves {

@@ -4,7 +4,7 @@
 //!
 //! Each strand's curve (any basis) is cut by bisection of its parameter: first at the
 //! segment ends nearest the middle, then within a segment at halves, down to
-//! [`MIN_PIECE`] of a segment. A piece is kept when a bound on the curve's distance from
+//! `MIN_PIECE` of a segment. A piece is kept when a bound on the curve's distance from
 //! the piece's chord is within the tolerance at the curve's distance from the eye. The
 //! bound, on each cubic part of the piece between segment ends, is the Hermite form of the
 //! curve's offset across the chord: at most the larger end offset plus 4/27 of the two end
@@ -55,8 +55,8 @@ pub fn check_pixels(pixels: f32) -> Result<()> {
 }
 
 /// `curves` as flat linear ribbons through points on their curves, within `pixels` of a
-/// pixel of an image `height` pixels tall seen from `camera`'s eye ([`Curves::polylines`]),
-/// and, apart, the strands that would need more than [`MAX_PIECES_PER_SEGMENT`] pieces
+/// pixel of an image `height` pixels tall seen from `camera`'s eye (`Curves::polylines`),
+/// and, apart, the strands that would need more than `MAX_PIECES_PER_SEGMENT` pieces
 /// per segment, as their own flat curves. Either is `None` when it has no strand.
 pub fn polylines(
     curves: Curves,

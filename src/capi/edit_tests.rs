@@ -10,7 +10,7 @@ use super::materials::*;
 use super::render::*;
 use super::render_tests::{bits, light, render_c, settings};
 use super::scene::*;
-use super::scene_tests::{Handles, curves_desc, fails, last_error, small_fur};
+use super::scene_tests::{Handles, curves_desc, fails, last_error, sized, small_fur};
 use crate::description::{
     GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc, MeshSource, SceneDescription,
 };
@@ -359,14 +359,7 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
     let (_, camera) = scene_mut(h.scene)
         .ok()
         .unwrap()
-        .prepare(
-            &crate::render::settings::RenderSettings {
-                width: 40,
-                height: 30,
-                ..Default::default()
-            },
-            &crate::scene::NoStages,
-        )
+        .prepare(&sized(40, 30), &crate::scene::NoStages)
         .unwrap();
     assert_eq!(camera.eye(), built.camera.eye());
     assert!(

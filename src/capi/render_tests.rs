@@ -5,7 +5,7 @@ use super::render::*;
 use crate::capi::geometry::*;
 use crate::capi::lights::*;
 use crate::capi::scene::*;
-use crate::capi::scene_tests::{Handles, fails, last_error, small_fur, xyzr, xyzr_desc};
+use crate::capi::scene_tests::{Handles, fails, last_error, sized, small_fur, xyzr, xyzr_desc};
 use crate::embree::{CurveBasis, CurveShape, Device, Geometry, SceneOptions};
 use crate::image::read_image;
 use crate::render::integrator::World;
@@ -231,16 +231,7 @@ fn shared_xyzr_points_render_like_a_copy_through_rebuilds() {
         // The points Embree reads in the shared scene's current build.
         let embree_points = || {
             let scene = scene_mut(scenes[1].scene).ok().unwrap();
-            let (world, _) = scene
-                .prepare(
-                    &crate::render::settings::RenderSettings {
-                        width: 1,
-                        height: 1,
-                        ..Default::default()
-                    },
-                    &NoStages,
-                )
-                .unwrap();
+            let (world, _) = scene.prepare(&sized(1, 1), &NoStages).unwrap();
             match world.tracer.scene().geometry(0) {
                 Some(Geometry::Curves(c)) => c.vertices().as_ptr(),
                 _ => panic!("curves expected"),

@@ -22,6 +22,15 @@ pub(crate) fn last_error() -> String {
         .into_owned()
 }
 
+/// Default render settings for an image of `width` x `height`.
+pub(crate) fn sized(width: u32, height: u32) -> crate::render::settings::RenderSettings {
+    crate::render::settings::RenderSettings {
+        width,
+        height,
+        ..Default::default()
+    }
+}
+
 /// Asserts `status` and that the message mentions `words`.
 #[track_caller]
 pub(crate) fn fails(status: HtStatus, want: HtStatus, words: &str) {
@@ -632,14 +641,7 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
                 scene_mut(h.scene)
                     .ok()
                     .unwrap()
-                    .prepare(
-                        &crate::render::settings::RenderSettings {
-                            width: 1,
-                            height: 1,
-                            ..Default::default()
-                        },
-                        &NoStages,
-                    )
+                    .prepare(&sized(1, 1), &NoStages)
                     .unwrap();
                 (held_bytes(h.scene()), monitor.current() as usize)
             });

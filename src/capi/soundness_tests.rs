@@ -8,7 +8,7 @@ use super::materials::*;
 use super::render::*;
 use super::render_tests::{bits, fur_scene, light, render_c, settings};
 use super::scene::*;
-use super::scene_tests::{Handles, fails, last_error, small_fur, xyzr, xyzr_desc};
+use super::scene_tests::{Handles, fails, last_error, sized, small_fur, xyzr, xyzr_desc};
 use crate::capi::bsdf::ht_hair_params_default;
 use crate::embree::Ray;
 use crate::scene::NoStages;
@@ -155,16 +155,7 @@ fn coordinates_embree_cannot_trace_are_refused_when_set() {
 
         // Should a ray Embree refuses ever be formed, it is a miss, not an abort.
         let scene = scene_mut(h.scene).ok().unwrap();
-        let (world, _) = scene
-            .prepare(
-                &crate::render::settings::RenderSettings {
-                    width: 1,
-                    height: 1,
-                    ..Default::default()
-                },
-                &NoStages,
-            )
-            .unwrap();
+        let (world, _) = scene.prepare(&sized(1, 1), &NoStages).unwrap();
         let bad = Ray::new(Vec3::new(1e19, 0.0, 0.0), Vec3::NEG_X);
         assert!(world.tracer.scene().intersect(&bad, None).is_none());
         let nan = Ray::new(Vec3::new(f32::NAN, 0.0, 4.0), Vec3::NEG_Z);

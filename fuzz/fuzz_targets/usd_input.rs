@@ -24,7 +24,7 @@ pub fn read_as(data: &[u8], extension: &str) {
     match read_usd_file(&path) {
         Ok(grooms) => {
             for c in &grooms.curves {
-                c.curves(CurveShape::Round, 1.0, |p| p, 0.3)
+                c.curves(CurveShape::Round, 1.0, |p| p)
                     .expect("read curves are valid Embree curves");
             }
         }

@@ -122,7 +122,19 @@ macro_rules! named_value {
 named_value!(Roulette { SqrtThroughput = "sqrt", Throughput = "throughput" });
 named_value!(Strategy { Mis = "mis", LightOnly = "light", BsdfOnly = "bsdf" });
 named_value!(Filter { Tent = "tent", Box = "box" });
-named_value!(Isa { Sse2 = "sse2", Avx = "avx", Avx2 = "avx2", Avx512 = "avx512" });
+
+/// By the names `Isa` itself gives Embree.
+impl Value for Isa {
+    fn kind() -> String {
+        Isa::ALL.map(Isa::name).join(" | ")
+    }
+    fn parse(text: &str) -> Option<Self> {
+        Isa::named(text.trim()).ok()
+    }
+    fn show(&self) -> String {
+        self.name().into()
+    }
+}
 
 /// The values a numeric setting may take.
 #[derive(Debug, Clone, Copy, PartialEq)]

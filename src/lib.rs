@@ -4,8 +4,9 @@
 //! checks it): [`math`] and [`bsdf`] know nothing of ray tracing; [`embree`] wraps Embree
 //! and knows nothing of shading; [`image`] reads and writes pictures through OpenImageIO;
 //! [`scene`] is the scene as data plus the tracer; [`mod@render`] makes images of it;
-//! [`description`] reads scene files and builds the demos; [`capi`] is a thin C shell
-//! over the same Rust API. Conventions (frames, units, signs): docs/conventions.md.
+//! [`description`] is a scene as plain data, built into a world, and the demos;
+//! [`formats`] reads and writes every file format (TOML and pbrt scenes, USD and `.hair`
+//! grooms, OBJ and PLY meshes); [`capi`] is a thin C shell over the same Rust API. Conventions (frames, units, signs): docs/conventions.md.
 //!
 //! The items re-exported here are the API a Rust host builds on: the hair BSDF alone
 //! ([`HairBsdf`], [`HairParams`], [`LocalBsdf`]), or a whole render from a scene file or
@@ -42,6 +43,9 @@ pub mod description;
 #[cfg(feature = "render")]
 pub mod embree;
 mod error;
+/// cbindgen:ignore
+#[cfg(feature = "render")]
+pub mod formats;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod image;

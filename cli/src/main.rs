@@ -4,25 +4,26 @@
 //! scene for a peer renderer; `report` measures speed against error and writes REPORT.md;
 //! `convert` takes grooms between .hair and USD.
 
+mod export;
 mod report;
 mod settings;
 
 use clap::{Args, Parser, Subcommand};
+use export::export_for_peer;
 use glam::Vec3;
 use hairtrace::bsdf::{
     DEFAULT_EUMELANIN, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset,
 };
-use hairtrace::description::convert::{self, ConvertOptions, ConvertSource};
-use hairtrace::description::pbrt::PbrtScene;
-use hairtrace::description::peer::export_for_peer;
-use hairtrace::description::{
-    self, BuiltScene, MaterialDesc, SceneDescription, has_extension, usd,
-};
+use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, has_extension};
 use hairtrace::embree::CurveBasis;
+use hairtrace::formats::convert::{self, ConvertOptions, ConvertSource};
+use hairtrace::formats::hair::{Thickness, info_report, read_hair_file};
+use hairtrace::formats::pbrt::PbrtScene;
+use hairtrace::formats::{SceneFormat, usd};
 use hairtrace::image::{self, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::material::HairColor;
-use hairtrace::scene::{GroomShape, Stage, StageProgress, Thickness, info_report, read_hair_file};
+use hairtrace::scene::{GroomShape, Stage, StageProgress};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
 use settings::SettingArgs;
@@ -335,26 +336,14 @@ impl Progress for Bar {
 /// The scene a command names: a scene file, a bare .hair groom or a demo (by default
 /// the fur ball).
 fn load_scene(scene: Option<&PathBuf>, demo: Option<&str>) -> hairtrace::Result<SceneDescription> {
-    match scene {
-        Some(path) if has_extension(path, "pbrt") => {
-            let pbrt = PbrtScene::from_file(path)?;
-            for w in &pbrt.warnings {
-                eprintln!("hairtrace: warning: {w}");
-            }
-            if let Some(name) = &pbrt.film_filename {
-                eprintln!(
-                    "hairtrace: note: the file's Film filename {} is not used: the image goes \
-                     to -o",
-                    name.display()
-                );
-            }
-            Ok(pbrt.description)
-        }
-        Some(path) if usd::is_usd_path(path) => description::quick_look(path),
-        Some(path) if has_extension(path, "hair") => description::quick_look(path),
-        Some(path) => SceneDescription::from_file(path),
-        None => description::demo(demo.unwrap_or("furball")),
+    let Some(path) = scene else {
+        return description::demo(demo.unwrap_or("furball"));
+    };
+    let description = SceneDescription::load(path)?;
+    for note in &description.notes {
+        eprintln!("hairtrace: warning: {note}");
     }
+    Ok(description)
 }
 
 fn export(args: &ExportArgs) -> hairtrace::Result<()> {
@@ -508,13 +497,22 @@ fn peak_memory() -> String {
 }
 
 fn info(args: &InfoArgs) -> hairtrace::Result<()> {
-    if has_extension(&args.file, "pbrt") {
-        print!("{}", PbrtScene::from_file(&args.file)?.info_report());
-        return Ok(());
-    }
-    if usd::is_usd_path(&args.file) {
-        print!("{}", usd::info_report(&usd::read_usd_file(&args.file)?));
-        return Ok(());
+    match SceneFormat::of(&args.file)? {
+        SceneFormat::Pbrt => {
+            print!("{}", PbrtScene::from_file(&args.file)?.info_report());
+            return Ok(());
+        }
+        SceneFormat::Usd => {
+            print!("{}", usd::info_report(&usd::read_usd_file(&args.file)?));
+            return Ok(());
+        }
+        SceneFormat::Toml => {
+            return Err(hairtrace::Error::InvalidArg(format!(
+                "{}: a TOML scene: `info` describes .hair, USD and pbrt files",
+                args.file.display()
+            )));
+        }
+        SceneFormat::Hair => {}
     }
     let thickness = if args.thickness_is_radius {
         Thickness::Radius

@@ -1,7 +1,8 @@
 //! The command line as a user meets it: the main job prints its table, `info` describes
 //! a groom or a pbrt scene, and every error is one line on stderr with a non-zero exit.
 
-use hairtrace::scene::{FurBall, Thickness, write_hair_file};
+use hairtrace::formats::hair::{Thickness, write_hair_file};
+use hairtrace::scene::FurBall;
 use std::process::{Command, Output};
 
 fn hairtrace(args: &[&str]) -> Output {

@@ -3,7 +3,7 @@
 #![no_main]
 
 use hairtrace::Error;
-use hairtrace::scene::hair_file::{Thickness, encode_hair, parse_hair};
+use hairtrace::formats::hair::{Thickness, encode_hair, parse_hair};
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     for thickness in [Thickness::Diameter, Thickness::Radius] {

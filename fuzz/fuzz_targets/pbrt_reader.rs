@@ -6,7 +6,7 @@
 
 use hairtrace::Error;
 use hairtrace::description::GroomSource;
-use hairtrace::description::pbrt::PbrtScene;
+use hairtrace::formats::pbrt::PbrtScene;
 
 libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {

@@ -6,7 +6,7 @@
 use std::sync::Once;
 
 use hairtrace::Error;
-use hairtrace::description::usd::read_usd_file;
+use hairtrace::formats::usd::read_usd_file;
 use hairtrace::embree::CurveShape;
 
 static HOOK: Once = Once::new();

@@ -1,16 +1,19 @@
 //! Geometry through the C ABI: curves from host arrays (copied, or float4 xyzr points
 //! shared in place), `.hair` files, and triangle meshes from arrays or files.
 
-use super::scene::{HtScene, Shape, add_with_id};
+use super::scene::{HtScene, add_with_id, curves_shape};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
-use crate::description::usd::read_usd_file;
+use crate::description::assembly::Shape;
 use crate::embree::{CurveBasis, SharedBuffer};
 use crate::error::{Result, invalid_arg};
+use crate::formats::hair::{Thickness, read_hair_file};
+use crate::formats::mesh::read_mesh_file;
+use crate::formats::usd::read_usd_file;
 use crate::scene::GroomShape;
+use crate::scene::Strands;
 use crate::scene::curves::Curves;
 use crate::scene::framing::Framing;
 use crate::scene::mesh::Mesh;
-use crate::scene::{Strands, Thickness, read_hair_file};
 use std::ffi::c_char;
 use std::ptr::NonNull;
 
@@ -197,7 +200,7 @@ pub unsafe extern "C" fn ht_scene_add_curves(
         };
         let curves = Curves::from_strands(&strands, basis, shape.built())?;
         let frame = |f: &mut Framing| f.add_strands(&strands);
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
+        Ok(scene.add_geometry(curves_shape(curves, shape), material_id, frame)?)
     })
 }
 
@@ -302,7 +305,7 @@ fn add_curves_xyzr(
         let curves =
             Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
         let frame = |f: &mut Framing| f.add_control_points(points);
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
+        Ok(scene.add_geometry(curves_shape(curves, shape), material_id, frame)?)
     })
 }
 
@@ -340,7 +343,7 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
         let strands = read_hair_file(&path, thickness)?;
         let curves = Curves::from_strands(&strands, basis, shape.built())?;
         let frame = |f: &mut Framing| f.add_strands(&strands);
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
+        Ok(scene.add_geometry(curves_shape(curves, shape), material_id, frame)?)
     })
 }
 
@@ -386,7 +389,7 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let count = u32::try_from(curves.len()).map_err(|_| invalid_arg!("too many prims"))?;
         for (c, prim) in curves.into_iter().zip(&grooms.curves) {
             let frame = |f: &mut Framing| prim.frame(f, 1.0, |p| p);
-            scene.add_geometry(Shape::curves(c, shape), material_id, frame)?;
+            scene.add_geometry(curves_shape(c, shape), material_id, frame)?;
         }
         // SAFETY: non-NULL (checked), the host's uint32_t.
         unsafe { count_out.write(count) };
@@ -461,7 +464,7 @@ pub unsafe extern "C" fn ht_scene_add_mesh_file(
     add_with_id(scene, geom_id, "geom_id", |scene| {
         let path = read_path(path, "path")?;
         scene.check_material(material_id, false)?;
-        let mesh = Mesh::load(&path)?;
+        let mesh = read_mesh_file(&path)?;
         Ok(scene.add_geometry(Shape::Mesh(mesh), material_id, |_| ())?)
     })
 }

@@ -31,6 +31,8 @@ mod settings_tests;
 pub mod render;
 #[cfg(all(test, feature = "render"))]
 mod render_tests;
+#[cfg(all(test, feature = "render"))]
+mod same_scene_tests;
 #[cfg(feature = "render")]
 pub mod shutdown;
 #[cfg(all(test, feature = "render"))]

@@ -2,12 +2,14 @@
 //! files, lights and the camera, added one call at a time.
 //!
 //! The scene keeps what the host added (curves already converted for Embree) and builds
-//! the Embree scene on the first render, then reuses it: adding geometry rebuilds it on
+//! the Embree scene on the first render, by the same assembly as scene files
+//! (`description::assembly`), then reuses it: adding geometry rebuilds it on
 //! the next render; adding a light, changing a material's parameters and a camera for
 //! which the `auto` curves' shapes still hold keep it.
 
 use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
-use crate::embree::{Device, Isa, SceneOptions};
+use crate::description::assembly::{Assembly, Shape};
+use crate::embree::{Device, Isa};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::render::settings::RenderSettings;
@@ -17,10 +19,8 @@ use crate::scene::detail_view::DetailView;
 use crate::scene::framing::Framing;
 use crate::scene::light::Light;
 use crate::scene::material::Material;
-use crate::scene::mesh::Mesh;
-use crate::scene::ribbons::{self, GroomShape};
+use crate::scene::ribbons::GroomShape;
 use crate::scene::stages::{StageProgress, StageRunner};
-use crate::scene::tracer::{Tracer, TracerBuilder};
 use crate::validate::{length, non_negative, positive};
 use std::ffi::c_char;
 use std::sync::Arc;
@@ -60,21 +60,11 @@ pub struct HtScene {
     pub(super) lights_changed: bool,
 }
 
-pub(super) enum Shape {
-    Curves(Curves),
-    /// Curves of the `auto` shape, kept round: each build shares them out between round and
-    /// flat for the render's camera and image height (`ribbons::share_out`).
-    AutoCurves(Curves),
-    Mesh(Mesh),
-}
-
-impl Shape {
-    /// Curves given with `shape`.
-    pub(super) fn curves(curves: Curves, shape: GroomShape) -> Shape {
-        match shape {
-            GroomShape::Auto => Shape::AutoCurves(curves),
-            _ => Shape::Curves(curves),
-        }
+/// Curves given with `shape`: `auto` ones are shared out by each build for its view.
+pub(super) fn curves_shape(curves: Curves, shape: GroomShape) -> Shape {
+    match shape {
+        GroomShape::Auto => Shape::AutoCurves(curves),
+        _ => Shape::Curves(curves),
     }
 }
 
@@ -144,45 +134,6 @@ impl HtScene {
         Ok(())
     }
 
-    /// The Embree scene, one material per Embree geometry and the geometry each came from;
-    /// `auto` curves are shared out for `view`.
-    fn build_tracer(
-        &self,
-        view: &DetailView,
-        progress: &dyn StageProgress,
-    ) -> Result<(Tracer, Vec<Material>, Vec<usize>)> {
-        let mut builder = TracerBuilder::new(self.device.clone(), SceneOptions::default())?;
-        let mut materials = Vec::with_capacity(self.geometries.len());
-        let mut built_from = Vec::with_capacity(self.geometries.len());
-        for (i, g) in self.geometries.iter().enumerate() {
-            // Embree geometries made of this one (several for auto curves split by shape).
-            let added = match &g.shape {
-                Shape::Mesh(m) => {
-                    builder.add_mesh(m.clone())?;
-                    1
-                }
-                Shape::AutoCurves(c) => {
-                    let parts =
-                        ribbons::share_out(c.clone(), &view.camera, view.height, view.lod_pixels)?;
-                    let n = parts.len();
-                    for part in parts {
-                        builder.add_view_curves(part, *view)?;
-                    }
-                    n
-                }
-                Shape::Curves(c) => {
-                    builder.add_curves(c.clone())?;
-                    1
-                }
-            };
-            let material = &self.materials[g.material as usize];
-            materials.extend(std::iter::repeat_n(material.clone(), added));
-            built_from.extend(std::iter::repeat_n(i, added));
-        }
-        let tracer = builder.build_with(&StageRunner::new(progress))?;
-        Ok((tracer, materials, built_from))
-    }
-
     /// The host's camera, or the one that frames the geometry as added, for an image of
     /// `aspect` (width over height), with the host's lens.
     fn camera(&self, aspect: f32) -> Result<Camera> {
@@ -231,9 +182,19 @@ impl HtScene {
             Some(world) if self.lights_changed => world.set_lights(self.lights.clone())?,
             Some(_) => {}
             None => {
-                let (tracer, materials, built_from) = self.build_tracer(&view, progress)?;
-                self.world = Some(World::new(tracer, materials, self.lights.clone())?);
-                self.built_from = built_from;
+                let mut assembly = Assembly::default();
+                for g in &self.geometries {
+                    let material = self.materials[g.material as usize].clone();
+                    assembly.add(g.shape.clone(), material, "");
+                }
+                let built = assembly.build(
+                    self.device.clone(),
+                    self.lights.clone(),
+                    &view,
+                    &mut StageRunner::new(progress),
+                )?;
+                self.world = Some(built.world);
+                self.built_from = built.built_from;
             }
         }
         self.lights_changed = false;

@@ -8,11 +8,12 @@ use super::materials::*;
 use super::scene::*;
 use crate::capi::bsdf::ht_hair_params_default;
 use crate::capi::ht_last_error;
+use crate::description::assembly::Shape;
 use crate::embree::{MemoryMonitor, padding_for};
+use crate::formats::hair::{Thickness, write_hair_file};
 use crate::scene::NoStages;
 use crate::scene::material::HairColor;
-use crate::scene::{FurBall, write_hair_file};
-use crate::scene::{Strands, Thickness};
+use crate::scene::{FurBall, Strands};
 use std::ffi::CStr;
 use std::ptr::{null, null_mut};
 

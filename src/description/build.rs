@@ -6,36 +6,32 @@ use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
 
+use super::assembly::{Assembly, Shape};
 use super::{
     BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
     MeshDesc, MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
-use crate::embree::{CurveBasis, Device, SceneOptions};
+use crate::embree::{CurveBasis, Device};
 use crate::error::{Error, Result, invalid_arg};
-use crate::render::integrator::World;
+use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
 use crate::scene::envmap::Environment;
 use crate::scene::footprint::{self, CurvesSize, available_bytes};
 use crate::scene::framing::Framing;
-use crate::scene::hair_file::read_hair_file;
 use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
 use crate::scene::strands::Strands;
-use crate::scene::tracer::TracerBuilder;
-use crate::scene::{GroomShape, ribbons};
 use crate::validate::positive;
 
-use super::usd::{is_usd_path, read_usd_file};
-
-/// Subdivisions of a `shape = "sphere"` mesh: 5120 triangles, whose silhouette strays
-/// from the true sphere by under 0.05% of its radius.
-pub(super) const SPHERE_SUBDIVISIONS: u32 = 4;
+use crate::formats::hair::read_hair_file;
+use crate::formats::mesh::read_mesh_file;
+use crate::formats::usd::{is_usd_path, read_usd_file};
 
 impl SceneDescription {
     /// Checks every value, reads the files, builds the grooms and meshes into one Embree
@@ -89,23 +85,27 @@ impl SceneDescription {
         self.check_memory(available_bytes())?;
 
         let mut stages = StageRunner::new(progress);
-        let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
         let mut framing = Framing::default();
         let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
-        // One material per geometry: a USD groom adds one geometry per BasisCurves prim.
-        let mut materials = Vec::with_capacity(self.grooms.len() + self.meshes.len());
-        let mut sources = Vec::with_capacity(materials.capacity());
-        // Curves wait for the camera: an `auto` groom's shapes depend on it.
-        let mut built = Vec::new();
+        let mut assembly = Assembly::default();
+        // The material name of each part, for `BuiltScene::set_material`.
+        let mut names = Vec::with_capacity(reads);
         for (i, g) in self.grooms.iter().enumerate() {
             let at = format!("groom[{i}]");
             let curves = g
                 .curves(&mut stages, (i, grooms, reads), &mut framing)
                 .map_err(|e| self.error(&at, e))?;
-            built.extend(curves.into_iter().map(|c| (i, c)));
+            for c in curves {
+                let shape = if g.shape == GroomShape::Auto {
+                    Shape::AutoCurves(c)
+                } else {
+                    Shape::Curves(c)
+                };
+                assembly.add(shape, groom_materials[i].clone(), self.at(&at));
+                names.push(g.material.clone());
+            }
         }
-        let mut meshes = Vec::with_capacity(self.meshes.len());
-        for (i, m) in self.meshes.iter().enumerate() {
+        for (i, (m, material)) in self.meshes.iter().zip(mesh_materials).enumerate() {
             let at = format!("mesh[{i}]");
             let mesh = stages
                 .run(Stage::Read, (grooms + i, reads), |_| m.mesh())
@@ -115,7 +115,8 @@ impl SceneDescription {
             if !matches!(m.source, MeshSource::Ground { .. }) {
                 framing.add_mesh(&mesh.positions);
             }
-            meshes.push(mesh);
+            assembly.add(Shape::Mesh(mesh), material, self.at(&at));
+            names.push(m.material.clone());
         }
         // A scene without grooms (or meshes) still goes through every stage.
         stages.report(Stage::Read, 1.0)?;
@@ -126,48 +127,17 @@ impl SceneDescription {
             .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
         let view = DetailView::new(camera, settings.height, settings.lod_pixels);
-        let mut sizes = Vec::new();
-        for (i, curves) in built {
-            let at = format!("groom[{i}]");
-            let groom = &self.grooms[i];
-            let auto = groom.shape == GroomShape::Auto;
-            let parts = if auto {
-                ribbons::share_out(curves, &camera, settings.height, settings.lod_pixels)
-                    .map_err(|e| self.error(&at, e))?
-            } else {
-                vec![curves]
-            };
-            for part in parts {
-                sizes.push(CurvesSize::of(&part));
-                let added = if auto {
-                    tracer.add_view_curves(part, view)
-                } else {
-                    tracer.add_curves(part)
-                };
-                added.map_err(|e| self.error(&at, e))?;
-                materials.push(groom_materials[i].clone());
-                sources.push(groom.material.clone());
-            }
-        }
-        // Geometry ids follow `materials`: the grooms' geometries, then the meshes.
-        for (i, mesh) in meshes.into_iter().enumerate() {
-            tracer
-                .add_mesh(mesh)
-                .map_err(|e| self.error(&format!("mesh[{i}]"), e))?;
-            sources.push(self.meshes[i].material.clone());
-        }
-        materials.extend(mesh_materials);
-        // What is built so far is held already: only Embree's part is still to come.
-        let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum();
-        footprint::check_fits(&sizes, bvh, "more for the BVH build", available_bytes())?;
-        let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
-        let world = World::new(tracer, materials, lights)?;
+        let built = assembly.build(device, lights, &view, &mut stages)?;
         Ok(BuiltScene {
-            world,
+            world: built.world,
             camera,
             settings,
             stages: stages.times(),
-            sources,
+            sources: built
+                .built_from
+                .into_iter()
+                .map(|p| names[p].clone())
+                .collect(),
         })
     }
 
@@ -225,7 +195,12 @@ impl SceneDescription {
 
     /// `e` with this description's origin and the entry or key `at` in front, same kind.
     fn error(&self, at: &str, e: Error) -> Error {
-        e.context(format!("{}: {at}", self.origin))
+        e.context(self.at(at))
+    }
+
+    /// The entry or key `at` of this description, as errors name it.
+    fn at(&self, at: &str) -> String {
+        format!("{}: {at}", self.origin)
     }
 }
 
@@ -332,7 +307,7 @@ impl GroomDesc {
     }
 
     /// The strands, transformed and with their radii scaled.
-    pub(crate) fn strands(&self) -> Result<Strands> {
+    pub fn strands(&self) -> Result<Strands> {
         let linear = self.transform.linear()?;
         positive("radius_scale", self.radius_scale)?;
         let mut strands = match &self.source {
@@ -376,13 +351,15 @@ impl MeshDesc {
     }
 
     /// The mesh, transformed.
-    pub(crate) fn mesh(&self) -> Result<Mesh> {
+    pub fn mesh(&self) -> Result<Mesh> {
         let linear = self.transform.linear()?;
         let mut mesh = match &self.source {
-            MeshSource::File(path) => Mesh::load(path)?,
-            MeshSource::Sphere { centre, radius } => {
-                shapes::sphere(Vec3::from_array(*centre), *radius, SPHERE_SUBDIVISIONS)?
-            }
+            MeshSource::File(path) => read_mesh_file(path)?,
+            MeshSource::Sphere { centre, radius } => shapes::sphere(
+                Vec3::from_array(*centre),
+                *radius,
+                shapes::SPHERE_SUBDIVISIONS,
+            )?,
             MeshSource::Ground { y, half_size } => shapes::ground(*y, *half_size)?,
             MeshSource::Triangles(mesh) => {
                 mesh.validate()?;

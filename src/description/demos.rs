@@ -8,9 +8,9 @@ use super::{
     SceneDescription, Transform,
 };
 use crate::error::{Error, Result, invalid_arg};
+use crate::formats::hair::Thickness;
 use crate::render::settings::RenderSettings;
 use crate::scene::groom::{FurBall, ScalpPatch};
-use crate::scene::hair_file::Thickness;
 use crate::scene::material::{HairColor, HairMaterial};
 
 /// Names of the built-in scenes of [`demo`].

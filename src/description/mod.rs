@@ -86,13 +86,9 @@
 //! (`scene.toml:12:1: groom[1].params.strands: ...`); errors found while building name the
 //! entry and key (`scene.toml: groom[1].material: no material named "blond" ...`).
 
+pub(crate) mod assembly;
 mod build;
-pub mod convert;
 mod demos;
-mod file;
-pub mod pbrt;
-pub mod peer;
-pub mod usd;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -101,6 +97,7 @@ use serde::Deserialize;
 
 use crate::embree::CurveBasis;
 use crate::error::{Result, invalid_arg};
+use crate::formats::hair::Thickness;
 use crate::render::integrator::World;
 use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
@@ -108,7 +105,6 @@ use crate::render::{Aovs, Progress};
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::groom::{FurBall, ScalpPatch};
-use crate::scene::hair_file::Thickness;
 use crate::scene::material::HairMaterial;
 use crate::scene::mesh::Mesh;
 use crate::scene::stages::StageTimes;
@@ -128,6 +124,9 @@ pub struct SceneDescription {
     pub lights: Vec<LightDesc>,
     /// What error messages call this description: the scene file's path, or "demo NAME".
     pub origin: String,
+    /// What the file's reader could not carry over (a pbrt file's unsupported directives,
+    /// say), one sentence each, for the caller to show.
+    pub notes: Vec<String>,
 }
 
 /// The `[camera]` table.

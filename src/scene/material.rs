@@ -153,13 +153,13 @@ impl HairMaterial {
 impl PreparedHair {
     /// Every hit shares one BSDF: nothing varies per strand, along strands or by the
     /// groom's absorption.
-    pub(crate) fn is_uniform(&self) -> bool {
+    pub fn is_uniform(&self) -> bool {
         self.uniform.is_some()
     }
 
     /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's
     /// absorption at the hit when it gives one ([`crate::scene::curves::StrandIndex::absorption`]).
-    pub(crate) fn params_at(&self, strand: u32, s: f32, groom: Option<HairColor>) -> HairParams {
+    pub fn params_at(&self, strand: u32, s: f32, groom: Option<HairColor>) -> HairParams {
         let m = &self.material;
         let mut p = self.base;
         if let (true, Some(a)) = (m.use_vertex_colors, groom) {

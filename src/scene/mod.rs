@@ -10,7 +10,6 @@ pub mod envmap;
 pub mod footprint;
 pub mod framing;
 pub(crate) mod groom;
-pub mod hair_file;
 pub mod hit;
 pub mod light;
 mod light_sample;
@@ -26,10 +25,8 @@ pub mod tracer;
 pub use camera::Camera;
 pub use envmap::Environment;
 pub use groom::{FurBall, HairStyle, ScalpPatch};
-pub use hair_file::{
-    Thickness, encode_hair, info_report, parse_hair, read_hair_file, write_hair_file,
-};
 pub use light::{Light, LightEval, LightSample};
+pub use mesh::Mesh;
 pub use ribbons::GroomShape;
 pub use stages::{NoStages, Stage, StageProgress, StageTimes};
 pub use strands::Strands;

@@ -13,7 +13,7 @@ const LAYERS: [&[&str]; 7] = [
     &["bsdf", "embree", "image"],
     &["scene"],
     &["render"],
-    &["description"],
+    &["description", "formats"],
     &["capi"],
 ];
 
@@ -176,5 +176,5 @@ fn the_scan_sees_what_it_must() {
         resolve("scene::light", "crate::math::luminance", &known).as_deref(),
         Some("math")
     );
-    assert_eq!(layer("description::peer"), 5);
+    assert_eq!(layer("formats::usd"), 5);
 }

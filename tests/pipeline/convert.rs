@@ -5,11 +5,12 @@
 
 use std::path::{Path, PathBuf};
 
-use hairtrace::description::convert::{ConvertOptions, ConvertSource, basis_named, convert};
-use hairtrace::description::usd::{UsdCurves, read_usd_file};
 use hairtrace::embree::{CurveBasis, CurveShape};
+use hairtrace::formats::convert::{ConvertOptions, ConvertSource, basis_named, convert};
+use hairtrace::formats::hair::{Thickness, read_hair_file, write_hair_file};
+use hairtrace::formats::usd::{UsdCurves, read_usd_file};
+use hairtrace::scene::Strands;
 use hairtrace::scene::curves::Curves;
-use hairtrace::scene::{Strands, Thickness, read_hair_file, write_hair_file};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/usd")

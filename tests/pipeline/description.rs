@@ -7,16 +7,16 @@ use std::sync::Arc;
 use glam::Vec3;
 use hairtrace::Error;
 use hairtrace::bsdf::SIGMA_A_PRESETS;
-use hairtrace::description::peer::export_for_peer;
 use hairtrace::description::{
     DEMOS, GroomSource, LightDesc, MaterialDesc, SceneDescription, demo, quick_look,
 };
 use hairtrace::embree::{CurveBasis, Device};
+use hairtrace::formats::hair::{Thickness, write_hair_file};
 use hairtrace::render::PixelFilter;
 use hairtrace::render::settings::Roulette;
 use hairtrace::scene::GroomShape;
 use hairtrace::scene::material::HairColor;
-use hairtrace::scene::{FurBall, HairStyle, Thickness, write_hair_file};
+use hairtrace::scene::{FurBall, HairStyle};
 
 fn device() -> Arc<Device> {
     Arc::new(Device::new(Some(1)).unwrap())
@@ -419,10 +419,10 @@ fn render_keys_pick_the_filter_the_roulette_and_the_fidelity_knobs() {
     );
 }
 
-/// The peer benchmark's scenes are scene files like any other: they parse, build and
-/// export for the peer.
+/// The peer benchmark's scenes are scene files like any other: they parse and build (the
+/// command line's `export` tests write them for the peer).
 #[test]
-fn bench_scenes_build_and_export() {
+fn bench_scenes_build() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("bench/scenes");
     let mut found = 0;
     for entry in std::fs::read_dir(&dir).unwrap() {
@@ -432,10 +432,6 @@ fn bench_scenes_build_and_export() {
             shrink(&mut desc);
             desc.build(device())
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            let out = scratch(&format!("peer-{found}"));
-            export_for_peer(&desc, &out).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            assert!(out.join("scene.json").is_file());
-            std::fs::remove_dir_all(&out).unwrap();
             found += 1;
         }
     }

@@ -2,7 +2,7 @@
 //! and a deterministic mini-fuzz that must never panic.
 
 use hairtrace::Error;
-use hairtrace::scene::hair_file::{
+use hairtrace::formats::hair::{
     HEADER_BYTES, Thickness, encode_hair, info_report, parse_hair, read_hair_file, write_hair_file,
 };
 use hairtrace::scene::{FurBall, Strands};

@@ -7,9 +7,9 @@ use std::sync::Arc;
 
 use hairtrace::Error;
 use hairtrace::bsdf::sigma_a_from_melanin;
-use hairtrace::description::pbrt::PbrtScene;
 use hairtrace::description::{EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource};
 use hairtrace::embree::{CurveBasis, Device};
+use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::render::{Aovs, NO_STRAND, NoProgress};
 use hairtrace::scene::GroomShape;
 use hairtrace::scene::material::{HairColor, HairMaterial};

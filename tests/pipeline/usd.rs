@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use hairtrace::Error;
-use hairtrace::description::usd::{UsdGrooms, read_usd_file};
 use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::embree::{CurveShape, Device};
+use hairtrace::formats::usd::{UsdGrooms, read_usd_file};
 use hairtrace::render::NO_STRAND;
 use hairtrace::scene::material::HairColor;
 use hairtrace::{Aovs, NoProgress};

@@ -9,7 +9,7 @@ use std::io::{Cursor, Write};
 use std::path::Path;
 
 use hairtrace::Error;
-use hairtrace::description::usd::read_usd_file;
+use hairtrace::formats::usd::read_usd_file;
 use openusd::usdc::CrateFile;
 
 use super::usd::refused;

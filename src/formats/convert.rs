@@ -18,22 +18,21 @@
 
 use std::path::Path;
 
-use super::demos::demo;
+use super::hair::{Thickness, read_hair_file, write_hair_file};
 use super::usd::{
     CurvesToWrite, Layout, StageUnits, UsdCurves, Wrap, is_usd_path, read_usd_file, write_usd_file,
 };
-use super::{SceneDescription, has_extension};
+use crate::description::{SceneDescription, demo, has_extension};
 use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::Strands;
-use crate::scene::hair_file::{Thickness, read_hair_file, write_hair_file};
 
 /// Where the grooms come from.
 #[derive(Debug, Clone, Copy)]
 pub enum ConvertSource<'a> {
     /// A `.hair` file, a USD file or a scene file (`.toml`, its grooms in world space).
     File(&'a Path),
-    /// A built-in scene (see [`super::DEMOS`]): its procedural groom.
+    /// A built-in scene (see [`DEMOS`](crate::description::DEMOS)): its procedural groom.
     Demo(&'a str),
 }
 

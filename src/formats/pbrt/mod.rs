@@ -33,7 +33,7 @@ mod shapes;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-use super::{EnvironmentSource, GroomSource, LightDesc, MeshSource, SceneDescription};
+use crate::description::{EnvironmentSource, GroomSource, LightDesc, MeshSource, SceneDescription};
 use crate::error::Result;
 use reader::Reader;
 

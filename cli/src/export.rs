@@ -14,12 +14,18 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use super::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
-use crate::embree::CurveBasis;
-use crate::error::{Error, Result, invalid_arg};
-use crate::scene::GroomShape;
-use crate::scene::hair_file::{Thickness, write_hair_file};
-use crate::scene::mesh::Mesh;
+use hairtrace::description::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
+use hairtrace::embree::CurveBasis;
+use hairtrace::formats::hair::{Thickness, write_hair_file};
+use hairtrace::scene::{GroomShape, Mesh};
+use hairtrace::{Error, Result};
+
+/// An invalid-argument error from a format string.
+macro_rules! invalid_arg {
+    ($($arg:tt)*) => {
+        Error::InvalidArg(format!($($arg)*))
+    };
+}
 
 #[derive(Serialize)]
 struct PeerScene {
@@ -250,7 +256,35 @@ fn obj_text(mesh: &Mesh) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::hair_file::read_hair_file;
+    use hairtrace::description::GroomSource;
+    use hairtrace::formats::hair::read_hair_file;
+
+    /// The peer benchmark's scenes (`bench/scenes`), with fewer strands, all export.
+    #[test]
+    fn bench_scenes_export_for_the_peer() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes");
+        let mut found = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "toml") {
+                let mut desc = SceneDescription::load(&path).unwrap();
+                for g in &mut desc.grooms {
+                    match &mut g.source {
+                        GroomSource::FurBall(f) => f.strands = 300,
+                        GroomSource::Scalp(s) => s.strands = 300,
+                        _ => {}
+                    }
+                }
+                let out = std::env::temp_dir()
+                    .join(format!("hairtrace-peer-{}-{found}", std::process::id()));
+                export_for_peer(&desc, &out).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                assert!(out.join("scene.json").is_file());
+                std::fs::remove_dir_all(&out).unwrap();
+                found += 1;
+            }
+        }
+        assert!(found >= 4, "only {found} bench scenes");
+    }
 
     const SCENE: &str = r#"
 [render]
@@ -308,7 +342,7 @@ angular_radius_deg = 2
         assert_eq!(json["camera"]["fov_y_deg"], 30.0);
         let groom = &json["grooms"][0];
         assert_eq!(groom["basis"], "linear");
-        let sigma_a = crate::bsdf::sigma_a_from_melanin(1.3, 0.0).unwrap();
+        let sigma_a = hairtrace::bsdf::sigma_a_from_melanin(1.3, 0.0).unwrap();
         let exported = groom["material"]["sigma_a"][1].as_f64().unwrap() as f32;
         assert_eq!(exported, sigma_a[1], "f32 values survive the text exactly");
         // The environment's scale is folded into its radiance.

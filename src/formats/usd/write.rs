@@ -2,7 +2,7 @@
 //! and layer writers (the format by the extension). Use `.usda`: the crate files openusd 0.6
 //! writes (`.usdc`, `.usd`, `.usdz`) read back here but Pixar's library cannot read them
 //! (usd-core 26.11 refuses nested prims, "Invalid children found in primChildren field", and
-//! reads root prims as none), so [`convert`](crate::description::convert) writes text only.
+//! reads root prims as none), so [`convert`](crate::formats::convert) writes text only.
 //!
 //! Every prim is authored with what the UsdGeom schema needs to be read anywhere: `type`,
 //! `basis` and `wrap` (uniform tokens), `points`, `curveVertexCounts`, `widths` as

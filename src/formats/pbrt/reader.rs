@@ -607,6 +607,7 @@ impl Reader {
             meshes: self.meshes,
             lights,
             origin: origin.to_string(),
+            notes: Vec::new(),
         })
     }
 

@@ -76,7 +76,7 @@ impl UsdCurves {
         point: impl Fn([f32; 3]) -> [f32; 3],
     ) -> Result<Curves> {
         let curves = Curves::from_control_points(
-            super::placed(&self.control, point, radius_scale),
+            crate::description::placed(&self.control, point, radius_scale),
             &self.control_counts,
             self.colors.clone(),
             self.layout.basis,

@@ -17,8 +17,8 @@
 //!   header and the arrays disagree, and guessing which one is right would hide it.
 //! - Flag bits the format does not define are an error: an unknown array may follow.
 
-use super::strands::Strands;
 use crate::error::{Error, Result, invalid_arg};
+use crate::scene::strands::Strands;
 use std::fmt::Write as _;
 use std::path::Path;
 

@@ -9,18 +9,18 @@ use std::path::{Path, PathBuf};
 use serde::Deserialize;
 use toml::Spanned;
 
+use super::hair::Thickness;
 use super::usd::is_usd_path;
-use super::{
+use crate::bsdf::sigma_a_preset;
+use crate::description::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc,
     MeshSource, SceneDescription, Transform,
 };
-use crate::bsdf::sigma_a_preset;
 use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
 use crate::render::settings::RenderSettings;
 use crate::scene::GroomShape;
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
-use crate::scene::hair_file::Thickness;
 use crate::scene::material::{HairColor, HairMaterial};
 
 impl SceneDescription {
@@ -69,6 +69,7 @@ impl SceneDescription {
                 .map_err(|e| invalid_arg!("{at}: render.{}", e.detail()))?;
         }
         Ok(SceneDescription {
+            notes: Vec::new(),
             render,
             camera: raw.camera,
             materials,

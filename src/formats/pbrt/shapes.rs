@@ -16,10 +16,10 @@ use std::path::Path;
 use glam::{DMat3, DMat4, DVec3, Vec3};
 
 use super::params::{Params, Warning};
-use crate::description::build::SPHERE_SUBDIVISIONS;
 use crate::description::{GroomDesc, GroomSource, MeshDesc, MeshSource};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::Result;
+use crate::formats::mesh::read_mesh_file;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 
@@ -247,14 +247,14 @@ pub(super) fn mesh(
                     return Err(p.fail(format_args!("{name}: only whole spheres are supported")));
                 }
             }
-            shapes::sphere(Vec3::ZERO, radius as f32, SPHERE_SUBDIVISIONS)
+            shapes::sphere(Vec3::ZERO, radius as f32, shapes::SPHERE_SUBDIVISIONS)
                 .map_err(|e| p.context(e))?
         }
         _ => {
             let file = p
                 .string("filename")?
                 .ok_or_else(|| p.fail("needs \"string filename\""))?;
-            Mesh::load(dir.join(file))
+            read_mesh_file(dir.join(file))
                 .map_err(|e| e.context(format_args!("{}: {}", p.loc, p.what)))?
         }
     };

@@ -1,0 +1,117 @@
+//! The one build every front end drives: geometries with their materials, the lights and
+//! the view go in, a [`World`] comes out. Scene files (through [`SceneDescription::build`])
+//! and the C ABI's scenes both end here, so that the same content gives the same world,
+//! geometry ids and image, whichever way it came.
+//!
+//! [`SceneDescription::build`]: super::SceneDescription::build
+
+use std::sync::Arc;
+
+use crate::embree::{Device, SceneOptions};
+use crate::error::{Error, Result};
+use crate::render::integrator::World;
+use crate::scene::curves::Curves;
+use crate::scene::detail_view::DetailView;
+use crate::scene::footprint::{self, CurvesSize, available_bytes};
+use crate::scene::light::Light;
+use crate::scene::material::Material;
+use crate::scene::mesh::Mesh;
+use crate::scene::ribbons;
+use crate::scene::stages::{Stage, StageRunner};
+use crate::scene::tracer::TracerBuilder;
+
+/// One geometry as a front end hands it over.
+#[derive(Clone)]
+pub(crate) enum Shape {
+    /// Curves traced as they are.
+    Curves(Curves),
+    /// Curves of the `auto` shape: each build shares them out between round, flat and
+    /// level-of-detail ribbons for its view (`ribbons::share_out`).
+    AutoCurves(Curves),
+    Mesh(Mesh),
+}
+
+/// What a build is made of, in geometry order.
+#[derive(Default)]
+pub(crate) struct Assembly {
+    parts: Vec<Part>,
+}
+
+struct Part {
+    shape: Shape,
+    material: Material,
+    /// Put in front of this part's errors (`groom[2]`); empty for none.
+    label: String,
+}
+
+/// A built world, and for each of its Embree geometries the index of the part it was
+/// made from (an `auto` part may make several).
+pub(crate) struct Assembled {
+    pub world: World,
+    pub built_from: Vec<usize>,
+}
+
+impl Assembly {
+    /// Adds a geometry with its material; `label` names it in errors.
+    pub fn add(&mut self, shape: Shape, material: Material, label: impl Into<String>) {
+        self.parts.push(Part {
+            shape,
+            material,
+            label: label.into(),
+        });
+    }
+
+    /// Builds the world for `view`: `auto` curves shared out for it, the memory the BVH
+    /// build will need checked against what is available, then the BVH built (timed as
+    /// [`Stage::Bvh`] in `stages`).
+    pub fn build(
+        self,
+        device: Arc<Device>,
+        lights: Vec<Light>,
+        view: &DetailView,
+        stages: &mut StageRunner,
+    ) -> Result<Assembled> {
+        let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
+        let (mut materials, mut built_from, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, part) in self.parts.into_iter().enumerate() {
+            let labelled = |e: Error| {
+                if part.label.is_empty() {
+                    e
+                } else {
+                    e.context(&part.label)
+                }
+            };
+            let added = match part.shape {
+                Shape::Mesh(m) => {
+                    tracer.add_mesh(m).map_err(labelled)?;
+                    1
+                }
+                Shape::Curves(c) => {
+                    sizes.push(CurvesSize::of(&c));
+                    tracer.add_curves(c).map_err(labelled)?;
+                    1
+                }
+                Shape::AutoCurves(c) => {
+                    let pieces = ribbons::share_out(c, &view.camera, view.height, view.lod_pixels)
+                        .map_err(labelled)?;
+                    let n = pieces.len();
+                    for piece in pieces {
+                        sizes.push(CurvesSize::of(&piece));
+                        tracer.add_view_curves(piece, *view).map_err(labelled)?;
+                    }
+                    n
+                }
+            };
+            materials.extend(std::iter::repeat_n(part.material, added));
+            built_from.extend(std::iter::repeat_n(i, added));
+        }
+        // What is built so far is held already: only Embree's part is still to come.
+        let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum();
+        footprint::check_fits(&sizes, bvh, "more for the BVH build", available_bytes())?;
+        let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
+        Ok(Assembled {
+            world: World::new(tracer, materials, lights)?,
+            built_from,
+        })
+    }
+}

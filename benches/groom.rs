@@ -5,7 +5,8 @@
 //! starts them past the fiber they leave, hairtrace uses its exclusion filter instead). Also the 8-wide packet call
 //! on primary rays, to see whether packets pay. Prints a markdown table.
 //!
-//! `cargo bench --bench groom` (all sizes) or `cargo bench --bench groom -- 100000` (sizes up
+//! `cargo bench --bench groom --features embree-sys` (all sizes; the feature opens the raw
+//! Embree bindings for the direct baseline) or add `-- 100000` (sizes up
 //! to the given strand count).
 
 use std::hint::black_box;
@@ -102,12 +103,12 @@ fn direct(scene: &Scene, ray: &Ray) -> usize {
     #[cfg(embree3)]
     unsafe {
         let mut ctx = context(false);
-        sys::rtcIntersect1(scene.raw(), &mut ctx, &mut rh);
+        sys::rtcIntersect1(scene.raw_handle(), &mut ctx, &mut rh);
     }
     #[cfg(embree4)]
     // SAFETY: committed scene; default arguments.
     unsafe {
-        sys::rtcIntersect1(scene.raw(), &mut rh, std::ptr::null_mut());
+        sys::rtcIntersect1(scene.raw_handle(), &mut rh, std::ptr::null_mut());
     }
     usize::from(rh.hit.geomID != u32::MAX)
 }
@@ -135,7 +136,7 @@ fn direct8(scene: &Scene, rays: &[Ray]) -> usize {
     let mut ctx = context(true);
     // SAFETY: committed scene; an RTCRayHit8 is 32-byte aligned by bindgen, and so is the
     // valid mask of 8 lanes.
-    unsafe { sys::rtcIntersect8(valid.0.as_ptr(), scene.raw(), &mut ctx, &mut p) };
+    unsafe { sys::rtcIntersect8(valid.0.as_ptr(), scene.raw_handle(), &mut ctx, &mut p) };
     p.hit.geomID.iter().filter(|&&g| g != u32::MAX).count()
 }
 

@@ -119,7 +119,7 @@ impl Device {
 
     /// The raw handle, for the scene and geometry layer. It is valid while `self` lives;
     /// code that keeps Embree objects beyond that must retain the device itself.
-    pub fn raw(&self) -> sys::RTCDevice {
+    pub(crate) fn raw(&self) -> sys::RTCDevice {
         self.raw.as_ptr()
     }
 

@@ -1,13 +1,12 @@
 //! Safe layer over Embree, the ray tracing kernels that intersect the hair curves.
 //!
-//! [`sys`](crate::embree::sys) is the raw bindgen output;
-//! [`Device`](crate::embree::Device) owns an Embree device;
-//! [`SceneBuilder`](crate::embree::SceneBuilder) attaches
-//! [`CurveGeometry`](crate::embree::CurveGeometry) and
-//! [`TriangleGeometry`](crate::embree::TriangleGeometry) and commits into a
+//! `sys` is the raw bindgen output, private to the crate (the `embree-sys` feature makes
+//! it public for the groom benchmark's direct-Embree baseline; no host should use it);
+//! [`Device`](crate::embree::Device) owns an Embree device; the crate's `SceneBuilder`
+//! attaches curve and triangle geometries and commits into a
 //! [`Scene`](crate::embree::Scene), which answers closest-hit and occlusion queries
-//! ([`Ray`](crate::embree::Ray), [`RayHit`](crate::embree::RayHit),
-//! [`Exclude`](crate::embree::Exclude)). This module
+//! ([`Ray`](crate::embree::Ray), [`RayHit`](crate::embree::RayHit)). Hosts reach all of it
+//! through the scene layer's `TracerBuilder` and `Tracer`. This module
 //! knows nothing of shading: it hands back hit records and leaves the rest to the renderer.
 //!
 //! Embree 3 (Debian) and Embree 4 differ in the ray query calls (`rtcIntersect1` and
@@ -23,17 +22,20 @@ mod isa;
 mod memory;
 mod query;
 mod scene;
+#[cfg(feature = "embree-sys")]
 pub mod sys;
+#[cfg(not(feature = "embree-sys"))]
+mod sys;
 
 pub use device::Device;
-pub use geometry::{
-    CurveBasis, CurveGeometry, CurvePoint, CurveShape, Geometry, SharedBuffer, TriangleGeometry,
-    padding_for,
-};
+pub use geometry::{CurveBasis, CurveShape, Geometry, SharedBuffer};
+pub(crate) use geometry::{CurveGeometry, CurvePoint, TriangleGeometry, padding_for};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
-pub use query::{Exclude, Ray, RayHit};
-pub use scene::{BuildMonitor, Scene, SceneBuilder, SceneOptions, cancelled, is_cancelled};
+pub(crate) use query::Exclude;
+pub use query::{Ray, RayHit};
+pub(crate) use scene::SceneBuilder;
+pub use scene::{Scene, SceneOptions, cancelled, is_cancelled};
 
 /// The Embree version hairtrace was built against, as `major.minor.patch`, read from the
 /// installed `rtcore_config.h` at build time.

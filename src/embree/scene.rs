@@ -145,7 +145,7 @@ unsafe extern "C" fn monitor(user: *mut std::ffi::c_void, fraction: f64) -> bool
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| progress(fraction))).unwrap_or(false)
 }
 
-/// Whether `e` is the error of a build that a [`BuildMonitor`] cancelled.
+/// Whether `e` is the error of a build that its progress callback cancelled.
 pub fn is_cancelled(e: &Error) -> bool {
     matches!(e, Error::Embree { code, .. } if *code == sys::RTCError::RTC_ERROR_CANCELLED.0)
 }
@@ -167,7 +167,7 @@ pub struct Scene {
 }
 
 impl Scene {
-    /// The geometry with the id [`SceneBuilder::attach`] returned.
+    /// The geometry with the id its attachment returned.
     pub fn geometry(&self, id: u32) -> Option<&Geometry> {
         self.geometries.get(id as usize)
     }
@@ -196,9 +196,14 @@ impl Scene {
         )
     }
 
-    /// The raw handle, for benchmarks that call Embree directly and for FFI. Valid while
-    /// `self` lives; do not release or modify it.
-    pub fn raw(&self) -> sys::RTCScene {
+    /// The raw handle. Valid while `self` lives; do not release or modify it.
+    pub(crate) fn raw(&self) -> sys::RTCScene {
         self.raw.0.as_ptr()
+    }
+
+    /// The raw handle, for the groom benchmark's direct Embree calls only.
+    #[cfg(feature = "embree-sys")]
+    pub fn raw_handle(&self) -> sys::RTCScene {
+        self.raw()
     }
 }

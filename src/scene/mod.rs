@@ -7,7 +7,7 @@ pub mod camera;
 pub mod curves;
 pub mod detail_view;
 pub mod envmap;
-pub mod footprint;
+pub(crate) mod footprint;
 pub mod framing;
 pub(crate) mod groom;
 pub mod hit;

@@ -5,10 +5,9 @@
 use super::HtStatus;
 use super::geometry::*;
 use super::lights::*;
-use super::render::ht_render_with;
 use super::scene::*;
 use super::scene_tests::{Handles, last_error, small_fur};
-use super::settings::{HtSettings, ht_settings_free, ht_settings_new, ht_settings_set};
+use super::settings_tests::Named;
 use crate::bsdf::HairParams;
 use crate::description::SceneDescription;
 use crate::embree::Device;
@@ -17,7 +16,6 @@ use crate::formats::hair::{Thickness, write_hair_file};
 use crate::render::{Aovs, NoProgress};
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
-use std::ptr::null_mut;
 use std::sync::Arc;
 
 const SIZE: (u32, u32) = (40, 30);
@@ -89,35 +87,11 @@ fn c_render(add: impl FnOnce(&Handles, u32) -> HtStatus, camera: bool) -> Vec<u3
             let s = ht_scene_set_camera(h.scene, EYE.as_ptr(), target.as_ptr(), up.as_ptr(), 40.0);
             assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
         }
-        let mut settings: *mut HtSettings = null_mut();
-        assert_eq!(ht_settings_new(&mut settings), HtStatus::HT_OK);
         let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
-        for (k, v) in [("width", w.as_str()), ("height", h_.as_str())]
-            .into_iter()
-            .chain(SETTINGS)
-        {
-            let (k, v) = (CString::new(k).unwrap(), CString::new(v).unwrap());
-            assert_eq!(
-                ht_settings_set(settings, k.as_ptr(), v.as_ptr()),
-                HtStatus::HT_OK
-            );
-        }
-        let pixels = (SIZE.0 * SIZE.1) as usize;
-        let mut rgb = vec![-1.0f32; 3 * pixels];
-        let s = ht_render_with(
-            h.scene,
-            settings,
-            None,
-            null_mut(),
-            rgb.as_mut_ptr(),
-            rgb.len(),
-            null_mut(),
-            null_mut(),
-            null_mut(),
-            pixels,
-        );
+        let mut pairs = vec![("width", w.as_str()), ("height", h_.as_str())];
+        pairs.extend(SETTINGS);
+        let (s, rgb) = Named::new(&pairs).render_rgb(h.scene, (SIZE.0 * SIZE.1) as usize);
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        ht_settings_free(settings);
         rgb.iter().map(|v| v.to_bits()).collect()
     }
 }

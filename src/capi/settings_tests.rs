@@ -3,6 +3,7 @@
 use super::HtStatus;
 use super::render::*;
 use super::render_tests::{bits, fur_scene, render_aovs_c, settings};
+use super::scene::HtScene;
 use super::scene_tests::{fails, last_error};
 use super::settings::*;
 use crate::render::settings::RenderSettings;
@@ -10,10 +11,10 @@ use std::ffi::{CStr, CString, c_char};
 use std::ptr::{null, null_mut};
 
 /// Settings from `ht_settings_new`, freed on drop.
-struct Named(*mut HtSettings);
+pub(super) struct Named(*mut HtSettings);
 
 impl Named {
-    fn new(pairs: &[(&str, &str)]) -> Named {
+    pub(super) fn new(pairs: &[(&str, &str)]) -> Named {
         let mut s = null_mut();
         assert_eq!(unsafe { ht_settings_new(&mut s) }, HtStatus::HT_OK);
         let named = Named(s);
@@ -26,6 +27,26 @@ impl Named {
     fn set(&self, key: &str, value: &str) -> HtStatus {
         let (k, v) = (CString::new(key).unwrap(), CString::new(value).unwrap());
         unsafe { ht_settings_set(self.0, k.as_ptr(), v.as_ptr()) }
+    }
+
+    /// Renders `scene` with these settings into a fresh RGB buffer of `pixels`.
+    pub(super) fn render_rgb(&self, scene: *mut HtScene, pixels: usize) -> (HtStatus, Vec<f32>) {
+        let mut rgb = vec![-1.0f32; 3 * pixels];
+        let status = unsafe {
+            ht_render_with(
+                scene,
+                self.0,
+                None,
+                null_mut(),
+                rgb.as_mut_ptr(),
+                rgb.len(),
+                null_mut(),
+                null_mut(),
+                null_mut(),
+                pixels,
+            )
+        };
+        (status, rgb)
     }
 
     fn get(&self, key: &str) -> String {
@@ -163,21 +184,7 @@ fn set_names_the_key_and_range_and_get_reads_back() {
     // Rules between settings are checked when they are used.
     let h = fur_scene(true);
     let crop = Named::new(&[("width", "8"), ("height", "8"), ("crop", "0,0,9,8")]);
-    let mut rgb = [0.0f32; 8 * 8 * 3];
-    let status = unsafe {
-        ht_render_with(
-            h.scene,
-            crop.0,
-            None,
-            null_mut(),
-            rgb.as_mut_ptr(),
-            rgb.len(),
-            null_mut(),
-            null_mut(),
-            null_mut(),
-            64,
-        )
-    };
+    let (status, _) = crop.render_rgb(h.scene, 64);
     fails(status, HtStatus::HT_ERR_INVALID_ARG, "crop = 0,0,9,8");
 }
 

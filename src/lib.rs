@@ -17,7 +17,7 @@
 //! use hairtrace::{Aovs, Device, NoProgress, SceneDescription, write_image};
 //! # fn main() -> hairtrace::Result<()> {
 //! let device = Arc::new(Device::new(None)?);
-//! let built = SceneDescription::from_file("scene.toml".as_ref())?.build(device)?;
+//! let built = SceneDescription::load("scene.toml".as_ref())?.build(device)?;
 //! let out = built.render(Aovs::default(), &NoProgress)?;
 //! let (w, h) = (built.settings.width as usize, built.settings.height as usize);
 //! write_image("out.exr".as_ref(), w, h, 3, out.film.rgb(), &Default::default())?;

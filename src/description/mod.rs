@@ -319,6 +319,31 @@ impl BuiltScene {
     /// new build: the next render is the one of the description built with `material`.
     /// Refused (nothing changed) when no geometry uses `name` or when the material does not
     /// suit its geometries.
+    ///
+    /// A look-development loop: one build, then one render per edit.
+    ///
+    /// ```no_run
+    /// use std::sync::Arc;
+    /// use hairtrace::description::{LightDesc, MaterialDesc};
+    /// use hairtrace::scene::material::{HairColor, HairMaterial};
+    /// use hairtrace::{Aovs, Device, NoProgress, SceneDescription};
+    /// # fn main() -> hairtrace::Result<()> {
+    /// let scene = SceneDescription::load("scene.toml".as_ref())?;
+    /// let mut built = scene.build(Arc::new(scene.render.device()?))?;
+    /// let first = built.render(Aovs::default(), &NoProgress)?;
+    /// let blond = HairMaterial {
+    ///     color: HairColor::Melanin { eumelanin: 0.3, pheomelanin: 0.1 },
+    ///     ..HairMaterial::default()
+    /// };
+    /// built.set_material("hair", &MaterialDesc::Hair(blond))?;
+    /// built.set_lights(&[LightDesc::Distant {
+    ///     direction: [0.0, 1.0, 1.0],
+    ///     irradiance: [3.0; 3],
+    ///     angular_radius_deg: 1.0,
+    /// }])?;
+    /// let second = built.render(Aovs::default(), &NoProgress)?; // no BVH build
+    /// # Ok(()) }
+    /// ```
     pub fn set_material(&mut self, name: &str, material: &MaterialDesc) -> Result<()> {
         let prepared = material.prepare()?;
         let users: Vec<u32> = (self.sources.iter().enumerate())

@@ -90,6 +90,15 @@ impl SceneDescription {
     /// TOML or pbrt scene as it is written, a bare `.hair` or USD groom as a quick look (an
     /// automatic camera, a sky and a key light). What a reader could not carry over is in
     /// [`SceneDescription::notes`].
+    ///
+    /// ```no_run
+    /// # fn main() -> hairtrace::Result<()> {
+    /// let scene = hairtrace::SceneDescription::load("groom.usdc".as_ref())?;
+    /// for note in &scene.notes {
+    ///     eprintln!("warning: {note}");
+    /// }
+    /// # Ok(()) }
+    /// ```
     pub fn load(path: &Path) -> Result<SceneDescription> {
         match SceneFormat::of(path)? {
             SceneFormat::Toml => SceneDescription::from_file(path),

@@ -198,9 +198,7 @@ pub unsafe extern "C" fn ht_scene_add_curves(
             counts: counts.to_vec(),
             colors,
         };
-        let curves = Curves::from_strands(&strands, basis, shape.built())?;
-        let frame = |f: &mut Framing| f.add_strands(&strands);
-        Ok(scene.add_geometry(curves_shape(curves, shape), material_id, frame)?)
+        Ok(scene.add_strands(&strands, basis, shape, material_id)?)
     })
 }
 
@@ -341,9 +339,7 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
             Thickness::Diameter
         };
         let strands = read_hair_file(&path, thickness)?;
-        let curves = Curves::from_strands(&strands, basis, shape.built())?;
-        let frame = |f: &mut Framing| f.add_strands(&strands);
-        Ok(scene.add_geometry(curves_shape(curves, shape), material_id, frame)?)
+        Ok(scene.add_strands(&strands, basis, shape, material_id)?)
     })
 }
 

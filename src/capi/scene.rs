@@ -9,10 +9,11 @@
 
 use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
 use crate::description::assembly::{Assembly, Shape};
-use crate::embree::{Device, Isa};
+use crate::embree::{CurveBasis, Device, Isa};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
 use crate::render::settings::RenderSettings;
+use crate::scene::Strands;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
@@ -86,6 +87,20 @@ impl HtScene {
                 "material_id = {id}: the scene has {} materials",
                 self.materials.len()
             )
+        })
+    }
+
+    /// Adds polyline strands converted for `basis` and `shape`, framed by their points.
+    pub(super) fn add_strands(
+        &mut self,
+        strands: &Strands,
+        basis: CurveBasis,
+        shape: GroomShape,
+        material: u32,
+    ) -> Result<u32> {
+        let curves = Curves::from_strands(strands, basis, shape.built())?;
+        self.add_geometry(curves_shape(curves, shape), material, |f| {
+            f.add_strands(strands)
         })
     }
 

@@ -40,6 +40,7 @@ fn srgb(v: f32) -> f32 {
 fn opts(pixel_type: PixelType) -> WriteOptions {
     WriteOptions {
         pixel_type: Some(pixel_type),
+        ..WriteOptions::default()
     }
 }
 

@@ -89,6 +89,7 @@
 mod build;
 pub mod convert;
 mod demos;
+pub mod farm;
 mod file;
 pub mod pbrt;
 pub mod peer;

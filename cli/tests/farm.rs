@@ -1,8 +1,8 @@
 //! Render farms through the command line: tiles (`render --tile`) assembled (`assemble`)
 //! into the whole-frame render bit for bit, tiles that do not belong together refused, no
 //! tile left by a task killed while writing it, and the job `hairtrace farm` writes run by
-//! openjd-cli, the reference runner of Open Job Description (the Slurm leg is
-//! `scripts/slurm-farm`, docs/farm.md). The library's side of ISA pinning is tested in
+//! openjd-cli, the reference runner of Open Job Description, and by a one-node Slurm
+//! (`scripts/slurm-farm`). The library's side of ISA pinning is tested in
 //! tests/pipeline/farm.rs.
 
 use std::os::unix::process::ExitStatusExt;
@@ -350,6 +350,33 @@ fn openjd_cli_runs_the_farm_template_into_the_whole_frames() {
         ]));
         assert_same_frame(&dir.join(format!("out/frame.000{f}.exr")), &whole);
     }
+}
+
+/// The Slurm job script of `hairtrace farm`, submitted to a one-node Slurm cluster that
+/// `scripts/slurm-farm` starts on localhost (and stops): both assembled frames equal the
+/// whole renders bit for bit. The daemons run as root, so other users skip it.
+#[test]
+fn slurm_runs_the_farm_job_array_into_the_whole_frames() {
+    // SAFETY: geteuid has no preconditions.
+    if unsafe { geteuid() } != 0 {
+        eprintln!("SKIPPED: scripts/slurm-farm starts Slurm's daemons, which needs root");
+        return;
+    }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let out = Command::new(root.join("scripts/slurm-farm"))
+        .env("HAIRTRACE", env!("CARGO_BIN_EXE_hairtrace"))
+        .output()
+        .expect("run scripts/slurm-farm (slurm-wlm and munge come from scripts/setup)");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "scripts/slurm-farm failed: {err}");
+    assert!(
+        err.contains("both frames equal the whole renders bit for bit"),
+        "{err}"
+    );
+}
+
+unsafe extern "C" {
+    fn geteuid() -> u32;
 }
 
 #[test]

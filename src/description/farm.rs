@@ -313,9 +313,11 @@ mod tests {
 
     #[test]
     fn the_header_names_what_changes_pixels_and_not_the_thread_count() {
-        let mut s = RenderSettings::default();
-        s.isa = Some(Isa::Sse2);
-        s.threads = Some(3);
+        let s = RenderSettings {
+            isa: Some(Isa::Sse2),
+            threads: Some(3),
+            ..RenderSettings::default()
+        };
         let h = header(&s, "demo:furball");
         let get = |k: &str| h.iter().find(|(n, _)| n == k).map(|(_, v)| v.as_str());
         assert_eq!(get("hairtrace:spp"), Some("16"));

@@ -47,6 +47,20 @@ bool pixel_type_desc(int code, OIIO::TypeDesc *out) {
     }
 }
 
+// Runs `body`, which returns 0 or 1 and reports its own failures in `err`, and turns any
+// exception into a failure with its message: one unwinding into Rust is undefined
+// behaviour.
+template <typename Body> int guarded(char *err, size_t err_len, Body body) {
+    try {
+        return body();
+    } catch (const std::exception &e) {
+        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
+    } catch (...) {
+        set_error(err, err_len, "OpenImageIO threw an unknown exception");
+    }
+    return 1;
+}
+
 }  // namespace
 
 // An open image file being read: keeps OIIO's reader between the two read calls.
@@ -69,7 +83,7 @@ int hairtrace_oiio_write(const char *path, const char *write_path, int width, in
                   int full_width, int full_height, const char *const *attribute_names,
                   const char *const *attribute_values, size_t attributes, char *err,
                   size_t err_len) {
-    try {
+    return guarded(err, err_len, [&] {
         OIIO::TypeDesc format;
         if (!pixel_type_desc(pixel_type, &format)) {
             set_error(err, err_len, "unknown pixel type code " + std::to_string(pixel_type));
@@ -112,12 +126,7 @@ int hairtrace_oiio_write(const char *path, const char *write_path, int width, in
             return 1;
         }
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
 }
 
 // Opens `path` and reports the size of its first subimage, where that lies in its full
@@ -129,7 +138,7 @@ int hairtrace_oiio_write(const char *path, const char *write_path, int width, in
 int hairtrace_oiio_open(const char *path, OiioInput **handle, int *width, int *height,
                  int *channels, int *origin_and_full, int *integer_format, int *alpha_channel,
                  int *unassociated_alpha, char *err, size_t err_len) {
-    try {
+    return guarded(err, err_len, [&] {
         *handle = nullptr;
         OIIO::ImageSpec config;
         config.attribute("oiio:UnassociatedAlpha", 1);
@@ -156,18 +165,13 @@ int hairtrace_oiio_open(const char *path, OiioInput **handle, int *width, int *h
         *unassociated_alpha = spec.get_int_attribute("oiio:UnassociatedAlpha", 0) ? 1 : 0;
         *handle = new OiioInput{std::move(in)};
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
 }
 
 // Reads the whole first subimage as interleaved floats into `pixels`, which holds
 // `len` floats (width * height * channels from hairtrace_oiio_open).
 int hairtrace_oiio_read(OiioInput *handle, float *pixels, size_t len, char *err, size_t err_len) {
-    try {
+    return guarded(err, err_len, [&] {
         const OIIO::ImageSpec &spec = handle->in->spec();
         size_t expected = size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels);
         if (len != expected) {
@@ -180,12 +184,7 @@ int hairtrace_oiio_read(OiioInput *handle, float *pixels, size_t len, char *err,
             return 1;
         }
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
 }
 
 // The open file's string attributes as NUL-terminated names and values one after the
@@ -193,7 +192,7 @@ int hairtrace_oiio_read(OiioInput *handle, float *pixels, size_t len, char *err,
 // buffer was too small (nothing is written then) calls again with a larger one.
 int hairtrace_oiio_attributes(OiioInput *handle, char *buf, size_t len, size_t *needed,
                               char *err, size_t err_len) {
-    try {
+    return guarded(err, err_len, [&] {
         std::string all;
         for (const OIIO::ParamValue &p : handle->in->spec().extra_attribs) {
             if (p.type() != OIIO::TypeDesc::STRING || p.nvalues() != 1)
@@ -207,12 +206,7 @@ int hairtrace_oiio_attributes(OiioInput *handle, char *buf, size_t len, size_t *
         if (all.size() <= len && !all.empty())
             std::memcpy(buf, all.data(), all.size());
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
 }
 
 // Closes the file and frees the handle; NULL is a no-op.

@@ -221,7 +221,8 @@ struct RenderArgs {
     aov: Vec<String>,
     /// Render tile I of N (from 1; a grid over the frame, the same on every machine)
     /// instead of the whole frame: -o then names the frame (.exr), and the tile goes beside
-    /// it as `NAME.tile-I-of-N.exr`, for `hairtrace assemble`.
+    /// it as `NAME.tile-I-of-N.exr` (an AOV's as `NAME.AOV.tile-I-of-N.exr`), for
+    /// `hairtrace assemble`.
     #[arg(long, value_name = "I/N", value_parser = parse_tile)]
     tile: Option<(u32, u32)>,
     /// The frame number: replaces the run of # in -o (`frame.####.exr` with 7:
@@ -460,16 +461,18 @@ fn numbered(output: &Path, frame: Option<u32>) -> hairtrace::Result<PathBuf> {
 
 fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let frame = numbered(&args.output, args.frame_number)?;
-    let output = match args.tile {
-        Some((i, n)) if has_extension(&frame, "exr") => tile_path(&frame, i, n),
-        Some(_) => {
-            return Err(hairtrace::Error::InvalidArg(format!(
-                "--tile: {} must be an .exr (float pixels, and the header assemble checks)",
-                frame.display()
-            )));
-        }
-        None => frame,
+    if args.tile.is_some() && !has_extension(&frame, "exr") {
+        return Err(hairtrace::Error::InvalidArg(format!(
+            "--tile: {} must be an .exr (float pixels, and the header assemble checks)",
+            frame.display()
+        )));
+    }
+    // Where an image of the frame goes: the image itself, or its tile.
+    let place = |image: PathBuf| match args.tile {
+        Some((i, n)) => tile_path(&image, i, n),
+        None => image,
     };
+    let output = place(frame.clone());
     // Refuse an output the writer will not take before spending minutes on the render.
     image::check_output_path(&output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
@@ -536,7 +539,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let aov_paths: Vec<(PathBuf, &str)> = args
         .aov
         .iter()
-        .map(|a| (tiles::tagged_path(&output, a), a.as_str()))
+        .map(|a| (place(tiles::tagged_path(&frame, a)), a.as_str()))
         .collect();
     for (path, _) in &aov_paths {
         image::check_output_path(path)?;

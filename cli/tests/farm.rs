@@ -97,14 +97,21 @@ fn assert_same_frame(a: &Path, b: &Path) {
 
 /// Four tiles rendered by four processes, with another thread count than the whole
 /// render, assemble into that render: the same bits, the same frame, the same header
-/// (every setting, the scene, the kernels and the version).
+/// (every setting, the scene, the kernels and the version); so do the tiles of an AOV.
 #[test]
 fn tiles_assemble_into_the_whole_frame_bit_for_bit() {
     let dir = scratch("farm_assemble");
     let (whole, frame) = (dir.join("whole.exr"), dir.join("frame.exr"));
-    ok(render(&["--threads", "1", "-o", text(&whole)]));
+    ok(render(&[
+        "--threads",
+        "1",
+        "--aov",
+        "depth",
+        "-o",
+        text(&whole),
+    ]));
     for i in 1..=4 {
-        ok(tile(&frame, i, &[]));
+        ok(tile(&frame, i, &["--aov", "depth"]));
     }
     let tile2 = read_image(&dir.join("frame.tile-2-of-4.exr")).unwrap();
     assert_eq!(
@@ -115,6 +122,10 @@ fn tiles_assemble_into_the_whole_frame_bit_for_bit() {
     assert_eq!(tile2.attribute("hairtrace:tile"), Some("2/4"));
     ok(assemble(&frame));
     assert_same_frame(&frame, &whole);
+    // An AOV's tiles assemble the same way, under its own name.
+    let depth = dir.join("frame.depth.exr");
+    ok(assemble(&depth));
+    assert_same_frame(&depth, &dir.join("whole.depth.exr"));
 }
 
 /// The error of an assembly that must fail, which must leave no frame behind.

@@ -126,29 +126,39 @@ impl Job {
     }
 
     /// The Open Job Description template (jobtemplate-2023-09), as JSON, to be written in
-    /// `folder`: the specification takes the defaults of paths relative to it.
-    pub fn openjd(&self, folder: &Path) -> String {
-        let relative = |path: &Path| {
-            pathdiff::diff_paths(path, folder)
-                .unwrap_or_else(|| path.to_path_buf())
-                .display()
-                .to_string()
+    /// `folder`, and the path parameters left without a default: the specification takes
+    /// a path's default only relative to the template's folder and inside it, so a path
+    /// elsewhere is given at submission (`-p Scene=...`).
+    pub fn openjd(&self, folder: &Path) -> (String, Vec<&'static str>) {
+        let mut undefaulted = Vec::new();
+        let mut path_param = |name: &'static str, path: &Path, flow: &str, about: &str| {
+            let mut param = serde_json::json!({
+                "name": name, "type": "PATH", "objectType": "FILE", "dataFlow": flow,
+                "description": about,
+            });
+            match pathdiff::diff_paths(path, folder).filter(|p| !p.starts_with("..")) {
+                Some(inside) => param["default"] = inside.display().to_string().into(),
+                None => undefaulted.push(name),
+            }
+            param
         };
         let mut params = Vec::new();
         if let Scene::File(path) = &self.scene {
-            params.push(serde_json::json!({
-                "name": "Scene", "type": "PATH", "objectType": "FILE", "dataFlow": "IN",
-                "default": relative(path),
-                "description": "The scene file every task renders.",
-            }));
+            params.push(path_param(
+                "Scene",
+                path,
+                "IN",
+                "The scene file every task renders.",
+            ));
         }
+        params.push(path_param(
+            "Output",
+            &self.output,
+            "OUT",
+            "The frames (.exr), with a run of # for the frame number; the tiles are written \
+             beside them.",
+        ));
         params.extend([
-            serde_json::json!({
-                "name": "Output", "type": "PATH", "objectType": "FILE", "dataFlow": "OUT",
-                "default": relative(&self.output),
-                "description": "The frames (.exr), with a run of # for the frame number; the \
-                                tiles are written beside them.",
-            }),
             serde_json::json!({
                 "name": "Frames", "type": "STRING",
                 "default": format!("{}-{}", self.first, self.last),
@@ -241,7 +251,7 @@ impl Job {
         });
         let mut text = serde_json::to_string_pretty(&template).expect("JSON values serialise");
         text.push('\n');
-        text
+        (text, undefaulted)
     }
 
     /// The Slurm script: run with bash, it submits itself as a job array of render tasks

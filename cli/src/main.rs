@@ -100,7 +100,8 @@ struct AssembleArgs {
 #[derive(Args)]
 struct FarmArgs {
     /// A scene description (.toml), a pbrt-v4 scene (.pbrt) or a groom (.hair, USD), as
-    /// `render` takes it; the job names it by its absolute path.
+    /// `render` takes it (the Slurm script names it by its absolute path, the OpenJD
+    /// template relative to its own folder).
     scene: Option<PathBuf>,
     /// A built-in scene instead of a file: furball (the default), furnace, scalp.
     #[arg(long, conflicts_with = "scene")]
@@ -738,12 +739,19 @@ fn farm_job(args: &FarmArgs) -> hairtrace::Result<()> {
     if let Some(path) = &args.openjd {
         let folder = std::path::absolute(path).map_err(|e| hairtrace::Error::io(path, e))?;
         let folder = folder.parent().unwrap_or(Path::new("/"));
-        farm::write_file(path, &job.openjd(folder))?;
+        let (template, undefaulted) = job.openjd(folder);
+        farm::write_file(path, &template)?;
         eprintln!(
             "{}: Open Job Description template ({})",
             path.display(),
             job.summary()
         );
+        for name in undefaulted {
+            eprintln!(
+                "hairtrace: note: {name} has no default (Open Job Description takes only \
+                 paths inside the template's folder): give it at submission, -p {name}=PATH"
+            );
+        }
     }
     if let Some(path) = &args.slurm {
         farm::write_file(path, &job.slurm())?;

@@ -256,8 +256,13 @@ fn a_task_killed_while_writing_leaves_no_tile_and_its_rerun_gives_the_frame() {
 }
 
 /// The venv with openjd-cli 0.8 under target/ (made once, then reused), or None when PyPI
-/// cannot be reached (said on stderr).
+/// cannot be reached (said on stderr). One test thread makes it; the others wait.
 fn openjd() -> Option<PathBuf> {
+    static VENV: std::sync::OnceLock<Option<PathBuf>> = std::sync::OnceLock::new();
+    VENV.get_or_init(make_openjd_venv).clone()
+}
+
+fn make_openjd_venv() -> Option<PathBuf> {
     let venv = Path::new(env!("CARGO_TARGET_TMPDIR")).join("openjd-venv");
     let bin = venv.join("bin/openjd");
     if bin.exists() {
@@ -288,6 +293,21 @@ fn openjd() -> Option<PathBuf> {
         return None;
     }
     Some(bin)
+}
+
+/// `openjd run` of the whole job (the Assemble step and the Render step it depends on),
+/// with job parameters `params`, which must succeed.
+fn run_job(openjd: &Path, template: &Path, params: &[&str]) {
+    let run = Command::new(openjd)
+        .arg("run")
+        .arg(template)
+        .args(["--step", "Assemble", "--run-dependencies"])
+        .args(params)
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&run.stdout);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "openjd run: {log}{err}");
 }
 
 /// The Open Job Description template of `hairtrace farm`, run by openjd-cli: 2 frames x 4
@@ -330,22 +350,7 @@ fn openjd_cli_runs_the_farm_template_into_the_whole_frames() {
         .output()
         .unwrap();
     assert!(check.status.success(), "openjd check: {check:?}");
-    let run = Command::new(&openjd)
-        .args([
-            "run",
-            text(&template),
-            "--step",
-            "Assemble",
-            "--run-dependencies",
-        ])
-        .output()
-        .unwrap();
-    let log = String::from_utf8_lossy(&run.stdout);
-    assert!(
-        run.status.success(),
-        "openjd run: {log}{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    run_job(&openjd, &template, &[]);
     for f in [1, 2] {
         let whole = dir.join(format!("whole.{f}.exr"));
         let (seed, frame) = (format!("seed={f}"), f.to_string());
@@ -361,6 +366,46 @@ fn openjd_cli_runs_the_farm_template_into_the_whole_frames() {
         ]));
         assert_same_frame(&dir.join(format!("out/frame.000{f}.exr")), &whole);
     }
+}
+
+/// A scene file outside the template's folder: the template gives `Scene` no default (the
+/// specification takes none outside its folder), farm says so, and the job runs with the
+/// scene given at submission into the whole frame.
+#[test]
+fn openjd_cli_runs_a_scene_file_given_at_submission() {
+    let Some(openjd) = openjd() else { return };
+    let dir = scratch("farm_openjd_scene");
+    std::fs::create_dir(dir.join("out")).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let scene = root.join("examples/scenes/fur_ball.toml");
+    let template = dir.join("job.json");
+    let size = [
+        "--width", "32", "--height", "24", "--spp", "1", "--isa", "sse2",
+    ];
+    let mut args = vec!["farm", text(&scene)];
+    args.extend(size);
+    args.extend(["--frames", "3", "--tiles", "2", "--output"]);
+    let output = dir.join("out/f.##.exr");
+    args.extend([
+        text(&output),
+        "--hairtrace",
+        env!("CARGO_BIN_EXE_hairtrace"),
+    ]);
+    args.extend(["--openjd", text(&template)]);
+    let farm = ok(hairtrace(&args));
+    let note = String::from_utf8_lossy(&farm.stderr);
+    assert!(note.contains("Scene has no default"), "{note}");
+    run_job(
+        &openjd,
+        &template,
+        &["-p", &format!("Scene={}", text(&scene))],
+    );
+    let mut whole = vec!["render", text(&scene)];
+    whole.extend(size);
+    let pattern = dir.join("whole.#.exr");
+    whole.extend(["--seed", "3", "--frame", "3", "-o", text(&pattern)]);
+    ok(hairtrace(&whole));
+    assert_same_frame(&dir.join("out/f.03.exr"), &dir.join("whole.3.exr"));
 }
 
 /// The Slurm job script of `hairtrace farm`, submitted to a one-node Slurm cluster that

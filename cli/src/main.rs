@@ -2,9 +2,11 @@
 //! `info` describes a .hair groom; `lobes` prints how a hair splits energy between its
 //! lobes; `compare` measures how far a render is from a reference; `export` writes a
 //! scene for a peer renderer; `report` measures speed against error and writes REPORT.md;
-//! `convert` takes grooms between .hair and USD.
+//! `convert` takes grooms between .hair and USD; `farm` writes render-farm jobs whose tiles
+//! `assemble` puts together.
 
 mod export;
+mod farm;
 mod report;
 mod settings;
 
@@ -14,20 +16,21 @@ use glam::Vec3;
 use hairtrace::bsdf::{
     DEFAULT_EUMELANIN, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset,
 };
+use hairtrace::description::farm::{self as tiles, frame_path, tile_path};
 use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, has_extension};
 use hairtrace::embree::CurveBasis;
 use hairtrace::formats::convert::{self, ConvertOptions, ConvertSource};
 use hairtrace::formats::hair::{Thickness, info_report, read_hair_file};
 use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::formats::{SceneFormat, usd};
-use hairtrace::image::{self, WriteOptions};
+use hairtrace::image::{self, Placement, WriteOptions};
 use hairtrace::render::{Aovs, Progress, renderer};
 use hairtrace::scene::material::HairColor;
 use hairtrace::scene::{GroomShape, Stage, StageProgress};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
 use settings::SettingArgs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 
@@ -72,6 +75,61 @@ enum Command {
     /// scene's [render] table, `render --NAME`/`--set NAME=VALUE` and the C ABI's
     /// `ht_settings_set` take.
     Settings,
+    /// Assemble a frame from the tiles `render --tile I/N` wrote: every tile must be
+    /// there, hold its window, and come from the same render (scene, settings, seed, ISA,
+    /// hairtrace version, as their EXR headers say); the frame keeps that header.
+    Assemble(AssembleArgs),
+    /// Write a render-farm job for a scene: an Open Job Description template (what AWS
+    /// Deadline Cloud and `openjd run` take) and/or a Slurm job-array script, frames x
+    /// tiles rendered with the ISA pinned, then one assembly per frame (docs/farm.md).
+    Farm(Box<FarmArgs>),
+}
+
+#[derive(Args)]
+struct AssembleArgs {
+    /// The frame to write (.exr); its tiles are beside it, as `render --tile` names them
+    /// (`frame.tile-I-of-N.exr`).
+    frame: PathBuf,
+    /// How many tiles the frame was split into.
+    #[arg(long)]
+    tiles: u32,
+    /// The frame number, for a FRAME with a run of # (`frame.####.exr`).
+    #[arg(long = "frame")]
+    frame_number: Option<u32>,
+}
+
+#[derive(Args)]
+struct FarmArgs {
+    /// A scene description (.toml), a pbrt-v4 scene (.pbrt) or a groom (.hair, USD), as
+    /// `render` takes it (the Slurm script names it by its absolute path, the OpenJD
+    /// template relative to its own folder).
+    scene: Option<PathBuf>,
+    /// A built-in scene instead of a file: furball (the default), furnace, scalp.
+    #[arg(long, conflicts_with = "scene")]
+    demo: Option<String>,
+    /// The frames, F or FIRST-LAST; frame F is rendered with seed F.
+    #[arg(long, default_value = "1")]
+    frames: String,
+    /// Tiles per frame (a grid, `render --tile`).
+    #[arg(long, default_value_t = 4)]
+    tiles: u32,
+    /// The frames' path, with a run of # for the frame number (`shots/a/frame.####.exr`;
+    /// made absolute). The tiles go beside it.
+    #[arg(long, value_name = "PATTERN.exr")]
+    output: PathBuf,
+    /// The hairtrace binary the tasks run (a job parameter: the workers' path may differ).
+    #[arg(long, default_value = "hairtrace")]
+    hairtrace: String,
+    /// Write the Open Job Description template (JSON) here.
+    #[arg(long, value_name = "FILE.json")]
+    openjd: Option<PathBuf>,
+    /// Write the Slurm job script here (`bash FILE` submits it).
+    #[arg(long, value_name = "FILE.sh")]
+    slurm: Option<PathBuf>,
+    /// The render settings every task uses, over the scene's: spp, isa and threads become
+    /// the job's parameters (isa must be pinned), the others are fixed in its commands.
+    #[command(flatten)]
+    settings: SettingArgs,
 }
 
 #[derive(Args)]
@@ -163,6 +221,16 @@ struct RenderArgs {
     /// before the extension: albedo (RGB), depth (camera distance), strand (strand id).
     #[arg(long, value_delimiter = ',', value_parser = ["albedo", "depth", "strand"])]
     aov: Vec<String>,
+    /// Render tile I of N (from 1; a grid over the frame, the same on every machine)
+    /// instead of the whole frame: -o then names the frame (.exr), and the tile goes beside
+    /// it as `NAME.tile-I-of-N.exr` (an AOV's as `NAME.AOV.tile-I-of-N.exr`), for
+    /// `hairtrace assemble`.
+    #[arg(long, value_name = "I/N", value_parser = parse_tile)]
+    tile: Option<(u32, u32)>,
+    /// The frame number: replaces the run of # in -o (`frame.####.exr` with 7:
+    /// `frame.0007.exr`) and is written into the image's header.
+    #[arg(long = "frame")]
+    frame_number: Option<u32>,
 }
 
 #[derive(Args)]
@@ -215,6 +283,18 @@ where
         .map_err(|e| format!("{s:?}: {e}"))?;
     v.try_into()
         .map_err(|_| format!("{s:?}: expected {N} comma-separated numbers"))
+}
+
+/// "I/N", tile I of N.
+fn parse_tile(s: &str) -> Result<(u32, u32), String> {
+    let [i, n] = s
+        .split_once('/')
+        .map(|(i, n)| [i, n].map(|v| v.trim().parse::<u32>()))
+        .ok_or_else(|| format!("{s:?}: must be I/N, tile I of N"))?;
+    Ok((
+        i.map_err(|e| format!("{s:?}: {e}"))?,
+        n.map_err(|e| format!("{s:?}: {e}"))?,
+    ))
 }
 
 fn parse_basis(name: &str) -> Result<CurveBasis, String> {
@@ -351,9 +431,40 @@ fn export(args: &ExportArgs) -> hairtrace::Result<()> {
     export_for_peer(&description, &args.output)
 }
 
+/// What the header calls a scene: a file by its name (the same on every machine of a farm,
+/// wherever its folder is mounted), a demo as `demo:NAME`.
+fn scene_label(scene: Option<&PathBuf>, demo: Option<&str>) -> String {
+    match scene {
+        Some(path) => path
+            .file_name()
+            .unwrap_or_default()
+            .to_string_lossy()
+            .into_owned(),
+        None => format!("demo:{}", demo.unwrap_or("furball")),
+    }
+}
+
+/// `-o` with its run of # replaced by the frame number, if one is given.
+fn numbered(output: &Path, frame: Option<u32>) -> hairtrace::Result<PathBuf> {
+    frame.map_or_else(|| Ok(output.to_path_buf()), |f| frame_path(output, f))
+}
+
 fn render(args: &RenderArgs) -> hairtrace::Result<()> {
+    let frame = numbered(&args.output, args.frame_number)?;
+    if args.tile.is_some() && !has_extension(&frame, "exr") {
+        return Err(hairtrace::Error::InvalidArg(format!(
+            "--tile: {} must be an .exr (float pixels, and the header assemble checks)",
+            frame.display()
+        )));
+    }
+    // Where an image of the frame goes: the image itself, or its tile.
+    let place = |image: PathBuf| match args.tile {
+        Some((i, n)) => tile_path(&image, i, n),
+        None => image,
+    };
+    let output = place(frame.clone());
     // Refuse an output the writer will not take before spending minutes on the render.
-    image::check_output_path(&args.output)?;
+    image::check_output_path(&output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
     if let Some(sigma_a) = args.preset {
         if !args
@@ -385,6 +496,15 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     }
     // Overrides go into the description, so that the camera's aspect follows the size.
     args.settings.apply(&mut description.render)?;
+    if let Some((i, n)) = args.tile {
+        let r = &mut description.render;
+        if r.crop.is_some() {
+            return Err(hairtrace::Error::InvalidArg(
+                "--tile and crop both choose the pixels to render: give one".into(),
+            ));
+        }
+        r.crop = Some(tiles::tile_window(r.width, r.height, i, n)?);
+    }
     let r = &description.render;
     let build_start = std::time::Instant::now();
     let device = Arc::new(r.device()?);
@@ -409,7 +529,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let aov_paths: Vec<(PathBuf, &str)> = args
         .aov
         .iter()
-        .map(|a| (aov_path(&args.output, a), a.as_str()))
+        .map(|a| (place(tiles::tagged_path(&frame, a)), a.as_str()))
         .collect();
     for (path, _) in &aov_paths {
         image::check_output_path(path)?;
@@ -417,11 +537,31 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let out = renderer::render(&world, &camera, &settings, aovs, &Bar(bar.clone()))?;
     bar.finish_and_clear();
     let window = out.film.crop();
+    let mut attributes = tiles::header(
+        &settings,
+        &scene_label(args.scene.as_ref(), args.demo.as_deref()),
+    );
+    if let Some((i, n)) = args.tile {
+        attributes.push((format!("{}tile", tiles::PREFIX), format!("{i}/{n}")));
+    }
+    if let Some(f) = args.frame_number {
+        attributes.push((format!("{}frame", tiles::PREFIX), f.to_string()));
+    }
+    let opts = WriteOptions {
+        placement: Some(Placement {
+            x: window.x0 as usize,
+            y: window.y0 as usize,
+            full_width: settings.width as usize,
+            full_height: settings.height as usize,
+        }),
+        attributes,
+        ..WriteOptions::default()
+    };
     let write = |path: &PathBuf, channels: usize, pixels: &[f32]| {
         let (w, h) = (window.width() as usize, window.height() as usize);
-        image::write_image(path, w, h, channels, pixels, &WriteOptions::default())
+        image::write_image(path, w, h, channels, pixels, &opts)
     };
-    write(&args.output, 3, out.film.rgb())?;
+    // The AOVs first: an image at `output` means that its render finished.
     for (path, name) in &aov_paths {
         let (channels, pixels) = match *name {
             "albedo" => (3, out.film.albedo()),
@@ -434,10 +574,11 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
             pixels.expect("the film keeps every AOV asked for"),
         )?;
     }
+    write(&output, 3, out.film.rgb())?;
     let s = out.stats;
     eprintln!(
         "{}: {}x{} at {} spp in {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s, peak memory {}",
-        args.output.display(),
+        output.display(),
         window.width(),
         window.height(),
         settings.spp,
@@ -460,7 +601,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
             "spp": settings.spp,
             "threads": settings.threads.unwrap_or_else(rayon::current_num_threads),
         });
-        std::fs::write(path, format!("{json}\n")).map_err(|e| hairtrace::Error::io(path, e))?;
+        farm::write_file(path, &format!("{json}\n"))?;
     }
     if out.film.rejected_samples() > 0 {
         eprintln!(
@@ -469,19 +610,6 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         );
     }
     Ok(())
-}
-
-/// `out.exr` -> `out.albedo.exr`.
-fn aov_path(output: &std::path::Path, aov: &str) -> PathBuf {
-    let stem = output
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let ext = output
-        .extension()
-        .map(|e| e.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    output.with_file_name(format!("{stem}.{aov}.{ext}"))
 }
 
 /// The process's peak resident memory, from Linux's /proc ("unknown" elsewhere).
@@ -568,6 +696,73 @@ fn convert_groom(args: &ConvertArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
+fn assemble(args: &AssembleArgs) -> hairtrace::Result<()> {
+    let frame = numbered(&args.frame, args.frame_number)?;
+    let done = tiles::assemble(&frame, args.tiles)?;
+    eprintln!(
+        "{}: {} tiles assembled into the {}x{} frame",
+        frame.display(),
+        done.tiles,
+        done.width,
+        done.height
+    );
+    Ok(())
+}
+
+fn farm_job(args: &FarmArgs) -> hairtrace::Result<()> {
+    let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
+    args.settings.apply(&mut description.render)?;
+    let scene = match (&args.scene, &args.demo) {
+        (Some(path), _) => {
+            farm::Scene::File(std::path::absolute(path).map_err(|e| hairtrace::Error::io(path, e))?)
+        }
+        (None, demo) => farm::Scene::Demo(demo.clone().unwrap_or_else(|| "furball".into())),
+    };
+    let output =
+        std::path::absolute(&args.output).map_err(|e| hairtrace::Error::io(&args.output, e))?;
+    let job = farm::Job::new(
+        scene,
+        &description.render,
+        &args.settings,
+        &args.frames,
+        args.tiles,
+        output,
+        args.hairtrace.clone(),
+    )?;
+    if args.openjd.is_none() && args.slurm.is_none() {
+        return Err(hairtrace::Error::InvalidArg(
+            "farm: name the job to write: --openjd FILE.json and/or --slurm FILE.sh".into(),
+        ));
+    }
+    if let Some(path) = &args.openjd {
+        let folder = std::path::absolute(path).map_err(|e| hairtrace::Error::io(path, e))?;
+        let folder = folder.parent().unwrap_or(Path::new("/"));
+        let (template, undefaulted) = job.openjd(folder);
+        farm::write_file(path, &template)?;
+        eprintln!(
+            "{}: Open Job Description template ({})",
+            path.display(),
+            job.summary()
+        );
+        for name in undefaulted {
+            eprintln!(
+                "hairtrace: note: {name} has no default (Open Job Description takes only \
+                 paths inside the template's folder): give it at submission, -p {name}=PATH"
+            );
+        }
+    }
+    if let Some(path) = &args.slurm {
+        farm::write_file(path, &job.slurm())?;
+        eprintln!(
+            "{}: Slurm job script, `bash {}` submits it ({})",
+            path.display(),
+            path.display(),
+            job.summary()
+        );
+    }
+    Ok(())
+}
+
 fn compare(args: &CompareArgs) -> hairtrace::Result<()> {
     let c = image::compare(
         &image::read_image(&args.image)?,
@@ -631,6 +826,8 @@ fn main() -> ExitCode {
             print!("{}", settings::markdown());
             Ok(())
         }
+        Command::Assemble(a) => assemble(a),
+        Command::Farm(a) => farm_job(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -89,6 +89,7 @@
 pub(crate) mod assembly;
 mod build;
 mod demos;
+pub mod farm;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;

@@ -84,6 +84,16 @@ impl Isa {
         }
     }
 
+    /// The widest ISA this CPU runs: the kernels an unpinned device gets from Embree's
+    /// builds, which carry all four.
+    pub fn widest_here() -> Option<Isa> {
+        Isa::widest(Isa::runs_here)
+    }
+
+    fn widest(runs: impl Fn(Isa) -> bool) -> Option<Isa> {
+        Isa::ALL.into_iter().rev().find(|&isa| runs(isa))
+    }
+
     /// Refuses an ISA this CPU cannot run, naming the widest one it can.
     pub(super) fn check_runs_here(self) -> Result<()> {
         self.check_runs(Isa::runs_here)
@@ -94,7 +104,7 @@ impl Isa {
         if runs(self) {
             return Ok(());
         }
-        let widest = Isa::ALL.into_iter().rev().find(|&isa| runs(isa));
+        let widest = Isa::widest(&runs);
         Err(invalid_arg!(
             "isa = {:?}: this CPU cannot run Embree's {} kernels (the widest it runs: {})",
             self.name(),

@@ -67,12 +67,7 @@ mod tests {
     use super::*;
 
     fn image(pixels: Vec<f32>, channels: usize) -> Image {
-        Image {
-            width: 2,
-            height: 1,
-            channels,
-            pixels,
-        }
+        Image::new(2, 1, channels, pixels)
     }
 
     #[test]
@@ -91,10 +86,7 @@ mod tests {
     #[test]
     fn mismatches_are_errors() {
         let a = image(vec![0.0; 6], 3);
-        let wide = Image {
-            width: 3,
-            ..image(vec![0.0; 9], 3)
-        };
+        let wide = Image::new(3, 1, 3, vec![0.0; 9]);
         assert!(compare(&a, &wide).unwrap_err().to_string().contains("size"));
         assert!(compare(&image(vec![0.0; 2], 1), &a).is_err());
         let nan = image(vec![f32::NAN, 0.0, 0.0, 0.0, 0.0, 0.0], 3);

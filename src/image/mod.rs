@@ -7,7 +7,10 @@
 
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 
-use ffi::{hairtrace_oiio_close, hairtrace_oiio_open, hairtrace_oiio_read, hairtrace_oiio_write};
+use ffi::{
+    hairtrace_oiio_attributes, hairtrace_oiio_close, hairtrace_oiio_open, hairtrace_oiio_read,
+    hairtrace_oiio_write,
+};
 use std::path::Path;
 
 use crate::error::invalid_arg;
@@ -46,10 +49,27 @@ impl PixelType {
 }
 
 /// Options for [`write_image`]. The file format always comes from the path's extension.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct WriteOptions {
     /// `None` picks the format's natural type: F32 for EXR, U8 for PNG, JPEG and TIFF.
     pub pixel_type: Option<PixelType>,
+    /// Where the pixels lie in a larger frame (a crop), for EXR, which stores it; other
+    /// formats store the pixels alone. `None`: they are the whole frame.
+    pub placement: Option<Placement>,
+    /// String attributes for the header, as (name, value): what rendered the image, for
+    /// whoever reads it later (formats without such a header drop them).
+    pub attributes: Vec<(String, String)>,
+}
+
+/// Where an image's pixels lie in a larger frame: a `width` x `height` window at (`x`, `y`)
+/// of a `full_width` x `full_height` frame, which EXR stores as its data window inside its
+/// display window (so OIIO, Nuke and others place a crop where it belongs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Placement {
+    pub x: usize,
+    pub y: usize,
+    pub full_width: usize,
+    pub full_height: usize,
 }
 
 /// An image read back as interleaved linear floats, row by row from the top.
@@ -61,6 +81,45 @@ pub struct Image {
     /// `width * height * channels` values; channel `c` of pixel `(x, y)` is at
     /// `(y * width + x) * channels + c`.
     pub pixels: Vec<f32>,
+    /// Where the pixels lie in the file's full frame (at (0, 0) of a frame their size,
+    /// unless the file says otherwise).
+    pub placement: Placement,
+    /// The header's string attributes, as (name, value).
+    pub attributes: Vec<(String, String)>,
+}
+
+impl Placement {
+    /// A `width` x `height` image that is its whole frame.
+    pub fn whole(width: usize, height: usize) -> Placement {
+        Placement {
+            x: 0,
+            y: 0,
+            full_width: width,
+            full_height: height,
+        }
+    }
+}
+
+impl Image {
+    /// Pixels that are a whole frame, with no attributes.
+    pub fn new(width: usize, height: usize, channels: usize, pixels: Vec<f32>) -> Image {
+        Image {
+            width,
+            height,
+            channels,
+            pixels,
+            placement: Placement::whole(width, height),
+            attributes: Vec::new(),
+        }
+    }
+
+    /// The value of the header attribute `name`.
+    pub fn attribute(&self, name: &str) -> Option<&str> {
+        self.attributes
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v.as_str())
+    }
 }
 
 /// The formats `write_image` knows, each with the pixel types it can store.
@@ -127,6 +186,11 @@ pub fn check_output_path(path: &Path) -> Result<()> {
 /// Writes interleaved linear pixels (`channels` values per pixel, rows from the top) to
 /// `path`, in the format its extension names.
 ///
+/// The file is written under a temporary name of its own in the same folder (a hidden
+/// `.NAME.XXXXXX.part`) and renamed to `path` only once complete: a process killed while
+/// writing leaves no file at `path` that could pass for a good one, and two processes
+/// writing the same `path` at once leave one whole image, never a mix.
+///
 /// Channels are grey, grey + alpha, RGB or RGBA. Alpha, when present, is premultiplied
 /// (associated), as in EXR and in a renderer's film.
 ///
@@ -183,31 +247,98 @@ pub fn write_image(
         pixels
     };
 
-    let c_path = c_path(path)?;
+    let whole = Placement::whole(width, height);
+    let placement = opts.placement.unwrap_or(whole);
+    check_placement(&placement, width, height)?;
+    let placement = if format == Format::Exr {
+        placement
+    } else {
+        whole
+    };
+    let text = |t: &str| {
+        CString::new(t).map_err(|_| invalid_arg!("image attribute {t:?} contains a NUL byte"))
+    };
+    let names = (opts.attributes.iter().map(|(n, _)| text(n))).collect::<Result<Vec<_>>>()?;
+    let values = (opts.attributes.iter().map(|(_, v)| text(v))).collect::<Result<Vec<_>>>()?;
+    let name_ptrs: Vec<*const c_char> = names.iter().map(|n| n.as_ptr()).collect();
+    let value_ptrs: Vec<*const c_char> = values.iter().map(|v| v.as_ptr()).collect();
+
+    let c_final = c_path(path)?;
+    let cannot = |why: String| Error::Image(format!("cannot write {}: {why}", path.display()));
+    let temporary = temporary_beside(path).map_err(|e| cannot(e.to_string()))?;
+    let c_temporary = c_path(temporary.path())?;
     let mut err = [0 as c_char; ERR_LEN];
-    // SAFETY: `data` holds width*height*channels floats (checked above), the sizes fit
-    // in c_int (checked in `check_size`), and `err` is a writable buffer of ERR_LEN.
+    // SAFETY: `data` holds width*height*channels floats (checked above), the sizes and the
+    // placement fit in c_int (checked in `check_size` and `check_placement`), the two
+    // attribute arrays hold `names.len()` live C strings each, and `err` is a writable
+    // buffer of ERR_LEN.
     let status = unsafe {
         hairtrace_oiio_write(
-            c_path.as_ptr(),
+            c_final.as_ptr(),
+            c_temporary.as_ptr(),
             width as c_int,
             height as c_int,
             channels as c_int,
             data.as_ptr(),
             pixel_type.code(),
             c_int::from(pixel_type.is_integer()),
+            placement.x as c_int,
+            placement.y as c_int,
+            placement.full_width as c_int,
+            placement.full_height as c_int,
+            name_ptrs.as_ptr(),
+            value_ptrs.as_ptr(),
+            name_ptrs.len(),
             err.as_mut_ptr(),
             ERR_LEN,
         )
     };
     if status != 0 {
-        return Err(Error::Image(format!(
-            "cannot write {}: {}",
-            path.display(),
-            message(&err)
-        )));
+        // Dropping `temporary` removes the incomplete file.
+        return Err(cannot(message(&err)));
     }
+    temporary
+        .persist(path)
+        .map_err(|e| cannot(e.error.to_string()))?;
     Ok(())
+}
+
+/// An empty file of a unique name in `path`'s folder (so that the rename is atomic),
+/// hidden from `*` globs, readable as a file created with `File::create` would be. It is
+/// removed when dropped unless persisted.
+fn temporary_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let name = path.file_name().unwrap_or_default().to_string_lossy();
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{name}.");
+    builder.prefix(&prefix).suffix(".part");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        // tempfile's default is 0600; the umask applies to this as to any new file.
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(folder)
+}
+
+fn check_placement(p: &Placement, width: usize, height: usize) -> Result<()> {
+    let fits = |v: usize| c_int::try_from(v).is_ok();
+    let inside = p.x.checked_add(width).is_some_and(|r| r <= p.full_width)
+        && p.y.checked_add(height).is_some_and(|b| b <= p.full_height);
+    if inside && fits(p.full_width) && fits(p.full_height) {
+        Ok(())
+    } else {
+        Err(invalid_arg!(
+            "a {width}x{height} image at ({}, {}) does not fit in its {}x{} frame",
+            p.x,
+            p.y,
+            p.full_width,
+            p.full_height
+        ))
+    }
 }
 
 /// Reads the first subimage of `path` as linear floats with premultiplied alpha, the
@@ -225,8 +356,10 @@ pub fn read_image(path: &Path) -> Result<Image> {
     let mut err = [0 as c_char; ERR_LEN];
     let mut handle: *mut c_void = std::ptr::null_mut();
     let (mut width, mut height, mut channels) = (0, 0, 0);
+    let mut origin_and_full: [c_int; 4] = [0; 4];
     let (mut integer, mut alpha, mut unassociated) = (0, 0, 0);
-    // SAFETY: every out-pointer refers to a live local; `err` holds ERR_LEN chars.
+    // SAFETY: every out-pointer refers to a live local (`origin_and_full` to 4 ints);
+    // `err` holds ERR_LEN chars.
     let status = unsafe {
         hairtrace_oiio_open(
             c_path.as_ptr(),
@@ -234,6 +367,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
             &mut width,
             &mut height,
             &mut channels,
+            origin_and_full.as_mut_ptr(),
             &mut integer,
             &mut alpha,
             &mut unassociated,
@@ -277,12 +411,67 @@ pub fn read_image(path: &Path) -> Result<Image> {
         let alpha = usize::try_from(alpha).ok().filter(|&a| a < channels);
         decode_display(&mut pixels, channels, alpha, unassociated != 0);
     }
+    // A window that does not lie inside its frame (a negative origin, a PNG's offset
+    // without a frame size) is read as a whole frame, as files were before windows.
+    let [x, y, full_width, full_height] = origin_and_full.map(|v| usize::try_from(v).ok());
+    let placement = match (x, y, full_width, full_height) {
+        (Some(x), Some(y), Some(full_width), Some(full_height))
+            if x + width <= full_width && y + height <= full_height =>
+        {
+            Placement {
+                x,
+                y,
+                full_width,
+                full_height,
+            }
+        }
+        _ => Placement::whole(width, height),
+    };
     Ok(Image {
         width,
         height,
         channels,
         pixels,
+        placement,
+        attributes: read_attributes(&input).map_err(|e| fail(&e))?,
     })
+}
+
+/// The string attributes of an open file's header.
+fn read_attributes(input: &Input) -> std::result::Result<Vec<(String, String)>, Vec<c_char>> {
+    let mut buf: Vec<u8> = Vec::new();
+    loop {
+        let mut err = vec![0 as c_char; ERR_LEN];
+        let mut needed = 0;
+        // SAFETY: `input.0` is an open handle, `buf` holds `buf.len()` writable bytes and
+        // `err` ERR_LEN chars.
+        let status = unsafe {
+            hairtrace_oiio_attributes(
+                input.0,
+                buf.as_mut_ptr().cast(),
+                buf.len(),
+                &mut needed,
+                err.as_mut_ptr(),
+                ERR_LEN,
+            )
+        };
+        if status != 0 {
+            return Err(err);
+        }
+        if needed <= buf.len() {
+            buf.truncate(needed);
+            break;
+        }
+        buf.resize(needed, 0);
+    }
+    let mut texts = buf
+        .split(|&b| b == 0)
+        .map(|t| String::from_utf8_lossy(t).into_owned());
+    let mut out = Vec::new();
+    while let (Some(name), Some(value)) = (texts.next(), texts.next()) {
+        out.push((name, value));
+    }
+    Ok(out)
 }
 
 /// Room for OIIO's error text; longer messages are truncated by the shim.
@@ -307,12 +496,20 @@ mod ffi {
     unsafe extern "C" {
         pub(super) fn hairtrace_oiio_write(
             path: *const c_char,
+            write_path: *const c_char,
             width: c_int,
             height: c_int,
             channels: c_int,
             pixels: *const f32,
             pixel_type: c_int,
             display: c_int,
+            x: c_int,
+            y: c_int,
+            full_width: c_int,
+            full_height: c_int,
+            attribute_names: *const *const c_char,
+            attribute_values: *const *const c_char,
+            attributes: usize,
             err: *mut c_char,
             err_len: usize,
         ) -> c_int;
@@ -322,6 +519,7 @@ mod ffi {
             width: *mut c_int,
             height: *mut c_int,
             channels: *mut c_int,
+            origin_and_full: *mut c_int,
             integer_format: *mut c_int,
             alpha_channel: *mut c_int,
             unassociated_alpha: *mut c_int,
@@ -332,6 +530,14 @@ mod ffi {
             handle: *mut c_void,
             pixels: *mut f32,
             len: usize,
+            err: *mut c_char,
+            err_len: usize,
+        ) -> c_int;
+        pub(super) fn hairtrace_oiio_attributes(
+            handle: *mut c_void,
+            buf: *mut c_char,
+            len: usize,
+            needed: *mut usize,
             err: *mut c_char,
             err_len: usize,
         ) -> c_int;
@@ -483,6 +689,7 @@ mod tests {
     fn pixel_type_must_suit_the_format() {
         let opts = WriteOptions {
             pixel_type: Some(PixelType::F16),
+            ..WriteOptions::default()
         };
         let err = write_image(Path::new("x.png"), 1, 1, 1, &[0.5], &opts).unwrap_err();
         assert!(matches!(err, Error::Image(m) if m.contains("F16")));

@@ -47,6 +47,20 @@ bool pixel_type_desc(int code, OIIO::TypeDesc *out) {
     }
 }
 
+// Runs `body`, which returns 0 or 1 and reports its own failures in `err`, and turns any
+// exception into a failure with its message: one unwinding into Rust is undefined
+// behaviour.
+template <typename Body> int guarded(char *err, size_t err_len, Body body) {
+    try {
+        return body();
+    } catch (const std::exception &e) {
+        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
+    } catch (...) {
+        set_error(err, err_len, "OpenImageIO threw an unknown exception");
+    }
+    return 1;
+}
+
 }  // namespace
 
 // An open image file being read: keeps OIIO's reader between the two read calls.
@@ -56,13 +70,20 @@ struct OiioInput {
 
 extern "C" {
 
-// Writes interleaved float pixels to `path`, converted by OIIO to `pixel_type`. With 2 or
-// 4 channels the last one is alpha. `display` says the caller has already sRGB-encoded
-// the colour and un-premultiplied it: OIIO must store the values as given (by default it
-// would divide by alpha itself, in the encoded space) and label them sRGB.
-int hairtrace_oiio_write(const char *path, int width, int height, int channels,
-                  const float *pixels, int pixel_type, int display, char *err, size_t err_len) {
-    try {
+// Writes interleaved float pixels to `write_path` in the format `path`'s extension names,
+// converted by OIIO to `pixel_type` (the caller writes to a temporary name and renames).
+// With 2 or 4 channels the last one is alpha. `display` says the caller has already
+// sRGB-encoded the colour and un-premultiplied it: OIIO must store the values as given (by
+// default it would divide by alpha itself, in the encoded space) and label them sRGB. The
+// pixels are the window at (`x`, `y`) of a `full_width` x `full_height` frame (EXR's data
+// and display windows), and the `attributes` pairs of names and values go into the header
+// as strings.
+int hairtrace_oiio_write(const char *path, const char *write_path, int width, int height,
+                  int channels, const float *pixels, int pixel_type, int display, int x, int y,
+                  int full_width, int full_height, const char *const *attribute_names,
+                  const char *const *attribute_values, size_t attributes, char *err,
+                  size_t err_len) {
+    return guarded(err, err_len, [&] {
         OIIO::TypeDesc format;
         if (!pixel_type_desc(pixel_type, &format)) {
             set_error(err, err_len, "unknown pixel type code " + std::to_string(pixel_type));
@@ -74,6 +95,14 @@ int hairtrace_oiio_write(const char *path, int width, int height, int channels,
             return 1;
         }
         OIIO::ImageSpec spec(width, height, channels, format);
+        spec.x = x;
+        spec.y = y;
+        spec.full_x = 0;
+        spec.full_y = 0;
+        spec.full_width = full_width;
+        spec.full_height = full_height;
+        for (size_t i = 0; i < attributes; i++)
+            spec.attribute(attribute_names[i], attribute_values[i]);
         if (channels == 2) {
             // OIIO names two channels "R", "G"; they are grey and alpha.
             spec.channelnames = {"Y", "A"};
@@ -82,7 +111,7 @@ int hairtrace_oiio_write(const char *path, int width, int height, int channels,
         spec.attribute("oiio:ColorSpace", display ? "sRGB" : "Linear");
         if (display)
             spec.attribute("oiio:UnassociatedAlpha", 1);
-        if (!out->open(path, spec)) {
+        if (!out->open(write_path, spec)) {
             set_error(err, err_len, oiio_reason(out->geterror()));
             return 1;
         }
@@ -97,23 +126,19 @@ int hairtrace_oiio_write(const char *path, int width, int height, int channels,
             return 1;
         }
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
 }
 
-// Opens `path` and reports the size of its first subimage, whether its pixels are stored
+// Opens `path` and reports the size of its first subimage, where that lies in its full
+// frame (`origin_and_full`: x, y, full width, full height), whether its pixels are stored
 // as integers (so the caller knows to decode sRGB), its alpha channel (-1 if none) and
 // whether that alpha is straight rather than premultiplied. Alpha is left as the file
 // stores it, so the caller can premultiply after decoding. On success `*handle` must be
 // released with hairtrace_oiio_close.
 int hairtrace_oiio_open(const char *path, OiioInput **handle, int *width, int *height,
-                 int *channels, int *integer_format, int *alpha_channel,
+                 int *channels, int *origin_and_full, int *integer_format, int *alpha_channel,
                  int *unassociated_alpha, char *err, size_t err_len) {
-    try {
+    return guarded(err, err_len, [&] {
         *handle = nullptr;
         OIIO::ImageSpec config;
         config.attribute("oiio:UnassociatedAlpha", 1);
@@ -131,23 +156,22 @@ int hairtrace_oiio_open(const char *path, OiioInput **handle, int *width, int *h
         *width = spec.width;
         *height = spec.height;
         *channels = spec.nchannels;
+        origin_and_full[0] = spec.x - spec.full_x;
+        origin_and_full[1] = spec.y - spec.full_y;
+        origin_and_full[2] = spec.full_width;
+        origin_and_full[3] = spec.full_height;
         *integer_format = spec.format.is_floating_point() ? 0 : 1;
         *alpha_channel = spec.alpha_channel;
         *unassociated_alpha = spec.get_int_attribute("oiio:UnassociatedAlpha", 0) ? 1 : 0;
         *handle = new OiioInput{std::move(in)};
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
 }
 
 // Reads the whole first subimage as interleaved floats into `pixels`, which holds
 // `len` floats (width * height * channels from hairtrace_oiio_open).
 int hairtrace_oiio_read(OiioInput *handle, float *pixels, size_t len, char *err, size_t err_len) {
-    try {
+    return guarded(err, err_len, [&] {
         const OIIO::ImageSpec &spec = handle->in->spec();
         size_t expected = size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels);
         if (len != expected) {
@@ -160,12 +184,29 @@ int hairtrace_oiio_read(OiioInput *handle, float *pixels, size_t len, char *err,
             return 1;
         }
         return 0;
-    } catch (const std::exception &e) {
-        set_error(err, err_len, std::string("OpenImageIO threw: ") + e.what());
-    } catch (...) {
-        set_error(err, err_len, "OpenImageIO threw an unknown exception");
-    }
-    return 1;
+    });
+}
+
+// The open file's string attributes as NUL-terminated names and values one after the
+// other, in `buf` of `len` bytes; `*needed` is the size they take, so a caller whose
+// buffer was too small (nothing is written then) calls again with a larger one.
+int hairtrace_oiio_attributes(OiioInput *handle, char *buf, size_t len, size_t *needed,
+                              char *err, size_t err_len) {
+    return guarded(err, err_len, [&] {
+        std::string all;
+        for (const OIIO::ParamValue &p : handle->in->spec().extra_attribs) {
+            if (p.type() != OIIO::TypeDesc::STRING || p.nvalues() != 1)
+                continue;
+            all += p.name().string();
+            all += '\0';
+            all += p.get_string();
+            all += '\0';
+        }
+        *needed = all.size();
+        if (all.size() <= len && !all.empty())
+            std::memcpy(buf, all.data(), all.size());
+        return 0;
+    });
 }
 
 // Closes the file and frees the handle; NULL is a no-op.

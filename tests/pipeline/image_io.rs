@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use hairtrace::Error;
-use hairtrace::image::{Image, PixelType, WriteOptions, read_image, write_image};
+use hairtrace::image::{Image, PixelType, Placement, WriteOptions, read_image, write_image};
 
 /// A scratch path unique to the test, inside cargo's per-target temporary directory.
 fn scratch(name: &str) -> PathBuf {
@@ -40,6 +40,7 @@ fn srgb(v: f32) -> f32 {
 fn opts(pixel_type: PixelType) -> WriteOptions {
     WriteOptions {
         pixel_type: Some(pixel_type),
+        ..WriteOptions::default()
     }
 }
 
@@ -307,4 +308,96 @@ fn non_utf8_path_is_refused() {
         "{err:?}"
     );
     assert!(matches!(read_image(&path), Err(Error::InvalidArg(_))));
+}
+
+/// Attributes and the data window go into an EXR's header and come back; formats without
+/// a data window store the pixels alone, read back as a whole frame.
+#[test]
+fn exr_keeps_its_attributes_and_its_place_in_the_frame() {
+    let (w, h) = (3, 2);
+    let px = ramp(w, h, 3, 0.0, 1.0);
+    let placement = Placement {
+        x: 5,
+        y: 1,
+        full_width: 10,
+        full_height: 4,
+    };
+    let o = WriteOptions {
+        placement: Some(placement),
+        attributes: vec![
+            ("hairtrace:seed".into(), "7".into()),
+            ("note".into(), "a b=c".into()),
+        ],
+        ..WriteOptions::default()
+    };
+    let exr = write_read("placed.exr", w, h, 3, &px, &o);
+    assert_eq!(exr.placement, placement);
+    assert_eq!(exr.attribute("hairtrace:seed"), Some("7"));
+    assert_eq!(exr.attribute("note"), Some("a b=c"));
+    assert_eq!(exr.pixels, px);
+    let png = write_read("placed.png", w, h, 3, &px, &o);
+    assert_eq!(png.placement, Placement::whole(w, h));
+    let outside = WriteOptions {
+        placement: Some(Placement { x: 8, ..placement }),
+        ..WriteOptions::default()
+    };
+    let err = write_image(&scratch("outside.exr"), w, h, 3, &px, &outside).unwrap_err();
+    assert!(
+        err.to_string().contains("does not fit in its 10x4 frame"),
+        "{err}"
+    );
+}
+
+/// Writers racing on one path, each with its own image, while a reader reads it over and
+/// over: every read finds a whole image of one writer (never a partial file, never a mix),
+/// and the last one standing is whole. Writing in place, or through one shared temporary
+/// name, fails this within a few of its hundreds of reads.
+#[test]
+fn concurrent_writers_never_leave_a_partial_or_mixed_image() {
+    let path = scratch("raced.exr");
+    let (w, h, writers, rounds) = (256, 128, 4, 12);
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let whole = |image: &Image| {
+        let v = image.pixels[0];
+        (1..=writers).any(|k| v == k as f32) && image.pixels.iter().all(|&p| p == v)
+    };
+    let reads = std::thread::scope(|s| {
+        for k in 1..=writers {
+            let (path, done) = (&path, &done);
+            s.spawn(move || {
+                // Counted even when a write fails, so that the reader stops.
+                let _finished = Finished(done);
+                let px = vec![k as f32; w * h * 3];
+                for _ in 0..rounds {
+                    write_image(path, w, h, 3, &px, &WriteOptions::default()).unwrap();
+                }
+            });
+        }
+        let mut reads = 0;
+        while done.load(std::sync::atomic::Ordering::SeqCst) < writers {
+            if path.exists() {
+                let image = read_image(&path).expect("a complete image at the path");
+                assert!(whole(&image), "a mixed image: {:?}", &image.pixels[..4]);
+                reads += 1;
+            }
+        }
+        reads
+    });
+    assert!(whole(&read_image(&path).unwrap()));
+    let leftovers = std::fs::read_dir(path.parent().unwrap())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".raced.exr."))
+        .count();
+    assert_eq!(leftovers, 0, "temporary files left behind");
+    eprintln!("{reads} reads during the race");
+}
+
+/// Counts a finished writer when dropped.
+struct Finished<'a>(&'a std::sync::atomic::AtomicUsize);
+
+impl Drop for Finished<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    }
 }

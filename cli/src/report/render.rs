@@ -154,12 +154,12 @@ impl Built {
         self.0.settings.seed = seed;
         let out = self.0.render(Aovs::default(), &NoProgress)?;
         let window = out.film.crop();
-        let image = Image {
-            width: window.width() as usize,
-            height: window.height() as usize,
-            channels: 3,
-            pixels: out.film.rgb().to_vec(),
-        };
+        let image = Image::new(
+            window.width() as usize,
+            window.height() as usize,
+            3,
+            out.film.rgb().to_vec(),
+        );
         let s = out.stats;
         Ok((image, s.seconds, s.rays as f64 / s.samples.max(1) as f64))
     }

@@ -95,11 +95,13 @@ mod tests {
 
     #[test]
     fn only_square_rgb_maps_are_taken() {
-        let image = |width, height, channels| Image {
-            width,
-            height,
-            channels,
-            pixels: vec![0.5; width * height * channels],
+        let image = |width, height, channels| {
+            Image::new(
+                width,
+                height,
+                channels,
+                vec![0.5; width * height * channels],
+            )
         };
         let e = latlong_from_equal_area(&image(8, 4, 3), DMat3::IDENTITY).unwrap_err();
         assert!(e.to_string().contains("must be square"), "{e}");

@@ -47,6 +47,7 @@ mod error;
 pub mod image;
 /// cbindgen:ignore
 pub mod math;
+mod quiet_panic;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod render;

@@ -40,6 +40,7 @@ pub use bsdf::HtHairParams;
 
 use crate::Error;
 use crate::error::invalid_arg;
+use crate::quiet_panic::quietly;
 use glam::Vec3;
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char};
@@ -159,9 +160,10 @@ fn set_last_error(msg: &str) {
 }
 
 /// Runs the body of an entry point: its error becomes a status plus `ht_last_error`'s
-/// message, and a panic becomes `HT_ERR_PANIC` instead of unwinding into C.
+/// message, and a panic becomes `HT_ERR_PANIC` instead of unwinding into C, printing
+/// nothing to the host's stderr (`quiet_panic`).
 pub(crate) fn boundary(body: impl FnOnce() -> Result<(), Failure>) -> HtStatus {
-    match catch_unwind(AssertUnwindSafe(body)) {
+    match quietly(|| catch_unwind(AssertUnwindSafe(body))) {
         Ok(Ok(())) => HtStatus::HT_OK,
         Ok(Err(Failure(status, msg))) => {
             set_last_error(&msg);

@@ -1,0 +1,77 @@
+//! Panics that the C ABI catches print nothing. Rust's default hook writes every panic, caught
+//! or not, and its backtrace to stderr, which in a C host is the host's; a library prints
+//! nothing a host did not ask for. The message still reaches the host, through the error
+//! the boundary returns.
+//!
+//! One hook is installed the first time a quiet call runs: silent on a thread inside such a
+//! call, and the hook it replaced (a Rust host's own, or the default) everywhere else, so a
+//! Rust host keeps its own hook for its own panics.
+
+use std::cell::Cell;
+use std::sync::Once;
+
+thread_local! {
+    static QUIET: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `f` with this thread's panics kept quiet, restoring the thread's previous state after
+/// (also when `f` unwinds), so calls may nest.
+pub(crate) fn quietly<R>(f: impl FnOnce() -> R) -> R {
+    install();
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            QUIET.set(self.0);
+        }
+    }
+    let _restore = Restore(QUIET.replace(true));
+    f()
+}
+
+/// Whether this thread runs a quiet call: the threads that call starts inherit it with
+/// [`inherit`].
+pub(crate) fn is_quiet() -> bool {
+    QUIET.get()
+}
+
+/// Runs `f` quietly when `quiet` (a worker of a quiet call), else as it is.
+pub(crate) fn inherit<R>(quiet: bool, f: impl FnOnce() -> R) -> R {
+    if quiet { quietly(f) } else { f() }
+}
+
+fn install() {
+    static HOOK: Once = Once::new();
+    // `set_hook` may not be called while this thread panics (a call from a destructor
+    // during unwinding): that call stays loud, and a later one installs the hook.
+    if HOOK.is_completed() || std::thread::panicking() {
+        return;
+    }
+    HOOK.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if !QUIET.try_with(Cell::get).unwrap_or(false) {
+                previous(info);
+            }
+        }));
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quiet_calls_nest_and_restore() {
+        assert!(!is_quiet());
+        quietly(|| {
+            assert!(is_quiet());
+            quietly(|| assert!(is_quiet()));
+            assert!(is_quiet());
+            let caught = std::panic::catch_unwind(|| quietly(|| panic!("quiet")));
+            assert!(caught.is_err() && is_quiet());
+        });
+        assert!(!is_quiet());
+        inherit(true, || assert!(is_quiet()));
+        inherit(false, || assert!(!is_quiet()));
+    }
+}

@@ -54,6 +54,7 @@ pub mod render;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod scene;
+/// cbindgen:ignore
 mod validate;
 
 pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf};

@@ -14,18 +14,23 @@ thread_local! {
     static QUIET: Cell<bool> = const { Cell::new(false) };
 }
 
-/// Runs `f` with this thread's panics kept quiet, restoring the thread's previous state after
-/// (also when `f` unwinds), so calls may nest.
-pub(crate) fn quietly<R>(f: impl FnOnce() -> R) -> R {
-    install();
-    struct Restore(bool);
-    impl Drop for Restore {
-        fn drop(&mut self) {
-            QUIET.set(self.0);
-        }
+/// Keeps this thread's panics quiet while it lives, then restores the thread's previous
+/// state (also when unwinding), so that quiet calls may nest. A guard rather than a
+/// closure, so that the code it covers is compiled as if it were not there.
+#[must_use]
+pub(crate) struct Quiet(bool);
+
+impl Quiet {
+    pub(crate) fn enter() -> Quiet {
+        install();
+        Quiet(QUIET.replace(true))
     }
-    let _restore = Restore(QUIET.replace(true));
-    f()
+}
+
+impl Drop for Quiet {
+    fn drop(&mut self) {
+        QUIET.set(self.0);
+    }
 }
 
 /// Whether this thread runs a quiet call: the threads that call starts inherit it with
@@ -36,7 +41,8 @@ pub(crate) fn is_quiet() -> bool {
 
 /// Runs `f` quietly when `quiet` (a worker of a quiet call), else as it is.
 pub(crate) fn inherit<R>(quiet: bool, f: impl FnOnce() -> R) -> R {
-    if quiet { quietly(f) } else { f() }
+    let _quiet = quiet.then(Quiet::enter);
+    f()
 }
 
 fn install() {
@@ -63,13 +69,17 @@ mod tests {
     #[test]
     fn quiet_calls_nest_and_restore() {
         assert!(!is_quiet());
-        quietly(|| {
+        {
+            let _outer = Quiet::enter();
             assert!(is_quiet());
-            quietly(|| assert!(is_quiet()));
+            drop(Quiet::enter());
             assert!(is_quiet());
-            let caught = std::panic::catch_unwind(|| quietly(|| panic!("quiet")));
+            let caught = std::panic::catch_unwind(|| {
+                let _inner = Quiet::enter();
+                panic!("quiet")
+            });
             assert!(caught.is_err() && is_quiet());
-        });
+        }
         assert!(!is_quiet());
         inherit(true, || assert!(is_quiet()));
         inherit(false, || assert!(!is_quiet()));

@@ -40,7 +40,7 @@ pub use bsdf::HtHairParams;
 
 use crate::Error;
 use crate::error::invalid_arg;
-use crate::quiet_panic::quietly;
+use crate::quiet_panic::Quiet;
 use glam::Vec3;
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char};
@@ -77,6 +77,13 @@ const _: () = {
         "HT_VERSION_MAJOR/MINOR/PATCH in src/capi/mod.rs differ from Cargo.toml's version"
     );
 };
+
+/// Largest magnitude of a coordinate the scene API accepts (positions, camera, lights, in
+/// world units): Embree cannot trace rays past about 1.8e18, and aborts on them.
+pub const HT_MAX_COORDINATE: f32 = 1e15;
+
+/// cbindgen:ignore
+const _: () = assert!(HT_MAX_COORDINATE == crate::validate::MAX_COORDINATE);
 
 /// Result of every C entry point; `HT_OK` is 0.
 #[repr(C)]
@@ -163,7 +170,8 @@ fn set_last_error(msg: &str) {
 /// message, and a panic becomes `HT_ERR_PANIC` instead of unwinding into C, printing
 /// nothing to the host's stderr (`quiet_panic`).
 pub(crate) fn boundary(body: impl FnOnce() -> Result<(), Failure>) -> HtStatus {
-    match quietly(|| catch_unwind(AssertUnwindSafe(body))) {
+    let _quiet = Quiet::enter();
+    match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(())) => HtStatus::HT_OK,
         Ok(Err(Failure(status, msg))) => {
             set_last_error(&msg);

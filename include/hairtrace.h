@@ -245,6 +245,38 @@ typedef struct HT_ALIGNED(16) HtHairPoint {
 
 #if defined(HT_RENDER)
 /**
+ * How a hair material varies over the groom, deterministically from the seed, the
+ * strand and the position along it.
+ */
+typedef struct HtHairVariation {
+    /**
+     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
+     * from [1 - x, 1 + x].
+     */
+    float absorption_variation;
+    /**
+     * Per-strand spread of beta_m and beta_n, in [0, 1].
+     */
+    float roughness_variation;
+    /**
+     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
+     */
+    float tip_absorption;
+    /**
+     * 1: take the absorption from the curves where they give one (their per-point colours,
+     * or the melanin of a USD file's strands, taken as it is); 0: ignore it. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
+     * than a `bool`, so that no byte the host stores here is undefined behaviour.
+     */
+    uint8_t use_vertex_colors;
+    /**
+     * Seed of the per-strand random choices.
+     */
+    uint64_t seed;
+} HtHairVariation;
+#endif
+
+#if defined(HT_RENDER)
+/**
  * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
  */
 typedef uint32_t HtCurveBasis;
@@ -342,38 +374,6 @@ typedef struct HtCurvesXyzr {
     HtCurveBasis basis;
     HtCurveShape shape;
 } HtCurvesXyzr;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * How a hair material varies over the groom, deterministically from the seed, the
- * strand and the position along it.
- */
-typedef struct HtHairVariation {
-    /**
-     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
-     * from [1 - x, 1 + x].
-     */
-    float absorption_variation;
-    /**
-     * Per-strand spread of beta_m and beta_n, in [0, 1].
-     */
-    float roughness_variation;
-    /**
-     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
-     */
-    float tip_absorption;
-    /**
-     * 1: take the absorption from the curves where they give one (their per-point colours,
-     * or the melanin of a USD file's strands, taken as it is); 0: ignore it. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
-     * than a `bool`, so that no byte the host stores here is undefined behaviour.
-     */
-    uint8_t use_vertex_colors;
-    /**
-     * Seed of the per-strand random choices.
-     */
-    uint64_t seed;
-} HtHairVariation;
 #endif
 
 #if defined(HT_RENDER)
@@ -850,6 +850,38 @@ enum HtStatus ht_hair_point_init_world(const struct HtHairPrepared *prepared,
                                        const struct HtHairFrame *frame,
                                        const float *wo,
                                        struct HtHairPoint *point);
+
+#if defined(HT_RENDER)
+/**
+ * `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
+ * material varies them (`ht_scene_add_hair_material_varied`): the parameters of
+ * `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
+ * (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
+ * `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
+ * allocation: the varied BSDF is built inside the point, and the point equals, bit for
+ * bit, the one the renderer shades that strand's hit with.
+ *
+ * - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
+ *   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
+ *   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
+ *   Else `HT_ERR_INVALID_ARG`.
+ * - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
+ *   as `ht_hair_point_init`. On error `*point` is untouched.
+ * - Cost: an init plus the preparation of the varied parameters (about one evaluation).
+ *
+ * # Safety
+ * As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
+ * floats.
+ */
+enum HtStatus ht_hair_point_init_strand(const struct HtHairPrepared *prepared,
+                                        const struct HtHairVariation *variation,
+                                        uint32_t strand,
+                                        float s,
+                                        const float *color,
+                                        float h,
+                                        const float *wo,
+                                        struct HtHairPoint *point);
+#endif
 
 /**
  * f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward

@@ -192,6 +192,20 @@ public:
         return p;
     }
 
+#if defined(HT_RENDER)
+    /** At strand `strand`, position `s`, of a groom varied as `variation` says, with the
+     * strand's colour `color` (NULL: none): `ht_hair_point_init_strand`. */
+    template <class V>
+    static Point strand(const Material &material, const HtHairVariation &variation,
+                        uint32_t strand, float s, const float *color, float h, const V &wo) {
+        const Vec3 w = vec3(wo);
+        Point p;
+        check(ht_hair_point_init_strand(material.get(), &variation, strand, s, color, h, w.data(),
+                                        &p.point_));
+        return p;
+    }
+#endif
+
     /** f |cos| and pdf toward the local `wi` (`ht_hair_point_eval_cos`). */
     template <class V> Eval eval(const V &wi) const { return eval_with(ht_hair_point_eval_cos, wi); }
     /** A local direction from `u` in [0, 1)^3 (`ht_hair_point_sample_cos`). */

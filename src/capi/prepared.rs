@@ -322,6 +322,70 @@ pub unsafe extern "C" fn ht_hair_point_init_world(
     })
 }
 
+/// `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
+/// material varies them (`ht_scene_add_hair_material_varied`): the parameters of
+/// `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
+/// (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
+/// `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
+/// allocation: the varied BSDF is built inside the point, and the point equals, bit for
+/// bit, the one the renderer shades that strand's hit with.
+///
+/// - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
+///   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
+///   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
+///   Else `HT_ERR_INVALID_ARG`.
+/// - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
+///   as `ht_hair_point_init`. On error `*point` is untouched.
+/// - Cost: an init plus the preparation of the varied parameters (about one evaluation).
+///
+/// # Safety
+/// As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
+/// floats.
+#[cfg(feature = "render")]
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn ht_hair_point_init_strand(
+    prepared: *const HtHairPrepared,
+    variation: *const super::materials::HtHairVariation,
+    strand: u32,
+    s: f32,
+    color: *const f32,
+    h: f32,
+    wo: *const f32,
+    point: *mut HtHairPoint,
+) -> HtStatus {
+    use crate::scene::material::HairColor;
+    boundary(|| {
+        require(&[(variation.cast(), "variation")])?;
+        check_init(prepared, wo, None, point)?;
+        let v = super::read_host(variation, "variation")?;
+        let h = check_h(h)?;
+        let wo = check_dir(read3(wo), "wo")?;
+        if !(0.0..=1.0).contains(&s) {
+            return Err(invalid_arg!("s = {s}: must be in [0, 1]").into());
+        }
+        let groom = if color.is_null() {
+            None
+        } else {
+            let c = super::read_vec3(color, "color")?.to_array();
+            if let Some(bad) = c.iter().position(|x| !(0.0..=1.0).contains(x)) {
+                return Err(invalid_arg!("color[{bad}] = {}: must be in [0, 1]", c[bad]).into());
+            }
+            Some(HairColor::Color(c))
+        };
+        // SAFETY: non-NULL (checked), a live handle (the caller's promise).
+        let base = *unsafe { &(*prepared).bsdf }.params();
+        let material = super::materials::varied_material(base, &v)?;
+        material.check_variation()?;
+        let bsdf = HairBsdf::new(&material.varied(base, strand, s, groom))?;
+        let prepared = HtHairPrepared { bsdf };
+        // SAFETY: non-NULL and aligned (checked), `HT_HAIR_POINT_SIZE` writable bytes that
+        // hold a `Stored` (asserted above).
+        unsafe { point.cast::<Stored>().write(stored(&prepared, h, wo, TAG)) };
+        Ok(())
+    })
+}
+
 /// f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward
 /// `wi[3]` at a filled point: the same bits as `ht_hair_eval` with the point's parameters,
 /// h and wo.
@@ -837,6 +901,114 @@ mod tests {
             assert_eq!((d_w, wt_w, p_w), (d_back, wt_l, p_l), "sample at {k}");
             assert!(pdf_w > 0.0 && p_w > 0.0, "{k}: a lobe toward every light");
         }
+        unsafe { ht_hair_prepared_free(handle) };
+    }
+
+    /// A strand's point is the BSDF the renderer shades that strand's hits with (the scene
+    /// material's `bsdf_at`), bit for bit, with and without a groom colour.
+    #[cfg(feature = "render")]
+    #[test]
+    fn strand_points_are_the_scene_materials_bsdf() {
+        use crate::capi::materials::{HtHairVariation, varied_material};
+        use crate::scene::material::HairColor;
+        let params: HtHairParams = HairParams::default().into();
+        let handle = prepare(&params);
+        let variation = HtHairVariation {
+            absorption_variation: 0.5,
+            roughness_variation: 0.4,
+            tip_absorption: 0.3,
+            use_vertex_colors: 1,
+            seed: 42,
+        };
+        let Ok(material) = varied_material(params.into(), &variation) else {
+            panic!("a valid variation")
+        };
+        let scene = material.prepare().unwrap();
+        let mut distinct = std::collections::BTreeSet::new();
+        for k in 0..120u32 {
+            let (strand, s) = (k * 7 % 23, (k % 11) as f32 / 10.0);
+            let color = [0.3 + 0.005 * k as f32, 0.2, 0.1];
+            let groom = (k % 2 == 0).then_some(color);
+            let (h, wo) = (
+                0.9 * (0.3 * k as f32).sin(),
+                Vec3::new(0.3, 0.2, 0.9).normalize(),
+            );
+            let mut pt = point();
+            let color_ptr = groom.as_ref().map_or(std::ptr::null(), |c| c.as_ptr());
+            let st = unsafe {
+                ht_hair_point_init_strand(
+                    handle,
+                    &variation,
+                    strand,
+                    s,
+                    color_ptr,
+                    h,
+                    wo.as_ref().as_ptr(),
+                    &mut pt,
+                )
+            };
+            assert_eq!(st, HtStatus::HT_OK, "{}", last_error());
+            let want = scene.bsdf_at(strand, s, groom.map(HairColor::Color));
+            distinct.insert(want.params().sigma_a.map(f32::to_bits));
+            let rust = want.at(h, wo);
+            let wi = Vec3::new(-0.2, 0.7, 0.5).normalize();
+            let (mut f, mut pdf) = ([0.0f32; 3], 0.0f32);
+            unsafe { ht_hair_point_eval(&pt, wi.as_ref().as_ptr(), f.as_mut_ptr(), &mut pdf) };
+            let e = rust.eval(wi);
+            assert_eq!((f, pdf), (e.f.to_array(), e.pdf), "strand {strand} s {s}");
+            let u = [0.61, 0.27, 0.83];
+            let (mut w, mut fs, mut ps) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
+            unsafe {
+                ht_hair_point_sample(&pt, u.as_ptr(), w.as_mut_ptr(), fs.as_mut_ptr(), &mut ps)
+            };
+            let want = rust.sample(u).unwrap();
+            assert_eq!(
+                (w, fs, ps),
+                (want.wi.to_array(), want.f.to_array(), want.pdf)
+            );
+        }
+        assert!(
+            distinct.len() > 100,
+            "the parameters vary: {}",
+            distinct.len()
+        );
+        let bad = HtHairVariation {
+            roughness_variation: 2.0,
+            ..variation
+        };
+        let wo = [0.0f32, 0.0, 1.0];
+        let mut pt = point();
+        let st = unsafe {
+            ht_hair_point_init_strand(
+                handle,
+                &bad,
+                0,
+                0.5,
+                std::ptr::null(),
+                0.0,
+                wo.as_ptr(),
+                &mut pt,
+            )
+        };
+        assert_eq!(st, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("roughness_variation = 2"),
+            "{}",
+            last_error()
+        );
+        let st = unsafe {
+            ht_hair_point_init_strand(
+                handle,
+                &variation,
+                0,
+                1.5,
+                std::ptr::null(),
+                0.0,
+                wo.as_ptr(),
+                &mut pt,
+            )
+        };
+        assert!(st == HtStatus::HT_ERR_INVALID_ARG && last_error().contains("s = 1.5"));
         unsafe { ht_hair_prepared_free(handle) };
     }
 

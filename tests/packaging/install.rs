@@ -203,5 +203,10 @@ fn assert_macros_prefixed(include: &Path) {
             );
         }
     }
-    assert_eq!(headers, 2, "hairtrace.h and hairtrace.hpp in {}", include.display());
+    assert_eq!(
+        headers,
+        2,
+        "hairtrace.h and hairtrace.hpp in {}",
+        include.display()
+    );
 }

@@ -25,7 +25,8 @@ impl Rng {
 
     fn unit(&mut self) -> [f32; 3] {
         let z = 2.0 * self.uniform() - 1.0;
-        let phi = 6.283_185_3 * self.uniform();
+        // bench.c's 6.2831853f is this f32.
+        let phi = std::f32::consts::TAU * self.uniform();
         let r = (1.0 - z * z).max(0.0).sqrt();
         [z, r * phi.cos(), r * phi.sin()]
     }

@@ -506,16 +506,7 @@ pub unsafe extern "C" fn ht_hair_point_eval_cos(
     f_cos: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| {
-        let outputs = [
-            (f_cos.cast_const(), "f_cos", 3),
-            (pdf.cast_const(), "pdf", 1),
-        ];
-        let p = checked_point(point, &[(wi, "wi", 3)], &outputs)?;
-        let wi = check_dir(read3(wi), "wi")?;
-        write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
-        Ok(())
-    })
+    boundary(|| eval_cos(point, wi, f_cos, pdf, false))
 }
 
 /// One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
@@ -534,17 +525,7 @@ pub unsafe extern "C" fn ht_hair_point_sample_cos(
     weight: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| {
-        let outputs = [
-            (wi.cast_const(), "wi", 3),
-            (weight.cast_const(), "weight", 3),
-            (pdf.cast_const(), "pdf", 1),
-        ];
-        let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
-        let s = p.point.sample(check_u(read3(u).to_array(), "u")?);
-        write_sample(weighted(s), wi, weight, pdf);
-        Ok(())
-    })
+    boundary(|| sample_cos(point, u, wi, weight, pdf, false))
 }
 
 /// `ht_hair_point_eval_cos` with `wi[3]` in *world* space, at a point filled by
@@ -565,16 +546,7 @@ pub unsafe extern "C" fn ht_hair_point_eval_world(
     f_cos: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| {
-        let outputs = [
-            (f_cos.cast_const(), "f_cos", 3),
-            (pdf.cast_const(), "pdf", 1),
-        ];
-        let p = checked_framed(point, &[(wi, "wi", 3)], &outputs)?;
-        let wi = check_dir(p.frame.to_local(read3(wi)), "wi (in the point's frame)")?;
-        write_eval(times_cos(p.stored.point.eval(wi), wi), f_cos, pdf);
-        Ok(())
-    })
+    boundary(|| eval_cos(point, wi, f_cos, pdf, true))
 }
 
 /// `ht_hair_point_sample_cos` giving `wi[3]` in *world* space, at a point filled by
@@ -595,21 +567,66 @@ pub unsafe extern "C" fn ht_hair_point_sample_world(
     weight: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| {
-        let outputs = [
-            (wi.cast_const(), "wi", 3),
-            (weight.cast_const(), "weight", 3),
-            (pdf.cast_const(), "pdf", 1),
-        ];
-        let p = checked_framed(point, &[(u, "u", 3)], &outputs)?;
-        let s = weighted(p.stored.point.sample(check_u(read3(u).to_array(), "u")?));
-        let s = s.map(|s| BsdfSample {
-            wi: p.frame.to_world(s.wi),
-            ..s
-        });
-        write_sample(s, wi, weight, pdf);
-        Ok(())
-    })
+    boundary(|| sample_cos(point, u, wi, weight, pdf, true))
+}
+
+/// The body of `ht_hair_point_eval_cos` and, with `world`, `ht_hair_point_eval_world`
+/// (`wi` in world space, taken to the point's frame).
+#[inline(always)]
+fn eval_cos(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+    world: bool,
+) -> Result<(), Failure> {
+    let inputs = [(wi, "wi", 3)];
+    let outputs = [
+        (f_cos.cast_const(), "f_cos", 3),
+        (pdf.cast_const(), "pdf", 1),
+    ];
+    let (p, wi) = if world {
+        let p = checked_framed(point, &inputs, &outputs)?;
+        let local = p.frame.to_local(read3(wi));
+        (&p.stored, check_dir(local, "wi (in the point's frame)")?)
+    } else {
+        let p = checked_point(point, &inputs, &outputs)?;
+        (p, check_dir(read3(wi), "wi")?)
+    };
+    write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
+    Ok(())
+}
+
+/// The body of `ht_hair_point_sample_cos` and, with `world`, `ht_hair_point_sample_world`
+/// (`wi` given in world space with the point's frame).
+#[inline(always)]
+fn sample_cos(
+    point: *const HtHairPoint,
+    u: *const f32,
+    wi: *mut f32,
+    weight: *mut f32,
+    pdf: *mut f32,
+    world: bool,
+) -> Result<(), Failure> {
+    let inputs = [(u, "u", 3)];
+    let outputs = [
+        (wi.cast_const(), "wi", 3),
+        (weight.cast_const(), "weight", 3),
+        (pdf.cast_const(), "pdf", 1),
+    ];
+    let (p, frame) = if world {
+        let p = checked_framed(point, &inputs, &outputs)?;
+        (&p.stored, Some(&p.frame))
+    } else {
+        (checked_point(point, &inputs, &outputs)?, None)
+    };
+    let s = weighted(p.point.sample(check_u(read3(u).to_array(), "u")?));
+    let s = s.map(|s| BsdfSample {
+        wi: frame.map_or(s.wi, |f| f.to_world(s.wi)),
+        ..s
+    });
+    write_sample(s, wi, weight, pdf);
+    Ok(())
 }
 
 /// The pointers of a batch over points, checked as one: `points[n]`, an input of `3n`

@@ -93,7 +93,11 @@ fn bsdf_only_cmake_host_builds_without_embree_or_openimageio_dev_files() {
     );
 
     let project = fresh_dir("hosts-bsdf-only-cmake");
-    std::fs::copy(root().join("tests/packaging/host.c"), project.join("host.c")).unwrap();
+    std::fs::copy(
+        root().join("tests/packaging/host.c"),
+        project.join("host.c"),
+    )
+    .unwrap();
     std::fs::write(
         project.join("CMakeLists.txt"),
         "cmake_minimum_required(VERSION 3.16)\nproject(host C)\n\

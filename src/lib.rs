@@ -51,12 +51,14 @@ pub mod formats;
 pub mod image;
 /// cbindgen:ignore
 pub mod math;
+mod quiet_panic;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod render;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod scene;
+/// cbindgen:ignore
 mod validate;
 
 pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf};

@@ -107,17 +107,23 @@ pub(super) const UNIT_TOLERANCE: f32 = 1e-3;
 /// angles from its components.
 #[inline(always)]
 pub(super) fn check_dir(v: Vec3, name: &str) -> Result<Vec3, Failure> {
+    if is_unit(v) {
+        Ok(v)
+    } else {
+        Err(not_unit(v, name))
+    }
+}
+
+/// Whether `v` is a finite unit vector to [`UNIT_TOLERANCE`]; false for NaN.
+#[inline(always)]
+pub(super) fn is_unit(v: Vec3) -> bool {
     // Squared length against the squared bounds: no square root on the hot path.
     let (lo, hi) = (
         (1.0 - UNIT_TOLERANCE).powi(2),
         (1.0 + UNIT_TOLERANCE).powi(2),
     );
     let len2 = v.length_squared();
-    if len2 >= lo && len2 <= hi {
-        Ok(v)
-    } else {
-        Err(not_unit(v, name))
-    }
+    len2 >= lo && len2 <= hi
 }
 
 #[cold]

@@ -2,7 +2,7 @@
 //! renderer builds them (`math::frame::hair_frame_offset`), with degenerate input refused
 //! by status instead of patched (docs/conventions.md, section 1).
 
-use super::bsdf::{UNIT_TOLERANCE, require, vec3};
+use super::bsdf::{UNIT_TOLERANCE, is_unit, require, vec3};
 use super::{Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut};
 use crate::error::invalid_arg;
 use crate::math::Frame;
@@ -136,20 +136,33 @@ pub unsafe extern "C" fn ht_hair_frame(
     })
 }
 
-/// The frame's axes, checked: finite, unit and orthogonal to 1e-3, right-handed.
-fn read_frame(ptr: *const HtHairFrame) -> Result<Frame, Failure> {
+/// The frame's axes, checked: finite, unit and orthogonal to 1e-3, right-handed; and its h,
+/// unchecked.
+pub(super) fn read_frame(ptr: *const HtHairFrame) -> Result<(Frame, f32), Failure> {
     let f = host_slice(ptr, 1, "frame")?[0];
+    Ok((checked_axes(&f)?, f.h))
+}
+
+/// The axes of a frame the host passed, checked as [`read_frame`] says.
+#[inline(always)]
+pub(super) fn checked_axes(f: &HtHairFrame) -> Result<Frame, Failure> {
     let [x, y, z] = [f.x, f.y, f.z].map(Vec3::from_array);
-    let unit = |v: Vec3| (v.length() - 1.0).abs() <= UNIT_TOLERANCE;
     let orthogonal = x.dot(y).abs().max(y.dot(z).abs()).max(z.dot(x).abs()) <= UNIT_TOLERANCE;
-    if !(unit(x) && unit(y) && unit(z) && orthogonal && x.cross(y).dot(z) > 0.0) {
-        return Err(invalid_arg!(
-            "frame (x = {x}, y = {y}, z = {z}) is not a right-handed orthonormal frame \
-             (build it with ht_hair_frame)"
-        )
-        .into());
+    if is_unit(x) && is_unit(y) && is_unit(z) && orthogonal && x.cross(y).dot(z) > 0.0 {
+        Ok(Frame { x, y, z })
+    } else {
+        Err(not_a_frame(x, y, z))
     }
-    Ok(Frame { x, y, z })
+}
+
+#[cold]
+#[inline(never)]
+fn not_a_frame(x: Vec3, y: Vec3, z: Vec3) -> Failure {
+    invalid_arg!(
+        "frame (x = {x}, y = {y}, z = {z}) is not a right-handed orthonormal frame (build it \
+         with ht_hair_frame)"
+    )
+    .into()
 }
 
 /// Shared body of the two conversions.
@@ -170,7 +183,7 @@ fn convert(
         &[Span::of("out", out, 3)],
         &[Span::of("w", w, 3), Span::of("frame", frame, 1)],
     )?;
-    let frame = read_frame(frame)?;
+    let (frame, _) = read_frame(frame)?;
     let w = finite(w_s, "w")?;
     host_slice_mut(out, 3, "out")?.copy_from_slice(&map(&frame, w).to_array());
     Ok(())

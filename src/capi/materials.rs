@@ -5,6 +5,7 @@
 use super::bsdf::HtHairParams;
 use super::scene::{HtScene, add_with_id, scene_mut};
 use super::{Failure, HtStatus, boundary, read_host, read_vec3};
+use crate::bsdf::HairParams;
 use crate::bsdf::diffuse::Diffuse;
 use crate::error::invalid_arg;
 use crate::scene::material::{HairColor, HairMaterial, Material};
@@ -125,7 +126,17 @@ fn hair_material(
 ) -> std::result::Result<Material, Failure> {
     let p = read_host(params, "params")?;
     let v = read_host(variation, "variation")?;
-    let material = HairMaterial {
+    let material = varied_material(p.into(), &v)?;
+    Ok(Material::Hair(Box::new(material.prepare()?)))
+}
+
+/// The hair material of parameters `p` varied as `v` says (`use_vertex_colors` checked;
+/// the other ranges by `HairMaterial::prepare` or `check_variation`).
+pub(super) fn varied_material(
+    p: HairParams,
+    v: &HtHairVariation,
+) -> std::result::Result<HairMaterial, Failure> {
+    Ok(HairMaterial {
         color: HairColor::SigmaA(p.sigma_a),
         eta: p.eta,
         beta_m: p.beta_m,
@@ -144,8 +155,7 @@ fn hair_material(
             }
         },
         seed: v.seed,
-    };
-    Ok(Material::Hair(Box::new(material.prepare()?)))
+    })
 }
 
 /// Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;

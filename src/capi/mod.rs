@@ -42,6 +42,7 @@ pub use bsdf::HtHairParams;
 
 use crate::Error;
 use crate::error::invalid_arg;
+use crate::quiet_panic::Quiet;
 use glam::Vec3;
 use std::cell::RefCell;
 use std::ffi::{CStr, CString, c_char};
@@ -78,6 +79,13 @@ const _: () = {
         "HT_VERSION_MAJOR/MINOR/PATCH in src/capi/mod.rs differ from Cargo.toml's version"
     );
 };
+
+/// Largest magnitude of a coordinate the scene API accepts (positions, camera, lights, in
+/// world units): Embree cannot trace rays past about 1.8e18, and aborts on them.
+pub const HT_MAX_COORDINATE: f32 = 1e15;
+
+/// cbindgen:ignore
+const _: () = assert!(HT_MAX_COORDINATE == crate::validate::MAX_COORDINATE);
 
 /// Result of every C entry point; `HT_OK` is 0.
 #[repr(C)]
@@ -161,8 +169,10 @@ fn set_last_error(msg: &str) {
 }
 
 /// Runs the body of an entry point: its error becomes a status plus `ht_last_error`'s
-/// message, and a panic becomes `HT_ERR_PANIC` instead of unwinding into C.
+/// message, and a panic becomes `HT_ERR_PANIC` instead of unwinding into C, printing
+/// nothing to the host's stderr (`quiet_panic`).
 pub(crate) fn boundary(body: impl FnOnce() -> Result<(), Failure>) -> HtStatus {
+    let _quiet = Quiet::enter();
     match catch_unwind(AssertUnwindSafe(body)) {
         Ok(Ok(())) => HtStatus::HT_OK,
         Ok(Err(Failure(status, msg))) => {

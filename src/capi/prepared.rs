@@ -4,17 +4,21 @@
 //!
 //! The point is an `OwnedPoint` (its own copy of the BSDF plus the (h, wo) work) written
 //! into the host's `HtHairPoint` bytes behind a tag; it runs the Rust `HairPoint` code, so
-//! it gives the same bits.
+//! it gives the same bits. A point filled from a frame keeps the frame's axes too, so that
+//! its world-space calls convert directions without the host's calls or a second check of
+//! the frame: what init established is not checked again per direction.
 
 use super::bsdf::{
-    Arg, check_args, check_dir, check_h, check_u, clean_args, read_params, read3, require,
-    sample_parts, write_eval, write_sample, write1,
+    Arg, check_args, check_dir, check_h, check_u, read_params, read3, require, sample_parts,
+    write_eval, write_sample, write1,
 };
+use super::frame::{HtHairFrame, checked_axes};
 use super::{
     Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
 };
-use crate::bsdf::{HairBsdf, OwnedPoint};
+use crate::bsdf::{BsdfEval, BsdfSample, HairBsdf, OwnedPoint};
 use crate::error::invalid_arg;
+use crate::math::Frame;
 use glam::Vec3;
 
 /// Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
@@ -53,24 +57,35 @@ pub struct HtHairPoint {
 /// What the host's `HtHairPoint` bytes hold.
 #[repr(C)]
 struct Stored {
-    /// [`TAG`] once filled: catches points that were never filled.
+    /// [`TAG`] or [`TAG_FRAMED`] once filled: catches points that were never filled.
     tag: u64,
     point: OwnedPoint,
 }
 
-/// "htpoint" and a layout version.
-const TAG: u64 = 0x6874_706f_696e_7401;
+/// What a point filled by `ht_hair_point_init_world` ([`TAG_FRAMED`]) holds: the point and
+/// the world axes of its frame, for the world-space calls.
+#[repr(C)]
+struct Framed {
+    stored: Stored,
+    frame: Frame,
+}
 
-// The host's storage must hold a `Stored` at its alignment: checked at compile time.
+/// "htpoint" and a layout version: a point filled in the local frame.
+const TAG: u64 = 0x6874_706f_696e_7401;
+/// The tag of a point filled from a frame, whose world-space calls may convert.
+const TAG_FRAMED: u64 = 0x6874_706f_696e_7402;
+
+// The host's storage must hold a `Framed` (and so a `Stored`) at its alignment: checked at
+// compile time.
 const _: () = assert!(
-    size_of::<Stored>() <= HT_HAIR_POINT_SIZE
-        && align_of::<Stored>() <= HT_HAIR_POINT_ALIGN
+    size_of::<Framed>() <= HT_HAIR_POINT_SIZE
+        && align_of::<Framed>() <= HT_HAIR_POINT_ALIGN
         && size_of::<HtHairPoint>() == HT_HAIR_POINT_SIZE
         && align_of::<HtHairPoint>() == HT_HAIR_POINT_ALIGN
 );
 
 /// The filled point behind the host's storage (NULL, misaligned or unfilled: an error).
-fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a OwnedPoint, Failure> {
+fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a Stored, Failure> {
     host_slice(point, 1, name)?;
     if !filled(point) {
         return Err(invalid_arg!(
@@ -79,7 +94,7 @@ fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a OwnedPoin
         .into());
     }
     // SAFETY: non-NULL, aligned and filled (checked); `HtHairPoint` holds a `Stored`.
-    Ok(unsafe { &(*point.cast::<Stored>()).point })
+    Ok(unsafe { &*point.cast::<Stored>() })
 }
 
 /// The tag of a non-NULL, aligned point.
@@ -87,7 +102,8 @@ fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a OwnedPoin
 fn filled(point: *const HtHairPoint) -> bool {
     // SAFETY: the caller checked `point`; `HtHairPoint` is at least as large and as aligned
     // as `Stored` (asserted above), and `Stored` is plain numbers, valid for any bytes.
-    unsafe { (*point.cast::<Stored>()).tag == TAG }
+    let tag = unsafe { (*point.cast::<Stored>()).tag };
+    tag == TAG || tag == TAG_FRAMED
 }
 
 /// The point of a per-point call, with the call's pointers checked: the common case (all
@@ -98,13 +114,38 @@ fn checked_point<'a>(
     point: *const HtHairPoint,
     inputs: &[Arg],
     outputs: &[Arg],
-) -> Result<&'a OwnedPoint, Failure> {
+) -> Result<&'a Stored, Failure> {
     check_args((point, "point"), inputs, outputs)?;
     if filled(point) {
         // SAFETY: non-NULL, aligned (checked above) and filled.
-        return Ok(unsafe { &(*point.cast::<Stored>()).point });
+        return Ok(unsafe { &*point.cast::<Stored>() });
     }
     read_point(point, "point")
+}
+
+/// [`checked_point`] for the world-space calls: the point must hold a frame.
+#[inline(always)]
+fn checked_framed<'a>(
+    point: *const HtHairPoint,
+    inputs: &[Arg],
+    outputs: &[Arg],
+) -> Result<&'a Framed, Failure> {
+    if checked_point(point, inputs, outputs)?.tag != TAG_FRAMED {
+        return Err(unframed());
+    }
+    // SAFETY: aligned (checked) and filled by `ht_hair_point_init_world`, which wrote a
+    // `Framed` there (asserted to fit above).
+    Ok(unsafe { &*point.cast::<Framed>() })
+}
+
+#[cold]
+#[inline(never)]
+fn unframed() -> Failure {
+    invalid_arg!(
+        "point was filled by ht_hair_point_init, without a frame: the world-space calls need \
+         a point from ht_hair_point_init_world"
+    )
+    .into()
 }
 
 /// Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
@@ -176,33 +217,171 @@ pub unsafe extern "C" fn ht_hair_point_init(
     point: *mut HtHairPoint,
 ) -> HtStatus {
     boundary(|| {
-        let fast = !prepared.is_null()
-            && !point.is_null()
-            && point.is_aligned()
-            && clean_args(&[(wo, "wo", 3)], &[], (0, 0))
-            && (wo as usize + 3 * size_of::<f32>() <= point as usize
-                || point as usize + HT_HAIR_POINT_SIZE <= wo as usize);
-        if !fast {
-            require(&[
-                (prepared.cast(), "prepared"),
-                (wo.cast(), "wo"),
-                (point.cast_const().cast(), "point"),
-            ])?;
-            host_slice(wo, 3, "wo")?;
-            host_slice(point.cast_const(), 1, "point")?;
-            check_disjoint(&[Span::of("point", point, 1)], &[Span::of("wo", wo, 3)])?;
-        }
+        check_init(prepared, wo, None, point)?;
         let h = check_h(h)?;
         let wo = check_dir(read3(wo), "wo")?;
-        // SAFETY: non-NULL (checked), a live handle (the caller's promise).
-        let bsdf = unsafe { &(*prepared).bsdf };
-        let stored = Stored {
-            tag: TAG,
-            point: OwnedPoint::new(bsdf, h, wo),
-        };
         // SAFETY: non-NULL and aligned (checked), `HT_HAIR_POINT_SIZE` writable bytes that
         // hold a `Stored` (asserted above).
-        unsafe { point.cast::<Stored>().write(stored) };
+        unsafe { point.cast::<Stored>().write(stored(prepared, h, wo, TAG)) };
+        Ok(())
+    })
+}
+
+/// The pointers of a point init, checked inline in the common case, else in the documented
+/// order with messages: every NULL first, then alignment, then `wo` or `frame` inside the
+/// point.
+#[inline(always)]
+fn check_init(
+    prepared: *const HtHairPrepared,
+    wo: *const f32,
+    frame: Option<*const HtHairFrame>,
+    point: *mut HtHairPoint,
+) -> Result<(), Failure> {
+    let start = point as usize;
+    let apart = |p: usize, bytes: usize| p + bytes <= start || start + HT_HAIR_POINT_SIZE <= p;
+    let fast = !prepared.is_null()
+        && !point.is_null()
+        && point.is_aligned()
+        && !wo.is_null()
+        && wo.is_aligned()
+        && apart(wo as usize, 3 * size_of::<f32>())
+        && frame.is_none_or(|f| {
+            !f.is_null() && f.is_aligned() && apart(f as usize, size_of::<HtHairFrame>())
+        });
+    if fast {
+        return Ok(());
+    }
+    let mut all = vec![(prepared.cast(), "prepared")];
+    all.extend(frame.map(|f| (f.cast(), "frame")));
+    all.extend([(wo.cast(), "wo"), (point.cast_const().cast(), "point")]);
+    require(&all)?;
+    host_slice(wo, 3, "wo")?;
+    host_slice(point.cast_const(), 1, "point")?;
+    let mut inputs = vec![Span::of("wo", wo, 3)];
+    if let Some(f) = frame {
+        host_slice(f, 1, "frame")?;
+        inputs.push(Span::of("frame", f, 1));
+    }
+    check_disjoint(&[Span::of("point", point, 1)], &inputs)
+}
+
+/// The point of `prepared` at (h, wo), tagged `tag`.
+#[inline(always)]
+fn stored(prepared: *const HtHairPrepared, h: f32, wo: Vec3, tag: u64) -> Stored {
+    // SAFETY: non-NULL (checked), a live handle (the caller's promise).
+    let bsdf = unsafe { &(*prepared).bsdf };
+    Stored {
+        tag,
+        point: OwnedPoint::new(bsdf, h, wo),
+    }
+}
+
+/// `ht_hair_point_init` from a hit's frame: h is `frame->h`, and `wo[3]` is in *world*
+/// space (toward the viewer, -ray_dir normalised at a camera hit). The point keeps the
+/// frame's axes, so that `ht_hair_point_eval_world` and `ht_hair_point_sample_world` take
+/// and give world directions; the local calls work on it as well. Equal, bit for bit, to
+/// `ht_hair_point_init(prepared, frame->h, wo_local, point)` with `wo_local` from
+/// `ht_hair_frame_to_local(frame, wo, wo_local)`.
+///
+/// - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
+///   or left-handed, or `h` outside [-1, 1]: `HT_ERR_INVALID_ARG`. Checked here once: the
+///   world-space calls trust it.
+/// - `wo`: a world direction whose local form is a unit vector (|length - 1| <= 1e-3);
+///   else `HT_ERR_INVALID_ARG`.
+/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `frame` and `wo` 4-byte and
+///   `point` 16-byte aligned; neither `frame` nor `wo` may lie inside `*point`
+///   (`HT_ERR_INVALID_ARG`). On error `*point` is untouched.
+///
+/// Any thread; `prepared` may be shared, `point` must not be read meanwhile.
+///
+/// # Safety
+/// `prepared` is NULL or a live handle; `frame` NULL or an `HtHairFrame`; `wo` NULL or 3
+/// floats; `point` NULL or writable storage of `HT_HAIR_POINT_SIZE` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_init_world(
+    prepared: *const HtHairPrepared,
+    frame: *const HtHairFrame,
+    wo: *const f32,
+    point: *mut HtHairPoint,
+) -> HtStatus {
+    boundary(|| {
+        check_init(prepared, wo, Some(frame), point)?;
+        // SAFETY: non-NULL and aligned (checked above), an `HtHairFrame` (the caller's
+        // promise).
+        let frame = unsafe { frame.read() };
+        let (axes, h) = (checked_axes(&frame)?, frame.h);
+        let h = check_h(h)?;
+        let wo = check_dir(axes.to_local(read3(wo)), "wo")?;
+        let framed = Framed {
+            stored: stored(prepared, h, wo, TAG_FRAMED),
+            frame: axes,
+        };
+        // SAFETY: as in `ht_hair_point_init`, for a `Framed`.
+        unsafe { point.cast::<Framed>().write(framed) };
+        Ok(())
+    })
+}
+
+/// `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
+/// material varies them (`ht_scene_add_hair_material_varied`): the parameters of
+/// `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
+/// (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
+/// `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
+/// allocation: the varied BSDF is built inside the point, and the point equals, bit for
+/// bit, the one the renderer shades that strand's hit with.
+///
+/// - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
+///   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
+///   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
+///   Else `HT_ERR_INVALID_ARG`.
+/// - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
+///   as `ht_hair_point_init`. On error `*point` is untouched.
+/// - Cost: an init plus the preparation of the varied parameters (about one evaluation).
+///
+/// # Safety
+/// As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
+/// floats.
+#[cfg(feature = "render")]
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn ht_hair_point_init_strand(
+    prepared: *const HtHairPrepared,
+    variation: *const super::materials::HtHairVariation,
+    strand: u32,
+    s: f32,
+    color: *const f32,
+    h: f32,
+    wo: *const f32,
+    point: *mut HtHairPoint,
+) -> HtStatus {
+    use crate::scene::material::HairColor;
+    boundary(|| {
+        require(&[(variation.cast(), "variation")])?;
+        check_init(prepared, wo, None, point)?;
+        let v = super::read_host(variation, "variation")?;
+        let h = check_h(h)?;
+        let wo = check_dir(read3(wo), "wo")?;
+        if !(0.0..=1.0).contains(&s) {
+            return Err(invalid_arg!("s = {s}: must be in [0, 1]").into());
+        }
+        let groom = if color.is_null() {
+            None
+        } else {
+            let c = super::read_vec3(color, "color")?.to_array();
+            if let Some(bad) = c.iter().position(|x| !(0.0..=1.0).contains(x)) {
+                return Err(invalid_arg!("color[{bad}] = {}: must be in [0, 1]", c[bad]).into());
+            }
+            Some(HairColor::Color(c))
+        };
+        // SAFETY: non-NULL (checked), a live handle (the caller's promise).
+        let base = *unsafe { &(*prepared).bsdf }.params();
+        let material = super::materials::varied_material(base, &v)?;
+        material.check_variation()?;
+        let bsdf = HairBsdf::new(&material.varied(base, strand, s, groom))?;
+        let prepared = HtHairPrepared { bsdf };
+        // SAFETY: non-NULL and aligned (checked), `HT_HAIR_POINT_SIZE` writable bytes that
+        // hold a `Stored` (asserted above).
+        unsafe { point.cast::<Stored>().write(stored(&prepared, h, wo, TAG)) };
         Ok(())
     })
 }
@@ -232,7 +411,7 @@ pub unsafe extern "C" fn ht_hair_point_eval(
 ) -> HtStatus {
     boundary(|| {
         let p = checked_point(point, &[(wi, "wi", 3)], &[(f, "f", 3), (pdf, "pdf", 1)])?;
-        write_eval(p.eval(check_dir(read3(wi), "wi")?), f, pdf);
+        write_eval(p.point.eval(check_dir(read3(wi), "wi")?), f, pdf);
         Ok(())
     })
 }
@@ -251,7 +430,7 @@ pub unsafe extern "C" fn ht_hair_point_pdf(
 ) -> HtStatus {
     boundary(|| {
         let p = checked_point(point, &[(wi, "wi", 3)], &[(pdf, "pdf", 1)])?;
-        write1(pdf, p.eval(check_dir(read3(wi), "wi")?).pdf);
+        write1(pdf, p.point.eval(check_dir(read3(wi), "wi")?).pdf);
         Ok(())
     })
 }
@@ -285,10 +464,169 @@ pub unsafe extern "C" fn ht_hair_point_sample(
             (pdf.cast_const(), "pdf", 1),
         ];
         let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
-        let s = p.sample(check_u(read3(u).to_array(), "u")?);
+        let s = p.point.sample(check_u(read3(u).to_array(), "u")?);
         write_sample(s, wi, f, pdf);
         Ok(())
     })
+}
+
+/// f |cos| and pdf of an evaluation at the local `wi`: `f * |wi.z|`, the scattered fraction
+/// per unit solid angle, as a host multiplies it.
+#[inline(always)]
+fn times_cos(e: BsdfEval, wi: Vec3) -> BsdfEval {
+    BsdfEval {
+        f: e.f * wi.z.abs(),
+        pdf: e.pdf,
+    }
+}
+
+/// A sample's wi, weight f |wi.z| / pdf and pdf, or zeros when there is none or the weight
+/// is not finite (a pdf that underflowed).
+#[inline(always)]
+fn weighted(s: Option<BsdfSample>) -> Option<BsdfSample> {
+    s.map(|s| BsdfSample {
+        f: s.f * s.wi.z.abs() / s.pdf,
+        ..s
+    })
+    .filter(|s| s.f.is_finite())
+}
+
+/// One call for what a path vertex wants of a light direction: writes `f_cos[3]` =
+/// f * |wi.z| (the `f` of `ht_hair_point_eval` times the cosine, in that order: the
+/// fraction scattered per unit solid angle) and `*pdf`, the same pdf as
+/// `ht_hair_point_eval`. Arguments, statuses and thread safety as `ht_hair_point_eval`
+/// (`f_cos` in place of `f`).
+///
+/// # Safety
+/// As `ht_hair_point_eval`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_eval_cos(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| eval_cos(point, wi, f_cos, pdf, false))
+}
+
+/// One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
+/// `ht_hair_point_sample`), `weight[3]` = f * |wi.z| / pdf (the path throughput factor,
+/// from that call's f and pdf in that order) and `*pdf`. pdf = 0 (wi, weight zero) means
+/// no direction, also when the weight would not be finite; still HT_OK. Arguments,
+/// statuses and thread safety as `ht_hair_point_sample` (`weight` in place of `f`).
+///
+/// # Safety
+/// As `ht_hair_point_sample`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_sample_cos(
+    point: *const HtHairPoint,
+    u: *const f32,
+    wi: *mut f32,
+    weight: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| sample_cos(point, u, wi, weight, pdf, false))
+}
+
+/// `ht_hair_point_eval_cos` with `wi[3]` in *world* space, at a point filled by
+/// `ht_hair_point_init_world`: wi is taken to the point's frame (as
+/// `ht_hair_frame_to_local` does, but with no check of the frame: init made it) and must be
+/// a unit vector there (|length - 1| <= 1e-3). The same bits as `ht_hair_frame_to_local`
+/// followed by `ht_hair_point_eval_cos`.
+///
+/// - A point filled by `ht_hair_point_init` (no frame): `HT_ERR_INVALID_ARG`.
+/// - Otherwise arguments, statuses and thread safety as `ht_hair_point_eval_cos`.
+///
+/// # Safety
+/// As `ht_hair_point_eval`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_eval_world(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| eval_cos(point, wi, f_cos, pdf, true))
+}
+
+/// `ht_hair_point_sample_cos` giving `wi[3]` in *world* space, at a point filled by
+/// `ht_hair_point_init_world`: the local sample taken to world space with the point's
+/// frame, the same bits as `ht_hair_point_sample_cos` followed by `ht_hair_frame_to_world`
+/// (weight and pdf are unchanged). pdf = 0 (wi, weight zero) means no direction.
+///
+/// - A point filled by `ht_hair_point_init` (no frame): `HT_ERR_INVALID_ARG`.
+/// - Otherwise arguments, statuses and thread safety as `ht_hair_point_sample_cos`.
+///
+/// # Safety
+/// As `ht_hair_point_sample`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_sample_world(
+    point: *const HtHairPoint,
+    u: *const f32,
+    wi: *mut f32,
+    weight: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| sample_cos(point, u, wi, weight, pdf, true))
+}
+
+/// The body of `ht_hair_point_eval_cos` and, with `world`, `ht_hair_point_eval_world`
+/// (`wi` in world space, taken to the point's frame).
+#[inline(always)]
+fn eval_cos(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+    world: bool,
+) -> Result<(), Failure> {
+    let inputs = [(wi, "wi", 3)];
+    let outputs = [
+        (f_cos.cast_const(), "f_cos", 3),
+        (pdf.cast_const(), "pdf", 1),
+    ];
+    let (p, wi) = if world {
+        let p = checked_framed(point, &inputs, &outputs)?;
+        let local = p.frame.to_local(read3(wi));
+        (&p.stored, check_dir(local, "wi (in the point's frame)")?)
+    } else {
+        let p = checked_point(point, &inputs, &outputs)?;
+        (p, check_dir(read3(wi), "wi")?)
+    };
+    write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
+    Ok(())
+}
+
+/// The body of `ht_hair_point_sample_cos` and, with `world`, `ht_hair_point_sample_world`
+/// (`wi` given in world space with the point's frame).
+#[inline(always)]
+fn sample_cos(
+    point: *const HtHairPoint,
+    u: *const f32,
+    wi: *mut f32,
+    weight: *mut f32,
+    pdf: *mut f32,
+    world: bool,
+) -> Result<(), Failure> {
+    let inputs = [(u, "u", 3)];
+    let outputs = [
+        (wi.cast_const(), "wi", 3),
+        (weight.cast_const(), "weight", 3),
+        (pdf.cast_const(), "pdf", 1),
+    ];
+    let (p, frame) = if world {
+        let p = checked_framed(point, &inputs, &outputs)?;
+        (&p.stored, Some(&p.frame))
+    } else {
+        (checked_point(point, &inputs, &outputs)?, None)
+    };
+    let s = weighted(p.point.sample(check_u(read3(u).to_array(), "u")?));
+    let s = s.map(|s| BsdfSample {
+        wi: frame.map_or(s.wi, |f| f.to_world(s.wi)),
+        ..s
+    });
+    write_sample(s, wi, weight, pdf);
+    Ok(())
 }
 
 /// The pointers of a batch over points, checked as one: `points[n]`, an input of `3n`
@@ -500,6 +838,195 @@ mod tests {
                 (want.wi.to_array(), want.f.to_array(), want.pdf)
             );
         }
+    }
+
+    /// The world-space calls are the host's conversions around the local calls, bit for bit.
+    #[test]
+    fn world_calls_equal_the_conversions_around_the_local_calls() {
+        use super::super::frame::{ht_hair_frame, ht_hair_frame_to_local, ht_hair_frame_to_world};
+        let handle = prepare(&HairParams::default().into());
+        for k in 0..200 {
+            let a = 0.37 * k as f32;
+            let tangent = Vec3::new(a.cos(), a.sin(), 0.3 * (2.0 * a).sin()).normalize();
+            let dir = Vec3::new((1.7 * a).sin(), -0.4, (0.9 * a).cos()).normalize();
+            let across = tangent.cross(dir).normalize();
+            let h = (0.61 * k as f32).sin() * 0.95;
+            let org = across * h - dir * 4.0;
+            let mut frame = HtHairFrame {
+                x: [0.0; 3],
+                y: [0.0; 3],
+                z: [0.0; 3],
+                h: 0.0,
+            };
+            let arr = |v: &Vec3| v.to_array();
+            let s = unsafe {
+                ht_hair_frame(
+                    arr(&tangent).as_ptr(),
+                    arr(&org).as_ptr(),
+                    arr(&dir).as_ptr(),
+                    [0.0f32; 3].as_ptr(),
+                    1.0,
+                    &mut frame,
+                )
+            };
+            assert_eq!(s, HtStatus::HT_OK);
+            let wo = arr(&-dir);
+            let (mut world, mut local) = (point(), point());
+            let mut wo_local = [0.0f32; 3];
+            unsafe {
+                assert_eq!(
+                    ht_hair_point_init_world(handle, &frame, wo.as_ptr(), &mut world),
+                    HtStatus::HT_OK
+                );
+                ht_hair_frame_to_local(&frame, wo.as_ptr(), wo_local.as_mut_ptr());
+                ht_hair_point_init(handle, frame.h, wo_local.as_ptr(), &mut local);
+            }
+            // Light from a direction of the world, and a sample.
+            let wi = arr(&Vec3::new(0.3, (1.3 * a).cos(), (1.3 * a).sin()).normalize());
+            let u = [(0.13 * k as f32).fract(), 0.42, (0.71 * k as f32).fract()];
+            let (mut f_w, mut pdf_w, mut f_l, mut pdf_l) =
+                ([0.0f32; 3], 0.0f32, [0.0f32; 3], 0.0f32);
+            let mut wi_local = [0.0f32; 3];
+            let (mut d_w, mut wt_w, mut p_w) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
+            let (mut d_l, mut wt_l, mut p_l, mut d_back) =
+                ([0.0f32; 3], [0.0f32; 3], 0.0f32, [0.0f32; 3]);
+            unsafe {
+                assert_eq!(
+                    ht_hair_point_eval_world(&world, wi.as_ptr(), f_w.as_mut_ptr(), &mut pdf_w),
+                    HtStatus::HT_OK
+                );
+                ht_hair_frame_to_local(&frame, wi.as_ptr(), wi_local.as_mut_ptr());
+                ht_hair_point_eval_cos(&local, wi_local.as_ptr(), f_l.as_mut_ptr(), &mut pdf_l);
+                let s = ht_hair_point_sample_world(
+                    &world,
+                    u.as_ptr(),
+                    d_w.as_mut_ptr(),
+                    wt_w.as_mut_ptr(),
+                    &mut p_w,
+                );
+                assert_eq!(s, HtStatus::HT_OK);
+                ht_hair_point_sample_cos(
+                    &local,
+                    u.as_ptr(),
+                    d_l.as_mut_ptr(),
+                    wt_l.as_mut_ptr(),
+                    &mut p_l,
+                );
+                ht_hair_frame_to_world(&frame, d_l.as_ptr(), d_back.as_mut_ptr());
+            }
+            assert_eq!((f_w, pdf_w), (f_l, pdf_l), "eval at {k}");
+            assert_eq!((d_w, wt_w, p_w), (d_back, wt_l, p_l), "sample at {k}");
+            assert!(pdf_w > 0.0 && p_w > 0.0, "{k}: a lobe toward every light");
+        }
+        unsafe { ht_hair_prepared_free(handle) };
+    }
+
+    /// A strand's point is the BSDF the renderer shades that strand's hits with (the scene
+    /// material's `bsdf_at`), bit for bit, with and without a groom colour.
+    #[cfg(feature = "render")]
+    #[test]
+    fn strand_points_are_the_scene_materials_bsdf() {
+        use crate::capi::materials::{HtHairVariation, varied_material};
+        use crate::scene::material::HairColor;
+        let params: HtHairParams = HairParams::default().into();
+        let handle = prepare(&params);
+        let variation = HtHairVariation {
+            absorption_variation: 0.5,
+            roughness_variation: 0.4,
+            tip_absorption: 0.3,
+            use_vertex_colors: 1,
+            seed: 42,
+        };
+        let Ok(material) = varied_material(params.into(), &variation) else {
+            panic!("a valid variation")
+        };
+        let scene = material.prepare().unwrap();
+        let mut distinct = std::collections::BTreeSet::new();
+        for k in 0..120u32 {
+            let (strand, s) = (k * 7 % 23, (k % 11) as f32 / 10.0);
+            let color = [0.3 + 0.005 * k as f32, 0.2, 0.1];
+            let groom = (k % 2 == 0).then_some(color);
+            let (h, wo) = (
+                0.9 * (0.3 * k as f32).sin(),
+                Vec3::new(0.3, 0.2, 0.9).normalize(),
+            );
+            let mut pt = point();
+            let color_ptr = groom.as_ref().map_or(std::ptr::null(), |c| c.as_ptr());
+            let st = unsafe {
+                ht_hair_point_init_strand(
+                    handle,
+                    &variation,
+                    strand,
+                    s,
+                    color_ptr,
+                    h,
+                    wo.as_ref().as_ptr(),
+                    &mut pt,
+                )
+            };
+            assert_eq!(st, HtStatus::HT_OK, "{}", last_error());
+            let want = scene.bsdf_at(strand, s, groom.map(HairColor::Color));
+            distinct.insert(want.params().sigma_a.map(f32::to_bits));
+            let rust = want.at(h, wo);
+            let wi = Vec3::new(-0.2, 0.7, 0.5).normalize();
+            let (mut f, mut pdf) = ([0.0f32; 3], 0.0f32);
+            unsafe { ht_hair_point_eval(&pt, wi.as_ref().as_ptr(), f.as_mut_ptr(), &mut pdf) };
+            let e = rust.eval(wi);
+            assert_eq!((f, pdf), (e.f.to_array(), e.pdf), "strand {strand} s {s}");
+            let u = [0.61, 0.27, 0.83];
+            let (mut w, mut fs, mut ps) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
+            unsafe {
+                ht_hair_point_sample(&pt, u.as_ptr(), w.as_mut_ptr(), fs.as_mut_ptr(), &mut ps)
+            };
+            let want = rust.sample(u).unwrap();
+            assert_eq!(
+                (w, fs, ps),
+                (want.wi.to_array(), want.f.to_array(), want.pdf)
+            );
+        }
+        assert!(
+            distinct.len() > 100,
+            "the parameters vary: {}",
+            distinct.len()
+        );
+        let bad = HtHairVariation {
+            roughness_variation: 2.0,
+            ..variation
+        };
+        let wo = [0.0f32, 0.0, 1.0];
+        let mut pt = point();
+        let st = unsafe {
+            ht_hair_point_init_strand(
+                handle,
+                &bad,
+                0,
+                0.5,
+                std::ptr::null(),
+                0.0,
+                wo.as_ptr(),
+                &mut pt,
+            )
+        };
+        assert_eq!(st, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(
+            last_error().contains("roughness_variation = 2"),
+            "{}",
+            last_error()
+        );
+        let st = unsafe {
+            ht_hair_point_init_strand(
+                handle,
+                &variation,
+                0,
+                1.5,
+                std::ptr::null(),
+                0.0,
+                wo.as_ptr(),
+                &mut pt,
+            )
+        };
+        assert!(st == HtStatus::HT_ERR_INVALID_ARG && last_error().contains("s = 1.5"));
+        unsafe { ht_hair_prepared_free(handle) };
     }
 
     #[test]

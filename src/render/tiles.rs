@@ -15,6 +15,7 @@ use super::film::{Film, PixelAccumulator, Window};
 use super::progress::Progress;
 use crate::Result;
 use crate::error::invalid_arg;
+use crate::quiet_panic;
 
 /// How the work is split and run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -165,10 +166,12 @@ where
     };
     // A pool of the render's own, joined when `build_scoped` returns: no thread outlives
     // the render (a host may unload the library after it).
+    // The workers of a C call keep its panics quiet as the calling thread does.
+    let quiet = quiet_panic::is_quiet();
     rayon::ThreadPoolBuilder::new()
         .num_threads(options.threads)
         .build_scoped(
-            |thread| thread.run(),
+            |thread| quiet_panic::inherit(quiet, || thread.run()),
             |pool| pool.install(|| work.par_iter().for_each(render_tile)),
         )
         .map_err(|e| invalid_arg!("cannot start {} render threads: {e}", options.threads))?;

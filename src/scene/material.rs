@@ -124,15 +124,7 @@ impl HairMaterial {
     /// Validates everything and precomputes what does not vary.
     pub fn prepare(&self) -> Result<PreparedHair> {
         let base = self.base_params()?;
-        for (name, v) in [
-            ("absorption_variation", self.absorption_variation),
-            ("roughness_variation", self.roughness_variation),
-        ] {
-            if !(0.0..=1.0).contains(&v) {
-                return Err(invalid_arg!("{name} = {v}: must be in [0, 1]"));
-            }
-        }
-        positive("tip_absorption", self.tip_absorption)?;
+        self.check_variation()?;
         let varies = self.absorption_variation > 0.0
             || self.roughness_variation > 0.0
             || self.tip_absorption != 1.0
@@ -150,19 +142,33 @@ impl HairMaterial {
     }
 }
 
-impl PreparedHair {
-    /// Every hit shares one BSDF: nothing varies per strand, along strands or by the
-    /// groom's absorption.
-    pub fn is_uniform(&self) -> bool {
-        self.uniform.is_some()
+impl HairMaterial {
+    /// Checks the variation's ranges (the parameters are checked with the base).
+    pub(crate) fn check_variation(&self) -> Result<()> {
+        for (name, v) in [
+            ("absorption_variation", self.absorption_variation),
+            ("roughness_variation", self.roughness_variation),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(invalid_arg!("{name} = {v}: must be in [0, 1]"));
+            }
+        }
+        positive("tip_absorption", self.tip_absorption)
     }
 
-    /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's
-    /// absorption at the hit when it gives one ([`crate::scene::curves::StrandIndex::absorption`]).
-    pub fn params_at(&self, strand: u32, s: f32, groom: Option<HairColor>) -> HairParams {
-        let m = &self.material;
-        let mut p = self.base;
-        if let (true, Some(a)) = (m.use_vertex_colors, groom) {
+    /// `base` (this material's valid parameters) varied as this material says at position
+    /// s (root 0, tip 1) of `strand`, with the groom's absorption at the hit when it gives
+    /// one ([`crate::scene::curves::StrandIndex::absorption`]). Always valid: the varied
+    /// values are clamped into range.
+    pub(crate) fn varied(
+        &self,
+        base: HairParams,
+        strand: u32,
+        s: f32,
+        groom: Option<HairColor>,
+    ) -> HairParams {
+        let mut p = base;
+        if let (true, Some(a)) = (self.use_vertex_colors, groom) {
             let a = match a {
                 // Colours are validated into [0, 1]; black, which no finite absorption
                 // makes, is taken as 1e-4 (documented with the colours of the C ABI and
@@ -173,14 +179,28 @@ impl PreparedHair {
             // The groom's values were validated with it: the fallback is never taken.
             p.sigma_a = a.sigma_a(p.beta_n).unwrap_or(p.sigma_a);
         }
-        let [ua, ur] = strand_uniforms(m.seed, strand);
-        let absorption = (1.0 + m.absorption_variation * (2.0 * ua - 1.0))
-            * (1.0 + (m.tip_absorption - 1.0) * s.clamp(0.0, 1.0));
+        let [ua, ur] = strand_uniforms(self.seed, strand);
+        let absorption = (1.0 + self.absorption_variation * (2.0 * ua - 1.0))
+            * (1.0 + (self.tip_absorption - 1.0) * s.clamp(0.0, 1.0));
         p.sigma_a = p.sigma_a.map(|v| (v * absorption).min(f32::MAX));
-        let roughness = 1.0 + m.roughness_variation * (2.0 * ur - 1.0);
+        let roughness = 1.0 + self.roughness_variation * (2.0 * ur - 1.0);
         p.beta_m = (p.beta_m * roughness).clamp(0.01, 1.0);
         p.beta_n = (p.beta_n * roughness).clamp(0.01, 1.0);
         p
+    }
+}
+
+impl PreparedHair {
+    /// Every hit shares one BSDF: nothing varies per strand, along strands or by the
+    /// groom's absorption.
+    pub fn is_uniform(&self) -> bool {
+        self.uniform.is_some()
+    }
+
+    /// The parameters at position s (root 0, tip 1) of `strand`, with the groom's
+    /// absorption at the hit when it gives one ([`crate::scene::curves::StrandIndex::absorption`]).
+    pub fn params_at(&self, strand: u32, s: f32, groom: Option<HairColor>) -> HairParams {
+        self.material.varied(self.base, strand, s, groom)
     }
 
     /// The BSDF at a hit: shared when the material is uniform.

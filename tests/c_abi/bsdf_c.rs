@@ -100,8 +100,17 @@ fn every_c_entry_point_gives_the_rust_bits() {
         let sample = point.sample(*u).map_or([0.0; 7], |s| {
             [s.wi.x, s.wi.y, s.wi.z, s.f.x, s.f.y, s.f.z, s.pdf]
         });
+        // f |cos| and the path weight f |cos| / pdf, as a host computes them from eval and
+        // sample (no direction, or a weight that is not finite: zeros).
+        let cos = e.f * wi[2].abs();
+        let eval_cos = [cos.x, cos.y, cos.z, e.pdf];
+        let sample_cos = point
+            .sample(*u)
+            .map(|s| (s.wi, s.f * s.wi.z.abs() / s.pdf, s.pdf))
+            .filter(|(_, w, _)| w.is_finite())
+            .map_or([0.0; 7], |(d, w, p)| [d.x, d.y, d.z, w.x, w.y, w.z, p]);
         // point eval, point pdf, point sample, eval, sample, points eval, points sample,
-        // eval batch: each the Rust HairPoint's bits.
+        // eval batch: each the Rust HairPoint's bits; then the combined calls.
         let want: Vec<u32> = eval
             .iter()
             .chain(&[e.pdf])
@@ -111,6 +120,8 @@ fn every_c_entry_point_gives_the_rust_bits() {
             .chain(&eval)
             .chain(&sample)
             .chain(&eval)
+            .chain(&eval_cos)
+            .chain(&sample_cos)
             .map(|v| v.to_bits())
             .collect();
         assert_eq!(

@@ -6,3 +6,4 @@ mod bsdf_c;
 mod c_examples;
 mod header;
 mod memcheck;
+mod quiet;

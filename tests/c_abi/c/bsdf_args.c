@@ -239,6 +239,44 @@ int main(void) {
     ROW(BAD, "out and frame overlap", ht_hair_frame_to_world(&fr, wo, fr.x));
     UNTOUCHED(out, 8);
 
+    /* The combined and world-space point calls. */
+    HtHairPoint framed;
+    float wo_world[3] = {0, 0, 1}, wi_world[3] = {0, 0.6f, 0.8f};
+    HtHairFrame bad_h = fr;
+    bad_h.h = 1.5f;
+    ROW(OK, NULL, ht_hair_prepare(&p, &prep));
+    ROW(NUL, "prepared is NULL", ht_hair_point_init_world(NULL, &fr, wo_world, &framed));
+    ROW(NUL, "frame is NULL", ht_hair_point_init_world(prep, NULL, wo_world, &framed));
+    ROW(NUL, "wo is NULL", ht_hair_point_init_world(prep, &fr, NULL, &framed));
+    ROW(NUL, "point is NULL", ht_hair_point_init_world(prep, &fr, wo_world, NULL));
+    ROW(BAD, "right-handed orthonormal", ht_hair_point_init_world(prep, &mirrored, wo_world, &framed));
+    ROW(BAD, "h = 1.5", ht_hair_point_init_world(prep, &bad_h, wo_world, &framed));
+    ROW(BAD, "wo = [0, 0, 0]", ht_hair_point_init_world(prep, &fr, zero3, &framed));
+    ROW(BAD, "not aligned to 16", ht_hair_point_init_world(prep, &fr, wo_world, odd_point));
+    ROW(BAD, "point and frame overlap",
+        ht_hair_point_init_world(prep, (const HtHairFrame *)store.p[1].opaque, wo_world, &store.p[1]));
+    ROW(OK, NULL, ht_hair_point_init_world(prep, &fr, wo_world, &framed));
+    ROW(OK, NULL, ht_hair_prepared_free(prep));
+    ROW(NUL, "f_cos is NULL", ht_hair_point_eval_cos(&pt, wi, NULL, &pdf));
+    ROW(BAD, "wi = [0, 0, 1.01]", ht_hair_point_eval_cos(&pt, long3, f, &pdf));
+    ROW(BAD, "f_cos and pdf overlap", ht_hair_point_eval_cos(&pt, wi, f, f + 1));
+    ROW(NUL, "weight is NULL", ht_hair_point_sample_cos(&pt, u, ws, NULL, &pdf));
+    ROW(BAD, "u[0] = 1", ht_hair_point_sample_cos(&pt, u_one, ws, f, &pdf));
+    ROW(BAD, "wi and weight overlap", ht_hair_point_sample_cos(&pt, u, f, f + 2, &pdf));
+    ROW(BAD, "not filled by ht_hair_point_init", ht_hair_point_eval_world(&zeroed, wi_world, f, &pdf));
+    ROW(BAD, "without a frame", ht_hair_point_eval_world(&pt, wi_world, f, &pdf));
+    ROW(BAD, "without a frame", ht_hair_point_sample_world(&pt, u, ws, f, &pdf));
+    ROW(NUL, "wi is NULL", ht_hair_point_eval_world(&framed, NULL, f, &pdf));
+    ROW(BAD, "wi (in the point's frame) = [0, 0, 0]", ht_hair_point_eval_world(&framed, zero3, f, &pdf));
+    ROW(BAD, "f_cos and point overlap",
+        ht_hair_point_eval_world(&framed, wi_world, (float *)framed.opaque, &pdf));
+    ROW(BAD, "u[2] = NaN", ht_hair_point_sample_world(&framed, u_nan, ws, f, &pdf));
+    ROW(BAD, "weight and pdf overlap", ht_hair_point_sample_world(&framed, u, ws, f, f + 2));
+    UNTOUCHED(f, 8);
+    UNTOUCHED(ws, 3);
+    ROW(OK, NULL, ht_hair_point_eval_world(&framed, wi_world, f, &pdf));
+    ROW(OK, NULL, ht_hair_point_sample_world(&framed, u, ws, f, &pdf));
+
     printf("checks %d failed %d\n", checks, failed);
     return failed ? 1 : 0;
 }

@@ -2,8 +2,9 @@
  * by argv[1], one case a line as 17 hexadecimal float bit patterns: sigma_a[3], eta,
  * beta_m, beta_n, alpha, h, wo[3], wi[3], u[3]. Prints one line a case with the bit
  * patterns of: ht_hair_point_eval (f, pdf), ht_hair_point_pdf, ht_hair_point_sample (wi,
- * f, pdf), ht_hair_eval, ht_hair_sample, ht_hair_points_eval, ht_hair_points_sample and
- * ht_hair_eval_batch (one material per case), so that the test compares them with Rust. */
+ * f, pdf), ht_hair_eval, ht_hair_sample, ht_hair_points_eval, ht_hair_points_sample,
+ * ht_hair_eval_batch (one material per case), ht_hair_point_eval_cos (f_cos, pdf) and
+ * ht_hair_point_sample_cos (wi, weight, pdf), so that the test compares them with Rust. */
 #include "hairtrace.h"
 
 #include <stdint.h>
@@ -89,13 +90,15 @@ int main(int argc, char **argv) {
 
     for (size_t i = 0; i < n; ++i) {
         const Case *c = &cases[i];
-        float f[3], pdf, pdf_only, s[7], e[4], t[7], b[4];
+        float f[3], pdf, pdf_only, s[7], e[4], t[7], b[4], ec[4], sc[7];
         ok(ht_hair_point_eval(&points[i], c->wi, f, &pdf), "point_eval", i);
         ok(ht_hair_point_pdf(&points[i], c->wi, &pdf_only), "point_pdf", i);
         ok(ht_hair_point_sample(&points[i], c->u, s, s + 3, s + 6), "point_sample", i);
         ok(ht_hair_eval(&c->params, c->h, c->wo, c->wi, e, e + 3), "eval", i);
         ok(ht_hair_sample(&c->params, c->h, c->wo, c->u, t, t + 3, t + 6), "sample", i);
         ok(ht_hair_eval_batch(&c->params, 1, &c->h, c->wo, c->wi, b, b + 3), "eval_batch", i);
+        ok(ht_hair_point_eval_cos(&points[i], c->wi, ec, ec + 3), "point_eval_cos", i);
+        ok(ht_hair_point_sample_cos(&points[i], c->u, sc, sc + 3, sc + 6), "point_sample_cos", i);
         put(f, 3);
         put(&pdf, 1);
         put(&pdf_only, 1);
@@ -108,6 +111,8 @@ int main(int argc, char **argv) {
         put(sf + 3 * i, 3);
         put(sp + i, 1);
         put(b, 4);
+        put(ec, 4);
+        put(sc, 7);
         printf("\n");
     }
     free(points);

@@ -1,0 +1,317 @@
+/*
+ * hairtrace.hpp: a C++17 layer over the C ABI of hairtrace.h, header-only.
+ *
+ * - Every handle has an owner that releases it: `Material` (HtHairPrepared), and with the
+ *   full library `Device`, `Scene`, `Settings`. `get()` gives the C handle, for the C
+ *   calls this layer does not wrap.
+ * - The host's own vectors go in and out as they are: anything with `x, y, z` members or
+ *   an `operator[]` (glm, Eigen, a `float[3]`, a std::array), converted to float.
+ * - Errors are exceptions (`hairtrace::Error`, with the status and `ht_last_error()`'s
+ *   message). Every status the library returns is a broken contract (a bad argument, a file
+ *   that cannot be read), never a per-sample outcome: "no direction" is a sample with
+ *   pdf 0, not an error. So a throw happens once in a failing run and costs nothing on the
+ *   paths a host takes per sample, and a C++17 host has no std::expected. A host built
+ *   without exceptions uses hairtrace.h directly.
+ *
+ * The hot path is three calls per path vertex: `Point::world` (or the local constructor),
+ * `eval_world` (f |cos| and pdf toward a light), `sample_world` (a direction, its weight
+ * f |cos| / pdf and pdf). They give the bits of the C calls they wrap.
+ */
+#ifndef HT_HAIRTRACE_HPP
+#define HT_HAIRTRACE_HPP
+
+#include "hairtrace.h"
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <utility>
+
+namespace hairtrace {
+
+/** A status other than HT_OK, with the library's message for it. */
+class Error : public std::runtime_error {
+public:
+    Error(HtStatus status, const std::string &message)
+        : std::runtime_error(message), status_(status) {}
+    /** The C status (`HT_ERR_INVALID_ARG`, ...). */
+    HtStatus status() const noexcept { return status_; }
+
+private:
+    HtStatus status_;
+};
+
+/** Throws `Error` for any status but HT_OK, with `ht_last_error()`'s message. */
+inline void check(HtStatus status) {
+    if (status != HT_OK) {
+        throw Error(status, std::string(ht_status_str(static_cast<int32_t>(status))) + ": " +
+                                ht_last_error());
+    }
+}
+
+/** The vectors of this layer: three floats, as the C ABI takes them. */
+using Vec3 = std::array<float, 3>;
+
+namespace detail {
+template <class V, class = void> struct HasXyz : std::false_type {};
+template <class V>
+struct HasXyz<V, std::void_t<decltype(std::declval<const V &>().x),
+                             decltype(std::declval<const V &>().y),
+                             decltype(std::declval<const V &>().z)>> : std::true_type {};
+} // namespace detail
+
+/** A host vector as three floats: its `x, y, z` if it has them, else `v[0], v[1], v[2]`. */
+template <class V> Vec3 vec3(const V &v) {
+    if constexpr (detail::HasXyz<V>::value) {
+        return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+    } else {
+        return {static_cast<float>(v[0]), static_cast<float>(v[1]), static_cast<float>(v[2])};
+    }
+}
+
+/** Three floats as a host vector type `V`, built as `V{x, y, z}`. */
+template <class V> V as(const Vec3 &v) {
+    return V{v[0], v[1], v[2]};
+}
+
+/** f |cos| (RGB, the fraction scattered per unit solid angle) and pdf toward a direction. */
+struct Eval {
+    Vec3 f_cos;
+    float pdf;
+};
+
+/** A sampled direction, its weight f |cos| / pdf and its pdf; pdf 0: no direction. */
+struct Sample {
+    Vec3 wi;
+    Vec3 weight;
+    float pdf;
+    explicit operator bool() const noexcept { return pdf > 0.0f; }
+};
+
+/** `HtHairParams` with the library's defaults (brown hair); fields as in hairtrace.h. */
+inline HtHairParams default_params() { return ht_hair_params_default(); }
+
+/** sigma_a for melanin concentrations (`ht_hair_sigma_a_from_melanin`). */
+inline Vec3 sigma_a_from_melanin(float eumelanin, float pheomelanin) {
+    Vec3 out;
+    check(ht_hair_sigma_a_from_melanin(eumelanin, pheomelanin, out.data()));
+    return out;
+}
+
+/** sigma_a that looks like the linear RGB `color` at `beta_n` (`ht_hair_sigma_a_from_color`). */
+template <class V> Vec3 sigma_a_from_color(const V &color, float beta_n) {
+    const Vec3 c = vec3(color);
+    Vec3 out;
+    check(ht_hair_sigma_a_from_color(c.data(), beta_n, out.data()));
+    return out;
+}
+
+/** sigma_a of a named preset (`ht_hair_sigma_a_preset`). */
+inline Vec3 sigma_a_preset(const char *name) {
+    Vec3 out;
+    check(ht_hair_sigma_a_preset(name, out.data()));
+    return out;
+}
+
+/**
+ * The shading frame and h of a hair hit (`HtHairFrame`, `ht_hair_frame`): the convention
+ * every call assumes, built from the hit instead of by hand.
+ */
+class Frame {
+public:
+    /** From the curve's tangent, the ray, the axis point at the hit and the radius there. */
+    template <class T, class O, class D, class A>
+    static Frame at_hit(const T &tangent, const O &ray_org, const D &ray_dir, const A &axis,
+                        float radius) {
+        const Vec3 t = vec3(tangent), o = vec3(ray_org), d = vec3(ray_dir), a = vec3(axis);
+        Frame f;
+        check(ht_hair_frame(t.data(), o.data(), d.data(), a.data(), radius, &f.frame_));
+        return f;
+    }
+    /** A frame the host built itself; checked where it is used. */
+    explicit Frame(const HtHairFrame &frame) : frame_(frame) {}
+
+    /** The offset across the fibre, in radii. */
+    float h() const noexcept { return frame_.h; }
+    /** A world direction in the local frame (`ht_hair_frame_to_local`). */
+    template <class V> Vec3 to_local(const V &w) const { return convert(ht_hair_frame_to_local, w); }
+    /** A local direction in world space (`ht_hair_frame_to_world`). */
+    template <class V> Vec3 to_world(const V &w) const { return convert(ht_hair_frame_to_world, w); }
+    const HtHairFrame &c() const noexcept { return frame_; }
+
+private:
+    Frame() : frame_() {}
+    template <class V>
+    Vec3 convert(HtStatus (*call)(const HtHairFrame *, const float *, float *), const V &w) const {
+        const Vec3 in = vec3(w);
+        Vec3 out;
+        check(call(&frame_, in.data(), out.data()));
+        return out;
+    }
+    HtHairFrame frame_;
+};
+
+/**
+ * A hair material: the BSDF prepared for one parameter set (`ht_hair_prepare`). Copies share
+ * the one immutable handle, which any number of threads may use at once; the last copy
+ * releases it.
+ */
+class Material {
+public:
+    explicit Material(const HtHairParams &params) {
+        HtHairPrepared *handle = nullptr;
+        check(ht_hair_prepare(&params, &handle));
+        handle_.reset(handle, [](HtHairPrepared *p) { ht_hair_prepared_free(p); });
+    }
+    const HtHairPrepared *get() const noexcept { return handle_.get(); }
+
+private:
+    std::shared_ptr<HtHairPrepared> handle_;
+};
+
+/**
+ * The BSDF at one path vertex (`HtHairPoint`): plain bytes in the host's memory, filled once
+ * and then evaluated and sampled any number of times, by any number of threads. Copyable,
+ * no release, independent of the `Material` it came from.
+ */
+class Point {
+public:
+    /** At offset `h` with `wo` in the local frame (`ht_hair_point_init`). */
+    template <class V> Point(const Material &material, float h, const V &wo) {
+        const Vec3 w = vec3(wo);
+        check(ht_hair_point_init(material.get(), h, w.data(), &point_));
+    }
+    /** At a hit's frame, `wo` in world space (`ht_hair_point_init_world`): the world calls. */
+    template <class V> static Point world(const Material &material, const Frame &frame, const V &wo) {
+        const Vec3 w = vec3(wo);
+        Point p;
+        check(ht_hair_point_init_world(material.get(), &frame.c(), w.data(), &p.point_));
+        return p;
+    }
+
+#if defined(HT_RENDER)
+    /** At strand `strand`, position `s`, of a groom varied as `variation` says, with the
+     * strand's colour `color` (NULL: none): `ht_hair_point_init_strand`. */
+    template <class V>
+    static Point strand(const Material &material, const HtHairVariation &variation,
+                        uint32_t strand, float s, const float *color, float h, const V &wo) {
+        const Vec3 w = vec3(wo);
+        Point p;
+        check(ht_hair_point_init_strand(material.get(), &variation, strand, s, color, h, w.data(),
+                                        &p.point_));
+        return p;
+    }
+#endif
+
+    /** f |cos| and pdf toward the local `wi` (`ht_hair_point_eval_cos`). */
+    template <class V> Eval eval(const V &wi) const { return eval_with(ht_hair_point_eval_cos, wi); }
+    /** A local direction from `u` in [0, 1)^3 (`ht_hair_point_sample_cos`). */
+    Sample sample(const Vec3 &u) const { return sample_with(ht_hair_point_sample_cos, u); }
+    /** f |cos| and pdf toward the world `wi` (`ht_hair_point_eval_world`). */
+    template <class V> Eval eval_world(const V &wi) const {
+        return eval_with(ht_hair_point_eval_world, wi);
+    }
+    /** A world direction from `u` in [0, 1)^3 (`ht_hair_point_sample_world`). */
+    Sample sample_world(const Vec3 &u) const { return sample_with(ht_hair_point_sample_world, u); }
+    const HtHairPoint &c() const noexcept { return point_; }
+
+private:
+    Point() {}
+    template <class V>
+    Eval eval_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *),
+                   const V &wi) const {
+        const Vec3 w = vec3(wi);
+        Eval e;
+        check(call(&point_, w.data(), e.f_cos.data(), &e.pdf));
+        return e;
+    }
+    Sample sample_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *,
+                                        float *),
+                       const Vec3 &u) const {
+        Sample s;
+        check(call(&point_, u.data(), s.wi.data(), s.weight.data(), &s.pdf));
+        return s;
+    }
+    HtHairPoint point_;
+};
+
+#if defined(HT_RENDER)
+namespace detail {
+/** An owner of a C handle released by `Free`; move-only. */
+template <class T, HtStatus (*Free)(T *)> class Owned {
+public:
+    Owned() = default;
+    explicit Owned(T *handle) noexcept : handle_(handle) {}
+    Owned(Owned &&other) noexcept : handle_(std::exchange(other.handle_, nullptr)) {}
+    Owned &operator=(Owned &&other) noexcept {
+        std::swap(handle_, other.handle_);
+        return *this;
+    }
+    Owned(const Owned &) = delete;
+    Owned &operator=(const Owned &) = delete;
+    ~Owned() { Free(handle_); }
+    T *get() const noexcept { return handle_; }
+
+private:
+    T *handle_ = nullptr;
+};
+} // namespace detail
+
+/** An Embree device (`ht_device_new`); 0 threads: every core. */
+class Device : public detail::Owned<HtDevice, ht_device_free> {
+public:
+    explicit Device(uint32_t threads = 0) : Owned(make(threads)) {}
+
+private:
+    static HtDevice *make(uint32_t threads) {
+        HtDevice *d = nullptr;
+        check(ht_device_new(threads, &d));
+        return d;
+    }
+};
+
+/** A scene on a device (`ht_scene_new`); fill it with the `ht_scene_*` calls on `get()`. */
+class Scene : public detail::Owned<HtScene, ht_scene_free> {
+public:
+    explicit Scene(const Device &device) : Owned(make(device)) {}
+
+private:
+    static HtScene *make(const Device &device) {
+        HtScene *s = nullptr;
+        check(ht_scene_new(device.get(), &s));
+        return s;
+    }
+};
+
+/** Render settings by name (`ht_settings_new`, `ht_settings_set`, `ht_settings_get`). */
+class Settings : public detail::Owned<HtSettings, ht_settings_free> {
+public:
+    Settings() : Owned(make()) {}
+    Settings &set(const char *key, const std::string &value) {
+        check(ht_settings_set(get(), key, value.c_str()));
+        return *this;
+    }
+    std::string value(const char *key) const {
+        size_t len = 0;
+        check(ht_settings_get(get(), key, nullptr, 0, &len));
+        std::string text(len + 1, '\0');
+        check(ht_settings_get(get(), key, &text[0], text.size(), &len));
+        text.resize(len);
+        return text;
+    }
+
+private:
+    static HtSettings *make() {
+        HtSettings *s = nullptr;
+        check(ht_settings_new(&s));
+        return s;
+    }
+};
+#endif
+
+} // namespace hairtrace
+
+#endif

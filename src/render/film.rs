@@ -151,8 +151,9 @@ pub const NO_HIT_DEPTH: f32 = 0.0;
 /// Strand-id AOV of a pixel whose nearest hit is not hair (or nothing).
 pub const NO_STRAND: f32 = -1.0;
 
-/// Sums one pixel's samples. The tiles hand a fresh one to the per-pixel function and
-/// store its averages.
+/// Sums one pixel's samples, in batches (a render's passes) whose spread estimates the
+/// noise of the mean. The film keeps one per pixel across passes; the tiles hand it to the
+/// per-pixel function and store its averages.
 #[derive(Debug, Clone)]
 pub struct PixelAccumulator {
     rgb: [f64; 3],
@@ -161,6 +162,12 @@ pub struct PixelAccumulator {
     rejected: u32,
     nearest: f32,
     strand: f32,
+    /// The open batch: its sum and its sample count.
+    batch: [f64; 3],
+    batch_samples: u32,
+    /// Over closed batches j of n_j samples summing to S_j: sum of S_j^2 / n_j, and j's count.
+    batch_sq: [f64; 3],
+    batches: u32,
 }
 
 impl Default for PixelAccumulator {
@@ -172,6 +179,10 @@ impl Default for PixelAccumulator {
             rejected: 0,
             nearest: f32::INFINITY,
             strand: NO_STRAND,
+            batch: [0.0; 3],
+            batch_samples: 0,
+            batch_sq: [0.0; 3],
+            batches: 0,
         }
     }
 }
@@ -186,13 +197,16 @@ impl PixelAccumulator {
     /// poisoning it, and the count tells the accident happened.
     pub fn add(&mut self, radiance: Vec3, hit: Option<&FirstHit>) {
         self.samples += 1;
+        self.batch_samples += 1;
         let hit_ok = hit.is_none_or(|h| h.albedo.is_finite() && h.depth.is_finite());
         if !(radiance.is_finite() && hit_ok) {
             self.rejected += 1;
             return;
         }
-        for (sum, v) in self.rgb.iter_mut().zip(radiance.to_array()) {
-            *sum += f64::from(v);
+        for (c, v) in radiance.to_array().into_iter().enumerate() {
+            let v = f64::from(v);
+            self.rgb[c] += v;
+            self.batch[c] += v;
         }
         if let Some(h) = hit {
             for (sum, v) in self.albedo.iter_mut().zip(h.albedo.to_array()) {
@@ -210,6 +224,35 @@ impl PixelAccumulator {
     fn mean(&self, sum: [f64; 3]) -> [f32; 3] {
         let n = f64::from(self.samples.max(1));
         sum.map(|s| (s / n) as f32)
+    }
+
+    /// Ends the open batch (the samples added since the last call), if it has any.
+    pub fn close_batch(&mut self) {
+        if self.batch_samples == 0 {
+            return;
+        }
+        let n = f64::from(self.batch_samples);
+        for (sq, s) in self.batch_sq.iter_mut().zip(self.batch) {
+            *sq += s * s / n;
+        }
+        (self.batch, self.batch_samples) = ([0.0; 3], 0);
+        self.batches += 1;
+    }
+
+    /// The variance of each channel's mean, from the spread of the closed batches' means
+    /// (each weighted by its samples); None below two batches. A batch is a pass of
+    /// consecutive Sobol samples, stratified within itself, so this counts the sampler's
+    /// stratification inside a batch, which a per-sample variance would ignore (and
+    /// overstate the noise); only the gain of stratifying across batches is missed.
+    pub fn variance_of_mean(&self) -> Option<[f64; 3]> {
+        if self.batches < 2 {
+            return None;
+        }
+        let n = f64::from(self.samples);
+        let spread = |c: usize| self.batch_sq[c] - self.rgb[c] * self.rgb[c] / n;
+        Some(std::array::from_fn(|c| {
+            (spread(c) / f64::from(self.batches - 1) / n).max(0.0)
+        }))
     }
 }
 
@@ -232,7 +275,8 @@ pub struct Film {
     albedo: Option<Vec<f32>>,
     depth: Option<Vec<f32>>,
     strand_id: Option<Vec<f32>>,
-    rejected: u64,
+    /// Every pixel's samples so far: a further render into this film adds to them.
+    accumulators: Vec<PixelAccumulator>,
 }
 
 impl Film {
@@ -262,6 +306,11 @@ impl Film {
         let pixels = usize::try_from(crop.pixel_count())
             .map_err(|_| invalid_arg!("film of {width} x {height} is too large"))?;
         let rgb = zeroed(pixels, 3)?;
+        let mut accumulators = Vec::new();
+        accumulators
+            .try_reserve_exact(pixels)
+            .map_err(|_| invalid_arg!("cannot allocate a film of {pixels} pixels"))?;
+        accumulators.resize(pixels, PixelAccumulator::default());
         let aov = |on: bool, channels, fill| -> Result<Option<Vec<f32>>> {
             on.then(|| {
                 let mut v = zeroed(pixels, channels)?;
@@ -278,7 +327,7 @@ impl Film {
             albedo: aov(aovs.albedo, 3, 0.0)?,
             depth: aov(aovs.depth, 1, NO_HIT_DEPTH)?,
             strand_id: aov(aovs.strand_id, 1, NO_STRAND)?,
-            rejected: 0,
+            accumulators,
         })
     }
 
@@ -326,13 +375,46 @@ impl Film {
     /// Samples whose values were NaN or infinite, counted as black (see
     /// [`PixelAccumulator::add`]).
     pub fn rejected_samples(&self) -> u64 {
-        self.rejected
+        self.accumulators
+            .iter()
+            .map(|a| u64::from(a.rejected))
+            .sum()
     }
 
-    /// Stores a finished pixel, given in full-frame coordinates inside the crop.
+    /// The estimated noise of the image: the RMSE of its pixels' means (over pixels and
+    /// channels, as `hairtrace compare` measures it) relative to the image's mean, from
+    /// [`PixelAccumulator::variance_of_mean`]. None before two batches, or for an image
+    /// whose mean is not positive while it has noise.
+    pub fn noise(&self) -> Option<f32> {
+        let (mut variance, mut sum) = (0.0, 0.0);
+        for acc in &self.accumulators {
+            variance += acc.variance_of_mean()?.iter().sum::<f64>();
+            sum += acc.rgb.iter().sum::<f64>() / f64::from(acc.samples.max(1));
+        }
+        match (variance, sum) {
+            (0.0, _) => Some(0.0),
+            (v, s) if s > 0.0 => {
+                let values = 3.0 * self.accumulators.len() as f64;
+                Some(((v / values).sqrt() / (s / values)) as f32)
+            }
+            _ => None,
+        }
+    }
+
+    fn index(&self, pixel: (u32, u32)) -> usize {
+        ((pixel.1 - self.crop.y0) as usize) * self.crop.width() as usize
+            + (pixel.0 - self.crop.x0) as usize
+    }
+
+    /// The samples so far of a pixel (full-frame coordinates, inside the crop).
+    pub(super) fn accumulator(&self, pixel: (u32, u32)) -> &PixelAccumulator {
+        &self.accumulators[self.index(pixel)]
+    }
+
+    /// Stores a pixel's samples so far, given in full-frame coordinates inside the crop.
     pub(super) fn store(&mut self, pixel: (u32, u32), acc: &PixelAccumulator) {
-        let i = ((pixel.1 - self.crop.y0) as usize) * self.crop.width() as usize
-            + (pixel.0 - self.crop.x0) as usize;
+        let i = self.index(pixel);
+        self.accumulators[i] = acc.clone();
         self.rgb[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.rgb));
         if let Some(albedo) = &mut self.albedo {
             albedo[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.albedo));
@@ -347,7 +429,6 @@ impl Film {
         if let Some(strand) = &mut self.strand_id {
             strand[i] = acc.strand;
         }
-        self.rejected += u64::from(acc.rejected);
     }
 }
 

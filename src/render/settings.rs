@@ -306,8 +306,14 @@ settings! {
         width: u32 = 640, Range::Closed(1.0, MAX_SIDE as f64);
         /// Image height in pixels.
         height: u32 = 480, Range::Closed(1.0, MAX_SIDE as f64);
-        /// Samples per pixel.
+        /// Samples per pixel; with a noise target or a time budget, the most.
         spp: u32 = 16, Range::AtLeast(1.0);
+        /// Stop once the estimated noise (RMSE relative to the image's mean) is at most this;
+        /// none: render all spp.
+        noise_target: Option<f32> = None, Range::Above(0.0);
+        /// Stop before a pass that would end past this many seconds of rendering; none: no
+        /// limit.
+        time_budget: Option<f32> = None, Range::Above(0.0);
         /// The image depends only on the scene, the settings and this seed.
         seed: u64 = 0, Range::Any;
         /// Worker threads; none: one per hardware thread.

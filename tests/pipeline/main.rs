@@ -21,5 +21,6 @@ mod rehit;
 mod render;
 mod ribbons;
 mod stages;
+mod stopping;
 mod usd;
 mod usd_crate;

@@ -37,11 +37,11 @@ fn fur_world(hair: HairMaterial, lights: Vec<Light>, strands: usize) -> World {
     .unwrap()
 }
 
-fn camera() -> Camera {
+pub(crate) fn camera() -> Camera {
     Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 1.0).unwrap()
 }
 
-fn mean(rgb: &[f32]) -> f64 {
+pub(crate) fn mean(rgb: &[f32]) -> f64 {
     rgb.iter().map(|v| f64::from(*v)).sum::<f64>() / rgb.len() as f64
 }
 
@@ -92,7 +92,7 @@ fn white_fur_ball_of_30k_strands_keeps_the_furnace_within_a_thousandth() {
 }
 
 /// A brown fur ball lit by three non-delta lights of different kinds.
-fn lit_world() -> World {
+pub(crate) fn lit_world() -> World {
     let lights = vec![
         Light::Environment(Environment::uniform(Vec3::splat(0.2)).unwrap()),
         Light::distant(Vec3::new(1.0, 1.0, 1.0), Vec3::new(2.0, 1.8, 1.5), 10.0).unwrap(),

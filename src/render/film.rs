@@ -157,6 +157,10 @@ pub const NO_STRAND: f32 = -1.0;
 #[derive(Debug, Clone)]
 pub struct PixelAccumulator {
     rgb: [f64; 3],
+    /// Sums of squares of the samples, for their variance.
+    rgb_sq: [f64; 3],
+    /// Rays the samples traced: their cost.
+    rays: u64,
     albedo: [f64; 3],
     samples: u32,
     rejected: u32,
@@ -174,6 +178,8 @@ impl Default for PixelAccumulator {
     fn default() -> Self {
         Self {
             rgb: [0.0; 3],
+            rgb_sq: [0.0; 3],
+            rays: 0,
             albedo: [0.0; 3],
             samples: 0,
             rejected: 0,
@@ -206,6 +212,7 @@ impl PixelAccumulator {
         for (c, v) in radiance.to_array().into_iter().enumerate() {
             let v = f64::from(v);
             self.rgb[c] += v;
+            self.rgb_sq[c] += v * v;
             self.batch[c] += v;
         }
         if let Some(h) = hit {
@@ -224,6 +231,38 @@ impl PixelAccumulator {
     fn mean(&self, sum: [f64; 3]) -> [f32; 3] {
         let n = f64::from(self.samples.max(1));
         sum.map(|s| (s / n) as f32)
+    }
+
+    /// Counts the rays a sample traced.
+    pub fn add_rays(&mut self, rays: u32) {
+        self.rays += u64::from(rays);
+    }
+
+    /// Rays traced so far.
+    pub fn rays(&self) -> u64 {
+        self.rays
+    }
+
+    /// Samples so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// The variance of one sample, per channel (the unbiased estimate; 0 below two samples).
+    pub fn sample_variance(&self) -> [f64; 3] {
+        if self.samples < 2 {
+            return [0.0; 3];
+        }
+        let n = f64::from(self.samples);
+        std::array::from_fn(|c| {
+            ((self.rgb_sq[c] - self.rgb[c] * self.rgb[c] / n) / (n - 1.0)).max(0.0)
+        })
+    }
+
+    /// Each channel's mean, in f64.
+    pub fn mean_rgb(&self) -> [f64; 3] {
+        let n = f64::from(self.samples.max(1));
+        self.rgb.map(|s| s / n)
     }
 
     /// Ends the open batch (the samples added since the last call), if it has any.
@@ -386,19 +425,21 @@ impl Film {
     /// [`PixelAccumulator::variance_of_mean`]. None before two batches, or for an image
     /// whose mean is not positive while it has noise.
     pub fn noise(&self) -> Option<f32> {
-        let (mut variance, mut sum) = (0.0, 0.0);
+        let mut pixels = Vec::with_capacity(self.accumulators.len());
         for acc in &self.accumulators {
-            variance += acc.variance_of_mean()?.iter().sum::<f64>();
-            sum += acc.rgb.iter().sum::<f64>() / f64::from(acc.samples.max(1));
+            pixels.push((acc.mean_rgb(), acc.variance_of_mean()?));
         }
-        match (variance, sum) {
-            (0.0, _) => Some(0.0),
-            (v, s) if s > 0.0 => {
-                let values = 3.0 * self.accumulators.len() as f64;
-                Some(((v / values).sqrt() / (s / values)) as f32)
-            }
-            _ => None,
-        }
+        relative_rmse(pixels)
+    }
+
+    /// Camera samples taken so far.
+    pub fn samples(&self) -> u64 {
+        self.accumulators.iter().map(|a| u64::from(a.samples)).sum()
+    }
+
+    /// Rays traced by the samples so far.
+    pub fn rays(&self) -> u64 {
+        self.accumulators.iter().map(|a| a.rays).sum()
     }
 
     fn index(&self, pixel: (u32, u32)) -> usize {
@@ -415,20 +456,66 @@ impl Film {
     pub(super) fn store(&mut self, pixel: (u32, u32), acc: &PixelAccumulator) {
         let i = self.index(pixel);
         self.accumulators[i] = acc.clone();
-        self.rgb[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.rgb));
-        if let Some(albedo) = &mut self.albedo {
-            albedo[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.albedo));
+        self.write(i, acc.mean(acc.rgb), acc.mean(acc.albedo), acc);
+    }
+
+    /// Makes a pixel's values `pilot_weight` x the pilot's means + the rest x its own
+    /// (its depth and strand those of the nearer of the two's nearest hits). Its samples
+    /// stay its own.
+    pub(super) fn store_blend(
+        &mut self,
+        pixel: (u32, u32),
+        pilot: &PixelAccumulator,
+        pilot_weight: f64,
+    ) {
+        let i = self.index(pixel);
+        let own = &self.accumulators[i];
+        let blend = |p: [f32; 3], o: [f32; 3]| {
+            std::array::from_fn(|c| {
+                (pilot_weight * f64::from(p[c]) + (1.0 - pilot_weight) * f64::from(o[c])) as f32
+            })
+        };
+        let rgb = blend(pilot.mean(pilot.rgb), own.mean(own.rgb));
+        let albedo = blend(pilot.mean(pilot.albedo), own.mean(own.albedo));
+        let nearest = if pilot.nearest < own.nearest {
+            pilot.clone()
+        } else {
+            own.clone()
+        };
+        self.write(i, rgb, albedo, &nearest);
+    }
+
+    /// Writes pixel `i`'s colour, albedo, and the depth and strand of `nearest`'s hit.
+    fn write(&mut self, i: usize, rgb: [f32; 3], albedo: [f32; 3], nearest: &PixelAccumulator) {
+        self.rgb[3 * i..3 * i + 3].copy_from_slice(&rgb);
+        if let Some(a) = &mut self.albedo {
+            a[3 * i..3 * i + 3].copy_from_slice(&albedo);
         }
         if let Some(depth) = &mut self.depth {
-            depth[i] = if acc.nearest.is_finite() {
-                acc.nearest
+            depth[i] = if nearest.nearest.is_finite() {
+                nearest.nearest
             } else {
                 NO_HIT_DEPTH
             };
         }
         if let Some(strand) = &mut self.strand_id {
-            strand[i] = acc.strand;
+            strand[i] = nearest.strand;
         }
+    }
+}
+
+/// The RMSE of pixels given as (mean, variance of the mean) per channel, over pixels and
+/// channels, relative to their mean: a film's estimated noise. Zero without variance, None
+/// for noise on a mean that is not positive.
+pub(super) fn relative_rmse(pixels: Vec<([f64; 3], [f64; 3])>) -> Option<f32> {
+    let values = 3.0 * pixels.len() as f64;
+    let (variance, sum) = pixels.iter().fold((0.0, 0.0), |(v, s), (m, var)| {
+        (v + var.iter().sum::<f64>(), s + m.iter().sum::<f64>())
+    });
+    match (variance, sum) {
+        (0.0, _) => Some(0.0),
+        (v, s) if s > 0.0 => Some(((v / values).sqrt() / (s / values)) as f32),
+        _ => None,
     }
 }
 

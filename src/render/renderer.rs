@@ -1,13 +1,13 @@
 //! One render: camera samples per pixel through the integrator, over tiles in parallel.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+use super::allocation::{self, ALLOCATED};
 use super::film::{Aovs, Film, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::sampler::PixelSampler;
-use super::settings::RenderSettings;
+use super::settings::{Allocation, RenderSettings};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
@@ -49,11 +49,12 @@ pub const PASS_SAMPLES: u32 = 8;
 /// renders only the views for which those shapes hold ([`crate::scene::tracer::Tracer::serves`]);
 /// any other is refused, to be built again for it.
 ///
-/// The samples are taken in passes of [`PASS_SAMPLES`] per pixel, in sample order. Between
-/// passes the render stops once the estimated noise of the window it renders is at most
-/// `noise_target`, or when the next pass (timed as the last one) would end past
-/// `time_budget`: the image is then, bit for bit, that of a render with `spp` = the samples
-/// taken ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`.
+/// The samples are taken in passes of [`PASS_SAMPLES`] per pixel (on average, under the
+/// `noise` allocation: [`super::allocation`]), in sample order. Between passes the render
+/// stops once the estimated noise of the window it renders is at most `noise_target`, or
+/// when the next pass (timed as the last one) would end past `time_budget`: the image is
+/// then, bit for bit, that of a render with `spp` = the samples taken
+/// ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`.
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -72,10 +73,20 @@ pub fn render(
              or with fewer pixels): build the scene again for this camera and image height"
         ));
     }
+    let (width, height) = (settings.width, settings.height);
     let crop = settings
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
-    let mut film = Film::new(settings.width, settings.height, crop, aovs)?;
+    let mut film = Film::new(width, height, crop, aovs)?;
+    // The noise allocation's pilot, over whole blocks around the crop.
+    let mut pilot = match settings.allocation {
+        Allocation::Uniform => None,
+        Allocation::Noise => {
+            let window = allocation::pilot_window(film.crop(), width, height);
+            Some(Film::new(width, height, Some(window), aovs)?)
+        }
+    };
+    let mut shares: Option<allocation::Shares> = None;
     let filter = settings.pixel_filter()?;
     let options = TileOptions {
         tile_size: 16,
@@ -83,7 +94,6 @@ pub fn render(
     };
     let pixels = film.crop().pixel_count();
     let passes = settings.spp.div_ceil(PASS_SAMPLES);
-    let rays = AtomicU64::new(0);
     let start = Instant::now();
     let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);
     let mut last_pass = 0.0;
@@ -96,19 +106,31 @@ pub fn render(
         if good_enough || out_of_time {
             break;
         }
-        let samples = spp..(spp + PASS_SAMPLES).min(settings.spp);
-        let offset = u64::from(pass) * pixels;
-        let total = u64::from(passes) * pixels;
-        let pass_progress = |done, _| progress.update(offset + done, total);
-        status = render_tiles(&mut film, &options, &pass_progress, |pixel, acc, pulse| {
-            let mut pixel_rays = 0u64;
-            for index in samples.clone() {
+        let end = (spp + PASS_SAMPLES).min(settings.spp);
+        // Sample indices of a pixel in this pass.
+        let indices = |pixel| match &shares {
+            None => spp..end,
+            Some(shares) => {
+                let n = shares.of(pixel);
+                let before = ALLOCATED + (pass - 1) * n;
+                before..before + n
+            }
+        };
+        let target = match (&mut pilot, pass) {
+            (Some(pilot), 0) => pilot,
+            _ => &mut film,
+        };
+        let (offset, total) = (u64::from(pass) * pixels, u64::from(passes) * pixels);
+        let in_pass = target.crop().pixel_count();
+        let pass_progress = |done, _| progress.update(offset + done * pixels / in_pass, total);
+        status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
+            for index in indices(pixel) {
                 if !pulse.keep_going() {
                     return;
                 }
                 let mut sampler = PixelSampler::new(settings.seed, pixel, index);
                 let offset = filter.sample(sampler.next_2d());
-                let image_point = ndc(settings.width, settings.height, pixel, offset);
+                let image_point = ndc(width, height, pixel, offset);
                 let lens = if camera.has_lens() {
                     sampler.next_2d()
                 } else {
@@ -118,30 +140,45 @@ pub fn render(
                 let (org, dir) = camera.ray(image_point, lens);
                 let (radiance, first, traced) =
                     world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
-                pixel_rays += u64::from(traced);
                 acc.add(radiance, first.as_ref());
+                acc.add_rays(traced);
             }
             acc.close_batch();
-            rays.fetch_add(pixel_rays, Ordering::Relaxed);
         })?;
         if status == RenderStatus::Cancelled {
             break;
         }
-        spp = samples.end;
-        noise = film.noise();
+        spp = end;
+        noise = match &pilot {
+            None => film.noise(),
+            Some(pilot) if pass == 0 => {
+                shares = Some(allocation::Shares::new(pilot, film.crop(), PASS_SAMPLES));
+                None
+            }
+            Some(pilot) => allocation::blended_noise(&film, pilot, pilot_weight(pass + 1)),
+        };
         last_pass = start.elapsed().as_secs_f64() - elapsed;
         progress.pass(spp, noise);
     }
+    if let Some(pilot) = &pilot {
+        allocation::blend(&mut film, pilot, pilot_weight(spp.div_ceil(PASS_SAMPLES)));
+    }
     let stats = RenderStats {
         seconds: start.elapsed().as_secs_f64(),
-        samples: pixels * u64::from(spp),
+        samples: film.samples() + pilot.as_ref().map_or(0, Film::samples),
         spp,
         noise,
-        rays: rays.into_inner(),
+        rays: film.rays() + pilot.as_ref().map_or(0, Film::rays),
     };
     Ok(RenderOutput {
         film,
         status,
         stats,
     })
+}
+
+/// The pilot's weight in a pixel after `passes` passes (the pilot's among them): its
+/// share of the average samples per pixel, the same in every pixel.
+fn pilot_weight(passes: u32) -> f64 {
+    1.0 / f64::from(passes.max(1))
 }

@@ -151,8 +151,8 @@ pub const NO_HIT_DEPTH: f32 = 0.0;
 /// Strand-id AOV of a pixel whose nearest hit is not hair (or nothing).
 pub const NO_STRAND: f32 = -1.0;
 
-/// Sums one pixel's samples, in batches (a render's passes) whose spread estimates the
-/// noise of the mean. The film keeps one per pixel across passes; the tiles hand it to the
+/// Sums one pixel's samples, over a render's passes, keeping the sums at the last two
+/// power-of-two pass counts: the two halves that estimate the noise of the mean. The film keeps one per pixel across passes; the tiles hand it to the
 /// per-pixel function and store its averages.
 #[derive(Debug, Clone)]
 pub struct PixelAccumulator {
@@ -166,12 +166,12 @@ pub struct PixelAccumulator {
     rejected: u32,
     nearest: f32,
     strand: f32,
-    /// The open batch: its sum and its sample count.
-    batch: [f64; 3],
-    batch_samples: u32,
-    /// Over closed batches j of n_j samples summing to S_j: sum of S_j^2 / n_j, and j's count.
-    batch_sq: [f64; 3],
-    batches: u32,
+    /// Passes ended ([`Self::end_pass`]).
+    passes: u32,
+    /// The sums and sample counts when `passes` was last a power of two, and the time
+    /// before (half as many passes).
+    last_power: ([f64; 3], u32),
+    half_power: ([f64; 3], u32),
 }
 
 impl Default for PixelAccumulator {
@@ -185,10 +185,9 @@ impl Default for PixelAccumulator {
             rejected: 0,
             nearest: f32::INFINITY,
             strand: NO_STRAND,
-            batch: [0.0; 3],
-            batch_samples: 0,
-            batch_sq: [0.0; 3],
-            batches: 0,
+            passes: 0,
+            last_power: ([0.0; 3], 0),
+            half_power: ([0.0; 3], 0),
         }
     }
 }
@@ -203,7 +202,6 @@ impl PixelAccumulator {
     /// poisoning it, and the count tells the accident happened.
     pub fn add(&mut self, radiance: Vec3, hit: Option<&FirstHit>) {
         self.samples += 1;
-        self.batch_samples += 1;
         let hit_ok = hit.is_none_or(|h| h.albedo.is_finite() && h.depth.is_finite());
         if !(radiance.is_finite() && hit_ok) {
             self.rejected += 1;
@@ -213,7 +211,6 @@ impl PixelAccumulator {
             let v = f64::from(v);
             self.rgb[c] += v;
             self.rgb_sq[c] += v * v;
-            self.batch[c] += v;
         }
         if let Some(h) = hit {
             for (sum, v) in self.albedo.iter_mut().zip(h.albedo.to_array()) {
@@ -265,32 +262,37 @@ impl PixelAccumulator {
         self.rgb.map(|s| s / n)
     }
 
-    /// Ends the open batch (the samples added since the last call), if it has any.
-    pub fn close_batch(&mut self) {
-        if self.batch_samples == 0 {
-            return;
+    /// Ends a pass of the render over this pixel.
+    pub fn end_pass(&mut self) {
+        self.passes += 1;
+        if self.passes.is_power_of_two() {
+            self.half_power = self.last_power;
+            self.last_power = (self.rgb, self.samples);
         }
-        let n = f64::from(self.batch_samples);
-        for (sq, s) in self.batch_sq.iter_mut().zip(self.batch) {
-            *sq += s * s / n;
-        }
-        (self.batch, self.batch_samples) = ([0.0; 3], 0);
-        self.batches += 1;
     }
 
-    /// The variance of each channel's mean, from the spread of the closed batches' means
-    /// (each weighted by its samples); None below two batches. A batch is a pass of
-    /// consecutive Sobol samples, stratified within itself, so this counts the sampler's
-    /// stratification inside a batch, which a per-sample variance would ignore (and
-    /// overstate the noise); only the gain of stratifying across batches is missed.
+    /// The variance of each channel's mean, from the difference between two halves: the
+    /// samples of the first h passes, h the largest power of two at most half the passes,
+    /// against the rest; None before two passes. The first half is a power-of-two block of
+    /// the Sobol sequence and the second nearly one, each stratified in itself, so the
+    /// estimate keeps the sampler's stratification within halves (a per-sample variance,
+    /// or the spread of the passes' means, would miss most of it and overstate the noise);
+    /// it misses only the gain of joining the two.
     pub fn variance_of_mean(&self) -> Option<[f64; 3]> {
-        if self.batches < 2 {
+        let (first, n_first) = self.half_power;
+        let n_rest = self.samples.checked_sub(n_first)?;
+        if self.passes < 2 || n_first == 0 || n_rest == 0 {
             return None;
         }
-        let n = f64::from(self.samples);
-        let spread = |c: usize| self.batch_sq[c] - self.rgb[c] * self.rgb[c] / n;
+        let (a, b, n) = (
+            f64::from(n_first),
+            f64::from(n_rest),
+            f64::from(self.samples),
+        );
         Some(std::array::from_fn(|c| {
-            (spread(c) / f64::from(self.batches - 1) / n).max(0.0)
+            let d = first[c] / a - (self.rgb[c] - first[c]) / b;
+            // E[d^2] = sigma^2 (1/a + 1/b) for independent samples of variance sigma^2.
+            d * d / (1.0 / a + 1.0 / b) / n
         }))
     }
 }
@@ -422,7 +424,7 @@ impl Film {
 
     /// The estimated noise of the image: the RMSE of its pixels' means (over pixels and
     /// channels, as `hairtrace compare` measures it) relative to the image's mean, from
-    /// [`PixelAccumulator::variance_of_mean`]. None before two batches, or for an image
+    /// [`PixelAccumulator::variance_of_mean`]. None before two passes, or for an image
     /// whose mean is not positive while it has noise.
     pub fn noise(&self) -> Option<f32> {
         let mut pixels = Vec::with_capacity(self.accumulators.len());

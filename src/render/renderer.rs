@@ -38,7 +38,7 @@ pub struct RenderStats {
 /// Samples per pixel of one pass. A render proceeds in passes and decides whether to stop
 /// only between two, so that its image is that of a plain render of the samples it took.
 /// A power of two, so that each pass is a block of the Sobol sequence stratified in itself
-/// (the noise estimate's batches, [`PixelAccumulator::variance_of_mean`]).
+/// (the noise estimate's halves, [`PixelAccumulator::variance_of_mean`]).
 ///
 /// [`PixelAccumulator::variance_of_mean`]: super::film::PixelAccumulator::variance_of_mean
 pub const PASS_SAMPLES: u32 = 8;
@@ -143,7 +143,7 @@ pub fn render(
                 acc.add(radiance, first.as_ref());
                 acc.add_rays(traced);
             }
-            acc.close_batch();
+            acc.end_pass();
         })?;
         if status == RenderStatus::Cancelled {
             break;

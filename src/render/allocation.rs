@@ -4,16 +4,17 @@
 //! Why it stays unbiased: a pixel's later samples come from a sequence of their own
 //! (sample indices from [`ALLOCATED`]: independently scrambled), so their mean is
 //! unbiased whatever number the pilot chose; the pilot's mean is unbiased; and the weight
-//! that combines the two is the pilot's share of the average samples per pixel, fixed by
-//! the pass count alone. A weight that followed the pixel's own count would correlate with
-//! its pilot (a bright strand in the pilot means noise, so many samples, so a small pilot
-//! weight) and bias it.
+//! that combines the two, the pilot's share of the pixel's samples, is independent of the
+//! pixel's own pilot, because its count is read from the pilot of its neighbours alone
+//! (those of the other colour of a checkerboard). A count read from the pixel's own pilot
+//! would correlate with it (a strand in the pilot means noise, so many samples, so a small
+//! pilot weight) and bias it.
 //!
 //! Why crops stay exact: a pixel's share depends only on the pilot of its block
 //! ([`BLOCK`] pixels square, aligned on the full frame), and a crop renders the pilot
 //! over every block it touches.
 
-use super::film::{Film, Window, relative_rmse};
+use super::film::{Film, PixelAccumulator, Window, relative_rmse};
 
 /// Side of the square blocks, aligned on the full frame, among whose pixels each pass
 /// shares the samples a uniform pass would give them.
@@ -51,7 +52,7 @@ impl Shares {
     /// block's pixels share `per_pixel` x its pixel count in proportion to sigma / sqrt(cost)
     /// (which minimises the block's summed variance for its rays), where sigma is the
     /// standard deviation of a sample and the cost the rays per sample, both over the
-    /// pixel's 3 x 3 neighbours inside its block, plus [`FLOOR`].
+    /// pixel's neighbours ([`block_shares`]), plus [`FLOOR`].
     pub(super) fn new(pilot: &Film, crop: Window, per_pixel: u32) -> Shares {
         let mut counts = vec![0; crop.pixel_count() as usize];
         let blocks = pilot.crop();
@@ -80,7 +81,11 @@ impl Shares {
     }
 }
 
-/// Each pixel of `block` and its samples per pass.
+/// Each pixel of `block` and its samples per pass. A pixel's share is read from the pilot
+/// of the other colour of a checkerboard only (the pixels of the other colour within two
+/// pixels, inside the block; each colour shares half the block's budget among its own),
+/// so that it is independent of the pixel's own pilot: [`blend`] may then weight the
+/// pilot by the pixel's count without bias.
 fn block_shares(pilot: &Film, block: Window, per_pixel: u32) -> Vec<((u32, u32), u32)> {
     let (variance, cost): (Vec<f64>, Vec<f64>) = block
         .pixels()
@@ -91,52 +96,66 @@ fn block_shares(pilot: &Film, block: Window, per_pixel: u32) -> Vec<((u32, u32),
         })
         .unzip();
     let (w, h) = (block.width() as i64, block.height() as i64);
-    let smooth = |v: &[f64], x: i64, y: i64| {
+    // Means over the other colour's pixels within two pixels (never the pixel itself).
+    let around = |v: &[f64], x: i64, y: i64| {
         let (mut sum, mut n) = (0.0, 0.0);
-        for ny in (y - 1).max(0)..=(y + 1).min(h - 1) {
-            for nx in (x - 1).max(0)..=(x + 1).min(w - 1) {
-                sum += v[(ny * w + nx) as usize];
-                n += 1.0;
+        for ny in (y - 2).max(0)..=(y + 2).min(h - 1) {
+            for nx in (x - 2).max(0)..=(x + 2).min(w - 1) {
+                if (nx + ny + x + y) % 2 == 1 {
+                    sum += v[(ny * w + nx) as usize];
+                    n += 1.0;
+                }
             }
         }
-        sum / n
+        if n > 0.0 { sum / n } else { 0.0 }
     };
-    let scores: Vec<f64> = (0..h)
-        .flat_map(|y| (0..w).map(move |x| (x, y)))
-        .map(|(x, y)| (smooth(&variance, x, y) / smooth(&cost, x, y)).sqrt())
+    let cells: Vec<(i64, i64)> = (0..h).flat_map(|y| (0..w).map(move |x| (x, y))).collect();
+    let scores: Vec<f64> = cells
+        .iter()
+        .map(|&(x, y)| (around(&variance, x, y) / around(&cost, x, y).max(1.0)).sqrt())
         .collect();
-    let budget = f64::from(per_pixel) * scores.len() as f64;
-    let mean = scores.iter().sum::<f64>() / scores.len() as f64;
-    let weights: Vec<f64> = scores.iter().map(|s| s + FLOOR * mean).collect();
-    let total: f64 = weights.iter().sum();
-    block
-        .pixels()
-        .zip(weights)
-        .map(|(p, weight)| {
-            let n = if total > 0.0 {
-                (budget * weight / total).round().max(1.0) as u32
-            } else {
-                per_pixel
-            };
-            (p, n)
-        })
-        .collect()
+    let mut counts = vec![per_pixel; cells.len()];
+    for colour in 0..2 {
+        let mine: Vec<usize> = (0..cells.len())
+            .filter(|&i| (cells[i].0 + cells[i].1) % 2 == colour)
+            .collect();
+        let budget = f64::from(per_pixel) * mine.len() as f64;
+        let mean = mine.iter().map(|&i| scores[i]).sum::<f64>() / mine.len().max(1) as f64;
+        let total = (1.0 + FLOOR) * mean * mine.len() as f64;
+        if total > 0.0 {
+            for &i in &mine {
+                let share = budget * (scores[i] + FLOOR * mean) / total;
+                counts[i] = share.round().max(1.0) as u32;
+            }
+        }
+    }
+    block.pixels().zip(counts).collect()
 }
 
-/// Writes into `film` each pixel's pilot mean x `pilot_weight` + its own mean x the rest.
-pub(super) fn blend(film: &mut Film, pilot: &Film, pilot_weight: f64) {
+/// The pilot's weight in a pixel: its share of the pixel's samples. Unbiased because the
+/// pixel's count never depends on its own pilot ([`block_shares`]).
+fn pilot_weight(pilot: &PixelAccumulator, own: &PixelAccumulator) -> f64 {
+    let (p, o) = (f64::from(pilot.samples()), f64::from(own.samples()));
+    if p + o > 0.0 { p / (p + o) } else { 1.0 }
+}
+
+/// Writes into `film` each pixel's blend of its pilot and its own samples.
+pub(super) fn blend(film: &mut Film, pilot: &Film) {
     for p in film.crop().pixels() {
-        film.store_blend(p, pilot.accumulator(p), pilot_weight);
+        let first = pilot.accumulator(p);
+        let weight = pilot_weight(first, film.accumulator(p));
+        film.store_blend(p, first, weight);
     }
 }
 
 /// The estimated noise of [`blend`]'s image: the pilot's variance from its samples', the
-/// rest's from its passes'. None before two passes after the pilot.
-pub(super) fn blended_noise(film: &Film, pilot: &Film, pilot_weight: f64) -> Option<f32> {
-    let (wp, wa) = (pilot_weight, 1.0 - pilot_weight);
+/// rest's from its halves. None before two passes after the pilot.
+pub(super) fn blended_noise(film: &Film, pilot: &Film) -> Option<f32> {
     let mut pixels = Vec::with_capacity(film.crop().pixel_count() as usize);
     for p in film.crop().pixels() {
         let (own, first) = (film.accumulator(p), pilot.accumulator(p));
+        let wp = pilot_weight(first, own);
+        let wa = 1.0 - wp;
         let (ma, va) = (own.mean_rgb(), own.variance_of_mean()?);
         let (mp, vp) = (first.mean_rgb(), first.sample_variance());
         let n = f64::from(first.samples().max(1));

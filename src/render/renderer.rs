@@ -155,13 +155,13 @@ pub fn render(
                 shares = Some(allocation::Shares::new(pilot, film.crop(), PASS_SAMPLES));
                 None
             }
-            Some(pilot) => allocation::blended_noise(&film, pilot, pilot_weight(pass + 1)),
+            Some(pilot) => allocation::blended_noise(&film, pilot),
         };
         last_pass = start.elapsed().as_secs_f64() - elapsed;
         progress.pass(spp, noise);
     }
     if let Some(pilot) = &pilot {
-        allocation::blend(&mut film, pilot, pilot_weight(spp.div_ceil(PASS_SAMPLES)));
+        allocation::blend(&mut film, pilot);
     }
     let stats = RenderStats {
         seconds: start.elapsed().as_secs_f64(),
@@ -175,10 +175,4 @@ pub fn render(
         status,
         stats,
     })
-}
-
-/// The pilot's weight in a pixel after `passes` passes (the pilot's among them): its
-/// share of the average samples per pixel, the same in every pixel.
-fn pilot_weight(passes: u32) -> f64 {
-    1.0 / f64::from(passes.max(1))
 }

@@ -50,7 +50,7 @@ pub const PASS_SAMPLES: u32 = 8;
 /// any other is refused, to be built again for it.
 ///
 /// The samples are taken in passes of [`PASS_SAMPLES`] per pixel (on average, under the
-/// `noise` allocation: [`super::allocation`]), in sample order. Between passes the render
+/// `noise` allocation, `src/render/allocation.rs`), in sample order. Between passes the render
 /// stops once the estimated noise of the window it renders is at most `noise_target`, or
 /// when the next pass (timed as the last one) would end past `time_budget`: the image is
 /// then, bit for bit, that of a render with `spp` = the samples taken

@@ -303,15 +303,23 @@ fn renders_are_deterministic_across_threads_and_crops() {
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(one.film.rgb()), bits(two.film.rgb()));
     let crop = run(RenderSettings {
-        crop: Some([7, 5, 29, 22]),
+        crop: Some(CROP),
         threads: Some(2),
         ..base
     });
-    let full = one.film.rgb();
-    let part = crop.film.rgb();
-    for y in 5..22 {
-        for x in 7..29 {
-            let (i, j) = (3 * (y * 40 + x), 3 * ((y - 5) * 22 + (x - 7)));
+    assert_crop_of(one.film.rgb(), crop.film.rgb());
+}
+
+/// A crop of a 40 x 30 frame, across the 16 x 16 blocks of the noise allocation.
+pub(crate) const CROP: [u32; 4] = [7, 5, 29, 22];
+
+/// `part`, the RGB of [`CROP`], is bit for bit those pixels of the 40 x 30 `full`.
+pub(crate) fn assert_crop_of(full: &[f32], part: &[f32]) {
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let [x0, y0, x1, y1] = CROP.map(|v| v as usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (i, j) = (3 * (y * 40 + x), 3 * ((y - y0) * (x1 - x0) + (x - x0)));
             assert_eq!(
                 bits(&full[i..i + 3]),
                 bits(&part[j..j + 3]),

@@ -172,7 +172,11 @@ def configure_render(scene, desc, args):
     cycles.samples = args.spp
     cycles.seed = args.seed
     cycles.use_animated_seed = False
-    cycles.use_adaptive_sampling = False
+    # Off unless asked for: then at the threshold given (Blender's default is 0.01), with
+    # the spp as its most samples.
+    cycles.use_adaptive_sampling = args.adaptive_threshold > 0
+    if cycles.use_adaptive_sampling:
+        cycles.adaptive_threshold = args.adaptive_threshold
     cycles.use_denoising = False
     cycles.use_light_tree = False
     cycles.use_guiding = False
@@ -491,6 +495,9 @@ def main():
     parser.add_argument("--sample-uniform-env", action="store_true",
                         help="light-sample uniform environments (with MIS) as hairtrace does; "
                              "by default Cycles reaches them by BSDF sampling only")
+    parser.add_argument("--adaptive-threshold", type=float, default=0.0,
+                        help="Cycles' adaptive sampling at this noise threshold (Blender's "
+                             "default: 0.01); 0 (the default): off")
     # Internal: run the render here and write the timing stats to this file.
     parser.add_argument("--worker-stats", help=argparse.SUPPRESS)
     args = parser.parse_args()

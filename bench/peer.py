@@ -15,7 +15,11 @@ then runs this file.) For each scene of bench/scenes/:
 3. Timed renders at the scene's spp, hairtrace and Cycles interleaved, `--repeats` times
    with different seeds: path-tracing seconds (scene build or sync excluded), camera
    samples per second, rays per camera sample, RMSE against the reference, efficiency
-   1 / (RMSE^2 x seconds). Medians are reported.
+   1 / (RMSE^2 x seconds). Medians are reported. Cycles renders twice, with its adaptive
+   sampling off and on at Blender's default threshold (`CYCLES_ADAPTIVE`, the spp then
+   its most samples); hairtrace is compared with the better of the two on each scene, and
+   the table says which. hairtrace renders with the scene's own settings (its
+   `allocation` among them); `--allocation` renders it once more with that allocation.
 
 RMSE against the mean of two references needs no pixel arithmetic here: for images x, a,
 b, |x - (a + b)/2|^2 = |x - a|^2 / 2 + |x - b|^2 / 2 - |a - b|^2 / 4 per pixel, so the
@@ -40,6 +44,8 @@ CYCLES = os.path.join(ROOT, "bench", "cycles.py")
 SCENES = os.path.join(ROOT, "bench", "scenes")
 REFERENCE_SEED = 1_000_003
 REFERENCE_FACTOR = 16
+# Blender's default noise threshold for Cycles' adaptive sampling.
+CYCLES_ADAPTIVE = 0.01
 
 
 def run(cmd, env=None):
@@ -70,16 +76,17 @@ class Scene:
         os.makedirs(self.work, exist_ok=True)
         run([HAIRTRACE, "export", self.path, "-o", os.path.join(self.work, "peer")])
 
-    def hairtrace(self, spp, seed, out):
+    def hairtrace(self, spp, seed, out, allocation=None):
         stats = out + ".json"
+        extra = ["--allocation", allocation] if allocation else []
         run([HAIRTRACE, "render", self.path, "--spp", str(spp), "--seed", str(seed),
              "--threads", str(self.threads), "--max-depth", str(self.max_depth),
-             "--filter", "box", "-o", out, "--stats", stats])
+             "--filter", "box", "-o", out, "--stats", stats] + extra)
         with open(stats) as f:
             s = json.load(f)
         return {"seconds": s["seconds"], "samples": s["samples"], "rays": s["rays"]}
 
-    def cycles(self, spp, seed, out):
+    def cycles(self, spp, seed, out, adaptive=0.0):
         stats = out + ".json"
         env = dict(os.environ)
         if self.shim:
@@ -87,7 +94,8 @@ class Scene:
             env["HT_RAY_COUNT_FILE"] = out + ".rays.json"
         run([sys.executable, CYCLES, os.path.join(self.work, "peer", "scene.json"),
              "--spp", str(spp), "--seed", str(seed), "--threads", str(self.threads),
-             "--max-depth", str(self.max_depth), "-o", out, "--stats", stats], env=env)
+             "--max-depth", str(self.max_depth), "--adaptive-threshold", str(adaptive),
+             "-o", out, "--stats", stats], env=env)
         with open(stats) as f:
             s = json.load(f)
         rays = None
@@ -96,11 +104,17 @@ class Scene:
         return {"seconds": s["render_seconds"], "samples": s["samples"], "rays": rays}
 
 
-def measure(scene, repeats, log):
-    renderers = {"hairtrace": scene.hairtrace, "Cycles": scene.cycles}
+def measure(scene, repeats, allocation, log):
+    references = {"hairtrace": scene.hairtrace, "Cycles": scene.cycles}
+    renderers = dict(references)
+    if allocation:
+        renderers[f"hairtrace allocation {allocation}"] = (
+            lambda spp, seed, out: scene.hairtrace(spp, seed, out, allocation))
+    renderers["Cycles adaptive"] = (
+        lambda spp, seed, out: scene.cycles(spp, seed, out, CYCLES_ADAPTIVE))
     ref = {}
     ref_spp = scene.spp * REFERENCE_FACTOR
-    for name, render in renderers.items():
+    for name, render in references.items():
         ref[name] = os.path.join(scene.work, f"reference-{name}.exr")
         t = time.time()
         render(ref_spp, REFERENCE_SEED, ref[name])
@@ -109,7 +123,7 @@ def measure(scene, repeats, log):
     runs = {name: [] for name in renderers}
     for seed in range(1, repeats + 1):
         for name, render in renderers.items():
-            out = os.path.join(scene.work, f"{name}-{seed}.exr")
+            out = os.path.join(scene.work, f"{name.replace(' ', '-')}-{seed}.exr")
             r = render(scene.spp, seed, out)
             ea, mean, _ = mse(out, ref["hairtrace"])
             eb, _, _ = mse(out, ref["Cycles"])
@@ -132,7 +146,8 @@ def measure(scene, repeats, log):
         }
     # Each reference carries the noise of a timed render divided by REFERENCE_FACTOR in
     # variance; the two differ by both.
-    expected = math.sqrt(sum(r["rmse"] ** 2 for r in rows.values()) / REFERENCE_FACTOR)
+    expected = math.sqrt(sum(rows[n]["rmse"] ** 2 for n in references) / REFERENCE_FACTOR)
+    best = max(("Cycles", "Cycles adaptive"), key=lambda n: rows[n]["efficiency"])
     converged = {
         "rmse_between_references": math.sqrt(ref_mse_ab),
         "expected_from_noise": expected,
@@ -141,17 +156,19 @@ def measure(scene, repeats, log):
     }
     return {"scene": scene.name, "spp": scene.spp, "reference_spp": ref_spp,
             "size": [scene.width, scene.height], "max_depth": scene.max_depth,
-            "threads": scene.threads, "renderers": rows, "converged": converged}
+            "threads": scene.threads, "renderers": rows, "converged": converged,
+            "best_cycles": best}
 
 
 def table(results):
     lines = [
         "| scene | renderer | path tracing s | camera samples/s | rays/sample | RMSE "
-        "| efficiency 1/(RMSE²·s) | vs Cycles |",
+        "| efficiency 1/(RMSE²·s) | vs Cycles' better |",
         "|---|---|---|---|---|---|---|---|",
     ]
     for res in results:
-        cycles = res["renderers"]["Cycles"]["efficiency"]
+        # Against Cycles' better setting on this scene, adaptive sampling off or on.
+        cycles = res["renderers"][res["best_cycles"]]["efficiency"]
         w, h = res["size"]
         label = f"{res['scene']} ({w}x{h}, {res['spp']} spp)"
         for name, r in res["renderers"].items():
@@ -181,6 +198,8 @@ def main():
     parser.add_argument("--work", default=os.path.join(ROOT, "target", "bench-peer"))
     parser.add_argument("--shim", help="the ray-counting LD_PRELOAD library for Cycles")
     parser.add_argument("--json", help="also write the results here")
+    parser.add_argument("--allocation", choices=["uniform", "noise"],
+                        help="also render hairtrace with this allocation")
     args = parser.parse_args()
     names = (args.scenes.split(",") if args.scenes else
              sorted(f[:-5] for f in os.listdir(SCENES) if f.endswith(".toml")))
@@ -191,11 +210,14 @@ def main():
     results = []
     for name in names:
         log(f"{name}:")
-        results.append(measure(Scene(name, args.work, args), args.repeats, log))
+        results.append(measure(Scene(name, args.work, args), args.repeats, args.allocation, log))
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
                 if l.startswith("model name")), platform.processor())
     print(f"Machine: {cpu}, {os.cpu_count()} cores; {args.threads} threads; "
-          f"box filter of one pixel; medians of {args.repeats} interleaved runs.\n")
+          f"box filter of one pixel; medians of {args.repeats} interleaved runs; load "
+          f"{os.getloadavg()[0]:.1f} at the end. Cycles adaptive: threshold "
+          f"{CYCLES_ADAPTIVE}; vs Cycles' better: against "
+          + ", ".join(f"{r['scene']}: {r['best_cycles']}" for r in results) + ".\n")
     print(table(results))
     if args.json:
         with open(args.json, "w") as f:

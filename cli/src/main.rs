@@ -361,9 +361,9 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
 /// A progress bar on stderr, named `prefix`, with an ETA if `eta`.
 fn stage_bar(prefix: &'static str, eta: bool) -> ProgressBar {
     let template = if eta {
-        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise}"
+        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise} eta {eta_precise} {msg}"
     } else {
-        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise}"
+        "{prefix:>6} {bar:40} {percent:>3}% {elapsed_precise} {msg}"
     };
     ProgressBar::new(STAGE_STEPS)
         .with_style(ProgressStyle::with_template(template).expect("a valid progress template"))
@@ -410,6 +410,13 @@ impl Progress for Bar {
         self.0.set_length(total);
         self.0.set_position(done);
         true
+    }
+
+    fn pass(&self, samples_per_pixel: u32, noise: Option<f32>) {
+        self.0.set_message(match noise {
+            Some(n) => format!("{samples_per_pixel} spp, noise {:.2}%", 100.0 * n),
+            None => format!("{samples_per_pixel} spp"),
+        });
     }
 }
 
@@ -576,12 +583,15 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     }
     write(&output, 3, out.film.rgb())?;
     let s = out.stats;
+    let noise = s
+        .noise
+        .map_or(String::new(), |n| format!(", noise {:.2}%", 100.0 * n));
     eprintln!(
-        "{}: {}x{} at {} spp in {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s, peak memory {}",
+        "{}: {}x{} at {} spp{noise} in {:.2} s, {:.3} Msamples/s, {:.2} Mrays/s, peak memory {}",
         output.display(),
         window.width(),
         window.height(),
-        settings.spp,
+        s.spp,
         s.seconds,
         s.samples as f64 / s.seconds / 1e6,
         s.rays as f64 / s.seconds / 1e6,
@@ -598,7 +608,8 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
                 .collect::<serde_json::Map<_, _>>(),
             "samples": s.samples,
             "rays": s.rays,
-            "spp": settings.spp,
+            "spp": s.spp,
+            "noise": s.noise,
             "threads": settings.threads.unwrap_or_else(rayon::current_num_threads),
         });
         farm::write_file(path, &format!("{json}\n"))?;

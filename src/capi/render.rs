@@ -15,11 +15,14 @@ use crate::scene::stages::{NoStages, Stage, StageProgress};
 use std::ffi::{c_char, c_void};
 use std::ptr::null_mut;
 
-/// Told how far a render has got: `done` of `total` pixels, `done` never decreasing from
-/// call to call. It is called when a 16 x 16 tile finishes and, while pixels take long
+/// Told how far a render has got: `done` of `total` pixels, counted over the render's
+/// passes of 8 spp (`total` is the pixels times the passes `spp` allows; a render that a
+/// noise target or a time budget stops ends below it), `done` never decreasing from call to
+/// call. It is called when a 16 x 16 tile finishes a pass and, while pixels take long
 /// (many samples), also every 20 ms or so of work with an unchanged `done`, so that it can
-/// cancel any render promptly. Return false to cancel: no new sample starts, unfinished
-/// tiles are dropped, and `ht_render` returns `HT_ERR_CANCELLED`.
+/// cancel any render promptly. Return false to cancel: no new sample starts, the pass of
+/// unfinished tiles is dropped (their pixels keep the passes they finished), and
+/// `ht_render` returns `HT_ERR_CANCELLED`.
 ///
 /// Called from the render's worker threads (not necessarily the one that called
 /// `ht_render`), but never two calls at once, so `user` needs no locking against itself.
@@ -329,8 +332,8 @@ pub unsafe extern "C" fn ht_render(
 ///   it is not hair or nothing was hit. Nearest rather than averaged: an average of ids is
 ///   no id.
 ///
-/// On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the finished pixels and the values of
-/// "nothing hit" elsewhere; on other errors every buffer is left untouched.
+/// On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the passes each pixel finished and the
+/// values of "nothing hit" elsewhere; on other errors every buffer is left untouched.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
 /// (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer

@@ -151,27 +151,43 @@ pub const NO_HIT_DEPTH: f32 = 0.0;
 /// Strand-id AOV of a pixel whose nearest hit is not hair (or nothing).
 pub const NO_STRAND: f32 = -1.0;
 
-/// Sums one pixel's samples. The tiles hand a fresh one to the per-pixel function and
-/// store its averages.
+/// Sums one pixel's samples, over a render's passes, keeping the sums at the last two
+/// power-of-two pass counts: the two halves that estimate the noise of the mean. The film keeps one per pixel across passes; the tiles hand it to the
+/// per-pixel function and store its averages.
 #[derive(Debug, Clone)]
 pub struct PixelAccumulator {
     rgb: [f64; 3],
+    /// Sums of squares of the samples, for their variance.
+    rgb_sq: [f64; 3],
+    /// Rays the samples traced: their cost.
+    rays: u64,
     albedo: [f64; 3],
     samples: u32,
     rejected: u32,
     nearest: f32,
     strand: f32,
+    /// Passes ended ([`Self::end_pass`]).
+    passes: u32,
+    /// The sums and sample counts when `passes` was last a power of two, and the time
+    /// before (half as many passes).
+    last_power: ([f64; 3], u32),
+    half_power: ([f64; 3], u32),
 }
 
 impl Default for PixelAccumulator {
     fn default() -> Self {
         Self {
             rgb: [0.0; 3],
+            rgb_sq: [0.0; 3],
+            rays: 0,
             albedo: [0.0; 3],
             samples: 0,
             rejected: 0,
             nearest: f32::INFINITY,
             strand: NO_STRAND,
+            passes: 0,
+            last_power: ([0.0; 3], 0),
+            half_power: ([0.0; 3], 0),
         }
     }
 }
@@ -191,8 +207,10 @@ impl PixelAccumulator {
             self.rejected += 1;
             return;
         }
-        for (sum, v) in self.rgb.iter_mut().zip(radiance.to_array()) {
-            *sum += f64::from(v);
+        for (c, v) in radiance.to_array().into_iter().enumerate() {
+            let v = f64::from(v);
+            self.rgb[c] += v;
+            self.rgb_sq[c] += v * v;
         }
         if let Some(h) = hit {
             for (sum, v) in self.albedo.iter_mut().zip(h.albedo.to_array()) {
@@ -210,6 +228,72 @@ impl PixelAccumulator {
     fn mean(&self, sum: [f64; 3]) -> [f32; 3] {
         let n = f64::from(self.samples.max(1));
         sum.map(|s| (s / n) as f32)
+    }
+
+    /// Counts the rays a sample traced.
+    pub fn add_rays(&mut self, rays: u32) {
+        self.rays += u64::from(rays);
+    }
+
+    /// Rays traced so far.
+    pub fn rays(&self) -> u64 {
+        self.rays
+    }
+
+    /// Samples so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// The variance of one sample, per channel (the unbiased estimate; 0 below two samples).
+    pub fn sample_variance(&self) -> [f64; 3] {
+        if self.samples < 2 {
+            return [0.0; 3];
+        }
+        let n = f64::from(self.samples);
+        std::array::from_fn(|c| {
+            ((self.rgb_sq[c] - self.rgb[c] * self.rgb[c] / n) / (n - 1.0)).max(0.0)
+        })
+    }
+
+    /// Each channel's mean, in f64.
+    pub fn mean_rgb(&self) -> [f64; 3] {
+        let n = f64::from(self.samples.max(1));
+        self.rgb.map(|s| s / n)
+    }
+
+    /// Ends a pass of the render over this pixel.
+    pub fn end_pass(&mut self) {
+        self.passes += 1;
+        if self.passes.is_power_of_two() {
+            self.half_power = self.last_power;
+            self.last_power = (self.rgb, self.samples);
+        }
+    }
+
+    /// The variance of each channel's mean, from the difference between two halves: the
+    /// samples of the first h passes, h the largest power of two at most half the passes,
+    /// against the rest; None before two passes. The first half is a power-of-two block of
+    /// the Sobol sequence and the second nearly one, each stratified in itself, so the
+    /// estimate keeps the sampler's stratification within halves (a per-sample variance,
+    /// or the spread of the passes' means, would miss most of it and overstate the noise);
+    /// it misses only the gain of joining the two.
+    pub fn variance_of_mean(&self) -> Option<[f64; 3]> {
+        let (first, n_first) = self.half_power;
+        let n_rest = self.samples.checked_sub(n_first)?;
+        if self.passes < 2 || n_first == 0 || n_rest == 0 {
+            return None;
+        }
+        let (a, b, n) = (
+            f64::from(n_first),
+            f64::from(n_rest),
+            f64::from(self.samples),
+        );
+        Some(std::array::from_fn(|c| {
+            let d = first[c] / a - (self.rgb[c] - first[c]) / b;
+            // E[d^2] = sigma^2 (1/a + 1/b) for independent samples of variance sigma^2.
+            d * d / (1.0 / a + 1.0 / b) / n
+        }))
     }
 }
 
@@ -232,7 +316,8 @@ pub struct Film {
     albedo: Option<Vec<f32>>,
     depth: Option<Vec<f32>>,
     strand_id: Option<Vec<f32>>,
-    rejected: u64,
+    /// Every pixel's samples so far: a further render into this film adds to them.
+    accumulators: Vec<PixelAccumulator>,
 }
 
 impl Film {
@@ -262,6 +347,11 @@ impl Film {
         let pixels = usize::try_from(crop.pixel_count())
             .map_err(|_| invalid_arg!("film of {width} x {height} is too large"))?;
         let rgb = zeroed(pixels, 3)?;
+        let mut accumulators = Vec::new();
+        accumulators
+            .try_reserve_exact(pixels)
+            .map_err(|_| invalid_arg!("cannot allocate a film of {pixels} pixels"))?;
+        accumulators.resize(pixels, PixelAccumulator::default());
         let aov = |on: bool, channels, fill| -> Result<Option<Vec<f32>>> {
             on.then(|| {
                 let mut v = zeroed(pixels, channels)?;
@@ -278,7 +368,7 @@ impl Film {
             albedo: aov(aovs.albedo, 3, 0.0)?,
             depth: aov(aovs.depth, 1, NO_HIT_DEPTH)?,
             strand_id: aov(aovs.strand_id, 1, NO_STRAND)?,
-            rejected: 0,
+            accumulators,
         })
     }
 
@@ -326,28 +416,108 @@ impl Film {
     /// Samples whose values were NaN or infinite, counted as black (see
     /// [`PixelAccumulator::add`]).
     pub fn rejected_samples(&self) -> u64 {
-        self.rejected
+        self.accumulators
+            .iter()
+            .map(|a| u64::from(a.rejected))
+            .sum()
     }
 
-    /// Stores a finished pixel, given in full-frame coordinates inside the crop.
+    /// The estimated noise of the image: the RMSE of its pixels' means (over pixels and
+    /// channels, as `hairtrace compare` measures it) relative to the image's mean, from
+    /// [`PixelAccumulator::variance_of_mean`]. None before two passes, or for an image
+    /// whose mean is not positive while it has noise.
+    pub fn noise(&self) -> Option<f32> {
+        let mut pixels = Vec::with_capacity(self.accumulators.len());
+        for acc in &self.accumulators {
+            pixels.push((acc.mean_rgb(), acc.variance_of_mean()?));
+        }
+        relative_rmse(pixels)
+    }
+
+    /// Camera samples taken so far.
+    pub fn samples(&self) -> u64 {
+        self.accumulators.iter().map(|a| u64::from(a.samples)).sum()
+    }
+
+    /// Rays traced by the samples so far.
+    pub fn rays(&self) -> u64 {
+        self.accumulators.iter().map(|a| a.rays).sum()
+    }
+
+    fn index(&self, pixel: (u32, u32)) -> usize {
+        ((pixel.1 - self.crop.y0) as usize) * self.crop.width() as usize
+            + (pixel.0 - self.crop.x0) as usize
+    }
+
+    /// The samples so far of a pixel (full-frame coordinates, inside the crop).
+    pub(super) fn accumulator(&self, pixel: (u32, u32)) -> &PixelAccumulator {
+        &self.accumulators[self.index(pixel)]
+    }
+
+    /// Stores a pixel's samples so far, given in full-frame coordinates inside the crop.
     pub(super) fn store(&mut self, pixel: (u32, u32), acc: &PixelAccumulator) {
-        let i = ((pixel.1 - self.crop.y0) as usize) * self.crop.width() as usize
-            + (pixel.0 - self.crop.x0) as usize;
-        self.rgb[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.rgb));
-        if let Some(albedo) = &mut self.albedo {
-            albedo[3 * i..3 * i + 3].copy_from_slice(&acc.mean(acc.albedo));
+        let i = self.index(pixel);
+        self.accumulators[i] = acc.clone();
+        self.write(i, acc.mean(acc.rgb), acc.mean(acc.albedo), acc);
+    }
+
+    /// Makes a pixel's values `pilot_weight` x the pilot's means + the rest x its own
+    /// (its depth and strand those of the nearer of the two's nearest hits). Its samples
+    /// stay its own.
+    pub(super) fn store_blend(
+        &mut self,
+        pixel: (u32, u32),
+        pilot: &PixelAccumulator,
+        pilot_weight: f64,
+    ) {
+        let i = self.index(pixel);
+        let own = &self.accumulators[i];
+        let blend = |p: [f32; 3], o: [f32; 3]| {
+            std::array::from_fn(|c| {
+                (pilot_weight * f64::from(p[c]) + (1.0 - pilot_weight) * f64::from(o[c])) as f32
+            })
+        };
+        let rgb = blend(pilot.mean(pilot.rgb), own.mean(own.rgb));
+        let albedo = blend(pilot.mean(pilot.albedo), own.mean(own.albedo));
+        let nearest = if pilot.nearest < own.nearest {
+            pilot.clone()
+        } else {
+            own.clone()
+        };
+        self.write(i, rgb, albedo, &nearest);
+    }
+
+    /// Writes pixel `i`'s colour, albedo, and the depth and strand of `nearest`'s hit.
+    fn write(&mut self, i: usize, rgb: [f32; 3], albedo: [f32; 3], nearest: &PixelAccumulator) {
+        self.rgb[3 * i..3 * i + 3].copy_from_slice(&rgb);
+        if let Some(a) = &mut self.albedo {
+            a[3 * i..3 * i + 3].copy_from_slice(&albedo);
         }
         if let Some(depth) = &mut self.depth {
-            depth[i] = if acc.nearest.is_finite() {
-                acc.nearest
+            depth[i] = if nearest.nearest.is_finite() {
+                nearest.nearest
             } else {
                 NO_HIT_DEPTH
             };
         }
         if let Some(strand) = &mut self.strand_id {
-            strand[i] = acc.strand;
+            strand[i] = nearest.strand;
         }
-        self.rejected += u64::from(acc.rejected);
+    }
+}
+
+/// The RMSE of pixels given as (mean, variance of the mean) per channel, over pixels and
+/// channels, relative to their mean: a film's estimated noise. Zero without variance, None
+/// for noise on a mean that is not positive.
+pub(super) fn relative_rmse(pixels: Vec<([f64; 3], [f64; 3])>) -> Option<f32> {
+    let values = 3.0 * pixels.len() as f64;
+    let (variance, sum) = pixels.iter().fold((0.0, 0.0), |(v, s), (m, var)| {
+        (v + var.iter().sum::<f64>(), s + m.iter().sum::<f64>())
+    });
+    match (variance, sum) {
+        (0.0, _) => Some(0.0),
+        (v, s) if s > 0.0 => Some(((v / values).sqrt() / (s / values)) as f32),
+        _ => None,
     }
 }
 

@@ -2,6 +2,7 @@
 //! run in parallel, progress and cancellation. The integrator composes them with the
 //! camera, the lights and the traceable scene.
 
+pub(crate) mod allocation;
 pub(crate) mod film;
 pub mod integrator;
 pub(crate) mod progress;

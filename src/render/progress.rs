@@ -2,11 +2,16 @@
 
 /// Told how far a render has got. The renderer calls [`update`](Progress::update) once
 /// per finished tile, from worker threads but never two calls at once, with `done`
-/// increasing from call to call up to `total` (both in pixels).
+/// increasing from call to call up to `total` (both in pixels, over every pass the render
+/// may make: one that stops early ends below `total`).
 pub trait Progress: Sync {
     /// Returns `false` to cancel the render: no new pixel starts after that, and the
     /// render returns [`RenderStatus::Cancelled`](super::RenderStatus::Cancelled).
     fn update(&self, done: u64, total: u64) -> bool;
+
+    /// Told, after each pass of a render, the samples per pixel so far and the estimated
+    /// noise then ([`Film::noise`](super::Film::noise)); by default, nothing.
+    fn pass(&self, _samples_per_pixel: u32, _noise: Option<f32>) {}
 }
 
 /// Reports nowhere and never cancels.

@@ -1,13 +1,13 @@
 //! One render: camera samples per pixel through the integrator, over tiles in parallel.
 
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
+use super::allocation::{self, ALLOCATED};
 use super::film::{Aovs, Film, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::sampler::PixelSampler;
-use super::settings::RenderSettings;
+use super::settings::{Allocation, RenderSettings};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
@@ -26,15 +26,35 @@ pub struct RenderStats {
     pub seconds: f64,
     /// Camera samples taken.
     pub samples: u64,
+    /// Samples per pixel taken: `spp`, or fewer where a noise target or a time budget
+    /// stopped the render.
+    pub spp: u32,
+    /// The estimated noise at the end ([`Film::noise`]); None after a single pass.
+    pub noise: Option<f32>,
     /// Rays traced: closest-hit and shadow.
     pub rays: u64,
 }
+
+/// Samples per pixel of one pass. A render proceeds in passes and decides whether to stop
+/// only between two, so that its image is that of a plain render of the samples it took.
+/// A power of two, so that each pass is a block of the Sobol sequence stratified in itself
+/// (the noise estimate's halves, [`PixelAccumulator::variance_of_mean`]).
+///
+/// [`PixelAccumulator::variance_of_mean`]: super::film::PixelAccumulator::variance_of_mean
+pub const PASS_SAMPLES: u32 = 8;
 
 /// Renders `world` through `camera`. Each sample's numbers depend only on the seed, the
 /// full-frame pixel and the sample index, so the image is the same for any thread count,
 /// tile order or crop. A world whose curves were shaped for a view (the `auto` shape)
 /// renders only the views for which those shapes hold ([`crate::scene::tracer::Tracer::serves`]);
 /// any other is refused, to be built again for it.
+///
+/// The samples are taken in passes of [`PASS_SAMPLES`] per pixel (on average, under the
+/// `noise` allocation, `src/render/allocation.rs`), in sample order. Between passes the render
+/// stops once the estimated noise of the window it renders is at most `noise_target`, or
+/// when the next pass (timed as the last one) would end past `time_budget`: the image is
+/// then, bit for bit, that of a render with `spp` = the samples taken
+/// ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`.
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -53,45 +73,102 @@ pub fn render(
              or with fewer pixels): build the scene again for this camera and image height"
         ));
     }
+    let (width, height) = (settings.width, settings.height);
     let crop = settings
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
-    let mut film = Film::new(settings.width, settings.height, crop, aovs)?;
+    let mut film = Film::new(width, height, crop, aovs)?;
+    // The noise allocation's pilot, over whole blocks around the crop.
+    let mut pilot = match settings.allocation {
+        Allocation::Uniform => None,
+        Allocation::Noise => {
+            let window = allocation::pilot_window(film.crop(), width, height);
+            Some(Film::new(width, height, Some(window), aovs)?)
+        }
+    };
+    let mut shares: Option<allocation::Shares> = None;
     let filter = settings.pixel_filter()?;
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),
     };
-    let rays = AtomicU64::new(0);
+    let pixels = film.crop().pixel_count();
+    let passes = settings.spp.div_ceil(PASS_SAMPLES);
     let start = Instant::now();
-    let status = render_tiles(&mut film, &options, progress, |pixel, acc, pulse| {
-        let mut pixel_rays = 0u64;
-        for index in 0..settings.spp {
-            if !pulse.keep_going() {
-                break;
-            }
-            let mut sampler = PixelSampler::new(settings.seed, pixel, index);
-            let offset = filter.sample(sampler.next_2d());
-            let image_point = ndc(settings.width, settings.height, pixel, offset);
-            let lens = if camera.has_lens() {
-                sampler.next_2d()
-            } else {
-                sampler.skip();
-                [0.5; 2]
-            };
-            let (org, dir) = camera.ray(image_point, lens);
-            let (radiance, first, traced) =
-                world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
-            pixel_rays += u64::from(traced);
-            acc.add(radiance, first.as_ref());
+    let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);
+    let mut last_pass = 0.0;
+    for pass in 0..passes {
+        let elapsed = start.elapsed().as_secs_f64();
+        let good_enough = matches!((settings.noise_target, noise), (Some(t), Some(n)) if n <= t);
+        let out_of_time = settings
+            .time_budget
+            .is_some_and(|budget| spp > 0 && elapsed + last_pass > f64::from(budget));
+        if good_enough || out_of_time {
+            break;
         }
-        rays.fetch_add(pixel_rays, Ordering::Relaxed);
-    })?;
-    let window = film.crop();
+        let end = (spp + PASS_SAMPLES).min(settings.spp);
+        // Sample indices of a pixel in this pass.
+        let indices = |pixel| match &shares {
+            None => spp..end,
+            Some(shares) => {
+                let n = shares.of(pixel);
+                let before = ALLOCATED + (pass - 1) * n;
+                before..before + n
+            }
+        };
+        let target = match (&mut pilot, pass) {
+            (Some(pilot), 0) => pilot,
+            _ => &mut film,
+        };
+        let (offset, total) = (u64::from(pass) * pixels, u64::from(passes) * pixels);
+        let in_pass = target.crop().pixel_count();
+        let pass_progress = |done, _| progress.update(offset + done * pixels / in_pass, total);
+        status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
+            for index in indices(pixel) {
+                if !pulse.keep_going() {
+                    return;
+                }
+                let mut sampler = PixelSampler::new(settings.seed, pixel, index);
+                let offset = filter.sample(sampler.next_2d());
+                let image_point = ndc(width, height, pixel, offset);
+                let lens = if camera.has_lens() {
+                    sampler.next_2d()
+                } else {
+                    sampler.skip();
+                    [0.5; 2]
+                };
+                let (org, dir) = camera.ray(image_point, lens);
+                let (radiance, first, traced) =
+                    world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
+                acc.add(radiance, first.as_ref());
+                acc.add_rays(traced);
+            }
+            acc.end_pass();
+        })?;
+        if status == RenderStatus::Cancelled {
+            break;
+        }
+        spp = end;
+        noise = match &pilot {
+            None => film.noise(),
+            Some(pilot) if pass == 0 => {
+                shares = Some(allocation::Shares::new(pilot, film.crop(), PASS_SAMPLES));
+                None
+            }
+            Some(pilot) => allocation::blended_noise(&film, pilot),
+        };
+        last_pass = start.elapsed().as_secs_f64() - elapsed;
+        progress.pass(spp, noise);
+    }
+    if let Some(pilot) = &pilot {
+        allocation::blend(&mut film, pilot);
+    }
     let stats = RenderStats {
         seconds: start.elapsed().as_secs_f64(),
-        samples: window.pixel_count() * u64::from(settings.spp),
-        rays: rays.into_inner(),
+        samples: film.samples() + pilot.as_ref().map_or(0, Film::samples),
+        spp,
+        noise,
+        rays: film.rays() + pilot.as_ref().map_or(0, Film::rays),
     };
     Ok(RenderOutput {
         film,

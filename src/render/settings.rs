@@ -122,6 +122,7 @@ macro_rules! named_value {
 named_value!(Roulette { SqrtThroughput = "sqrt", Throughput = "throughput" });
 named_value!(Strategy { Mis = "mis", LightOnly = "light", BsdfOnly = "bsdf" });
 named_value!(Filter { Tent = "tent", Box = "box" });
+named_value!(Allocation { Uniform = "uniform", Noise = "noise" });
 
 /// By the names `Isa` itself gives Embree.
 impl Value for Isa {
@@ -306,8 +307,18 @@ settings! {
         width: u32 = 640, Range::Closed(1.0, MAX_SIDE as f64);
         /// Image height in pixels.
         height: u32 = 480, Range::Closed(1.0, MAX_SIDE as f64);
-        /// Samples per pixel.
+        /// Samples per pixel; with a noise target or a time budget, the most.
         spp: u32 = 16, Range::AtLeast(1.0);
+        /// Stop once the estimated noise (RMSE relative to the image's mean) is at most this;
+        /// none: render all spp.
+        noise_target: Option<f32> = None, Range::Above(0.0);
+        /// Stop before a pass that would end past this many seconds of rendering; none: no
+        /// limit.
+        time_budget: Option<f32> = None, Range::Above(0.0);
+        /// Where samples go: uniform (spp in every pixel) or noise (a pilot pass of 8 spp,
+        /// then each pixel's share in proportion to its noise over the square root of its
+        /// cost, unbiased; the same number of samples over each 16 x 16 block).
+        allocation: Allocation = Allocation::Uniform, Range::Any;
         /// The image depends only on the scene, the settings and this seed.
         seed: u64 = 0, Range::Any;
         /// Worker threads; none: one per hardware thread.
@@ -385,6 +396,15 @@ pub enum Strategy {
     LightOnly,
     /// BSDF sampling only: no shadow rays.
     BsdfOnly,
+}
+
+/// How a render shares its samples among pixels (`super::allocation`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Allocation {
+    /// `spp` samples in every pixel.
+    Uniform,
+    /// A pilot pass, then samples in proportion to each pixel's estimated noise.
+    Noise,
 }
 
 /// The pixel filter's kind (its radius is `filter_radius`).

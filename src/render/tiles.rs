@@ -1,8 +1,9 @@
 //! Parallel rendering over square tiles with rayon.
 //!
-//! Each pixel is computed by one call of the per-pixel function, which sees only its
-//! full-frame coordinates, and stored once: the result cannot depend on the number of
-//! threads, the order tiles finish in, the tile size or the crop.
+//! Each pixel is computed by one call of the per-pixel function per render, which sees only
+//! its full-frame coordinates and the pixel's own samples so far, and stored once: the
+//! result cannot depend on the number of threads, the order tiles finish in, the tile size
+//! or the crop.
 
 use std::cell::Cell;
 use std::sync::Mutex;
@@ -41,8 +42,8 @@ impl Default for TileOptions {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum RenderStatus {
     Complete,
-    /// The progress sink asked to stop. Tiles finished before that hold their final
-    /// values; the others stay black.
+    /// The progress sink asked to stop. Tiles finished before that hold their new
+    /// values; the others keep what they had (black in a fresh film).
     Cancelled,
 }
 
@@ -92,7 +93,8 @@ impl Pulse<'_> {
 }
 
 /// Renders every pixel of `film`'s crop window with `shade(pixel, accumulator, pulse)`,
-/// which adds the pixel's samples to the fresh accumulator it is given, asking
+/// which adds the pixel's samples to the accumulator it is given (the pixel's samples so
+/// far: none in a fresh film, so that a render in passes calls this once a pass), asking
 /// `pulse.keep_going()` before each; `pixel` is in full-frame coordinates.
 ///
 /// `progress` hears of each finished tile, and between those at most every
@@ -140,14 +142,17 @@ where
             heartbeat: &heartbeat,
             calls: Cell::new(0),
         };
-        let mut pixels = Vec::with_capacity(tile.pixel_count() as usize);
-        for pixel in tile.pixels() {
+        let mut pixels: Vec<((u32, u32), PixelAccumulator)> = {
+            let guard = shared.lock().unwrap_or_else(|e| e.into_inner());
+            tile.pixels()
+                .map(|p| (p, guard.0.accumulator(p).clone()))
+                .collect()
+        };
+        for (pixel, acc) in &mut pixels {
             if cancelled.load(Ordering::Relaxed) {
                 return;
             }
-            let mut acc = PixelAccumulator::default();
-            shade(pixel, &mut acc, &pulse);
-            pixels.push((pixel, acc));
+            shade(*pixel, acc, &pulse);
         }
         // A pixel cut short by a cancellation is not stored.
         if cancelled.load(Ordering::Relaxed) {

@@ -4,6 +4,7 @@
 //! its own package, cli/tests). One test binary, so that the crate (with Embree and
 //! OpenImageIO) is linked once.
 
+mod adaptive;
 mod architecture;
 mod camera_film;
 mod convert;

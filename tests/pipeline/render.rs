@@ -16,7 +16,7 @@ use hairtrace::scene::material::{HairColor, HairMaterial, Material};
 use hairtrace::scene::tracer::TracerBuilder;
 use std::sync::Arc;
 
-fn fur_world(hair: HairMaterial, lights: Vec<Light>, strands: usize) -> World {
+pub(crate) fn fur_world(hair: HairMaterial, lights: Vec<Light>, strands: usize) -> World {
     let device = Arc::new(Device::new(Some(2)).unwrap());
     let mut b = TracerBuilder::new(device, SceneOptions::default()).unwrap();
     let groom = FurBall {
@@ -37,11 +37,11 @@ fn fur_world(hair: HairMaterial, lights: Vec<Light>, strands: usize) -> World {
     .unwrap()
 }
 
-fn camera() -> Camera {
+pub(crate) fn camera() -> Camera {
     Camera::new(Vec3::new(0.0, 0.0, 4.0), Vec3::ZERO, Vec3::Y, 40.0, 1.0).unwrap()
 }
 
-fn mean(rgb: &[f32]) -> f64 {
+pub(crate) fn mean(rgb: &[f32]) -> f64 {
     rgb.iter().map(|v| f64::from(*v)).sum::<f64>() / rgb.len() as f64
 }
 
@@ -92,7 +92,7 @@ fn white_fur_ball_of_30k_strands_keeps_the_furnace_within_a_thousandth() {
 }
 
 /// A brown fur ball lit by three non-delta lights of different kinds.
-fn lit_world() -> World {
+pub(crate) fn lit_world() -> World {
     let lights = vec![
         Light::Environment(Environment::uniform(Vec3::splat(0.2)).unwrap()),
         Light::distant(Vec3::new(1.0, 1.0, 1.0), Vec3::new(2.0, 1.8, 1.5), 10.0).unwrap(),
@@ -124,11 +124,11 @@ fn strategies_agree(max_depth: u32) {
     let means = |strategy| {
         quadrant_means(
             &world,
-            PathSettings {
+            quadrant_settings(PathSettings {
                 strategy,
                 max_depth,
                 ..PathSettings::default()
-            },
+            }),
         )
     };
     let mis = means(Strategy::Mis);
@@ -138,23 +138,35 @@ fn strategies_agree(max_depth: u32) {
     }
 }
 
-/// Mean and standard error of each image quadrant's mean over 64 seeds of a 24 x 24,
-/// 8-spp render, and the rays per camera sample.
-fn quadrant_means(world: &World, path: PathSettings) -> (Vec<(f64, f64)>, f64) {
-    const SEEDS: u64 = 64;
+/// A 24 x 24, 8-spp render with these path settings: what [`quadrant_means`] takes.
+pub(crate) fn quadrant_settings(path: PathSettings) -> RenderSettings {
+    RenderSettings {
+        width: 24,
+        height: 24,
+        spp: 8,
+        path,
+        ..RenderSettings::default()
+    }
+}
+
+/// Mean and standard error of each image quadrant's mean over 64 seeds of a 24 x 24
+/// render with these settings, and the rays per camera sample.
+fn quadrant_means(world: &World, base: RenderSettings) -> (Vec<(f64, f64)>, f64) {
+    quadrant_means_over(world, base, 64)
+}
+
+/// As [`quadrant_means`], over `seeds` seeds.
+pub(crate) fn quadrant_means_over(
+    world: &World,
+    base: RenderSettings,
+    seeds: u64,
+) -> (Vec<(f64, f64)>, f64) {
     let mut rays = 0.0;
-    let per_seed: Vec<[f64; 4]> = (0..SEEDS)
+    let per_seed: Vec<[f64; 4]> = (0..seeds)
         .map(|seed| {
-            let settings = RenderSettings {
-                width: 24,
-                height: 24,
-                spp: 8,
-                seed,
-                path,
-                ..RenderSettings::default()
-            };
+            let settings = RenderSettings { seed, ..base };
             let out = render(world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
-            rays += out.stats.rays as f64 / out.stats.samples as f64 / SEEDS as f64;
+            rays += out.stats.rays as f64 / out.stats.samples as f64 / seeds as f64;
             let rgb = out.film.rgb();
             let mut q = [0.0f64; 4];
             for y in 0..24 {
@@ -169,16 +181,20 @@ fn quadrant_means(world: &World, path: PathSettings) -> (Vec<(f64, f64)>, f64) {
         .collect();
     let quadrants = (0..4)
         .map(|k| {
-            let m = per_seed.iter().map(|q| q[k]).sum::<f64>() / SEEDS as f64;
-            let var = per_seed.iter().map(|q| (q[k] - m).powi(2)).sum::<f64>() / (SEEDS - 1) as f64;
-            (m, (var / SEEDS as f64).sqrt())
+            let m = per_seed.iter().map(|q| q[k]).sum::<f64>() / seeds as f64;
+            let var = per_seed.iter().map(|q| (q[k] - m).powi(2)).sum::<f64>() / (seeds - 1) as f64;
+            (m, (var / seeds as f64).sqrt())
         })
         .collect();
     (quadrants, rays)
 }
 
 /// Each quadrant's means agree within 4 standard errors.
-fn assert_quadrants_agree(label: &str, a: &(Vec<(f64, f64)>, f64), b: &(Vec<(f64, f64)>, f64)) {
+pub(crate) fn assert_quadrants_agree(
+    label: &str,
+    a: &(Vec<(f64, f64)>, f64),
+    b: &(Vec<(f64, f64)>, f64),
+) {
     for k in 0..4 {
         let ((ma, sa), (mb, sb)) = (a.0[k], b.0[k]);
         let bound = 4.0 * (sa * sa + sb * sb).sqrt() + 1e-4;
@@ -200,10 +216,10 @@ fn shadow_ray_roulette_keeps_the_image_and_saves_rays() {
     let at = |light_threshold| {
         quadrant_means(
             &world,
-            PathSettings {
+            quadrant_settings(PathSettings {
                 light_threshold,
                 ..PathSettings::default()
-            },
+            }),
         )
     };
     let every = at(0.0);
@@ -287,15 +303,23 @@ fn renders_are_deterministic_across_threads_and_crops() {
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(one.film.rgb()), bits(two.film.rgb()));
     let crop = run(RenderSettings {
-        crop: Some([7, 5, 29, 22]),
+        crop: Some(CROP),
         threads: Some(2),
         ..base
     });
-    let full = one.film.rgb();
-    let part = crop.film.rgb();
-    for y in 5..22 {
-        for x in 7..29 {
-            let (i, j) = (3 * (y * 40 + x), 3 * ((y - 5) * 22 + (x - 7)));
+    assert_crop_of(one.film.rgb(), crop.film.rgb());
+}
+
+/// A crop of a 40 x 30 frame, across the 16 x 16 blocks of the noise allocation.
+pub(crate) const CROP: [u32; 4] = [7, 5, 29, 22];
+
+/// `part`, the RGB of [`CROP`], is bit for bit those pixels of the 40 x 30 `full`.
+pub(crate) fn assert_crop_of(full: &[f32], part: &[f32]) {
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    let [x0, y0, x1, y1] = CROP.map(|v| v as usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (i, j) = (3 * (y * 40 + x), 3 * ((y - y0) * (x1 - x0) + (x - x0)));
             assert_eq!(
                 bits(&full[i..i + 3]),
                 bits(&part[j..j + 3]),

@@ -24,12 +24,16 @@ use hairtrace::formats::hair::{Thickness, info_report, read_hair_file};
 use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::formats::{SceneFormat, usd};
 use hairtrace::image::{self, Placement, WriteOptions};
+use hairtrace::render::integrator::World;
+use hairtrace::render::renderer::RenderStats;
+use hairtrace::render::settings::RenderSettings;
 use hairtrace::render::{Aovs, Progress, renderer};
+use hairtrace::scene::Camera;
 use hairtrace::scene::material::HairColor;
 use hairtrace::scene::{GroomShape, Stage, StageProgress};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
-use settings::SettingArgs;
+use settings::{SettingArgs, Variant};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -221,6 +225,12 @@ struct RenderArgs {
     /// before the extension: albedo (RGB), depth (camera distance), strand (strand id).
     #[arg(long, value_delimiter = ',', value_parser = ["albedo", "depth", "strand"])]
     aov: Vec<String>,
+    /// One more image from the same build, after the main one: OUT with these settings
+    /// changed (spp, seed, fidelity knobs, a noise target...), e.g. `--variant
+    /// 'ref.exr:spp=1024 seed=9'`. Repeatable. Settings the build is made for (width,
+    /// height, isa, lod_pixels) are refused: they need a command of their own.
+    #[arg(long, value_name = "OUT:NAME=VALUE ...", value_parser = Variant::parse)]
+    variant: Vec<Variant>,
     /// Render tile I of N (from 1; a grid over the frame, the same on every machine)
     /// instead of the whole frame: -o then names the frame (.exr), and the tile goes beside
     /// it as `NAME.tile-I-of-N.exr` (an AOV's as `NAME.AOV.tile-I-of-N.exr`), for
@@ -512,20 +522,64 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         }
         r.crop = Some(tiles::tile_window(r.width, r.height, i, n)?);
     }
-    let r = &description.render;
+    // Every variant is checked before the build, so that a typo does not wait for it.
+    let mut renders = vec![(frame.clone(), description.render)];
+    for v in &args.variant {
+        let frame = numbered(&v.output, args.frame_number)?;
+        image::check_output_path(&place(frame.clone()))?;
+        renders.push((frame, v.settings(&description.render)?));
+    }
     let build_start = std::time::Instant::now();
-    let device = Arc::new(r.device()?);
+    let device = Arc::new(description.render.device()?);
     let bars = StageBars::default();
     let BuiltScene {
         world,
         camera,
-        settings,
         stages,
         ..
     } = description.build_with(device, &bars)?;
     bars.finish();
     let build_seconds = build_start.elapsed().as_secs_f64();
+    let label = scene_label(args.scene.as_ref(), args.demo.as_deref());
+    for (i, (frame, settings)) in renders.iter().enumerate() {
+        let s = render_frame(args, &world, &camera, settings, frame, &label)?;
+        // The figures of the first render: what benchmarks read.
+        if let (0, Some(path)) = (i, &args.stats) {
+            let json = serde_json::json!({
+                "seconds": s.seconds,
+                "build_seconds": build_seconds,
+                "stage_seconds": Stage::ALL
+                    .iter()
+                    .map(|&st| (st.name().to_owned(), stages.get(st).into()))
+                    .chain([("render".to_owned(), s.seconds.into())])
+                    .collect::<serde_json::Map<_, _>>(),
+                "samples": s.samples,
+                "rays": s.rays,
+                "spp": s.spp,
+                "noise": s.noise,
+                "threads": settings.threads.unwrap_or_else(rayon::current_num_threads),
+            });
+            farm::write_file(path, &format!("{json}\n"))?;
+        }
+    }
+    Ok(())
+}
 
+/// Renders one image of the built world with `settings` and writes it (its tile, with
+/// `--tile`) and its AOVs to `frame`'s names, with the render's header.
+fn render_frame(
+    args: &RenderArgs,
+    world: &World,
+    camera: &Camera,
+    settings: &RenderSettings,
+    frame: &Path,
+    label: &str,
+) -> hairtrace::Result<RenderStats> {
+    let place = |image: PathBuf| match args.tile {
+        Some((i, n)) => tile_path(&image, i, n),
+        None => image,
+    };
+    let output = place(frame.to_path_buf());
     let bar = stage_bar("render", true);
     let wants = |name: &str| args.aov.iter().any(|a| a == name);
     let aovs = Aovs {
@@ -536,18 +590,15 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let aov_paths: Vec<(PathBuf, &str)> = args
         .aov
         .iter()
-        .map(|a| (place(tiles::tagged_path(&frame, a)), a.as_str()))
+        .map(|a| (place(tiles::tagged_path(frame, a)), a.as_str()))
         .collect();
     for (path, _) in &aov_paths {
         image::check_output_path(path)?;
     }
-    let out = renderer::render(&world, &camera, &settings, aovs, &Bar(bar.clone()))?;
+    let out = renderer::render(world, camera, settings, aovs, &Bar(bar.clone()))?;
     bar.finish_and_clear();
     let window = out.film.crop();
-    let mut attributes = tiles::header(
-        &settings,
-        &scene_label(args.scene.as_ref(), args.demo.as_deref()),
-    );
+    let mut attributes = tiles::header(settings, label);
     if let Some((i, n)) = args.tile {
         attributes.push((format!("{}tile", tiles::PREFIX), format!("{i}/{n}")));
     }
@@ -597,30 +648,13 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
         s.rays as f64 / s.seconds / 1e6,
         peak_memory()
     );
-    if let Some(path) = &args.stats {
-        let json = serde_json::json!({
-            "seconds": s.seconds,
-            "build_seconds": build_seconds,
-            "stage_seconds": Stage::ALL
-                .iter()
-                .map(|&st| (st.name().to_owned(), stages.get(st).into()))
-                .chain([("render".to_owned(), s.seconds.into())])
-                .collect::<serde_json::Map<_, _>>(),
-            "samples": s.samples,
-            "rays": s.rays,
-            "spp": s.spp,
-            "noise": s.noise,
-            "threads": settings.threads.unwrap_or_else(rayon::current_num_threads),
-        });
-        farm::write_file(path, &format!("{json}\n"))?;
-    }
     if out.film.rejected_samples() > 0 {
         eprintln!(
             "warning: {} samples were not finite and were dropped",
             out.film.rejected_samples()
         );
     }
-    Ok(())
+    Ok(s)
 }
 
 /// The process's peak resident memory, from Linux's /proc ("unknown" elsewhere).

@@ -83,6 +83,63 @@ impl Args for SettingArgs {
     }
 }
 
+/// One more render of the same build (`render --variant 'OUT:NAME=VALUE ...'`): its image
+/// and the settings it changes, after every other flag.
+#[derive(Debug, Clone)]
+pub struct Variant {
+    pub output: std::path::PathBuf,
+    pub values: SettingArgs,
+}
+
+/// The settings a build is made for: a variant that changes one needs a build of its own.
+const BUILD_SETTINGS: [&str; 4] = ["width", "height", "isa", "lod_pixels"];
+
+impl Variant {
+    /// `OUT:NAME=VALUE NAME=VALUE ...`: the image, then settings separated by spaces (no
+    /// setting's value holds a colon, so the output is what comes before the last one).
+    pub fn parse(text: &str) -> Result<Variant, String> {
+        let (output, sets) = text
+            .rsplit_once(':')
+            .filter(|(o, _)| !o.is_empty())
+            .ok_or_else(|| format!("{text:?}: must be OUT:NAME=VALUE [NAME=VALUE ...]"))?;
+        let values = (sets.split_whitespace())
+            .map(|pair| {
+                let (k, v) = pair
+                    .split_once('=')
+                    .ok_or_else(|| format!("{text:?}: {pair:?} must be NAME=VALUE"))?;
+                Ok((k.to_owned(), v.to_owned()))
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        if values.is_empty() {
+            return Err(format!(
+                "{text:?}: give at least one NAME=VALUE after the colon"
+            ));
+        }
+        Ok(Variant {
+            output: output.into(),
+            values: SettingArgs { values },
+        })
+    }
+
+    /// `base` with this variant's values, checked, refused when it changes what the build
+    /// was made for.
+    pub fn settings(&self, base: &RenderSettings) -> hairtrace::Result<RenderSettings> {
+        let mut settings = *base;
+        self.values.apply(&mut settings)?;
+        settings.validate()?;
+        for name in BUILD_SETTINGS {
+            if settings.get(name).ok() != base.get(name).ok() {
+                return Err(hairtrace::Error::InvalidArg(format!(
+                    "--variant {}: {name} is a setting the build is made for: render it \
+                     with a command of its own",
+                    self.output.display()
+                )));
+            }
+        }
+        Ok(settings)
+    }
+}
+
 /// The schema as a Markdown table: what `hairtrace settings` prints and docs/settings.md
 /// holds (cli/tests checks that the two agree).
 pub fn markdown() -> String {

@@ -323,6 +323,49 @@ fn render_crop_matches_the_full_frame() {
     );
 }
 
+/// `--variant` renders more images from the one build, each the image its own command
+/// would give; a variant of what the build is made for is refused before the build.
+#[test]
+fn variants_render_from_one_build_as_their_own_commands_would() {
+    let (main, variant, alone) = (
+        tmp("cli_variant_main.exr"),
+        tmp("cli_variant_spp.exr"),
+        tmp("cli_variant_alone.exr"),
+    );
+    let common = ["render", "--width", "24", "--height", "16", "--spp", "2"];
+    let spec = format!("{variant}:spp=4 seed=3");
+    let mut args = common.to_vec();
+    args.extend(["-o", &main, "--variant", &spec]);
+    let o = hairtrace(&args);
+    assert!(o.status.success(), "{o:?}");
+    // One summary line per image, from one build.
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("at 2 spp") && err.contains("at 4 spp"),
+        "{err}"
+    );
+    let mut args = common.to_vec();
+    args.extend(["--set", "spp=4", "--set", "seed=3", "-o", &alone]);
+    let o = hairtrace(&args);
+    assert!(o.status.success(), "{o:?}");
+    let read = |p: &str| hairtrace::image::read_image(std::path::Path::new(p)).unwrap();
+    assert_eq!(read(&variant).pixels, read(&alone).pixels);
+    assert_ne!(read(&variant).pixels, read(&main).pixels);
+
+    let wider = tmp("cli_variant_wider.exr");
+    let spec = format!("{wider}:width=48");
+    let mut args = common.to_vec();
+    args.extend(["-o", &main, "--variant", &spec]);
+    assert_one_line_error(
+        &hairtrace(&args),
+        "width is a setting the build is made for",
+    );
+    assert!(!std::path::Path::new(&wider).exists());
+    let mut args = common.to_vec();
+    args.extend(["-o", &main, "--variant", "no-colon.exr"]);
+    assert_one_line_error(&hairtrace(&args), "OUT:NAME=VALUE");
+}
+
 /// What the peer benchmark drives: a box-filtered render with its figures in JSON,
 /// `compare` against another seed, `export` for Cycles.
 #[test]

@@ -22,6 +22,10 @@
 #define HT_ALIGNED(n) __attribute__((aligned(n)))
 #endif
 
+/* ====================================================================================
+ * 1. Versions, status and errors
+ * ==================================================================================== */
+
 /**
  * Version of the C ABI; bumped on any incompatible change of a signature or struct. The
  * shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
@@ -49,24 +53,6 @@
  * world units): Embree cannot trace rays past about 1.8e18, and aborts on them.
  */
 #define HT_MAX_COORDINATE 1e15
-
-/**
- * How far past the radius (in radii) a ray may pass the axis and still count as a hit,
- * its h clamped to +-1: room for a host's intersection code (Embree's flat curves are
- * tessellated, and their hits reach 1.012 radii on a bent strand).
- */
-#define HT_HAIR_FRAME_H_TOLERANCE 5e-2
-
-/**
- * Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
- * grow without changing the ABI.
- */
-#define HT_HAIR_POINT_SIZE 384
-
-/**
- * Alignment of an `HtHairPoint` in bytes.
- */
-#define HT_HAIR_POINT_ALIGN 16
 
 /**
  * Result of every C entry point; `HT_OK` is 0.
@@ -103,44 +89,46 @@ typedef enum HtStatus {
     HT_ERR_CANCELLED = 7,
 } HtStatus;
 
-#if defined(HT_RENDER)
-/**
- * An Embree device: its thread pool builds the scenes made on it. Create one per
- * process and share it between scenes. Thread safe.
- */
-typedef struct HtDevice HtDevice;
-#endif
+#ifdef __cplusplus
+extern "C" {
+#endif // __cplusplus
 
 /**
- * The hair BSDF prepared for one parameter set (the constants that depend on the
- * parameters only). Create with `ht_hair_prepare`, release with `ht_hair_prepared_free`.
- * Immutable: any number of threads may use one handle at once.
+ * The ABI version this library was built with; compare with `HT_ABI_VERSION`.
  */
-typedef struct HtHairPrepared HtHairPrepared;
+uint32_t ht_abi_version(void);
 
-#if defined(HT_RENDER)
 /**
- * A scene under construction and, after the first render, its built form. Not thread
- * safe: call the functions of one scene from one thread at a time (different scenes may
- * be used concurrently).
- *
- * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
- * later additions, and a rendered scene holds a second copy in Embree's buffers plus the
- * BVH; control points added with `ht_scene_add_curves_xyzr_shared` are never copied, by
- * either. For the largest grooms, share them (or add everything before the first render)
- * and free the scene when done.
+ * The library version, e.g. "0.1.0" (static storage).
  */
-typedef struct HtScene HtScene;
-#endif
+const char *ht_version(void);
 
-#if defined(HT_RENDER)
 /**
- * Render settings (every one has a default), read and written by name. Create with
- * `ht_settings_new`, release with `ht_settings_free`. A handle may be read by any number
- * of threads at once, but not while one of them sets it.
+ * A short static description of a status code (an `HtStatus` value); unknown codes
+ * give "unknown status".
  */
-typedef struct HtSettings HtSettings;
-#endif
+const char *ht_status_str(int32_t status);
+
+/**
+ * The message of the last failure on the calling thread ("" if none). Never NULL; valid
+ * until the next failing call on this thread.
+ */
+const char *ht_last_error(void);
+
+#ifdef __cplusplus
+}  // extern "C"
+#endif  // __cplusplus
+
+/* ====================================================================================
+ * 2. The hair BSDF alone: parameters, frames, eval and sample
+ * ==================================================================================== */
+
+/**
+ * How far past the radius (in radii) a ray may pass the axis and still count as a hit,
+ * its h clamped to +-1: room for a host's intersection code (Embree's flat curves are
+ * tessellated, and their hits reach 1.012 radii on a bent strand).
+ */
+#define HT_HAIR_FRAME_H_TOLERANCE 5e-2
 
 /**
  * Parameters of the hair BSDF (Chiang et al. 2016), all checked, never clamped:
@@ -222,377 +210,9 @@ typedef struct HtHairFrame {
     float h;
 } HtHairFrame;
 
-/**
- * Storage for the BSDF at one shading point (a prepared BSDF at a fixed h and wo), filled
- * by `ht_hair_point_init` and then evaluated and sampled any number of times.
- *
- * - The host allocates it (stack, arrays, its own vertex structs): `HT_HAIR_POINT_SIZE`
- *   bytes aligned to `HT_HAIR_POINT_ALIGN` (16); this type has both, so declaring an
- *   `HtHairPoint` (or `malloc`, which aligns to 16 on 64-bit platforms) is enough. A
- *   misaligned point is refused with `HT_ERR_INVALID_ARG`.
- * - The bytes are opaque. They hold plain numbers and no pointer: a filled point is
- *   self-contained, may be copied with `memcpy` or assignment, stays valid after its
- *   `HtHairPrepared` is freed, and needs no release.
- * - A point that `ht_hair_point_init` did not fill (zeroed, or overwritten) is refused
- *   with `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised
- *   storage.
- * - Reading it from several threads at once is safe; filling it while another thread
- *   reads it is a data race (the host's to avoid).
- */
-typedef struct HT_ALIGNED(16) HtHairPoint {
-    uint8_t opaque[HT_HAIR_POINT_SIZE];
-} HtHairPoint;
-
-#if defined(HT_RENDER)
-/**
- * How a hair material varies over the groom, deterministically from the seed, the
- * strand and the position along it.
- */
-typedef struct HtHairVariation {
-    /**
-     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
-     * from [1 - x, 1 + x].
-     */
-    float absorption_variation;
-    /**
-     * Per-strand spread of beta_m and beta_n, in [0, 1].
-     */
-    float roughness_variation;
-    /**
-     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
-     */
-    float tip_absorption;
-    /**
-     * 1: take the absorption from the curves where they give one (their per-point colours,
-     * or the melanin of a USD file's strands, taken as it is); 0: ignore it. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
-     * than a `bool`, so that no byte the host stores here is undefined behaviour.
-     */
-    uint8_t use_vertex_colors;
-    /**
-     * Seed of the per-strand random choices.
-     */
-    uint64_t seed;
-} HtHairVariation;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
- */
-typedef uint32_t HtCurveBasis;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`,
- * `HT_CURVE_AUTO`.
- */
-typedef uint32_t HtCurveShape;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
- * when the call returns.
- *
- * Every basis draws each strand from its first point (root) to its last (tip), one curve
- * segment per polyline segment: linear joins the points, Catmull-Rom passes through them,
- * B-spline smooths between root and tip, Bezier is the Catmull-Rom curve in Bezier form.
- */
-typedef struct HtCurves {
-    /**
-     * Number of strands, >= 1.
-     */
-    size_t strand_count;
-    /**
-     * Points of each strand (each >= 2), `strand_count` values adding up to `point_count`.
-     */
-    const uint32_t *point_counts;
-    /**
-     * Points of all strands.
-     */
-    size_t point_count;
-    /**
-     * x, y, z of every point (world units, finite, within +-1e15), strand after strand:
-     * `3 * point_count` floats.
-     */
-    const float *points;
-    /**
-     * Fiber radius (not diameter) at every point, finite and > 0: `point_count` floats;
-     * or NULL.
-     */
-    const float *radii;
-    /**
-     * Fiber radius (not diameter) of every point when `radii` is NULL, > 0.
-     */
-    float radius;
-    /**
-     * Linear RGB reflectance at every point (`3 * point_count` floats, each in [0, 1]; 0
-     * is taken as 1e-4, the darkest colour a finite absorption makes), used by hair
-     * materials with `use_vertex_colors`; or NULL.
-     */
-    const float *colors;
-    HtCurveBasis basis;
-    HtCurveShape shape;
-} HtCurves;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
- * that hold that layout. `ht_scene_add_curves_xyzr` copies them, and the host may free its
- * arrays when the call returns; `ht_scene_add_curves_xyzr_shared` reads `points` in place
- * for the life of the scene (see there).
- *
- * A strand of n control points has n - 1 linear segments, n - 3 B-spline or Catmull-Rom
- * segments (the curve runs between the second and the second-to-last point), or (n - 1) / 3
- * Bezier segments (n = 3k + 1, consecutive segments sharing end points).
- */
-typedef struct HtCurvesXyzr {
-    /**
-     * Number of strands, >= 1.
-     */
-    size_t strand_count;
-    /**
-     * Control points of each strand, `strand_count` values adding up to `point_count`.
-     */
-    const uint32_t *point_counts;
-    /**
-     * Control points of all strands.
-     */
-    size_t point_count;
-    /**
-     * x, y, z (world units, within +-1e15), radius (not diameter, >= 0) of every control
-     * point, all finite: `4 * point_count` floats.
-     */
-    const float *points;
-    /**
-     * Linear RGB reflectance (each in [0, 1], as in `HtCurves`) at every segment end,
-     * segments + 1 per strand, strand after strand; or NULL.
-     */
-    const float *colors;
-    HtCurveBasis basis;
-    HtCurveShape shape;
-} HtCurvesXyzr;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * A pixel filter: one of the `HT_FILTER_*` constants.
- */
-typedef uint32_t HtPixelFilter;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Told how far a render has got: `done` of `total` pixels, counted over the render's
- * passes of 8 spp (`total` is the pixels times the passes `spp` allows; a render that a
- * noise target or a time budget stops ends below it), `done` never decreasing from call to
- * call. It is called when a 16 x 16 tile finishes a pass and, while pixels take long
- * (many samples), also every 20 ms or so of work with an unchanged `done`, so that it can
- * cancel any render promptly. Return false to cancel: no new sample starts, the pass of
- * unfinished tiles is dropped (their pixels keep the passes they finished), and
- * `ht_render` returns `HT_ERR_CANCELLED`.
- *
- * Called from the render's worker threads (not necessarily the one that called
- * `ht_render`), but never two calls at once, so `user` needs no locking against itself.
- * The callback must return normally: a C++ exception or a longjmp out of it is undefined
- * behaviour (catch inside and return false instead).
- */
-typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Deprecated (ABI 6, the last to have it): use `HtSettings` with `ht_settings_set`,
- * `ht_scene_build_with` and `ht_render_with`, whose settings are named and never change
- * the ABI's layout (settings added since, such as `isa`, are only there).
- *
- * What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
- * the fields you need.
- */
-typedef struct HtRenderSettings {
-    /**
-     * Image size in pixels, each in [1, 32768].
-     */
-    uint32_t width;
-    uint32_t height;
-    /**
-     * Samples per pixel, >= 1.
-     */
-    uint32_t spp;
-    /**
-     * The image depends only on the scene, these settings and this seed: never on the
-     * thread count.
-     */
-    uint64_t seed;
-    /**
-     * Render threads; 0: one per hardware thread.
-     */
-    uint32_t threads;
-    /**
-     * Longest path in scattering events, >= 1. Light hair needs many: the default (256)
-     * keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
-     */
-    uint32_t max_depth;
-    /**
-     * Crop window: render only the pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
-     * full width x height frame (x0 < x1 <= width, y0 < y1 <= height); all four 0 renders
-     * the full frame. The output buffers then hold the window's pixels alone, rows from
-     * its top. A crop renders exactly the values the full frame has at those pixels (the
-     * camera still sees the full frame, and every sample depends only on the seed and its
-     * full-frame pixel), so a render farm can split a frame into windows and reassemble
-     * them bit for bit.
-     */
-    uint32_t crop_x0;
-    uint32_t crop_y0;
-    uint32_t crop_x1;
-    uint32_t crop_y1;
-    /**
-     * Pixel filter: `HT_FILTER_TENT` (the default: thin strands alias under a box) or
-     * `HT_FILTER_BOX` (one pixel, for comparisons with renderers that use it).
-     */
-    HtPixelFilter filter;
-    /**
-     * The tent's half-width in pixels, in (0, 8]; ignored by the box. Default 1.
-     */
-    float filter_radius;
-    /**
-     * May be NULL: no progress reports, no cancellation.
-     */
-    HtProgressFn progress;
-    /**
-     * Passed to `progress` as it is.
-     */
-    void *progress_user;
-    /**
-     * Past this many scattering events a hair BSDF is one merged lobe: the same energy
-     * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
-     * per event and far less noisy on light hair, but biased (light hair comes out
-     * brighter), so off by default. 0 (the default): the exact model at every event.
-     * Otherwise in [1, max_depth]; max_depth changes nothing. docs/measurements.md, "Speed against
-     * error", has what it costs and buys. (ABI 5.)
-     */
-    uint32_t deep_bounce_depth;
-    /**
-     * Hair lobes whose attenuation (largest channel) is below this fraction of the total
-     * are dropped from evaluation and sampling (the strongest lobe is always kept); in
-     * [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
-     * measured, saves no time: off by default (docs/measurements.md, "Speed against error"). (ABI 5.)
-     */
-    float lobe_cull;
-    /**
-     * Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
-     * (largest channel, in the image's units) is below this value traces its shadow ray
-     * with probability contribution / threshold and is reweighted by the inverse. Unbiased;
-     * finite and >= 0, 0 traces every shadow ray. Default 0.03, chosen on the bench
-     * scenes (docs/measurements.md, "Render efficiency"). (ABI 6.)
-     */
-    float light_threshold;
-} HtRenderSettings;
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never
- * decreasing from call to call. Return false to cancel the build. Called from Embree's
- * worker threads, never two calls at once; it must return normally (as `HtProgressFn`).
- */
-typedef bool (*HtBuildProgressFn)(double fraction, void *user);
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Straight segments between consecutive points.
- */
-#define HT_CURVE_LINEAR 0
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Cubic Bezier.
- */
-#define HT_CURVE_BEZIER 1
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Uniform cubic B-spline.
- */
-#define HT_CURVE_BSPLINE 2
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Catmull-Rom spline.
- */
-#define HT_CURVE_CATMULL_ROM 3
-#endif
-
-#if defined(HT_RENDER)
-/**
- * A true tube: the reference, and what close-ups need.
- */
-#define HT_CURVE_ROUND 0
-#endif
-
-#if defined(HT_RENDER)
-/**
- * A ribbon facing the ray: faster, approximate up close.
- */
-#define HT_CURVE_FLAT 1
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Per strand, at a build: a ribbon where the strand is at most one pixel wide from the
- * camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
- * tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A later
- * render keeps the build while no pixel is smaller where the strands are than at that
- * build (farther, a wider view, fewer pixels); a nearer or finer view builds again.
- */
-#define HT_CURVE_AUTO 2
-#endif
-
-#if defined(HT_RENDER)
-/**
- * A separable tent of half-width `filter_radius` pixels.
- */
-#define HT_FILTER_TENT 0
-#endif
-
-#if defined(HT_RENDER)
-/**
- * The one-pixel box.
- */
-#define HT_FILTER_BOX 1
-#endif
-
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
-
-/**
- * The ABI version this library was built with; compare with `HT_ABI_VERSION`.
- */
-uint32_t ht_abi_version(void);
-
-/**
- * The library version, e.g. "0.1.0" (static storage).
- */
-const char *ht_version(void);
-
-/**
- * A short static description of a status code (an `HtStatus` value); unknown codes
- * give "unknown status".
- */
-const char *ht_status_str(int32_t status);
-
-/**
- * The message of the last failure on the calling thread ("" if none). Never NULL; valid
- * until the next failing call on this thread.
- */
-const char *ht_last_error(void);
 
 /**
  * Brown hair: sigma_a from eumelanin 1.3, eta 1.55, beta_m = beta_n = 0.3, alpha = 2.
@@ -778,6 +398,91 @@ enum HtStatus ht_hair_frame_to_local(const struct HtHairFrame *frame, const floa
  */
 enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const float *w, float *out);
 
+#ifdef __cplusplus
+}  // extern "C"
+#endif  // __cplusplus
+
+/* ====================================================================================
+ * 3. The prepared BSDF and path vertices
+ * ==================================================================================== */
+
+/**
+ * Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
+ * grow without changing the ABI.
+ */
+#define HT_HAIR_POINT_SIZE 384
+
+/**
+ * Alignment of an `HtHairPoint` in bytes.
+ */
+#define HT_HAIR_POINT_ALIGN 16
+
+/**
+ * The hair BSDF prepared for one parameter set (the constants that depend on the
+ * parameters only). Create with `ht_hair_prepare`, release with `ht_hair_prepared_free`.
+ * Immutable: any number of threads may use one handle at once.
+ */
+typedef struct HtHairPrepared HtHairPrepared;
+
+/**
+ * Storage for the BSDF at one shading point (a prepared BSDF at a fixed h and wo), filled
+ * by `ht_hair_point_init` and then evaluated and sampled any number of times.
+ *
+ * - The host allocates it (stack, arrays, its own vertex structs): `HT_HAIR_POINT_SIZE`
+ *   bytes aligned to `HT_HAIR_POINT_ALIGN` (16); this type has both, so declaring an
+ *   `HtHairPoint` (or `malloc`, which aligns to 16 on 64-bit platforms) is enough. A
+ *   misaligned point is refused with `HT_ERR_INVALID_ARG`.
+ * - The bytes are opaque. They hold plain numbers and no pointer: a filled point is
+ *   self-contained, may be copied with `memcpy` or assignment, stays valid after its
+ *   `HtHairPrepared` is freed, and needs no release.
+ * - A point that `ht_hair_point_init` did not fill (zeroed, or overwritten) is refused
+ *   with `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised
+ *   storage.
+ * - Reading it from several threads at once is safe; filling it while another thread
+ *   reads it is a data race (the host's to avoid).
+ */
+typedef struct HT_ALIGNED(16) HtHairPoint {
+    uint8_t opaque[HT_HAIR_POINT_SIZE];
+} HtHairPoint;
+
+#if defined(HT_RENDER)
+
+/**
+ * How a hair material varies over the groom, deterministically from the seed, the
+ * strand and the position along it.
+ */
+typedef struct HtHairVariation {
+    /**
+     * Per-strand spread of the absorption, in [0, 1]: sigma_a is scaled by a factor drawn
+     * from [1 - x, 1 + x].
+     */
+    float absorption_variation;
+    /**
+     * Per-strand spread of beta_m and beta_n, in [0, 1].
+     */
+    float roughness_variation;
+    /**
+     * Absorption at the tip relative to the root, > 0 (below 1: lighter tips).
+     */
+    float tip_absorption;
+    /**
+     * 1: take the absorption from the curves where they give one (their per-point colours,
+     * or the melanin of a USD file's strands, taken as it is); 0: ignore it. Any other value is refused (`HT_ERR_INVALID_ARG`). An integer rather
+     * than a `bool`, so that no byte the host stores here is undefined behaviour.
+     */
+    uint8_t use_vertex_colors;
+    /**
+     * Seed of the per-strand random choices.
+     */
+    uint64_t seed;
+} HtHairVariation;
+
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif // __cplusplus
+
 /**
  * Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
  * handle to `*out`.
@@ -853,38 +558,6 @@ enum HtStatus ht_hair_point_init_world(const struct HtHairPrepared *prepared,
                                        const struct HtHairFrame *frame,
                                        const float *wo,
                                        struct HtHairPoint *point);
-
-#if defined(HT_RENDER)
-/**
- * `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
- * material varies them (`ht_scene_add_hair_material_varied`): the parameters of
- * `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
- * (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
- * `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
- * allocation: the varied BSDF is built inside the point, and the point equals, bit for
- * bit, the one the renderer shades that strand's hit with.
- *
- * - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
- *   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
- *   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
- *   Else `HT_ERR_INVALID_ARG`.
- * - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
- *   as `ht_hair_point_init`. On error `*point` is untouched.
- * - Cost: an init plus the preparation of the varied parameters (about one evaluation).
- *
- * # Safety
- * As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
- * floats.
- */
-enum HtStatus ht_hair_point_init_strand(const struct HtHairPrepared *prepared,
-                                        const struct HtHairVariation *variation,
-                                        uint32_t strand,
-                                        float s,
-                                        const float *color,
-                                        float h,
-                                        const float *wo,
-                                        struct HtHairPoint *point);
-#endif
 
 /**
  * f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward
@@ -1048,6 +721,204 @@ enum HtStatus ht_hair_points_sample(const struct HtHairPoint *points,
                                     float *pdf);
 
 #if defined(HT_RENDER)
+
+/**
+ * `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
+ * material varies them (`ht_scene_add_hair_material_varied`): the parameters of
+ * `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
+ * (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
+ * `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
+ * allocation: the varied BSDF is built inside the point, and the point equals, bit for
+ * bit, the one the renderer shades that strand's hit with.
+ *
+ * - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
+ *   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
+ *   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
+ *   Else `HT_ERR_INVALID_ARG`.
+ * - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
+ *   as `ht_hair_point_init`. On error `*point` is untouched.
+ * - Cost: an init plus the preparation of the varied parameters (about one evaluation).
+ *
+ * # Safety
+ * As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
+ * floats.
+ */
+enum HtStatus ht_hair_point_init_strand(const struct HtHairPrepared *prepared,
+                                        const struct HtHairVariation *variation,
+                                        uint32_t strand,
+                                        float s,
+                                        const float *color,
+                                        float h,
+                                        const float *wo,
+                                        struct HtHairPoint *point);
+
+#endif
+
+#ifdef __cplusplus
+}  // extern "C"
+#endif  // __cplusplus
+
+/* ====================================================================================
+ * 4. Devices and scenes: geometry, materials, lights
+ * ==================================================================================== */
+
+#if defined(HT_RENDER)
+
+/**
+ * An Embree device: its thread pool builds the scenes made on it. Create one per
+ * process and share it between scenes. Thread safe.
+ */
+typedef struct HtDevice HtDevice;
+
+/**
+ * A scene under construction and, after the first render, its built form. Not thread
+ * safe: call the functions of one scene from one thread at a time (different scenes may
+ * be used concurrently).
+ *
+ * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
+ * later additions, and a rendered scene holds a second copy in Embree's buffers plus the
+ * BVH; control points added with `ht_scene_add_curves_xyzr_shared` are never copied, by
+ * either. For the largest grooms, share them (or add everything before the first render)
+ * and free the scene when done.
+ */
+typedef struct HtScene HtScene;
+
+/**
+ * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
+ */
+typedef uint32_t HtCurveBasis;
+
+/**
+ * The surface Embree builds around a curve: one of `HT_CURVE_ROUND`, `HT_CURVE_FLAT`,
+ * `HT_CURVE_AUTO`.
+ */
+typedef uint32_t HtCurveShape;
+
+/**
+ * Strands as polylines, copied by `ht_scene_add_curves`: the host may free its arrays
+ * when the call returns.
+ *
+ * Every basis draws each strand from its first point (root) to its last (tip), one curve
+ * segment per polyline segment: linear joins the points, Catmull-Rom passes through them,
+ * B-spline smooths between root and tip, Bezier is the Catmull-Rom curve in Bezier form.
+ */
+typedef struct HtCurves {
+    /**
+     * Number of strands, >= 1.
+     */
+    size_t strand_count;
+    /**
+     * Points of each strand (each >= 2), `strand_count` values adding up to `point_count`.
+     */
+    const uint32_t *point_counts;
+    /**
+     * Points of all strands.
+     */
+    size_t point_count;
+    /**
+     * x, y, z of every point (world units, finite, within +-1e15), strand after strand:
+     * `3 * point_count` floats.
+     */
+    const float *points;
+    /**
+     * Fiber radius (not diameter) at every point, finite and > 0: `point_count` floats;
+     * or NULL.
+     */
+    const float *radii;
+    /**
+     * Fiber radius (not diameter) of every point when `radii` is NULL, > 0.
+     */
+    float radius;
+    /**
+     * Linear RGB reflectance at every point (`3 * point_count` floats, each in [0, 1]; 0
+     * is taken as 1e-4, the darkest colour a finite absorption makes), used by hair
+     * materials with `use_vertex_colors`; or NULL.
+     */
+    const float *colors;
+    HtCurveBasis basis;
+    HtCurveShape shape;
+} HtCurves;
+
+/**
+ * Control points already laid out for the basis, as float4 (x, y, z, radius), for hosts
+ * that hold that layout. `ht_scene_add_curves_xyzr` copies them, and the host may free its
+ * arrays when the call returns; `ht_scene_add_curves_xyzr_shared` reads `points` in place
+ * for the life of the scene (see there).
+ *
+ * A strand of n control points has n - 1 linear segments, n - 3 B-spline or Catmull-Rom
+ * segments (the curve runs between the second and the second-to-last point), or (n - 1) / 3
+ * Bezier segments (n = 3k + 1, consecutive segments sharing end points).
+ */
+typedef struct HtCurvesXyzr {
+    /**
+     * Number of strands, >= 1.
+     */
+    size_t strand_count;
+    /**
+     * Control points of each strand, `strand_count` values adding up to `point_count`.
+     */
+    const uint32_t *point_counts;
+    /**
+     * Control points of all strands.
+     */
+    size_t point_count;
+    /**
+     * x, y, z (world units, within +-1e15), radius (not diameter, >= 0) of every control
+     * point, all finite: `4 * point_count` floats.
+     */
+    const float *points;
+    /**
+     * Linear RGB reflectance (each in [0, 1], as in `HtCurves`) at every segment end,
+     * segments + 1 per strand, strand after strand; or NULL.
+     */
+    const float *colors;
+    HtCurveBasis basis;
+    HtCurveShape shape;
+} HtCurvesXyzr;
+
+/**
+ * Straight segments between consecutive points.
+ */
+#define HT_CURVE_LINEAR 0
+
+/**
+ * Cubic Bezier.
+ */
+#define HT_CURVE_BEZIER 1
+
+/**
+ * Uniform cubic B-spline.
+ */
+#define HT_CURVE_BSPLINE 2
+
+/**
+ * Catmull-Rom spline.
+ */
+#define HT_CURVE_CATMULL_ROM 3
+
+/**
+ * A true tube: the reference, and what close-ups need.
+ */
+#define HT_CURVE_ROUND 0
+
+/**
+ * A ribbon facing the ray: faster, approximate up close.
+ */
+#define HT_CURVE_FLAT 1
+
+/**
+ * Per strand, at a build: a ribbon where the strand is at most one pixel wide from the
+ * camera, a tube elsewhere. On the bench scenes it renders 1.15-1.5x as fast as round
+ * tubes, at an error within the noise of a render (docs/measurements.md, "Curve shapes"). A later
+ * render keeps the build while no pixel is smaller where the strands are than at that
+ * build (farther, a wider view, fewer pixels); a nearer or finer view builds again.
+ */
+#define HT_CURVE_AUTO 2
+
+#ifdef __cplusplus
+extern "C" {
+#endif // __cplusplus
+
 /**
  * Creates a device with `threads` Embree worker threads (0: one per hardware thread),
  * which build the scenes made on it, and writes the handle to `*out`. Free it with
@@ -1060,9 +931,7 @@ enum HtStatus ht_hair_points_sample(const struct HtHairPoint *points,
  * `out` is NULL or points to a writable `HtDevice*`.
  */
 enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * As `ht_device_new`, with Embree's kernels pinned to the instruction set named by `isa`
  * ("sse2", "avx", "avx2" or "avx512"; NULL: not pinned, the widest this CPU runs).
@@ -1078,9 +947,7 @@ enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
  * `HtDevice*`.
  */
 enum HtStatus ht_device_new_pinned(uint32_t threads, const char *isa, struct HtDevice **out);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Releases a device handle (NULL: nothing to do, `HT_OK`). Scenes made on it stay valid
  * and release the device with the last of them. Always `HT_OK`.
@@ -1090,9 +957,7 @@ enum HtStatus ht_device_new_pinned(uint32_t threads, const char *isa, struct HtD
  * the call.
  */
 enum HtStatus ht_device_free(struct HtDevice *device);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Creates an empty scene on `device` and writes the handle to `*out`. Free it with
  * `ht_scene_free`. The device handle may be freed before the scene.
@@ -1105,9 +970,7 @@ enum HtStatus ht_device_free(struct HtDevice *device);
  * writable `HtScene*`.
  */
 enum HtStatus ht_scene_new(const struct HtDevice *device, struct HtScene **out);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Releases a scene and everything it holds, the Embree scene included (NULL: nothing to
  * do). After it returns, the host may free the points it shared with
@@ -1118,9 +981,7 @@ enum HtStatus ht_scene_new(const struct HtDevice *device, struct HtScene **out);
  * thread; it is invalid after the call.
  */
 enum HtStatus ht_scene_free(struct HtScene *scene);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Places the pinhole camera at `eye` looking at `target` (world units, each `float[3]`,
  * every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
@@ -1144,9 +1005,7 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
                                   const float *target,
                                   const float *up,
                                   float fov_y_deg);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world
  * units, in [0, 1e15]; 0 is the pinhole again) focused at `focus_distance` (world units
@@ -1163,9 +1022,7 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
 enum HtStatus ht_scene_set_thin_lens(struct HtScene *scene,
                                      float aperture_radius,
                                      float focus_distance);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds strands given as polylines (copied: see `HtCurves`), shaded by the hair material
  * `material_id`; writes the geometry id (0, 1, ... over curves and meshes, in the order
@@ -1186,9 +1043,7 @@ enum HtStatus ht_scene_add_curves(struct HtScene *scene,
                                   const struct HtCurves *desc,
                                   uint32_t material_id,
                                   uint32_t *geom_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds strands of float4 control points laid out for the basis (copied: see
  * `HtCurvesXyzr`, any 4-byte alignment), shaded by the hair material `material_id`;
@@ -1209,9 +1064,7 @@ enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
                                        const struct HtCurvesXyzr *desc,
                                        uint32_t material_id,
                                        uint32_t *geom_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * As `ht_scene_add_curves_xyzr`, but `desc->points` is shared, not copied: Embree reads
  * the host's array in place, through every render and every rebuild after later
@@ -1235,9 +1088,7 @@ enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
                                               const struct HtCurvesXyzr *desc,
                                               uint32_t material_id,
                                               uint32_t *geom_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds the strands of a Cem Yuksel `.hair` file (read during the call) as polylines for
  * `basis`, shaded by the hair material `material_id`; writes the geometry id. The file's
@@ -1259,9 +1110,7 @@ enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
                                      HtCurveShape shape,
                                      uint32_t material_id,
                                      uint32_t *geom_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds every BasisCurves prim of a USD stage (.usd, .usda, .usdc or .usdz, read and
  * composed during the call; see docs/formats.md) as its own curve geometry, laid out by the
@@ -1289,9 +1138,7 @@ enum HtStatus ht_scene_add_usd_file(struct HtScene *scene,
                                     uint32_t material_id,
                                     uint32_t *first_geom_id,
                                     uint32_t *geom_count);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
  * `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
@@ -1317,9 +1164,7 @@ enum HtStatus ht_scene_add_mesh(struct HtScene *scene,
                                 const uint32_t *indices,
                                 uint32_t material_id,
                                 uint32_t *geom_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
  * material `material_id`; writes the geometry id. The file is read during the call.
@@ -1337,9 +1182,7 @@ enum HtStatus ht_scene_add_mesh_file(struct HtScene *scene,
                                      const char *path,
                                      uint32_t material_id,
                                      uint32_t *geom_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds an environment of the same linear RGB `radiance` (finite, >= 0) from every
  * direction.
@@ -1352,9 +1195,7 @@ enum HtStatus ht_scene_add_mesh_file(struct HtScene *scene,
  * is NULL or points to 3 readable floats.
  */
 enum HtStatus ht_scene_add_environment(struct HtScene *scene, const float *radiance);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a lat-long environment map read through OpenImageIO (EXR, HDR, ...: linear
  * radiance), turned by `rotation_deg` about +y and its radiance multiplied by `scale`
@@ -1372,9 +1213,7 @@ enum HtStatus ht_scene_add_environment_map(struct HtScene *scene,
                                            const char *path,
                                            float rotation_deg,
                                            float scale);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a light at infinity: `direction` (world frame) points toward it (any finite,
  * non-zero length), it delivers linear RGB `irradiance` (finite, >= 0) to a surface
@@ -1393,9 +1232,7 @@ enum HtStatus ht_scene_add_distant_light(struct HtScene *scene,
                                          const float *direction,
                                          const float *irradiance,
                                          float angular_radius_deg);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a parallelogram light with corners `corner`, `corner + edge_u`, `corner + edge_v`
  * and `corner + edge_u + edge_v`, emitting linear RGB `radiance` (>= 0) toward
@@ -1416,16 +1253,12 @@ enum HtStatus ht_scene_add_rect_light(struct HtScene *scene,
                                       const float *edge_v,
                                       const float *radiance,
                                       bool two_sided);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * No variation: every strand has the material's parameters, and seed 0.
  */
 struct HtHairVariation ht_hair_variation_default(void);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a hair material with the same parameters on every strand (ranges as for
  * `ht_hair_eval`); writes its id (0, 1, ... in the order materials are added) to
@@ -1442,9 +1275,7 @@ struct HtHairVariation ht_hair_variation_default(void);
 enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
                                          const struct HtHairParams *params,
                                          uint32_t *material_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a hair material whose parameters vary over the groom as `variation` says (its
  * ranges on `HtHairVariation`).
@@ -1459,9 +1290,7 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
                                                 const struct HtHairParams *params,
                                                 const struct HtHairVariation *variation,
                                                 uint32_t *material_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Gives hair material `material_id` new parameters and variation (as
  * `ht_scene_add_hair_material_varied` takes them), without a new build: the next render
@@ -1481,9 +1310,7 @@ enum HtStatus ht_scene_set_hair_material(struct HtScene *scene,
                                          uint32_t material_id,
                                          const struct HtHairParams *params,
                                          const struct HtHairVariation *variation);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Adds a Lambertian material for meshes, with linear RGB `albedo` in [0, 1] per channel;
  * writes its id.
@@ -1498,9 +1325,7 @@ enum HtStatus ht_scene_set_hair_material(struct HtScene *scene,
 enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
                                             const float *albedo,
                                             uint32_t *material_id);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Gives diffuse material `material_id` a new `albedo` (3 floats, linear RGB, each in
  * [0, 1]), without a new build: the next render is the one of a scene built with it.
@@ -1516,9 +1341,48 @@ enum HtStatus ht_scene_add_diffuse_material(struct HtScene *scene,
 enum HtStatus ht_scene_set_diffuse_material(struct HtScene *scene,
                                             uint32_t material_id,
                                             const float *albedo);
-#endif
+
+/**
+ * Joins the worker threads the library started, once every device and scene has been
+ * freed: TBB's workers, which Embree used to build scenes and which otherwise run until
+ * the process exits. Render threads need no call: each `ht_render` joins its own before
+ * it returns. After `HT_OK` no thread started by hairtrace is running, and the library
+ * may still be used again (a new device starts new workers).
+ *
+ * Call it from one thread, with no other hairtrace call running. Statuses:
+ * `HT_ERR_INVALID_ARG` when a device or scene is still alive (nothing is joined: free them
+ * first); `HT_ERR_EMBREE` when TBB refuses because something else in the process (the
+ * host, another library) still uses it: its workers then keep running, as they would
+ * without this call.
+ *
+ * # Safety
+ * No other thread is inside a hairtrace call, and none starts one until it returns.
+ */
+enum HtStatus ht_shutdown(void);
+
+#ifdef __cplusplus
+}  // extern "C"
+#endif  // __cplusplus
+
+#endif  /* HT_RENDER */
+
+/* ====================================================================================
+ * 5. Render settings by name
+ * ==================================================================================== */
 
 #if defined(HT_RENDER)
+
+/**
+ * Render settings (every one has a default), read and written by name. Create with
+ * `ht_settings_new`, release with `ht_settings_free`. A handle may be read by any number
+ * of threads at once, but not while one of them sets it.
+ */
+typedef struct HtSettings HtSettings;
+
+#ifdef __cplusplus
+extern "C" {
+#endif // __cplusplus
+
 /**
  * Creates settings holding every default into `*out` (640 x 480, 16 samples per pixel,
  * seed 0, every core, the full frame, a tent filter of radius 1, the exact hair BSDF,
@@ -1530,9 +1394,7 @@ enum HtStatus ht_scene_set_diffuse_material(struct HtScene *scene,
  * `out` is NULL or writable.
  */
 enum HtStatus ht_settings_new(struct HtSettings **out);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Releases settings (NULL: nothing to do; returns HT_OK).
  *
@@ -1540,9 +1402,7 @@ enum HtStatus ht_settings_new(struct HtSettings **out);
  * `settings` is NULL or a live handle from `ht_settings_new`, not used after this call.
  */
 enum HtStatus ht_settings_free(struct HtSettings *settings);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Sets the setting `key` from the text `value`, as a scene file's `[render]` table and the
  * command line's `--set key=value` do: integers and numbers in decimal ("64", "0.03"),
@@ -1559,9 +1419,7 @@ enum HtStatus ht_settings_free(struct HtSettings *settings);
  * and `value` are NULL or NUL-terminated strings.
  */
 enum HtStatus ht_settings_set(struct HtSettings *settings, const char *key, const char *value);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Writes the value of `key` as text (the form `ht_settings_set` reads), NUL-terminated,
  * into `buf` of `buf_len` bytes, and its length without the NUL into `*len` (may be NULL).
@@ -1580,17 +1438,156 @@ enum HtStatus ht_settings_get(const struct HtSettings *settings,
                               char *buf,
                               size_t buf_len,
                               size_t *len);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * The name of setting number `index` (0, 1, ... in the order of docs/settings.md), or NULL
  * past the last: how a host lists every setting. Static storage.
  */
 const char *ht_settings_key(size_t index);
-#endif
+
+#ifdef __cplusplus
+}  // extern "C"
+#endif  // __cplusplus
+
+#endif  /* HT_RENDER */
+
+/* ====================================================================================
+ * 6. Rendering and images
+ * ==================================================================================== */
 
 #if defined(HT_RENDER)
+
+/**
+ * A pixel filter: one of the `HT_FILTER_*` constants.
+ */
+typedef uint32_t HtPixelFilter;
+
+/**
+ * Told how far a render has got: `done` of `total` pixels, counted over the render's
+ * passes of 8 spp (`total` is the pixels times the passes `spp` allows; a render that a
+ * noise target or a time budget stops ends below it), `done` never decreasing from call to
+ * call. It is called when a 16 x 16 tile finishes a pass and, while pixels take long
+ * (many samples), also every 20 ms or so of work with an unchanged `done`, so that it can
+ * cancel any render promptly. Return false to cancel: no new sample starts, the pass of
+ * unfinished tiles is dropped (their pixels keep the passes they finished), and
+ * `ht_render` returns `HT_ERR_CANCELLED`.
+ *
+ * Called from the render's worker threads (not necessarily the one that called
+ * `ht_render`), but never two calls at once, so `user` needs no locking against itself.
+ * The callback must return normally: a C++ exception or a longjmp out of it is undefined
+ * behaviour (catch inside and return false instead).
+ */
+typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
+
+/**
+ * Deprecated (ABI 6, the last to have it): use `HtSettings` with `ht_settings_set`,
+ * `ht_scene_build_with` and `ht_render_with`, whose settings are named and never change
+ * the ABI's layout (settings added since, such as `isa`, are only there).
+ *
+ * What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
+ * the fields you need.
+ */
+typedef struct HtRenderSettings {
+    /**
+     * Image size in pixels, each in [1, 32768].
+     */
+    uint32_t width;
+    uint32_t height;
+    /**
+     * Samples per pixel, >= 1.
+     */
+    uint32_t spp;
+    /**
+     * The image depends only on the scene, these settings and this seed: never on the
+     * thread count.
+     */
+    uint64_t seed;
+    /**
+     * Render threads; 0: one per hardware thread.
+     */
+    uint32_t threads;
+    /**
+     * Longest path in scattering events, >= 1. Light hair needs many: the default (256)
+     * keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
+     */
+    uint32_t max_depth;
+    /**
+     * Crop window: render only the pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
+     * full width x height frame (x0 < x1 <= width, y0 < y1 <= height); all four 0 renders
+     * the full frame. The output buffers then hold the window's pixels alone, rows from
+     * its top. A crop renders exactly the values the full frame has at those pixels (the
+     * camera still sees the full frame, and every sample depends only on the seed and its
+     * full-frame pixel), so a render farm can split a frame into windows and reassemble
+     * them bit for bit.
+     */
+    uint32_t crop_x0;
+    uint32_t crop_y0;
+    uint32_t crop_x1;
+    uint32_t crop_y1;
+    /**
+     * Pixel filter: `HT_FILTER_TENT` (the default: thin strands alias under a box) or
+     * `HT_FILTER_BOX` (one pixel, for comparisons with renderers that use it).
+     */
+    HtPixelFilter filter;
+    /**
+     * The tent's half-width in pixels, in (0, 8]; ignored by the box. Default 1.
+     */
+    float filter_radius;
+    /**
+     * May be NULL: no progress reports, no cancellation.
+     */
+    HtProgressFn progress;
+    /**
+     * Passed to `progress` as it is.
+     */
+    void *progress_user;
+    /**
+     * Past this many scattering events a hair BSDF is one merged lobe: the same energy
+     * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
+     * per event and far less noisy on light hair, but biased (light hair comes out
+     * brighter), so off by default. 0 (the default): the exact model at every event.
+     * Otherwise in [1, max_depth]; max_depth changes nothing. docs/measurements.md, "Speed against
+     * error", has what it costs and buys. (ABI 5.)
+     */
+    uint32_t deep_bounce_depth;
+    /**
+     * Hair lobes whose attenuation (largest channel) is below this fraction of the total
+     * are dropped from evaluation and sampling (the strongest lobe is always kept); in
+     * [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
+     * measured, saves no time: off by default (docs/measurements.md, "Speed against error"). (ABI 5.)
+     */
+    float lobe_cull;
+    /**
+     * Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
+     * (largest channel, in the image's units) is below this value traces its shadow ray
+     * with probability contribution / threshold and is reweighted by the inverse. Unbiased;
+     * finite and >= 0, 0 traces every shadow ray. Default 0.03, chosen on the bench
+     * scenes (docs/measurements.md, "Render efficiency"). (ABI 6.)
+     */
+    float light_threshold;
+} HtRenderSettings;
+
+/**
+ * Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never
+ * decreasing from call to call. Return false to cancel the build. Called from Embree's
+ * worker threads, never two calls at once; it must return normally (as `HtProgressFn`).
+ */
+typedef bool (*HtBuildProgressFn)(double fraction, void *user);
+
+/**
+ * A separable tent of half-width `filter_radius` pixels.
+ */
+#define HT_FILTER_TENT 0
+
+/**
+ * The one-pixel box.
+ */
+#define HT_FILTER_BOX 1
+
+#ifdef __cplusplus
+extern "C" {
+#endif // __cplusplus
+
 /**
  * Deprecated with `HtRenderSettings`: use `ht_settings_new`.
  *
@@ -1599,9 +1596,7 @@ const char *ht_settings_key(size_t index);
  * deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
  */
 struct HtRenderSettings ht_render_settings_default(void);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Deprecated with `HtRenderSettings`: use `ht_scene_build_with`.
  *
@@ -1624,9 +1619,7 @@ enum HtStatus ht_scene_build(struct HtScene *scene,
                              const struct HtRenderSettings *settings,
                              HtBuildProgressFn progress,
                              void *user);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * As `ht_scene_build` (deprecated), with settings by name.
  *
@@ -1639,9 +1632,7 @@ enum HtStatus ht_scene_build_with(struct HtScene *scene,
                                   const struct HtSettings *settings,
                                   HtBuildProgressFn progress,
                                   void *user);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Deprecated with `HtRenderSettings`: use `ht_render_with`.
  *
@@ -1665,9 +1656,7 @@ enum HtStatus ht_render(struct HtScene *scene,
                         const struct HtRenderSettings *settings,
                         float *rgb,
                         size_t rgb_len);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Deprecated with `HtRenderSettings`: use `ht_render_with`.
  *
@@ -1708,9 +1697,7 @@ enum HtStatus ht_render_aovs(struct HtScene *scene,
                              float *depth,
                              float *strand_id,
                              size_t pixel_count);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * As `ht_render_aovs` (deprecated), with settings by name and the progress callback
  * (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
@@ -1732,9 +1719,7 @@ enum HtStatus ht_render_with(struct HtScene *scene,
                              float *depth,
                              float *strand_id,
                              size_t pixel_count);
-#endif
 
-#if defined(HT_RENDER)
 /**
  * Writes `pixels` (width * height * channels linear floats, interleaved, rows from the
  * top; channels 1 grey, 2 grey + alpha, 3 RGB or 4 RGBA with premultiplied alpha) through
@@ -1762,30 +1747,11 @@ enum HtStatus ht_image_write(const char *path,
                              uint32_t channels,
                              const float *pixels,
                              size_t pixels_len);
-#endif
-
-#if defined(HT_RENDER)
-/**
- * Joins the worker threads the library started, once every device and scene has been
- * freed: TBB's workers, which Embree used to build scenes and which otherwise run until
- * the process exits. Render threads need no call: each `ht_render` joins its own before
- * it returns. After `HT_OK` no thread started by hairtrace is running, and the library
- * may still be used again (a new device starts new workers).
- *
- * Call it from one thread, with no other hairtrace call running. Statuses:
- * `HT_ERR_INVALID_ARG` when a device or scene is still alive (nothing is joined: free them
- * first); `HT_ERR_EMBREE` when TBB refuses because something else in the process (the
- * host, another library) still uses it: its workers then keep running, as they would
- * without this call.
- *
- * # Safety
- * No other thread is inside a hairtrace call, and none starts one until it returns.
- */
-enum HtStatus ht_shutdown(void);
-#endif
 
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus
+
+#endif  /* HT_RENDER */
 
 #endif  /* HT_HAIRTRACE_H */

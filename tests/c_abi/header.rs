@@ -16,6 +16,7 @@ fn header_matches_the_sources() {
     let mut generated = Vec::new();
     bindings.write(&mut generated);
     let generated = String::from_utf8(generated).expect("cbindgen writes UTF-8");
+    let generated = super::sections::sectioned(&generated, &root.join("src/capi"));
 
     let path = root.join("include").join("hairtrace.h");
     if std::env::var_os("HT_BLESS_HEADER").is_some_and(|v| v == "1") {

@@ -7,3 +7,4 @@ mod c_examples;
 mod header;
 mod memcheck;
 mod quiet;
+mod sections;

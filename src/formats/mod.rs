@@ -32,8 +32,8 @@ pub enum SceneFormat {
 
 impl SceneFormat {
     /// The format of the file at `path`: by the file's signature where it has one (`.hair`'s
-    /// `HAIR`, USD's `PXR-USDC` and `#usda`), which a misnamed file cannot hide; else by the
-    /// extension (`.toml`, `.pbrt`, `.usd*`, `.hair`); else, for a text file with another
+    /// `HAIR`, USD's `PXR-USDC` and `#usda`), which a misnamed file cannot hide (a USD stage
+    /// must still carry a USD extension, which its reader needs); else by the extension (`.toml`, `.pbrt`, `.usd*`, `.hair`); else, for a text file with another
     /// name, TOML when a line opens a `[table]` or sets a `key =`, pbrt when its first word
     /// is a capitalised directive.
     pub fn of(path: &Path) -> Result<SceneFormat> {
@@ -44,10 +44,19 @@ impl SceneFormat {
         if head.starts_with(b"HAIR") {
             return Ok(SceneFormat::Hair);
         }
+        let usd_name = usd::is_usd_path(path);
         if head.starts_with(b"PXR-USDC") || head.starts_with(b"#usda") {
-            return Ok(SceneFormat::Usd);
+            // The USD library picks its file format by the extension alone.
+            return match usd_name {
+                true => Ok(SceneFormat::Usd),
+                false => Err(invalid_arg!(
+                    "{}: a USD stage (by its first bytes): name it .usd, .usda or .usdc, as \
+                     the USD reader needs",
+                    path.display()
+                )),
+            };
         }
-        if usd::is_usd_path(path) {
+        if usd_name {
             return Ok(SceneFormat::Usd);
         }
         for (ext, format) in [
@@ -140,7 +149,8 @@ mod tests {
         assert_eq!(of("a.usdz", b"PK\x03\x04"), SceneFormat::Usd);
         // A signature wins over a wrong name.
         assert_eq!(of("groom.toml", b"HAIR\x01\0\0\0"), SceneFormat::Hair);
-        assert_eq!(of("stage.scene", b"PXR-USDC"), SceneFormat::Usd);
+        let e = SceneFormat::of(&file("stage.scene", b"PXR-USDC")).unwrap_err();
+        assert!(e.to_string().contains("name it .usd"), "{e}");
         // Without a known extension, the text decides.
         assert_eq!(of("scene", b"# a scene\n\nspp = 4\n"), SceneFormat::Toml);
         assert_eq!(

@@ -1,7 +1,7 @@
 //! Geometry through the C ABI: curves from host arrays (copied, or float4 xyzr points
 //! shared in place), `.hair` files, and triangle meshes from arrays or files.
 
-use super::scene::{HtScene, add_with_id, curves_shape};
+use super::scene::{HtScene, add_with_id};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
 use crate::description::assembly::Shape;
 use crate::embree::{CurveBasis, SharedBuffer};
@@ -303,7 +303,7 @@ fn add_curves_xyzr(
         let curves =
             Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
         let frame = |f: &mut Framing| f.add_control_points(points);
-        Ok(scene.add_geometry(curves_shape(curves, shape), material_id, frame)?)
+        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
     })
 }
 
@@ -385,7 +385,7 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let count = u32::try_from(curves.len()).map_err(|_| invalid_arg!("too many prims"))?;
         for (c, prim) in curves.into_iter().zip(&grooms.curves) {
             let frame = |f: &mut Framing| prim.frame(f, 1.0, |p| p);
-            scene.add_geometry(curves_shape(c, shape), material_id, frame)?;
+            scene.add_geometry(Shape::curves(c, shape), material_id, frame)?;
         }
         // SAFETY: non-NULL (checked), the host's uint32_t.
         unsafe { count_out.write(count) };

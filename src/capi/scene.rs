@@ -61,14 +61,6 @@ pub struct HtScene {
     pub(super) lights_changed: bool,
 }
 
-/// Curves given with `shape`: `auto` ones are shared out by each build for its view.
-pub(super) fn curves_shape(curves: Curves, shape: GroomShape) -> Shape {
-    match shape {
-        GroomShape::Auto => Shape::AutoCurves(curves),
-        _ => Shape::Curves(curves),
-    }
-}
-
 pub(super) struct Geometry {
     pub(super) shape: Shape,
     pub(super) material: u32,
@@ -99,7 +91,7 @@ impl HtScene {
         material: u32,
     ) -> Result<u32> {
         let curves = Curves::from_strands(strands, basis, shape.built())?;
-        self.add_geometry(curves_shape(curves, shape), material, |f| {
+        self.add_geometry(Shape::curves(curves, shape), material, |f| {
             f.add_strands(strands)
         })
     }

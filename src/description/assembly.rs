@@ -16,7 +16,7 @@ use crate::scene::footprint::{self, CurvesSize, available_bytes};
 use crate::scene::light::Light;
 use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
-use crate::scene::ribbons;
+use crate::scene::ribbons::{self, GroomShape};
 use crate::scene::stages::{Stage, StageRunner};
 use crate::scene::tracer::TracerBuilder;
 
@@ -29,6 +29,16 @@ pub(crate) enum Shape {
     /// level-of-detail ribbons for its view (`ribbons::share_out`).
     AutoCurves(Curves),
     Mesh(Mesh),
+}
+
+impl Shape {
+    /// Curves given with `shape`: `auto` ones are shared out by each build for its view.
+    pub fn curves(curves: Curves, shape: GroomShape) -> Shape {
+        match shape {
+            GroomShape::Auto => Shape::AutoCurves(curves),
+            _ => Shape::Curves(curves),
+        }
+    }
 }
 
 /// What a build is made of, in geometry order.

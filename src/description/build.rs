@@ -96,11 +96,7 @@ impl SceneDescription {
                 .curves(&mut stages, (i, grooms, reads), &mut framing)
                 .map_err(|e| self.error(&at, e))?;
             for c in curves {
-                let shape = if g.shape == GroomShape::Auto {
-                    Shape::AutoCurves(c)
-                } else {
-                    Shape::Curves(c)
-                };
+                let shape = Shape::curves(c, g.shape);
                 assembly.add(shape, groom_materials[i].clone(), self.at(&at));
                 names.push(g.material.clone());
             }

@@ -466,22 +466,32 @@ fn numbered(output: &Path, frame: Option<u32>) -> hairtrace::Result<PathBuf> {
     frame.map_or_else(|| Ok(output.to_path_buf()), |f| frame_path(output, f))
 }
 
-fn render(args: &RenderArgs) -> hairtrace::Result<()> {
-    let frame = numbered(&args.output, args.frame_number)?;
-    if args.tile.is_some() && !has_extension(&frame, "exr") {
-        return Err(hairtrace::Error::InvalidArg(format!(
-            "--tile: {} must be an .exr (float pixels, and the header assemble checks)",
-            frame.display()
-        )));
+impl RenderArgs {
+    /// Where an image of the frame goes: the image itself, or its tile.
+    fn placed(&self, image: PathBuf) -> PathBuf {
+        match self.tile {
+            Some((i, n)) => tile_path(&image, i, n),
+            None => image,
+        }
     }
-    // Where an image of the frame goes: the image itself, or its tile.
-    let place = |image: PathBuf| match args.tile {
-        Some((i, n)) => tile_path(&image, i, n),
-        None => image,
-    };
-    let output = place(frame.clone());
-    // Refuse an output the writer will not take before spending minutes on the render.
-    image::check_output_path(&output)?;
+
+    /// The frame `output` names (its run of # filled), refused now, before minutes of
+    /// work, when the writer would not take it or its tile.
+    fn checked_frame(&self, output: &Path) -> hairtrace::Result<PathBuf> {
+        let frame = numbered(output, self.frame_number)?;
+        if self.tile.is_some() && !has_extension(&frame, "exr") {
+            return Err(hairtrace::Error::InvalidArg(format!(
+                "--tile: {} must be an .exr (float pixels, and the header assemble checks)",
+                frame.display()
+            )));
+        }
+        image::check_output_path(&self.placed(frame.clone()))?;
+        Ok(frame)
+    }
+}
+
+fn render(args: &RenderArgs) -> hairtrace::Result<()> {
+    let frame = args.checked_frame(&args.output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
     if let Some(sigma_a) = args.preset {
         if !args
@@ -525,9 +535,10 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     // Every variant is checked before the build, so that a typo does not wait for it.
     let mut renders = vec![(frame.clone(), description.render)];
     for v in &args.variant {
-        let frame = numbered(&v.output, args.frame_number)?;
-        image::check_output_path(&place(frame.clone()))?;
-        renders.push((frame, v.settings(&description.render)?));
+        renders.push((
+            args.checked_frame(&v.output)?,
+            v.settings(&description.render)?,
+        ));
     }
     let build_start = std::time::Instant::now();
     let device = Arc::new(description.render.device()?);
@@ -575,11 +586,7 @@ fn render_frame(
     frame: &Path,
     label: &str,
 ) -> hairtrace::Result<RenderStats> {
-    let place = |image: PathBuf| match args.tile {
-        Some((i, n)) => tile_path(&image, i, n),
-        None => image,
-    };
-    let output = place(frame.to_path_buf());
+    let output = args.placed(frame.to_path_buf());
     let bar = stage_bar("render", true);
     let wants = |name: &str| args.aov.iter().any(|a| a == name);
     let aovs = Aovs {
@@ -590,7 +597,7 @@ fn render_frame(
     let aov_paths: Vec<(PathBuf, &str)> = args
         .aov
         .iter()
-        .map(|a| (place(tiles::tagged_path(frame, a)), a.as_str()))
+        .map(|a| (args.placed(tiles::tagged_path(frame, a)), a.as_str()))
         .collect();
     for (path, _) in &aov_paths {
         image::check_output_path(path)?;

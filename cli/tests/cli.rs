@@ -364,6 +364,11 @@ fn variants_render_from_one_build_as_their_own_commands_would() {
     let mut args = common.to_vec();
     args.extend(["-o", &main, "--variant", "no-colon.exr"]);
     assert_one_line_error(&hairtrace(&args), "OUT:NAME=VALUE");
+    // A tile of a variant is an .exr, as the main image's is.
+    let png = format!("{}:spp=4", tmp("cli_variant_tile.png"));
+    let mut args = common.to_vec();
+    args.extend(["--tile", "1/2", "-o", &main, "--variant", &png]);
+    assert_one_line_error(&hairtrace(&args), "must be an .exr");
 }
 
 /// What the peer benchmark drives: a box-filtered render with its figures in JSON,

@@ -351,23 +351,9 @@ fn quote(text: &str) -> String {
 /// Writes `text` to `path` under a temporary name beside it, then renames it: a reader
 /// never sees half a file.
 pub fn write_file(path: &Path, text: &str) -> Result<()> {
-    let folder = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
     let io = |e: std::io::Error| Error::io(path, e);
-    let mut file = tempfile::Builder::new()
-        .prefix(".hairtrace.")
-        .tempfile_in(folder)
-        .map_err(io)?;
+    let mut file = hairtrace::image::temporary_beside(path).map_err(io)?;
     std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        // As `fs::write` would create it (tempfile's are private to the user).
-        let mode = std::fs::Permissions::from_mode(0o644);
-        file.as_file().set_permissions(mode).map_err(io)?;
-    }
     file.persist(path).map_err(|e| io(e.error))?;
     Ok(())
 }

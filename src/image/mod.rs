@@ -305,8 +305,9 @@ pub fn write_image(
 
 /// An empty file of a unique name in `path`'s folder (so that the rename is atomic),
 /// hidden from `*` globs, readable as a file created with `File::create` would be. It is
-/// removed when dropped unless persisted.
-fn temporary_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
+/// removed when dropped unless persisted to `path`: what every file a long job writes
+/// goes through, so that a reader never sees half of one.
+pub fn temporary_beside(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),

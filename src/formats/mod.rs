@@ -33,9 +33,10 @@ pub enum SceneFormat {
 impl SceneFormat {
     /// The format of the file at `path`: by the file's signature where it has one (`.hair`'s
     /// `HAIR`, USD's `PXR-USDC` and `#usda`), which a misnamed file cannot hide (a USD stage
-    /// must still carry a USD extension, which its reader needs); else by the extension (`.toml`, `.pbrt`, `.usd*`, `.hair`); else, for a text file with another
-    /// name, TOML when a line opens a `[table]` or sets a `key =`, pbrt when its first word
-    /// is a capitalised directive.
+    /// must still carry a USD extension, which its reader needs); else by the extension
+    /// (`.toml`, `.pbrt`, `.usd*`, `.hair`); else, for a text file with another name, TOML
+    /// when a line opens a `[table]` or sets a `key =`, pbrt when its first word is a
+    /// capitalised directive.
     pub fn of(path: &Path) -> Result<SceneFormat> {
         let mut head = Vec::with_capacity(4096);
         std::fs::File::open(path)
@@ -132,6 +133,7 @@ impl SceneDescription {
 mod tests {
     use super::*;
 
+    /// A file of `bytes` named `name` in this process's scratch folder.
     fn file(name: &str, bytes: &[u8]) -> std::path::PathBuf {
         let dir = std::env::temp_dir().join(format!("hairtrace-formats-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();

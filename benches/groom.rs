@@ -5,8 +5,8 @@
 //! starts them past the fiber they leave, hairtrace uses its exclusion filter instead). Also the 8-wide packet call
 //! on primary rays, to see whether packets pay. Prints a markdown table.
 //!
-//! `cargo bench --bench groom --features embree-sys` (all sizes; the feature opens the raw
-//! Embree bindings for the direct baseline) or add `-- 100000` (sizes up
+//! `cargo bench --bench groom --features bench-internals` (all sizes; the feature opens the tracer
+//! and the raw Embree bindings for the direct baseline) or add `-- 100000` (sizes up
 //! to the given strand count).
 
 use std::hint::black_box;

@@ -27,8 +27,20 @@
 //! Without the default `render` feature the crate is the BSDF alone ([`bsdf`], [`math`] and
 //! the BSDF's C entry points): it builds and links without Embree and OpenImageIO.
 //!
-//! The modules stay public for hosts that assemble scenes piece by piece (strands, curves,
-//! a tracer, lights) and for the integration tests, which check those pieces one by one.
+//! The entry points, each with an example on its page:
+//! - the BSDF alone: [`HairBsdf`] (a path vertex: `at`, then `eval` and `sample`);
+//! - a scene from a file: [`SceneDescription::load`], then [`SceneDescription::build`];
+//! - a scene in code: [`description::demo`] (a description to change before the build,
+//!   with the host's own strands as `GroomSource::ControlPoints`);
+//! - settings by name, as the TOML file, the CLI and the C ABI set them:
+//!   [`RenderSettings::set`];
+//! - renders from one build: [`BuiltScene::render`], [`BuiltScene::render_with`] (other
+//!   settings), [`BuiltScene::set_material`] and `set_lights` (edits without a new build);
+//! - images: [`write_image`], [`read_image`].
+//!
+//! The tracer, the film and the integrator are the crate's own: their tests live beside
+//! them (`src/<layer>/tests/`), and the groom benchmark opens them with the
+//! `bench-internals` feature, which is not an API.
 
 // The BSDF-only build compiles the lower layers without the render code that uses some of
 // their helpers; the default build (every feature) still reports code nothing uses.
@@ -67,14 +79,16 @@ pub use description::{BuiltScene, SceneDescription};
 #[cfg(feature = "render")]
 pub use embree::Device;
 pub use error::{Error, Result};
+/// The vector types of the BSDF's and the scene's signatures, so that a host uses the very
+/// version the crate was built with.
+pub use glam;
 #[cfg(feature = "render")]
 pub use image::{read_image, write_image};
 #[cfg(feature = "render")]
-pub use render::renderer::{RenderOutput, render};
 #[cfg(feature = "render")]
 pub use render::settings::RenderSettings;
 #[cfg(feature = "render")]
-pub use render::{Aovs, NoProgress, PixelFilter, Progress};
+pub use render::{Aovs, NoProgress, PixelFilter, Progress, RenderOutput};
 
 /// The crate version, as the C ABI reports it.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");

@@ -24,12 +24,9 @@ use hairtrace::formats::hair::{Thickness, info_report, read_hair_file};
 use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::formats::{SceneFormat, usd};
 use hairtrace::image::{self, Placement, WriteOptions};
-use hairtrace::render::integrator::World;
-use hairtrace::render::renderer::RenderStats;
 use hairtrace::render::settings::RenderSettings;
-use hairtrace::render::{Aovs, Progress, renderer};
-use hairtrace::scene::Camera;
-use hairtrace::scene::material::HairColor;
+use hairtrace::render::{Aovs, Progress, RenderStats};
+use hairtrace::scene::HairColor;
 use hairtrace::scene::{GroomShape, Stage, StageProgress};
 use hairtrace::{HairBsdf, HairParams};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -543,17 +540,12 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let build_start = std::time::Instant::now();
     let device = Arc::new(description.render.device()?);
     let bars = StageBars::default();
-    let BuiltScene {
-        world,
-        camera,
-        stages,
-        ..
-    } = description.build_with(device, &bars)?;
+    let built = description.build_with(device, &bars)?;
     bars.finish();
     let build_seconds = build_start.elapsed().as_secs_f64();
     let label = scene_label(args.scene.as_ref(), args.demo.as_deref());
     for (i, (frame, settings)) in renders.iter().enumerate() {
-        let s = render_frame(args, &world, &camera, settings, frame, &label)?;
+        let s = render_frame(args, &built, settings, frame, &label)?;
         // The figures of the first render: what benchmarks read.
         if let (0, Some(path)) = (i, &args.stats) {
             let json = serde_json::json!({
@@ -561,7 +553,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
                 "build_seconds": build_seconds,
                 "stage_seconds": Stage::ALL
                     .iter()
-                    .map(|&st| (st.name().to_owned(), stages.get(st).into()))
+                    .map(|&st| (st.name().to_owned(), built.stages.get(st).into()))
                     .chain([("render".to_owned(), s.seconds.into())])
                     .collect::<serde_json::Map<_, _>>(),
                 "samples": s.samples,
@@ -580,8 +572,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
 /// `--tile`) and its AOVs to `frame`'s names, with the render's header.
 fn render_frame(
     args: &RenderArgs,
-    world: &World,
-    camera: &Camera,
+    built: &BuiltScene,
     settings: &RenderSettings,
     frame: &Path,
     label: &str,
@@ -602,7 +593,7 @@ fn render_frame(
     for (path, _) in &aov_paths {
         image::check_output_path(path)?;
     }
-    let out = renderer::render(world, camera, settings, aovs, &Bar(bar.clone()))?;
+    let out = built.render_with(settings, aovs, &Bar(bar.clone()))?;
     bar.finish_and_clear();
     let window = out.film.crop();
     let mut attributes = tiles::header(settings, label);

@@ -34,6 +34,23 @@ const MIN_COS_WI: f32 = 1e-20;
 
 /// The hair BSDF for one parameter set, with every parameter-only constant precomputed.
 /// Plain numbers only (`Copy`), so a copy can travel inside a self-contained point.
+///
+/// A path vertex in a host's integrator: the point once, then eval for the light and a
+/// sample for the path. Directions are in the fiber's frame (x along the fiber, z toward
+/// the viewer; docs/conventions.md).
+///
+/// ```
+/// use hairtrace::glam::Vec3;
+/// use hairtrace::{HairBsdf, HairParams};
+/// let bsdf = HairBsdf::new(&HairParams { beta_m: 0.25, ..HairParams::default() })?;
+/// let point = bsdf.at(0.5, Vec3::Z); // h = 0.5, seen straight on
+/// let light = point.eval(Vec3::new(0.0, 0.6, 0.8)); // toward a light
+/// assert!(light.pdf > 0.0 && light.f.min_element() >= 0.0);
+/// let next = point.sample([0.3, 0.6, 0.9]).expect("a direction");
+/// let weight = next.f * next.wi.z.abs() / next.pdf; // f |cos| / pdf, the path's throughput
+/// assert!(weight.is_finite() && (next.wi.length() - 1.0).abs() < 1e-5);
+/// # Ok::<(), hairtrace::Error>(())
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HairBsdf {
     params: HairParams,

@@ -20,6 +20,29 @@ pub const DEMOS: [&str; 3] = ["furball", "furnace", "scalp"];
 /// fur on a ball over a floor, under the default lights), `"furnace"` (white fur, sigma_a = 0, around
 /// a white diffuse sphere under a uniform environment of radiance 1: every pixel's
 /// expected value is 1) or `"scalp"` (wavy auburn hair on a head).
+///
+/// A demo is a [`SceneDescription`] like any other, to change in code before the build;
+/// here the host's own strands replace the fur:
+///
+/// ```no_run
+/// use std::sync::Arc;
+/// use hairtrace::description::{GroomDesc, GroomSource, demo};
+/// use hairtrace::{Aovs, NoProgress};
+/// # fn main() -> hairtrace::Result<()> {
+/// let mut scene = demo("furball")?;
+/// // Two strands of three control points each: x, y, z, radius.
+/// let points = vec![
+///     [0.0, 0.0, 0.0, 0.01], [0.0, 0.5, 0.1, 0.008], [0.0, 1.0, 0.0, 0.005],
+///     [0.2, 0.0, 0.0, 0.01], [0.2, 0.5, 0.1, 0.008], [0.2, 1.0, 0.0, 0.005],
+/// ];
+/// let source = GroomSource::ControlPoints { points, counts: vec![3, 3] };
+/// scene.grooms = vec![GroomDesc::new(source, "hair")];
+/// scene.render.set("spp", "64")?;
+/// let built = scene.build(Arc::new(scene.render.device()?))?;
+/// let image = built.render(Aovs::default(), &NoProgress)?.film;
+/// # let _ = image;
+/// # Ok(()) }
+/// ```
 pub fn demo(name: &str) -> Result<SceneDescription> {
     let scene = match name {
         "furball" => furball_demo(),

@@ -299,9 +299,9 @@ pub(crate) fn placed(
 /// What a render needs, built from a description. Materials and lights can be changed
 /// on it without a new build ([`BuiltScene::set_material`], [`BuiltScene::set_lights`]),
 /// and so can the camera and the settings, as long as the curves' view-dependent shapes
-/// still hold for them (`world.tracer.serves(...)`; a render checks it).
+/// still hold for them (a render checks it, and refuses a view they no longer serve).
 pub struct BuiltScene {
-    pub world: World,
+    pub(crate) world: World,
     pub camera: Camera,
     pub settings: RenderSettings,
     /// Seconds each build stage took.
@@ -313,7 +313,32 @@ pub struct BuiltScene {
 impl BuiltScene {
     /// Renders the scene as built, its film and AOVs as `aovs` asks.
     pub fn render(&self, aovs: Aovs, progress: &dyn Progress) -> Result<RenderOutput> {
-        renderer::render(&self.world, &self.camera, &self.settings, aovs, progress)
+        self.render_with(&self.settings, aovs, progress)
+    }
+
+    /// Renders the scene as built with other settings, without a new build: more samples,
+    /// another seed, a noise target. Refused when the settings ask for a view the build's
+    /// curve shapes do not serve (more pixels, a finer level of detail).
+    ///
+    /// ```no_run
+    /// # use std::sync::Arc;
+    /// # use hairtrace::{Aovs, Device, NoProgress, SceneDescription};
+    /// # fn main() -> hairtrace::Result<()> {
+    /// let built = SceneDescription::load("scene.toml".as_ref())?.build(Arc::new(Device::new(None)?))?;
+    /// let preview = built.render(Aovs::default(), &NoProgress)?;
+    /// let mut finer = built.settings.clone();
+    /// finer.spp *= 16;
+    /// let final_frame = built.render_with(&finer, Aovs::default(), &NoProgress)?;
+    /// # let _ = (preview, final_frame);
+    /// # Ok(()) }
+    /// ```
+    pub fn render_with(
+        &self,
+        settings: &RenderSettings,
+        aovs: Aovs,
+        progress: &dyn Progress,
+    ) -> Result<RenderOutput> {
+        renderer::render(&self.world, &self.camera, settings, aovs, progress)
     }
 
     /// Gives the material `name` new parameters on every geometry that uses it, without a
@@ -326,7 +351,7 @@ impl BuiltScene {
     /// ```no_run
     /// use std::sync::Arc;
     /// use hairtrace::description::{LightDesc, MaterialDesc};
-    /// use hairtrace::scene::material::{HairColor, HairMaterial};
+    /// use hairtrace::scene::{HairColor, HairMaterial};
     /// use hairtrace::{Aovs, Device, NoProgress, SceneDescription};
     /// # fn main() -> hairtrace::Result<()> {
     /// let scene = SceneDescription::load("scene.toml".as_ref())?;
@@ -378,3 +403,6 @@ impl BuiltScene {
         self.world.set_lights(lights)
     }
 }
+
+#[cfg(test)]
+mod tests;

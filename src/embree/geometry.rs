@@ -407,12 +407,14 @@ impl CurveGeometry {
         self.indices.as_slice()
     }
 
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn segment_count(&self) -> usize {
         self.indices.len()
     }
 
     /// Bytes of the buffers hairtrace holds for this geometry (Embree's own memory is
     /// reported by [`super::MemoryMonitor`]).
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
         self.vertices.heap_bytes() + self.indices.heap_bytes()
     }
@@ -531,6 +533,7 @@ impl TriangleGeometry {
         self.triangles.as_slice()
     }
 
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
         self.vertices.heap_bytes() + self.triangles.heap_bytes()
     }
@@ -555,6 +558,7 @@ impl Geometry {
         }
     }
 
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
         match self {
             Geometry::Curves(c) => c.heap_bytes(),

@@ -1,12 +1,11 @@
 //! Safe layer over Embree, the ray tracing kernels that intersect the hair curves.
 //!
-//! `sys` is the raw bindgen output, private to the crate (the `embree-sys` feature makes
-//! it public for the groom benchmark's direct-Embree baseline; no host should use it);
+//! `sys` is the raw bindgen output, private to the crate (the `bench-internals` feature
+//! makes it public for the groom benchmark's direct-Embree baseline; no host should use it);
 //! [`Device`](crate::embree::Device) owns an Embree device; the crate's `SceneBuilder`
-//! attaches curve and triangle geometries and commits into a
-//! [`Scene`](crate::embree::Scene), which answers closest-hit and occlusion queries
-//! ([`Ray`](crate::embree::Ray), [`RayHit`](crate::embree::RayHit)). Hosts reach all of it
-//! through the scene layer's `TracerBuilder` and `Tracer`. This module
+//! attaches curve and triangle geometries and commits into a `Scene`, which answers
+//! closest-hit and occlusion queries (`Ray`, `RayHit`). The scene layer's tracer is the
+//! only user of those; a host sees the device, the curve types and the ISA. This module
 //! knows nothing of shading: it hands back hit records and leaves the rest to the renderer.
 //!
 //! Embree 3 (Debian) and Embree 4 differ in the ray query calls (`rtcIntersect1` and
@@ -22,20 +21,30 @@ mod isa;
 mod memory;
 mod query;
 mod scene;
-#[cfg(feature = "embree-sys")]
+#[cfg(feature = "bench-internals")]
 pub mod sys;
-#[cfg(not(feature = "embree-sys"))]
+#[cfg(not(feature = "bench-internals"))]
 mod sys;
 
 pub use device::Device;
-pub use geometry::{CurveBasis, CurveShape, Geometry, SharedBuffer};
+pub use geometry::{CurveBasis, CurveShape};
 pub(crate) use geometry::{CurveGeometry, CurvePoint, TriangleGeometry, padding_for};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
 pub(crate) use query::Exclude;
-pub use query::{Ray, RayHit};
-pub(crate) use scene::SceneBuilder;
-pub use scene::{Scene, SceneOptions, cancelled, is_cancelled};
+pub use scene::is_cancelled;
+pub(crate) use scene::{SceneBuilder, cancelled};
+
+// The groom bench (`benches/groom.rs`) traces through Embree directly beside the tracer; the
+// `bench-internals` feature opens what it needs. No host should use them.
+#[cfg(feature = "bench-internals")]
+pub use scene::{Scene, SceneOptions};
+#[cfg(not(feature = "bench-internals"))]
+pub(crate) use scene::{Scene, SceneOptions};
+#[cfg(feature = "bench-internals")]
+pub use {geometry::Geometry, geometry::SharedBuffer, query::Ray, query::RayHit};
+#[cfg(not(feature = "bench-internals"))]
+pub(crate) use {geometry::Geometry, geometry::SharedBuffer, query::Ray, query::RayHit};
 
 /// The Embree version hairtrace was built against, as `major.minor.patch`, read from the
 /// installed `rtcore_config.h` at build time.

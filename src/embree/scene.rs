@@ -129,7 +129,7 @@ impl SceneBuilder {
         Ok(Scene {
             raw: self.raw,
             geometries: self.geometries,
-            device: self.device,
+            _device: self.device,
         })
     }
 }
@@ -163,7 +163,8 @@ pub fn cancelled() -> Error {
 pub struct Scene {
     raw: RawScene,
     geometries: Vec<Geometry>,
-    device: Arc<Device>,
+    /// Held so that the device outlives every scene made on it.
+    _device: Arc<Device>,
 }
 
 impl Scene {
@@ -176,11 +177,8 @@ impl Scene {
         &self.geometries
     }
 
-    pub fn device(&self) -> &Arc<Device> {
-        &self.device
-    }
-
     /// Bytes of the buffers hairtrace holds for the geometries (not Embree's BVH).
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
         self.geometries.iter().map(Geometry::heap_bytes).sum()
     }
@@ -202,7 +200,7 @@ impl Scene {
     }
 
     /// The raw handle, for the groom benchmark's direct Embree calls only.
-    #[cfg(feature = "embree-sys")]
+    #[cfg(feature = "bench-internals")]
     pub fn raw_handle(&self) -> sys::RTCScene {
         self.raw()
     }

@@ -3,7 +3,7 @@
 //!
 //! A `.hair` file holds polylines and says nothing of the curve drawn through them; hairtrace
 //! reads its points with a groom's `basis` (B-spline by default), as
-//! [`Curves::from_strands`](crate::scene::curves::Curves::from_strands) lays them out. The
+//! the scene layer's `Curves::from_strands` lays them out. The
 //! conversion keeps that curve exactly, in both directions:
 //! - linear: a `linear` (`nonperiodic`) prim of the same points;
 //! - B-spline: a `cubic` `bspline` prim with `pinned` wrap, whose phantom end points

@@ -199,6 +199,17 @@ pub fn check_output_path(path: &Path) -> Result<()> {
 /// (where alpha > 0), clamped to [0, 1] and sRGB-encoded here; alpha is clamped but stays
 /// linear. JPEG has no alpha, so it takes 1 or 3 channels only. Any NaN or infinite value
 /// is an error, so a broken render never becomes a plausible-looking file.
+///
+/// ```
+/// use hairtrace::{read_image, write_image};
+/// let path = std::env::temp_dir().join(format!("hairtrace-doc-{}.exr", std::process::id()));
+/// let rgb = [0.5, 0.25, 1.0, 0.0, 2.0, 0.125]; // two pixels
+/// write_image(&path, 2, 1, 3, &rgb, &Default::default())?;
+/// assert_eq!(read_image(&path)?.pixels, rgb); // EXR keeps floats exactly
+/// assert!(write_image(&path, 2, 1, 3, &[f32::NAN; 6], &Default::default()).is_err());
+/// # std::fs::remove_file(&path).ok();
+/// # Ok::<(), hairtrace::Error>(())
+/// ```
 pub fn write_image(
     path: &Path,
     width: usize,

@@ -5,7 +5,7 @@ pub mod bessel;
 pub(crate) mod fast;
 pub(crate) mod frame;
 pub(crate) mod lanes;
-pub mod sampling;
+pub(crate) mod sampling;
 
 pub use frame::Frame;
 pub use lanes::Lanes;

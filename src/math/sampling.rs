@@ -219,11 +219,6 @@ impl Distribution2D {
         Ok(Self { rows, marginal })
     }
 
-    /// Mean of the table.
-    pub fn integral(&self) -> f32 {
-        self.marginal.integral()
-    }
-
     /// Maps `u` in [0, 1)^2 to a point `[u, v]` in [0, 1)^2 and its density.
     pub fn sample(&self, u: [f32; 2]) -> ([f32; 2], f32) {
         let (v, pdf_v, row) = self.marginal.sample(u[1]);

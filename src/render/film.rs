@@ -386,7 +386,7 @@ impl Film {
         self.crop
     }
 
-    /// The camera's [0, 1]^2 image point of a sample; see [`ndc`].
+    /// The camera's [0, 1]^2 image point of a sample; see `render::film::ndc`.
     pub fn ndc(&self, pixel: (u32, u32), offset: [f32; 2]) -> [f32; 2] {
         ndc(self.width, self.height, pixel, offset)
     }
@@ -414,7 +414,7 @@ impl Film {
     }
 
     /// Samples whose values were NaN or infinite, counted as black (see
-    /// [`PixelAccumulator::add`]).
+    /// `PixelAccumulator::add`).
     pub fn rejected_samples(&self) -> u64 {
         self.accumulators
             .iter()
@@ -424,7 +424,7 @@ impl Film {
 
     /// The estimated noise of the image: the RMSE of its pixels' means (over pixels and
     /// channels, as `hairtrace compare` measures it) relative to the image's mean, from
-    /// [`PixelAccumulator::variance_of_mean`]. None before two passes, or for an image
+    /// `PixelAccumulator::variance_of_mean`. None before two passes, or for an image
     /// whose mean is not positive while it has noise.
     pub fn noise(&self) -> Option<f32> {
         let mut pixels = Vec::with_capacity(self.accumulators.len());

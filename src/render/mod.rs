@@ -4,16 +4,17 @@
 
 pub(crate) mod allocation;
 pub(crate) mod film;
-pub mod integrator;
+pub(crate) mod integrator;
 pub(crate) mod progress;
-pub mod renderer;
+pub(crate) mod renderer;
 pub(crate) mod sampler;
 pub mod settings;
 pub(crate) mod tiles;
 
-pub use film::{
-    Aovs, Film, FirstHit, NO_HIT_DEPTH, NO_STRAND, PixelAccumulator, PixelFilter, Window, ndc,
-};
+pub use film::{Aovs, Film, NO_HIT_DEPTH, NO_STRAND, PixelFilter, Window};
 pub use progress::{NoProgress, Progress};
-pub use sampler::PixelSampler;
-pub use tiles::{Pulse, REPORT_INTERVAL, RenderStatus, TileOptions, render_tiles, tiles};
+pub use renderer::{RenderOutput, RenderStats};
+pub use tiles::RenderStatus;
+
+#[cfg(test)]
+mod tests;

@@ -439,6 +439,16 @@ impl RenderSettings {
     /// Sets `key` from its text (`"16"`, `"box"`, `"none"`, `"0,0,64,48"`), checked against
     /// the setting's type and range; an error names the key and what it allows. Checks
     /// across settings (a crop inside the frame) wait for [`Self::validate`].
+    ///
+    /// ```
+    /// let mut settings = hairtrace::RenderSettings::default();
+    /// settings.set("spp", "256")?;
+    /// settings.set("noise_target", "0.02")?;
+    /// assert_eq!(settings.spp, 256);
+    /// let e = settings.set("spp", "0").unwrap_err();
+    /// assert!(e.to_string().contains("spp"), "{e}");
+    /// # Ok::<(), hairtrace::Error>(())
+    /// ```
     pub fn set(&mut self, key: &str, value: &str) -> Result<()> {
         let s = Self::setting(key)?;
         (s.set)(self, value).map_err(|why| Error::InvalidArg(format!("{key} = {value}: {why}")))

@@ -44,11 +44,6 @@ impl DetailView {
         }
     }
 
-    /// The side of one pixel (at the image centre) at `p`, in world units.
-    pub fn footprint(&self, p: Vec3) -> f32 {
-        self.camera.eye().distance(p) * self.camera.pixel_spread(self.height)
-    }
-
     /// Whether choices made for this view hold for `new` at every one of `points` (x, y,
     /// z, radius; the radius is not used): at each, `new`'s footprint is at least this
     /// view's times 1 - [`FOOTPRINT_TOLERANCE`]. A lens, the aspect and the target play
@@ -83,11 +78,6 @@ pub struct ViewDependent {
 }
 
 impl ViewDependent {
-    /// The view the geometries were made for; None when the scene depends on no view.
-    pub fn view(&self) -> Option<&DetailView> {
-        self.view.as_ref()
-    }
-
     /// Refuses a second view: one scene's choices are made for one view.
     pub(crate) fn check(&self, view: &DetailView) -> Result<()> {
         match self.view {

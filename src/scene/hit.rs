@@ -60,7 +60,7 @@ pub struct HairHit {
     /// Parameter along the segment, in [0, 1], of the axis point the hit belongs to.
     pub u: f32,
     /// Embree's v: 0 on round curves, the offset across a flat ribbon in [-1, 1] (along -y;
-    /// `h` is the more accurate measure, see `tests/pipeline/curves_geometry.rs`).
+    /// `h` is the more accurate measure, see `src/scene/tests/curves_geometry.rs`).
     pub v: f32,
     /// The strand and segment hit.
     pub strand: StrandSegment,
@@ -117,6 +117,7 @@ impl Hit {
         }
     }
 
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn as_hair(&self) -> Option<&HairHit> {
         match self {
             Hit::Hair(h) => Some(h),

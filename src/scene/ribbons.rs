@@ -37,7 +37,7 @@ pub enum GroomShape {
 
 impl GroomShape {
     /// The shape the groom is built with before the camera is known (`Auto`: round, until
-    /// [`share_out`] picks its thin strands).
+    /// `share_out` picks its thin strands for the view).
     pub fn built(self) -> CurveShape {
         match self {
             GroomShape::Flat => CurveShape::Flat,

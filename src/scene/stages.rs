@@ -36,7 +36,7 @@ impl Stage {
 /// converted ([`Stage::Read`], [`Stage::Curves`]), the meshes are read after the grooms,
 /// and the BVH is built last; each stage's `fraction` (of all its grooms and meshes)
 /// never decreases from call to call and ends at exactly 1. Returning `false` cancels the
-/// build, which fails with [`crate::embree::cancelled`]'s error: inside the BVH build at
+/// build, which fails with a cancellation error ([`crate::embree::is_cancelled`]): inside the BVH build at
 /// Embree's next check, elsewhere at the next update.
 pub trait StageProgress: Sync {
     fn update(&self, stage: Stage, fraction: f64) -> bool;

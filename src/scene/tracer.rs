@@ -10,7 +10,7 @@ use super::curves::{Curves, StrandIndex, StrandSegment, TrueCurves};
 use super::detail_view::{DetailView, ViewDependent};
 use super::hit::{HairHit, Hit, SurfaceHit, hair_frame};
 use super::mesh::Mesh;
-use super::stages::{NoStages, Stage, StageRunner};
+use super::stages::{Stage, StageRunner};
 use crate::Result;
 use crate::embree::{
     CurveBasis, CurveGeometry, CurvePoint, CurveShape, Device, Exclude, Geometry, Ray, RayHit,
@@ -24,7 +24,7 @@ pub const SURFACE_MASK: u32 = 2;
 
 /// How a continued ray (reflection, transmission, shadow) leaves a fiber.
 ///
-/// Measured re-hit rates (`tests/pipeline/rehit.rs`: ~2500 round-curve hits x 64 random
+/// Measured re-hit rates (`src/scene/tests/rehit.rs`: ~2500 round-curve hits x 64 random
 /// directions, every basis, straight and bent strands): `Offset` re-hits ~100% of transmitted and ~50%
 /// of shadow rays; the three filtered strategies at most 0.005%. `ExitAndFilter` is the
 /// default because it is the fastest of those on round cubic curves (`benches/groom.rs`:
@@ -34,8 +34,10 @@ pub enum Escape {
     /// Move the origin off the surface, to the side the ray goes: transmitted rays start
     /// inside the tube and hit its far wall. Kept as the baseline the others are measured
     /// against.
+    #[cfg(any(test, feature = "bench-internals"))]
     Offset,
     /// The offset plus the exclusion filter.
+    #[cfg(any(test, feature = "bench-internals"))]
     OffsetAndFilter,
     /// Start where the ray leaves the tube (past the far wall for a transmitted ray, just
     /// off the surface for a reflected one, from the local cylinder at the hit), plus the
@@ -45,6 +47,7 @@ pub enum Escape {
     ExitAndFilter,
     /// Start exactly at the hit point and let the exclusion filter reject every hit on the
     /// same tube (same strand, neighbouring segments) before the ray can have left it.
+    #[cfg(any(test, feature = "bench-internals"))]
     Filter,
 }
 
@@ -139,8 +142,9 @@ impl TracerBuilder {
     }
 
     /// Builds the BVH.
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn build(self) -> Result<Tracer> {
-        self.build_with(&StageRunner::new(&NoStages))
+        self.build_with(&StageRunner::new(&super::stages::NoStages))
     }
 
     /// Builds the BVH, reporting its progress as [`Stage::Bvh`] to `stages`.
@@ -174,11 +178,6 @@ impl Tracer {
         self.view.holds_for(&self.scene, view)
     }
 
-    /// The view-dependent curves and the view they were made for.
-    pub fn view_dependent(&self) -> &ViewDependent {
-        &self.view
-    }
-
     /// The strand table of curves `geom_id`.
     pub fn strands(&self, geom_id: u32) -> Option<&StrandIndex> {
         match self.tables.get(geom_id as usize)? {
@@ -188,6 +187,7 @@ impl Tracer {
     }
 
     /// Heap bytes hairtrace holds for the scene (buffers and tables; not Embree's BVH).
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
         let tables: usize = self
             .tables
@@ -203,6 +203,7 @@ impl Tracer {
     }
 
     /// The closest hit along `ray`, as a full hit record.
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let hit = self.scene.intersect(ray, None)?;
         self.record(ray, &hit)
@@ -226,9 +227,11 @@ impl Tracer {
         // The origin, and how far along the ray it was moved (the ray's end stays put).
         let (org, advance, exclude) = match (from, escape) {
             (Hit::Surface(_), _) => (p + side * ulps, 0.0, None),
+            #[cfg(any(test, feature = "bench-internals"))]
             (Hit::Hair(h), Escape::Offset) => {
                 (p + side * (OFFSET_RADII * h.radius + ulps), 0.0, None)
             }
+            #[cfg(any(test, feature = "bench-internals"))]
             (Hit::Hair(h), Escape::OffsetAndFilter) => (
                 p + side * (OFFSET_RADII * h.radius + ulps),
                 0.0,
@@ -248,6 +251,7 @@ impl Tracer {
                     _ => (p + side * (OFFSET_RADII * h.radius + ulps), 0.0, exclude),
                 }
             }
+            #[cfg(any(test, feature = "bench-internals"))]
             (Hit::Hair(h), Escape::Filter) => (p, 0.0, self.exclusion(h, dir)),
         };
         SpawnedRay {
@@ -263,6 +267,7 @@ impl Tracer {
         }
     }
 
+    #[cfg(any(test, feature = "bench-internals"))]
     pub fn intersect_spawned(&self, s: &SpawnedRay) -> Option<Hit> {
         let hit = self.find_spawned(s)?;
         self.record_spawned(s, &hit)
@@ -383,7 +388,7 @@ fn hair_hit(
     };
     // One formula for every shape: on flat cubic curves it beats Embree's v (the offset
     // across the tessellated ribbon) by two orders of magnitude on bent fibers
-    // (tests/pipeline/curves_geometry.rs prints both).
+    // (src/scene/tests/curves_geometry.rs prints both).
     let (frame, h) = hair_frame(tangent, ray.dir, ray.org, axis, c.radius);
     let ng = match geom.shape() {
         CurveShape::Round => hit.ng.try_normalize().unwrap_or(frame.z),

@@ -15,7 +15,7 @@ use hairtrace::formats::hair::{Thickness, write_hair_file};
 use hairtrace::render::PixelFilter;
 use hairtrace::render::settings::Roulette;
 use hairtrace::scene::GroomShape;
-use hairtrace::scene::material::HairColor;
+use hairtrace::scene::HairColor;
 use hairtrace::scene::{FurBall, HairStyle};
 
 fn device() -> Arc<Device> {

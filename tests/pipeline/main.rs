@@ -4,23 +4,13 @@
 //! its own package, cli/tests). One test binary, so that the crate (with Embree and
 //! OpenImageIO) is linked once.
 
-mod adaptive;
 mod architecture;
-mod camera_film;
-mod convert;
-mod curves_geometry;
 mod description;
-mod edits;
 mod farm;
 mod groom;
 mod hair_file;
 mod image_io;
-mod large_groom;
-mod lights;
 mod pbrt;
-mod rehit;
-mod render;
-mod ribbons;
 mod stages;
 mod usd;
 mod usd_crate;

@@ -12,7 +12,7 @@ use hairtrace::embree::{CurveBasis, Device};
 use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::render::{Aovs, NO_STRAND, NoProgress};
 use hairtrace::scene::GroomShape;
-use hairtrace::scene::material::{HairColor, HairMaterial};
+use hairtrace::scene::{HairColor, HairMaterial};
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/pbrt")

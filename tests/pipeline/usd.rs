@@ -11,7 +11,7 @@ use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::embree::{CurveShape, Device};
 use hairtrace::formats::usd::{UsdGrooms, read_usd_file};
 use hairtrace::render::NO_STRAND;
-use hairtrace::scene::material::HairColor;
+use hairtrace::scene::HairColor;
 use hairtrace::{Aovs, NoProgress};
 use serde_json::Value;
 

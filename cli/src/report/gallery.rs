@@ -7,7 +7,7 @@ use super::{Context, bench_scene};
 use hairtrace::bsdf::sigma_a_preset;
 use hairtrace::description::MaterialDesc;
 use hairtrace::image::{Image, srgb_encode};
-use hairtrace::scene::material::{HairColor, HairMaterial};
+use hairtrace::scene::{HairColor, HairMaterial};
 use hairtrace::{Error, Result};
 use plotters::prelude::*;
 

@@ -4,14 +4,14 @@
 use std::path::Path;
 use std::sync::Arc;
 
+use crate::description::{LightDesc, MaterialDesc, SceneDescription};
+use crate::embree::Device;
+use crate::render::{Aovs, NoProgress};
+use crate::scene::camera::Camera;
+use crate::scene::detail_view::DetailView;
+use crate::scene::material::{HairColor, HairMaterial};
+use crate::{BuiltScene, Error};
 use glam::Vec3;
-use hairtrace::description::{LightDesc, MaterialDesc, SceneDescription};
-use hairtrace::embree::Device;
-use hairtrace::render::{Aovs, NoProgress};
-use hairtrace::scene::camera::Camera;
-use hairtrace::scene::detail_view::DetailView;
-use hairtrace::scene::material::{HairColor, HairMaterial};
-use hairtrace::{BuiltScene, Error};
 
 /// An `auto` fur ball over a ground quad, sky and sun, seen from `z` at 32 x 32 pixels:
 /// every strand thinner than a pixel from z = 4 and farther. `brown` and `floor` are the

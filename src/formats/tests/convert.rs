@@ -5,12 +5,12 @@
 
 use std::path::{Path, PathBuf};
 
-use hairtrace::embree::{CurveBasis, CurveShape};
-use hairtrace::formats::convert::{ConvertOptions, ConvertSource, basis_named, convert};
-use hairtrace::formats::hair::{Thickness, read_hair_file, write_hair_file};
-use hairtrace::formats::usd::{UsdCurves, read_usd_file};
-use hairtrace::scene::Strands;
-use hairtrace::scene::curves::Curves;
+use crate::embree::{CurveBasis, CurveShape};
+use crate::formats::convert::{ConvertOptions, ConvertSource, basis_named, convert};
+use crate::formats::hair::{Thickness, read_hair_file, write_hair_file};
+use crate::formats::usd::{UsdCurves, read_usd_file};
+use crate::scene::Strands;
+use crate::scene::curves::Curves;
 
 fn fixtures() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/usd")
@@ -29,7 +29,7 @@ fn opts(basis: &str) -> ConvertOptions {
     }
 }
 
-fn run(from: &Path, to: &Path, basis: &str) -> hairtrace::Result<Vec<String>> {
+fn run(from: &Path, to: &Path, basis: &str) -> crate::Result<Vec<String>> {
     convert(ConvertSource::File(from), to, &opts(basis)).map(|c| c.notes)
 }
 

@@ -9,12 +9,12 @@
 
 use std::sync::Arc;
 
+use crate::embree::{CurveBasis, CurveShape, Device, Ray, SceneOptions};
+use crate::scene::Strands;
+use crate::scene::curves::Curves;
+use crate::scene::hit::Hit;
+use crate::scene::tracer::{Escape, Tracer, TracerBuilder};
 use glam::Vec3;
-use hairtrace::embree::{CurveBasis, CurveShape, Device, Ray, SceneOptions};
-use hairtrace::scene::Strands;
-use hairtrace::scene::curves::Curves;
-use hairtrace::scene::hit::Hit;
-use hairtrace::scene::tracer::{Escape, Tracer, TracerBuilder};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 

@@ -8,14 +8,14 @@
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+use crate::embree::{CurveBasis, CurveShape, Device, Geometry, Ray, SceneOptions};
+use crate::scene::Strands;
+use crate::scene::curves::Curves;
+use crate::scene::hit::{HairHit, Hit};
+use crate::scene::material::HairColor;
+use crate::scene::tracer::{Tracer, TracerBuilder};
+use crate::{HairBsdf, HairParams};
 use glam::{DVec3, Vec3};
-use hairtrace::embree::{CurveBasis, CurveShape, Device, Geometry, Ray, SceneOptions};
-use hairtrace::scene::Strands;
-use hairtrace::scene::curves::Curves;
-use hairtrace::scene::hit::{HairHit, Hit};
-use hairtrace::scene::material::HairColor;
-use hairtrace::scene::tracer::{Tracer, TracerBuilder};
-use hairtrace::{HairBsdf, HairParams};
 
 const RADIUS: f32 = 0.05;
 

@@ -3,15 +3,15 @@
 
 use std::sync::Mutex;
 
-use hairtrace::render::integrator::World;
-use hairtrace::render::renderer::{PASS_SAMPLES, RenderOutput, render};
-use hairtrace::render::settings::{Allocation, PathSettings, RenderSettings};
-use hairtrace::render::{Aovs, NoProgress, Progress};
+use crate::render::integrator::World;
+use crate::render::renderer::{PASS_SAMPLES, RenderOutput, render};
+use crate::render::settings::{Allocation, PathSettings, RenderSettings};
+use crate::render::{Aovs, NoProgress, Progress};
 
+use crate::scene::envmap::Environment;
+use crate::scene::light::Light;
+use crate::scene::material::HairMaterial;
 use glam::Vec3;
-use hairtrace::scene::envmap::Environment;
-use hairtrace::scene::light::Light;
-use hairtrace::scene::material::HairMaterial;
 
 use super::render::{
     CROP, assert_crop_of, assert_quadrants_agree, camera, fur_world, lit_world,

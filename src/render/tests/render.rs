@@ -1,19 +1,19 @@
 //! The renderer end to end: the scene-level furnace, MIS against its two halves,
 //! determinism across thread counts and crops.
 
+use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
+use crate::render::integrator::World;
+use crate::render::renderer::render;
+use crate::render::settings::{PathSettings, RenderSettings, Strategy};
+use crate::render::{Aovs, NoProgress, RenderStatus};
+use crate::scene::FurBall;
+use crate::scene::camera::Camera;
+use crate::scene::curves::Curves;
+use crate::scene::envmap::Environment;
+use crate::scene::light::Light;
+use crate::scene::material::{HairColor, HairMaterial, Material};
+use crate::scene::tracer::TracerBuilder;
 use glam::Vec3;
-use hairtrace::embree::{CurveBasis, CurveShape, Device, SceneOptions};
-use hairtrace::render::integrator::World;
-use hairtrace::render::renderer::render;
-use hairtrace::render::settings::{PathSettings, RenderSettings, Strategy};
-use hairtrace::render::{Aovs, NoProgress, RenderStatus};
-use hairtrace::scene::FurBall;
-use hairtrace::scene::camera::Camera;
-use hairtrace::scene::curves::Curves;
-use hairtrace::scene::envmap::Environment;
-use hairtrace::scene::light::Light;
-use hairtrace::scene::material::{HairColor, HairMaterial, Material};
-use hairtrace::scene::tracer::TracerBuilder;
 use std::sync::Arc;
 
 pub(crate) fn fur_world(hair: HairMaterial, lights: Vec<Light>, strands: usize) -> World {
@@ -341,7 +341,7 @@ pub(crate) fn assert_crop_of(full: &[f32], part: &[f32]) {
 ///   absorbs, nothing else emits), plus [`SPHERE_LEAK`].
 #[test]
 fn furnace_demo_is_a_furnace() {
-    let mut d = hairtrace::description::demo("furnace").unwrap();
+    let mut d = crate::description::demo("furnace").unwrap();
     d.render.width = 96;
     d.render.height = 72;
     d.render.spp = 8;

@@ -7,10 +7,10 @@
 use std::f32::consts::PI;
 use std::path::PathBuf;
 
+use crate::image::{WriteOptions, write_image};
+use crate::math::sampling::{UNIFORM_SPHERE_PDF, cosine_hemisphere, uniform_sphere};
+use crate::scene::{Environment, Light};
 use glam::Vec3;
-use hairtrace::image::{WriteOptions, write_image};
-use hairtrace::math::sampling::{UNIFORM_SPHERE_PDF, cosine_hemisphere, uniform_sphere};
-use hairtrace::scene::{Environment, Light};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
@@ -153,7 +153,7 @@ fn integral_over_sphere(f: impl Fn(Vec3) -> Vec3) -> Vec3 {
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("lights");
+    let dir = std::env::temp_dir().join(format!("hairtrace-lights-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }

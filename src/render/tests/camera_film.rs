@@ -4,12 +4,12 @@
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
+use crate::render::film::{FirstHit, PixelAccumulator};
+use crate::render::sampler::PixelSampler;
+use crate::render::tiles::{TileOptions, render_tiles, tiles};
+use crate::render::{Aovs, Film, NoProgress, PixelFilter, RenderStatus, Window};
+use crate::scene::Camera;
 use glam::Vec3;
-use hairtrace::render::{
-    Aovs, Film, FirstHit, NoProgress, PixelAccumulator, PixelFilter, PixelSampler, RenderStatus,
-    TileOptions, Window, render_tiles, tiles,
-};
-use hairtrace::scene::Camera;
 
 const EPS: f32 = 1e-5;
 

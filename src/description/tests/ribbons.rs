@@ -5,10 +5,10 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use hairtrace::description::SceneDescription;
-use hairtrace::embree::{CurveBasis, CurveShape, Device, Geometry};
-use hairtrace::render::renderer::RenderOutput;
-use hairtrace::render::{Aovs, NoProgress};
+use crate::description::SceneDescription;
+use crate::embree::{CurveBasis, CurveShape, Device, Geometry};
+use crate::render::renderer::RenderOutput;
+use crate::render::{Aovs, NoProgress};
 
 /// A fur ball of `strands` brown strands with per-strand variation, in a uniform sky,
 /// seen from `distance` at `size` x `size` pixels.

@@ -12,12 +12,12 @@
 use std::sync::Arc;
 use std::time::Instant;
 
+use crate::embree::{CurveBasis, CurveShape, Device, MemoryMonitor, Ray, SceneOptions};
+use crate::scene::FurBall;
+use crate::scene::curves::Curves;
+use crate::scene::hit::Hit;
+use crate::scene::tracer::TracerBuilder;
 use glam::Vec3;
-use hairtrace::embree::{CurveBasis, CurveShape, Device, MemoryMonitor, Ray, SceneOptions};
-use hairtrace::scene::FurBall;
-use hairtrace::scene::curves::Curves;
-use hairtrace::scene::hit::Hit;
-use hairtrace::scene::tracer::TracerBuilder;
 
 const STRANDS: usize = 1_000_000;
 const SEGMENTS: u32 = 16;

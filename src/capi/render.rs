@@ -184,6 +184,11 @@ impl Progress for HostProgress {
         // SAFETY: the host's function pointer and its own user pointer.
         unsafe { (self.callback)(done, total, self.user) }
     }
+
+    /// A cancelled render leaves the passes each pixel finished, as `HtProgressFn` says.
+    fn keeps_passes(&self) -> bool {
+        true
+    }
 }
 
 /// Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never

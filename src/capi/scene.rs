@@ -200,7 +200,7 @@ impl HtScene {
                     self.device.clone(),
                     self.lights.clone(),
                     &view,
-                    film_bytes(settings, Aovs::default()),
+                    film_bytes(settings, Aovs::default(), true),
                     &mut StageRunner::new(progress),
                 )?;
                 self.world = Some(built.world);

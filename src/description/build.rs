@@ -12,10 +12,10 @@ use super::{
     MeshDesc, MeshSource, SceneDescription, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
-use crate::render::Aovs;
-use crate::render::renderer::film_bytes;
 use crate::embree::{CurveBasis, Device};
 use crate::error::{Error, Result, invalid_arg};
+use crate::render::Aovs;
+use crate::render::renderer::film_bytes;
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -125,7 +125,7 @@ impl SceneDescription {
             .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
         let view = DetailView::new(camera, settings.height, settings.lod_pixels);
-        let film = film_bytes(&settings, Aovs::default());
+        let film = film_bytes(&settings, Aovs::default(), true);
         let built = assembly.build(device, lights, &view, film, &mut stages)?;
         Ok(BuiltScene {
             world: built.world,
@@ -143,10 +143,10 @@ impl SceneDescription {
     /// Refuses the description when its render's film, or its procedural grooms (whose
     /// sizes are known before anything is made) with the film, would need more than
     /// `available` bytes at their peak (see [`footprint`]); grooms from files are checked
-    /// once read, before the BVH build. The film is counted without AOVs, which a render
-    /// chooses (and checks again).
+    /// once read, before the BVH build. The film is counted without AOVs and as one in
+    /// passes (the larger), as a render chooses those (and checks again).
     pub(crate) fn check_memory(&self, available: Option<u64>) -> Result<()> {
-        let film = film_bytes(&self.render, Aovs::default());
+        let film = film_bytes(&self.render, Aovs::default(), true);
         footprint::check_film_fits(film, available).map_err(|e| e.context(&self.origin))?;
         let (mut sizes, mut conversion) = (Vec::new(), 0);
         for g in &self.grooms {

@@ -12,8 +12,7 @@ pub mod settings;
 pub(crate) mod tiles;
 
 pub use film::{
-    Aovs, Film, FirstHit, Keep, NO_HIT_DEPTH, NO_STRAND, PixelAccumulator, PixelFilter, Window,
-    ndc,
+    Aovs, Film, FirstHit, Keep, NO_HIT_DEPTH, NO_STRAND, PixelAccumulator, PixelFilter, Window, ndc,
 };
 pub use progress::{NoProgress, Progress};
 pub use sampler::PixelSampler;

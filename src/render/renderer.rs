@@ -51,20 +51,22 @@ fn stops_early(settings: &RenderSettings) -> bool {
     settings.noise_target.is_some() || settings.time_budget.is_some()
 }
 
-/// What the film of a render with `settings` keeps besides its image: nothing for a
-/// render that takes each pixel's samples at once, the sums for one whose pilot comes
-/// first, and the noise estimate's halves for one that may stop early.
-pub fn film_keep(settings: &RenderSettings) -> Keep {
-    match (stops_early(settings), settings.allocation) {
-        (true, _) => Keep::Halves,
-        (false, Allocation::Noise) => Keep::Sums,
-        (false, Allocation::Uniform) => Keep::Image,
+/// What the film of a render with `settings` keeps besides its image: the noise
+/// estimate's halves for one that may stop early, the sums for one in passes (whose
+/// progress sink [keeps passes](Progress::keeps_passes)) or whose pilot comes first, and
+/// nothing for one that takes each pixel's samples at once.
+pub fn film_keep(settings: &RenderSettings, keeps_passes: bool) -> Keep {
+    match (stops_early(settings), keeps_passes, settings.allocation) {
+        (true, _, _) => Keep::Halves,
+        (false, true, _) | (false, false, Allocation::Noise) => Keep::Sums,
+        (false, false, Allocation::Uniform) => Keep::Image,
     }
 }
 
-/// The bytes of the films a render with `settings` and `aovs` holds: its film's and the
-/// noise allocation's pilot's. Zero for settings whose crop is not inside the frame.
-pub fn film_bytes(settings: &RenderSettings, aovs: Aovs) -> u64 {
+/// The bytes of the films a render with `settings` and `aovs` holds, its progress sink
+/// keeping passes or not: its film's and the noise allocation's pilot's. Zero for settings
+/// whose crop is not inside the frame.
+pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> u64 {
     let (width, height) = (settings.width, settings.height);
     let window = settings.crop.map_or(
         Window {
@@ -77,7 +79,7 @@ pub fn film_bytes(settings: &RenderSettings, aovs: Aovs) -> u64 {
     );
     let film = window
         .pixel_count()
-        .saturating_mul(film_keep(settings).bytes_per_pixel(aovs));
+        .saturating_mul(film_keep(settings, keeps_passes).bytes_per_pixel(aovs));
     let pilot = match settings.allocation {
         Allocation::Uniform => 0,
         Allocation::Noise => allocation::pilot_window(window, width, height)
@@ -100,7 +102,8 @@ pub fn film_bytes(settings: &RenderSettings, aovs: Aovs) -> u64 {
 /// then, bit for bit, that of a render with `spp` = the samples taken
 /// ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`. A render
 /// with neither takes all its passes (after the pilot) at once, the same samples in the
-/// same order, so that its film need not keep them between passes ([`film_keep`]).
+/// same order, so that its film need not keep them between passes ([`film_keep`]), unless
+/// `progress` [keeps passes](Progress::keeps_passes).
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -119,18 +122,27 @@ pub fn render(
              or with fewer pixels): build the scene again for this camera and image height"
         ));
     }
-    footprint::check_film_fits(film_bytes(settings, aovs), available_bytes())?;
+    let in_passes = stops_early(settings) || progress.keeps_passes();
+    let bytes = film_bytes(settings, aovs, progress.keeps_passes());
+    footprint::check_film_fits(bytes, available_bytes())?;
     let (width, height) = (settings.width, settings.height);
     let crop = settings
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
-    let mut film = Film::keeping(width, height, crop, aovs, film_keep(settings))?;
+    let keep = film_keep(settings, progress.keeps_passes());
+    let mut film = Film::keeping(width, height, crop, aovs, keep)?;
     // The noise allocation's pilot, over whole blocks around the crop.
     let mut pilot = match settings.allocation {
         Allocation::Uniform => None,
         Allocation::Noise => {
             let window = allocation::pilot_window(film.crop(), width, height);
-            Some(Film::keeping(width, height, Some(window), aovs, Keep::Spread)?)
+            Some(Film::keeping(
+                width,
+                height,
+                Some(window),
+                aovs,
+                Keep::Spread,
+            )?)
         }
     };
     let mut shares: Option<allocation::Shares> = None;
@@ -143,10 +155,13 @@ pub fn render(
     let passes = settings.spp.div_ceil(PASS_SAMPLES);
     // The passes each round of tiles takes: one at a time where the render may stop
     // between them, else all at once (the pilot first).
-    let rounds: Vec<Range<u32>> = match (stops_early(settings), &pilot) {
+    let rounds: Vec<Range<u32>> = match (in_passes, &pilot) {
         (true, _) => (0..passes).map(|p| p..p + 1).collect(),
-        (false, None) => vec![0..passes],
-        (false, Some(_)) => [0..1, 1..passes].into_iter().filter(|r| !r.is_empty()).collect(),
+        (false, None) => std::iter::once(0..passes).collect(),
+        (false, Some(_)) => [0..1, 1..passes]
+            .into_iter()
+            .filter(|r| !r.is_empty())
+            .collect(),
     };
     let start = Instant::now();
     let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);

@@ -114,9 +114,10 @@ fn a_noise_target_stops_at_the_first_pass_that_reaches_it_with_the_plain_renders
     assert_eq!((plain.stats.noise, plain.film.keep()), (None, Keep::Image));
 }
 
-/// A film keeps only what its render reads: a plain render its image alone, one that may
-/// stop early the sums and the noise estimate's halves, the noise allocation the sums of
-/// its film and its pilot's squares and rays. The bytes per pixel are the layout's.
+/// A film keeps only what its render reads: a plain render its image alone (the sums too
+/// for a progress sink that keeps passes), one that may stop early the sums and the noise
+/// estimate's halves, the noise allocation the sums of its film and its pilot's squares and
+/// rays. The bytes per pixel are the layout's.
 #[test]
 fn a_film_keeps_only_what_its_render_reads() {
     let world = lit_world();
@@ -157,8 +158,21 @@ fn a_film_keeps_only_what_its_render_reads() {
             Allocation::Uniform => 0,
             Allocation::Noise => pixels * Keep::Spread.bytes_per_pixel(all),
         };
-        assert_eq!(film_bytes(&settings, all), out.film.bytes() + pilot);
+        assert_eq!(film_bytes(&settings, all, false), out.film.bytes() + pilot);
     }
+    // A sink that keeps passes (the C ABI's callback) has a plain render keep the sums.
+    struct KeepsPasses;
+    impl Progress for KeepsPasses {
+        fn update(&self, _: u64, _: u64) -> bool {
+            true
+        }
+        fn keeps_passes(&self) -> bool {
+            true
+        }
+    }
+    let out = render(&world, &camera(), &small(16, 1), all, &KeepsPasses).unwrap();
+    assert_eq!(out.film.keep(), Keep::Sums);
+    assert_eq!(film_bytes(&small(16, 1), all, true), out.film.bytes());
 }
 
 /// A time budget far below one pass's time (a microsecond) still renders the first pass,

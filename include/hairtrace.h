@@ -1474,7 +1474,8 @@ typedef uint32_t HtPixelFilter;
  *
  * Called from the render's worker threads (not necessarily the one that called
  * `ht_render`), but never two calls at once, so `user` needs no locking against itself.
- * The callback must return normally: a C++ exception or a longjmp out of it is undefined
+ * Inside it, `ht_progress_noise()` tells the render's estimated noise so far. The
+ * callback must return normally: a C++ exception or a longjmp out of it is undefined
  * behaviour (catch inside and return false instead).
  */
 typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
@@ -1596,6 +1597,15 @@ extern "C" {
  * deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
  */
 struct HtRenderSettings ht_render_settings_default(void);
+
+/**
+ * The estimated noise of the render whose progress callback calls this (the RMSE of its
+ * pixels relative to the image's mean, as `noise_target` measures it) after its last
+ * finished pass. -1 outside a progress callback, and inside one before the render has an
+ * estimate: until two passes have finished, or always for a render with neither a
+ * `noise_target` nor a `time_budget` (which estimates no noise).
+ */
+float ht_progress_noise(void);
 
 /**
  * Deprecated with `HtRenderSettings`: use `ht_scene_build_with`.

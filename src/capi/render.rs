@@ -12,8 +12,10 @@ use crate::render::renderer::render;
 use crate::render::settings::{Filter, PathSettings, RenderSettings};
 use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
 use crate::scene::stages::{NoStages, Stage, StageProgress};
+use std::cell::Cell;
 use std::ffi::{c_char, c_void};
 use std::ptr::null_mut;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Told how far a render has got: `done` of `total` pixels, counted over the render's
 /// passes of 8 spp (`total` is the pixels times the passes `spp` allows; a render that a
@@ -26,7 +28,8 @@ use std::ptr::null_mut;
 ///
 /// Called from the render's worker threads (not necessarily the one that called
 /// `ht_render`), but never two calls at once, so `user` needs no locking against itself.
-/// The callback must return normally: a C++ exception or a longjmp out of it is undefined
+/// Inside it, `ht_progress_noise()` tells the render's estimated noise so far. The
+/// callback must return normally: a C++ exception or a longjmp out of it is undefined
 /// behaviour (catch inside and return false instead).
 pub type HtProgressFn =
     Option<unsafe extern "C" fn(done: u64, total: u64, user: *mut c_void) -> bool>;
@@ -172,6 +175,27 @@ impl HtRenderSettings {
 struct HostProgress {
     callback: unsafe extern "C" fn(u64, u64, *mut c_void) -> bool,
     user: *mut c_void,
+    /// The estimated noise after the last pass, as f32 bits; [`NO_NOISE`] before one.
+    noise: AtomicU32,
+}
+
+/// What [`ht_progress_noise`] returns without an estimate.
+const NO_NOISE: f32 = -1.0;
+
+thread_local! {
+    /// The noise of the render whose progress callback this thread is running, while it
+    /// runs it: [`ht_progress_noise`]'s answer.
+    static CALLBACK_NOISE: Cell<f32> = const { Cell::new(NO_NOISE) };
+}
+
+/// The estimated noise of the render whose progress callback calls this (the RMSE of its
+/// pixels relative to the image's mean, as `noise_target` measures it) after its last
+/// finished pass. -1 outside a progress callback, and inside one before the render has an
+/// estimate: until two passes have finished, or always for a render with neither a
+/// `noise_target` nor a `time_budget` (which estimates no noise).
+#[unsafe(no_mangle)]
+pub extern "C" fn ht_progress_noise() -> f32 {
+    CALLBACK_NOISE.with(Cell::get)
 }
 
 // SAFETY: the renderer never calls `update` from two threads at once (the Progress
@@ -181,8 +205,22 @@ unsafe impl Sync for HostProgress {}
 
 impl Progress for HostProgress {
     fn update(&self, done: u64, total: u64) -> bool {
+        let noise = f32::from_bits(self.noise.load(Ordering::Relaxed));
+        let before = CALLBACK_NOISE.replace(noise);
         // SAFETY: the host's function pointer and its own user pointer.
-        unsafe { (self.callback)(done, total, self.user) }
+        let going_on = unsafe { (self.callback)(done, total, self.user) };
+        CALLBACK_NOISE.set(before);
+        going_on
+    }
+
+    fn pass(&self, _samples_per_pixel: u32, noise: Option<f32>) {
+        let noise = noise.unwrap_or(NO_NOISE);
+        self.noise.store(noise.to_bits(), Ordering::Relaxed);
+    }
+
+    /// A cancelled render leaves the passes each pixel finished, as `HtProgressFn` says.
+    fn keeps_passes(&self) -> bool {
+        true
     }
 }
 
@@ -415,7 +453,11 @@ fn render_into(
     let host;
     let progress: &dyn Progress = match progress {
         Some(callback) => {
-            host = HostProgress { callback, user };
+            host = HostProgress {
+                callback,
+                user,
+                noise: AtomicU32::new(NO_NOISE.to_bits()),
+            };
             &host
         }
         None => &NoProgress,

@@ -202,3 +202,58 @@ fn every_setting_is_listed_by_key() {
         assert_eq!(named.get(s.name), s.default_text());
     }
 }
+
+/// Each noise a progress callback reads through `ht_progress_noise`, as f32 bits.
+extern "C" fn record_noise(_done: u64, _total: u64, user: *mut std::ffi::c_void) -> bool {
+    // SAFETY: the test's vector, alive until the render returns; calls never overlap.
+    let seen = unsafe { &*user.cast::<std::sync::Mutex<Vec<f32>>>() };
+    seen.lock().unwrap().push(ht_progress_noise());
+    true
+}
+
+/// A progress callback of a render with a noise target reads the estimated noise: -1
+/// until two passes have finished, then finite and positive, the last one read above the
+/// target the render then reached. Outside a callback, and in a render without a target
+/// or a time budget (which estimates none), it reads -1.
+#[test]
+fn a_progress_callback_reads_the_estimated_noise() {
+    let h = fur_scene(true);
+    let run = |pairs: &[(&str, &str)]| {
+        let named = Named::new(pairs);
+        let seen = std::sync::Mutex::new(Vec::new());
+        let pixels = 24 * 24;
+        let mut rgb = vec![-1.0f32; 3 * pixels];
+        let status = unsafe {
+            ht_render_with(
+                h.scene,
+                named.0,
+                Some(record_noise),
+                std::ptr::from_ref(&seen).cast_mut().cast(),
+                rgb.as_mut_ptr(),
+                rgb.len(),
+                null_mut(),
+                null_mut(),
+                null_mut(),
+                pixels,
+            )
+        };
+        assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
+        seen.into_inner().unwrap()
+    };
+    let size = [("width", "24"), ("height", "24"), ("threads", "2")];
+    let target = 0.02;
+    let seen = run(&[size.as_slice(), &[("spp", "512"), ("noise_target", "0.02")]].concat());
+    let estimates: Vec<f32> = seen.iter().copied().filter(|&n| n != -1.0).collect();
+    assert!(seen[0] == -1.0, "{seen:?}");
+    assert!(
+        estimates.len() > 2 && estimates.iter().all(|n| n.is_finite() && *n > 0.0),
+        "{seen:?}"
+    );
+    assert!(*estimates.last().unwrap() > target, "{estimates:?}");
+    let plain = run(&[size.as_slice(), &[("spp", "32")]].concat());
+    assert!(
+        !plain.is_empty() && plain.iter().all(|&n| n == -1.0),
+        "{plain:?}"
+    );
+    assert_eq!(ht_progress_noise(), -1.0);
+}

@@ -72,13 +72,14 @@ impl Assembly {
     }
 
     /// Builds the world for `view`: `auto` curves shared out for it, the memory the BVH
-    /// build will need checked against what is available, then the BVH built (timed as
-    /// [`Stage::Bvh`] in `stages`).
+    /// build and then a render's `film` bytes (`renderer::film_bytes`) will need checked
+    /// against what is available, then the BVH built (timed as [`Stage::Bvh`] in `stages`).
     pub fn build(
         self,
         device: Arc<Device>,
         lights: Vec<Light>,
         view: &DetailView,
+        film: u64,
         stages: &mut StageRunner,
     ) -> Result<Assembled> {
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
@@ -115,9 +116,15 @@ impl Assembly {
             materials.extend(std::iter::repeat_n(part.material, added));
             built_from.extend(std::iter::repeat_n(i, added));
         }
-        // What is built so far is held already: only Embree's part is still to come.
-        let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum();
-        footprint::check_fits(&sizes, bvh, "more for the BVH build", available_bytes())?;
+        // What is built so far is held already: only Embree's part and the film are still
+        // to come.
+        let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum::<u64>();
+        footprint::check_fits(
+            &sizes,
+            bvh.saturating_add(film),
+            "more for the BVH build and the film",
+            available_bytes(),
+        )?;
         let tracer = stages.run(Stage::Bvh, (0, 1), |stages| tracer.build_with(stages))?;
         Ok(Assembled {
             world: World::new(tracer, materials, lights)?,

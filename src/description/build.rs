@@ -14,6 +14,8 @@ use super::{
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device};
 use crate::error::{Error, Result, invalid_arg};
+use crate::render::Aovs;
+use crate::render::renderer::film_bytes;
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -123,7 +125,8 @@ impl SceneDescription {
             .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
         let view = DetailView::new(camera, settings.height, settings.lod_pixels);
-        let built = assembly.build(device, lights, &view, &mut stages)?;
+        let film = film_bytes(&settings, Aovs::default(), true);
+        let built = assembly.build(device, lights, &view, film, &mut stages)?;
         Ok(BuiltScene {
             world: built.world,
             camera,
@@ -137,10 +140,14 @@ impl SceneDescription {
         })
     }
 
-    /// Refuses the description when its procedural grooms, whose sizes are known before
-    /// anything is made, would need more than `available` bytes at their peak (see
-    /// [`footprint`]); grooms from files are checked once read, before the BVH build.
+    /// Refuses the description when its render's film, or its procedural grooms (whose
+    /// sizes are known before anything is made) with the film, would need more than
+    /// `available` bytes at their peak (see [`footprint`]); grooms from files are checked
+    /// once read, before the BVH build. The film is counted without AOVs and as one in
+    /// passes (the larger), as a render chooses those (and checks again).
     pub(crate) fn check_memory(&self, available: Option<u64>) -> Result<()> {
+        let film = film_bytes(&self.render, Aovs::default(), true);
+        footprint::check_film_fits(film, available).map_err(|e| e.context(&self.origin))?;
         let (mut sizes, mut conversion) = (Vec::new(), 0);
         for g in &self.grooms {
             let (strands, segments) = match &g.source {
@@ -162,7 +169,10 @@ impl SceneDescription {
         if sizes.is_empty() {
             return Ok(());
         }
-        let needed = footprint::build_bytes(&sizes).max(conversion);
+        // The film comes after the build, beside what the build keeps (at most its peak).
+        let needed = footprint::build_bytes(&sizes)
+            .saturating_add(film)
+            .max(conversion);
         footprint::check_fits(&sizes, needed, "at their peak", available)
             .map_err(|e| e.context(&self.origin))
     }

@@ -143,8 +143,8 @@ fn pilot_weight(pilot: &PixelAccumulator, own: &PixelAccumulator) -> f64 {
 pub(super) fn blend(film: &mut Film, pilot: &Film) {
     for p in film.crop().pixels() {
         let first = pilot.accumulator(p);
-        let weight = pilot_weight(first, film.accumulator(p));
-        film.store_blend(p, first, weight);
+        let weight = pilot_weight(&first, &film.accumulator(p));
+        film.store_blend(p, &first, weight);
     }
 }
 
@@ -154,7 +154,7 @@ pub(super) fn blended_noise(film: &Film, pilot: &Film) -> Option<f32> {
     let mut pixels = Vec::with_capacity(film.crop().pixel_count() as usize);
     for p in film.crop().pixels() {
         let (own, first) = (film.accumulator(p), pilot.accumulator(p));
-        let wp = pilot_weight(first, own);
+        let wp = pilot_weight(&first, &own);
         let wa = 1.0 - wp;
         let (ma, va) = (own.mean_rgb(), own.variance_of_mean()?);
         let (mp, vp) = (first.mean_rgb(), first.sample_variance());

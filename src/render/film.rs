@@ -152,8 +152,9 @@ pub const NO_HIT_DEPTH: f32 = 0.0;
 pub const NO_STRAND: f32 = -1.0;
 
 /// Sums one pixel's samples, over a render's passes, keeping the sums at the last two
-/// power-of-two pass counts: the two halves that estimate the noise of the mean. The film keeps one per pixel across passes; the tiles hand it to the
-/// per-pixel function and store its averages.
+/// power-of-two pass counts: the two halves that estimate the noise of the mean. The tiles
+/// take one from the film for each pixel they render, hand it to the per-pixel function and
+/// store it back; the film keeps of it only what its [`Keep`] says.
 #[derive(Debug, Clone)]
 pub struct PixelAccumulator {
     rgb: [f64; 3],
@@ -169,9 +170,9 @@ pub struct PixelAccumulator {
     /// Passes ended ([`Self::end_pass`]).
     passes: u32,
     /// The sums and sample counts when `passes` was last a power of two, and the time
-    /// before (half as many passes).
-    last_power: ([f64; 3], u32),
-    half_power: ([f64; 3], u32),
+    /// before (half as many passes); f32, as they only estimate the noise.
+    last_power: ([f32; 3], u32),
+    half_power: ([f32; 3], u32),
 }
 
 impl Default for PixelAccumulator {
@@ -267,7 +268,7 @@ impl PixelAccumulator {
         self.passes += 1;
         if self.passes.is_power_of_two() {
             self.half_power = self.last_power;
-            self.last_power = (self.rgb, self.samples);
+            self.last_power = (self.rgb.map(|v| v as f32), self.samples);
         }
     }
 
@@ -290,10 +291,61 @@ impl PixelAccumulator {
             f64::from(self.samples),
         );
         Some(std::array::from_fn(|c| {
-            let d = first[c] / a - (self.rgb[c] - first[c]) / b;
+            let first = f64::from(first[c]);
+            let d = first / a - (self.rgb[c] - first) / b;
             // E[d^2] = sigma^2 (1/a + 1/b) for independent samples of variance sigma^2.
             d * d / (1.0 / a + 1.0 / b) / n
         }))
+    }
+}
+
+/// What a film keeps of each pixel's samples besides its image: only what the render that
+/// fills it reads, since at 4K each byte per pixel is 8 MB.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum Keep {
+    /// The image alone: a render into the film replaces its pixels. For a render that takes
+    /// all its samples of a pixel at once.
+    Image,
+    /// Also each pixel's sums, so that a further render into the film adds to them: a
+    /// render in passes.
+    #[default]
+    Sums,
+    /// The sums and the two halves of [`PixelAccumulator::variance_of_mean`]: a render in
+    /// passes that estimates its noise.
+    Halves,
+    /// The sums, the squares and the rays of each pixel: its variance and cost per sample
+    /// (the noise allocation's pilot).
+    Spread,
+}
+
+/// The two halves a [`Keep::Halves`] film keeps of a pixel.
+#[derive(Debug, Clone, Copy, Default)]
+struct Halves {
+    passes: u32,
+    last_power: ([f32; 3], u32),
+    half_power: ([f32; 3], u32),
+}
+
+impl Keep {
+    /// The bytes a film of `aovs` keeping this takes per pixel: its image and AOVs, and the
+    /// running sums kept besides.
+    pub fn bytes_per_pixel(self, aovs: Aovs) -> u64 {
+        let f32s = |n: usize| (n * size_of::<f32>()) as u64;
+        let mut bytes = f32s(3)
+            + f32s(3) * u64::from(aovs.albedo)
+            + f32s(1) * u64::from(aovs.depth)
+            + f32s(1) * u64::from(aovs.strand_id);
+        if self != Keep::Image {
+            bytes += (size_of::<[f64; 3]>() + size_of::<u32>()) as u64;
+            bytes += size_of::<[f64; 3]>() as u64 * u64::from(aovs.albedo);
+            bytes += f32s(1) * u64::from(aovs.depth || aovs.strand_id);
+        }
+        bytes
+            + match self {
+                Keep::Halves => size_of::<Halves>() as u64,
+                Keep::Spread => (size_of::<[f64; 3]>() + size_of::<u64>()) as u64,
+                Keep::Image | Keep::Sums => 0,
+            }
     }
 }
 
@@ -306,23 +358,53 @@ pub fn ndc(width: u32, height: u32, pixel: (u32, u32), offset: [f32; 2]) -> [f32
     ]
 }
 
-/// Float RGB (and AOV) pixels of a crop window of a `width` x `height` frame.
+/// Float RGB (and AOV) pixels of a crop window of a `width` x `height` frame, and what
+/// its [`Keep`] says of each pixel's samples.
 #[derive(Debug, Clone)]
 pub struct Film {
     width: u32,
     height: u32,
     crop: Window,
+    keep: Keep,
     rgb: Vec<f32>,
     albedo: Option<Vec<f32>>,
     depth: Option<Vec<f32>>,
     strand_id: Option<Vec<f32>>,
-    /// Every pixel's samples so far: a further render into this film adds to them.
-    accumulators: Vec<PixelAccumulator>,
+    /// Each pixel's kept sums; empty where the [`Keep`] or the AOVs do not ask for them.
+    sums: Vec<[f64; 3]>,
+    samples: Vec<u32>,
+    albedo_sums: Vec<[f64; 3]>,
+    nearest: Vec<f32>,
+    halves: Vec<Halves>,
+    squares: Vec<[f64; 3]>,
+    rays: Vec<u64>,
+    /// Over the whole film: samples taken, rejected ([`PixelAccumulator::add`]) and rays
+    /// traced by the samples of the pixels as stored.
+    totals: Totals,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+struct Totals {
+    samples: u64,
+    rejected: u64,
+    rays: u64,
 }
 
 impl Film {
-    /// A black film of the full frame, or of `crop` (non-empty, inside the frame).
+    /// A black film of the full frame, or of `crop` (non-empty, inside the frame), that
+    /// keeps each pixel's sums ([`Keep::Sums`]).
     pub fn new(width: u32, height: u32, crop: Option<Window>, aovs: Aovs) -> Result<Self> {
+        Self::keeping(width, height, crop, aovs, Keep::Sums)
+    }
+
+    /// A black film as [`Self::new`] makes, keeping `keep` of each pixel's samples.
+    pub fn keeping(
+        width: u32,
+        height: u32,
+        crop: Option<Window>,
+        aovs: Aovs,
+        keep: Keep,
+    ) -> Result<Self> {
         if width == 0 || height == 0 {
             return Err(invalid_arg!(
                 "film size {width} x {height} must be at least 1 x 1"
@@ -346,29 +428,33 @@ impl Film {
         }
         let pixels = usize::try_from(crop.pixel_count())
             .map_err(|_| invalid_arg!("film of {width} x {height} is too large"))?;
-        let rgb = zeroed(pixels, 3)?;
-        let mut accumulators = Vec::new();
-        accumulators
-            .try_reserve_exact(pixels)
-            .map_err(|_| invalid_arg!("cannot allocate a film of {pixels} pixels"))?;
-        accumulators.resize(pixels, PixelAccumulator::default());
-        let aov = |on: bool, channels, fill| -> Result<Option<Vec<f32>>> {
-            on.then(|| {
-                let mut v = zeroed(pixels, channels)?;
-                v.fill(fill);
-                Ok(v)
-            })
-            .transpose()
+        let values = |channels: usize| {
+            pixels
+                .checked_mul(channels)
+                .ok_or_else(|| invalid_arg!("film of {width} x {height} is too large"))
         };
+        let aov = |on: bool, channels, fill| -> Result<Option<Vec<f32>>> {
+            on.then(|| filled(values(channels)?, fill)).transpose()
+        };
+        let sums = keep != Keep::Image;
+        let kept = |on: bool| if on { pixels } else { 0 };
         Ok(Self {
             width,
             height,
             crop,
-            rgb,
+            keep,
+            rgb: filled(values(3)?, 0.0)?,
             albedo: aov(aovs.albedo, 3, 0.0)?,
             depth: aov(aovs.depth, 1, NO_HIT_DEPTH)?,
             strand_id: aov(aovs.strand_id, 1, NO_STRAND)?,
-            accumulators,
+            sums: filled(kept(sums), [0.0; 3])?,
+            samples: filled(kept(sums), 0)?,
+            albedo_sums: filled(kept(sums && aovs.albedo), [0.0; 3])?,
+            nearest: filled(kept(sums && (aovs.depth || aovs.strand_id)), f32::INFINITY)?,
+            halves: filled(kept(keep == Keep::Halves), Halves::default())?,
+            squares: filled(kept(keep == Keep::Spread), [0.0; 3])?,
+            rays: filled(kept(keep == Keep::Spread), 0)?,
+            totals: Totals::default(),
         })
     }
 
@@ -384,6 +470,28 @@ impl Film {
 
     pub fn crop(&self) -> Window {
         self.crop
+    }
+
+    /// What the film keeps of each pixel's samples.
+    pub fn keep(&self) -> Keep {
+        self.keep
+    }
+
+    /// The bytes the film's pixels take: its image, AOVs and kept sums.
+    pub fn bytes(&self) -> u64 {
+        fn of<T>(v: &[T]) -> u64 {
+            size_of_val(v) as u64
+        }
+        let aovs = [&self.albedo, &self.depth, &self.strand_id];
+        of(&self.rgb)
+            + aovs.iter().map(|a| a.as_deref().map_or(0, of)).sum::<u64>()
+            + of(&self.sums)
+            + of(&self.samples)
+            + of(&self.albedo_sums)
+            + of(&self.nearest)
+            + of(&self.halves)
+            + of(&self.squares)
+            + of(&self.rays)
     }
 
     /// The camera's [0, 1]^2 image point of a sample; see `render::film::ndc`.
@@ -416,19 +524,21 @@ impl Film {
     /// Samples whose values were NaN or infinite, counted as black (see
     /// `PixelAccumulator::add`).
     pub fn rejected_samples(&self) -> u64 {
-        self.accumulators
-            .iter()
-            .map(|a| u64::from(a.rejected))
-            .sum()
+        self.totals.rejected
     }
 
     /// The estimated noise of the image: the RMSE of its pixels' means (over pixels and
     /// channels, as `hairtrace compare` measures it) relative to the image's mean, from
-    /// `PixelAccumulator::variance_of_mean`. None before two passes, or for an image
-    /// whose mean is not positive while it has noise.
+    /// `PixelAccumulator::variance_of_mean`. None before two passes, for a film that
+    /// does not keep the halves ([`Keep::Halves`]), or for an image whose mean is not
+    /// positive while it has noise.
     pub fn noise(&self) -> Option<f32> {
-        let mut pixels = Vec::with_capacity(self.accumulators.len());
-        for acc in &self.accumulators {
+        if self.halves.is_empty() {
+            return None;
+        }
+        let mut pixels = Vec::with_capacity(self.halves.len());
+        for p in self.crop.pixels() {
+            let acc = self.accumulator(p);
             pixels.push((acc.mean_rgb(), acc.variance_of_mean()?));
         }
         relative_rmse(pixels)
@@ -436,12 +546,12 @@ impl Film {
 
     /// Camera samples taken so far.
     pub fn samples(&self) -> u64 {
-        self.accumulators.iter().map(|a| u64::from(a.samples)).sum()
+        self.totals.samples
     }
 
     /// Rays traced by the samples so far.
     pub fn rays(&self) -> u64 {
-        self.accumulators.iter().map(|a| a.rays).sum()
+        self.totals.rays
     }
 
     fn index(&self, pixel: (u32, u32)) -> usize {
@@ -449,15 +559,60 @@ impl Film {
             + (pixel.0 - self.crop.x0) as usize
     }
 
-    /// The samples so far of a pixel (full-frame coordinates, inside the crop).
-    pub(super) fn accumulator(&self, pixel: (u32, u32)) -> &PixelAccumulator {
-        &self.accumulators[self.index(pixel)]
+    /// The samples so far of a pixel (full-frame coordinates, inside the crop), as far as
+    /// the film keeps them: none of an [`Keep::Image`] film's, and its rejected samples
+    /// and (but for [`Keep::Spread`]) rays counted in the film's totals instead.
+    pub(super) fn accumulator(&self, pixel: (u32, u32)) -> PixelAccumulator {
+        let i = self.index(pixel);
+        let mut acc = PixelAccumulator::default();
+        if let (Some(&rgb), Some(&samples)) = (self.sums.get(i), self.samples.get(i)) {
+            (acc.rgb, acc.samples) = (rgb, samples);
+        }
+        if let Some(&albedo) = self.albedo_sums.get(i) {
+            acc.albedo = albedo;
+        }
+        if let Some(&nearest) = self.nearest.get(i) {
+            acc.nearest = nearest;
+            acc.strand = self.strand_id.as_ref().map_or(NO_STRAND, |s| s[i]);
+        }
+        if let Some(h) = self.halves.get(i) {
+            (acc.passes, acc.last_power, acc.half_power) = (h.passes, h.last_power, h.half_power);
+        }
+        if let (Some(&squares), Some(&rays)) = (self.squares.get(i), self.rays.get(i)) {
+            (acc.rgb_sq, acc.rays) = (squares, rays);
+        }
+        acc
     }
 
-    /// Stores a pixel's samples so far, given in full-frame coordinates inside the crop.
+    /// Stores a pixel's samples so far, given in full-frame coordinates inside the crop:
+    /// `acc` grew from [`Self::accumulator`]'s.
     pub(super) fn store(&mut self, pixel: (u32, u32), acc: &PixelAccumulator) {
         let i = self.index(pixel);
-        self.accumulators[i] = acc.clone();
+        let kept = self.accumulator(pixel);
+        // What `acc` adds to the kept counts (the totals hold those, so never go negative).
+        let t = &mut self.totals;
+        t.samples = t.samples + u64::from(acc.samples) - u64::from(kept.samples);
+        t.rejected = t.rejected + u64::from(acc.rejected) - u64::from(kept.rejected);
+        t.rays = t.rays + acc.rays - kept.rays;
+        if let (Some(rgb), Some(samples)) = (self.sums.get_mut(i), self.samples.get_mut(i)) {
+            (*rgb, *samples) = (acc.rgb, acc.samples);
+        }
+        if let Some(albedo) = self.albedo_sums.get_mut(i) {
+            *albedo = acc.albedo;
+        }
+        if let Some(nearest) = self.nearest.get_mut(i) {
+            *nearest = acc.nearest;
+        }
+        if let Some(h) = self.halves.get_mut(i) {
+            *h = Halves {
+                passes: acc.passes,
+                last_power: acc.last_power,
+                half_power: acc.half_power,
+            };
+        }
+        if let (Some(squares), Some(rays)) = (self.squares.get_mut(i), self.rays.get_mut(i)) {
+            (*squares, *rays) = (acc.rgb_sq, acc.rays);
+        }
         self.write(i, acc.mean(acc.rgb), acc.mean(acc.albedo), acc);
     }
 
@@ -471,7 +626,7 @@ impl Film {
         pilot_weight: f64,
     ) {
         let i = self.index(pixel);
-        let own = &self.accumulators[i];
+        let own = self.accumulator(pixel);
         let blend = |p: [f32; 3], o: [f32; 3]| {
             std::array::from_fn(|c| {
                 (pilot_weight * f64::from(p[c]) + (1.0 - pilot_weight) * f64::from(o[c])) as f32
@@ -480,11 +635,11 @@ impl Film {
         let rgb = blend(pilot.mean(pilot.rgb), own.mean(own.rgb));
         let albedo = blend(pilot.mean(pilot.albedo), own.mean(own.albedo));
         let nearest = if pilot.nearest < own.nearest {
-            pilot.clone()
+            pilot
         } else {
-            own.clone()
+            &own
         };
-        self.write(i, rgb, albedo, &nearest);
+        self.write(i, rgb, albedo, nearest);
     }
 
     /// Writes pixel `i`'s colour, albedo, and the depth and strand of `nearest`'s hit.
@@ -521,14 +676,12 @@ pub(super) fn relative_rmse(pixels: Vec<([f64; 3], [f64; 3])>) -> Option<f32> {
     }
 }
 
-/// A zero-filled buffer, or an error rather than an abort when memory runs out.
-fn zeroed(pixels: usize, channels: usize) -> Result<Vec<f32>> {
-    let n = pixels
-        .checked_mul(channels)
-        .ok_or_else(|| invalid_arg!("film of {pixels} pixels is too large"))?;
+/// A buffer of `n` copies of `fill`, or an error rather than an abort when memory runs
+/// out.
+fn filled<T: Copy>(n: usize, fill: T) -> Result<Vec<T>> {
     let mut v = Vec::new();
     v.try_reserve_exact(n)
-        .map_err(|_| invalid_arg!("cannot allocate a film of {pixels} pixels"))?;
-    v.resize(n, 0.0);
+        .map_err(|_| invalid_arg!("cannot allocate a film of {n} values"))?;
+    v.resize(n, fill);
     Ok(v)
 }

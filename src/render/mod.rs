@@ -11,7 +11,7 @@ pub(crate) mod sampler;
 pub mod settings;
 pub(crate) mod tiles;
 
-pub use film::{Aovs, Film, NO_HIT_DEPTH, NO_STRAND, PixelFilter, Window};
+pub use film::{Aovs, Film, Keep, NO_HIT_DEPTH, NO_STRAND, PixelFilter, Window};
 pub use progress::{NoProgress, Progress};
 pub use renderer::{RenderOutput, RenderStats};
 pub use tiles::RenderStatus;

@@ -1,9 +1,10 @@
 //! One render: camera samples per pixel through the integrator, over tiles in parallel.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use super::allocation::{self, ALLOCATED};
-use super::film::{Aovs, Film, Window, ndc};
+use super::film::{Aovs, Film, Keep, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::sampler::PixelSampler;
@@ -12,6 +13,7 @@ use super::tiles::{RenderStatus, TileOptions, render_tiles};
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
 use crate::scene::detail_view::DetailView;
+use crate::scene::footprint::{self, available_bytes};
 
 /// A finished (or cancelled) render and what it cost.
 #[derive(Debug)]
@@ -43,6 +45,50 @@ pub struct RenderStats {
 /// [`PixelAccumulator::variance_of_mean`]: super::film::PixelAccumulator::variance_of_mean
 pub const PASS_SAMPLES: u32 = 8;
 
+/// Whether a render may stop before `spp`: it then renders pass by pass, and estimates its
+/// noise (to stop on it, or to tell what a time budget reached).
+fn stops_early(settings: &RenderSettings) -> bool {
+    settings.noise_target.is_some() || settings.time_budget.is_some()
+}
+
+/// What the film of a render with `settings` keeps besides its image: the noise
+/// estimate's halves for one that may stop early, the sums for one in passes (whose
+/// progress sink [keeps passes](Progress::keeps_passes)) or whose pilot comes first, and
+/// nothing for one that takes each pixel's samples at once.
+pub fn film_keep(settings: &RenderSettings, keeps_passes: bool) -> Keep {
+    match (stops_early(settings), keeps_passes, settings.allocation) {
+        (true, _, _) => Keep::Halves,
+        (false, true, _) | (false, false, Allocation::Noise) => Keep::Sums,
+        (false, false, Allocation::Uniform) => Keep::Image,
+    }
+}
+
+/// The bytes of the films a render with `settings` and `aovs` holds, its progress sink
+/// keeping passes or not: its film's and the noise allocation's pilot's. Zero for settings
+/// whose crop is not inside the frame.
+pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> u64 {
+    let (width, height) = (settings.width, settings.height);
+    let window = settings.crop.map_or(
+        Window {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        },
+        |[x0, y0, x1, y1]| Window { x0, y0, x1, y1 },
+    );
+    let film = window
+        .pixel_count()
+        .saturating_mul(film_keep(settings, keeps_passes).bytes_per_pixel(aovs));
+    let pilot = match settings.allocation {
+        Allocation::Uniform => 0,
+        Allocation::Noise => allocation::pilot_window(window, width, height)
+            .pixel_count()
+            .saturating_mul(Keep::Spread.bytes_per_pixel(aovs)),
+    };
+    film.saturating_add(pilot)
+}
+
 /// Renders `world` through `camera`. Each sample's numbers depend only on the seed, the
 /// full-frame pixel and the sample index, so the image is the same for any thread count,
 /// tile order or crop. A world whose curves were shaped for a view (the `auto` shape)
@@ -54,7 +100,10 @@ pub const PASS_SAMPLES: u32 = 8;
 /// stops once the estimated noise of the window it renders is at most `noise_target`, or
 /// when the next pass (timed as the last one) would end past `time_budget`: the image is
 /// then, bit for bit, that of a render with `spp` = the samples taken
-/// ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`.
+/// ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`. A render
+/// with neither takes all its passes (after the pilot) at once, the same samples in the
+/// same order, so that its film need not keep them between passes ([`film_keep`]), unless
+/// `progress` [keeps passes](Progress::keeps_passes).
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -73,17 +122,27 @@ pub fn render(
              or with fewer pixels): build the scene again for this camera and image height"
         ));
     }
+    let in_passes = stops_early(settings) || progress.keeps_passes();
+    let bytes = film_bytes(settings, aovs, progress.keeps_passes());
+    footprint::check_film_fits(bytes, available_bytes())?;
     let (width, height) = (settings.width, settings.height);
     let crop = settings
         .crop
         .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
-    let mut film = Film::new(width, height, crop, aovs)?;
+    let keep = film_keep(settings, progress.keeps_passes());
+    let mut film = Film::keeping(width, height, crop, aovs, keep)?;
     // The noise allocation's pilot, over whole blocks around the crop.
     let mut pilot = match settings.allocation {
         Allocation::Uniform => None,
         Allocation::Noise => {
             let window = allocation::pilot_window(film.crop(), width, height);
-            Some(Film::new(width, height, Some(window), aovs)?)
+            Some(Film::keeping(
+                width,
+                height,
+                Some(window),
+                aovs,
+                Keep::Spread,
+            )?)
         }
     };
     let mut shares: Option<allocation::Shares> = None;
@@ -94,10 +153,21 @@ pub fn render(
     };
     let pixels = film.crop().pixel_count();
     let passes = settings.spp.div_ceil(PASS_SAMPLES);
+    // The passes each round of tiles takes: one at a time where the render may stop
+    // between them, else all at once (the pilot first).
+    let rounds: Vec<Range<u32>> = match (in_passes, &pilot) {
+        (true, _) => (0..passes).map(|p| p..p + 1).collect(),
+        (false, None) => std::iter::once(0..passes).collect(),
+        (false, Some(_)) => [0..1, 1..passes]
+            .into_iter()
+            .filter(|r| !r.is_empty())
+            .collect(),
+    };
     let start = Instant::now();
     let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);
     let mut last_pass = 0.0;
-    for pass in 0..passes {
+    for round in rounds {
+        let pass = round.start;
         let elapsed = start.elapsed().as_secs_f64();
         let good_enough = matches!((settings.noise_target, noise), (Some(t), Some(n)) if n <= t);
         let out_of_time = settings
@@ -106,23 +176,27 @@ pub fn render(
         if good_enough || out_of_time {
             break;
         }
-        let end = (spp + PASS_SAMPLES).min(settings.spp);
-        // Sample indices of a pixel in this pass.
+        let end = (round.end * PASS_SAMPLES).min(settings.spp);
+        // Sample indices of a pixel in this round.
         let indices = |pixel| match &shares {
             None => spp..end,
             Some(shares) => {
                 let n = shares.of(pixel);
-                let before = ALLOCATED + (pass - 1) * n;
-                before..before + n
+                ALLOCATED + (pass - 1) * n..ALLOCATED + (round.end - 1) * n
             }
         };
         let target = match (&mut pilot, pass) {
             (Some(pilot), 0) => pilot,
             _ => &mut film,
         };
+        // Progress in pixels over every pass, the round's spread over its passes.
         let (offset, total) = (u64::from(pass) * pixels, u64::from(passes) * pixels);
-        let in_pass = target.crop().pixel_count();
-        let pass_progress = |done, _| progress.update(offset + done * pixels / in_pass, total);
+        let round_pixels = u128::from(round.len() as u64 * pixels);
+        let in_pass = u128::from(target.crop().pixel_count());
+        let pass_progress = |done: u64, _| {
+            let done = u128::from(done) * round_pixels / in_pass;
+            progress.update(offset + done as u64, total)
+        };
         status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
             for index in indices(pixel) {
                 if !pulse.keep_going() {

@@ -144,9 +144,7 @@ where
         };
         let mut pixels: Vec<((u32, u32), PixelAccumulator)> = {
             let guard = shared.lock().unwrap_or_else(|e| e.into_inner());
-            tile.pixels()
-                .map(|p| (p, guard.0.accumulator(p).clone()))
-                .collect()
+            tile.pixels().map(|p| (p, guard.0.accumulator(p))).collect()
         };
         for (pixel, acc) in &mut pixels {
             if cancelled.load(Ordering::Relaxed) {

@@ -14,8 +14,8 @@ use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
 
-/// Bytes a process holding a scene needs besides its grooms (code, Embree's thread pool,
-/// meshes, film), measured as the peak of a render of a 1-strand scalp.
+/// Bytes a process holding a scene needs besides its grooms and its render's film (code,
+/// Embree's thread pool, meshes), measured as the peak of a render of a 1-strand scalp.
 pub const BASE_BYTES: u64 = 140 << 20;
 
 /// The size of one curve geometry: what its memory depends on.
@@ -159,5 +159,20 @@ pub fn check_fits(
         sizes.join(" + "),
         gib(needed),
         gib(available)
+    ))
+}
+
+/// Refuses a render whose films need `bytes` (`crate::render::renderer::film_bytes`) when
+/// that exceeds `available` (from [`available_bytes`]), before any is allocated.
+pub fn check_film_fits(bytes: u64, available: Option<u64>) -> Result<()> {
+    let Some(available) = available.filter(|&a| bytes > a) else {
+        return Ok(());
+    };
+    let mib = |b: u64| b as f64 / f64::from(1u32 << 20);
+    Err(invalid_arg!(
+        "the render's film needs about {:.0} MiB of memory, and {:.0} MiB are available: \
+         render fewer pixels (a crop, or the frame in tiles)",
+        mib(bytes),
+        mib(available)
     ))
 }

@@ -4,9 +4,9 @@
 use std::sync::Mutex;
 
 use crate::render::integrator::World;
-use crate::render::renderer::{PASS_SAMPLES, RenderOutput, render};
+use crate::render::renderer::{PASS_SAMPLES, RenderOutput, film_bytes, render};
 use crate::render::settings::{Allocation, PathSettings, RenderSettings};
-use crate::render::{Aovs, NoProgress, Progress};
+use crate::render::{Aovs, Keep, NoProgress, Progress};
 
 use crate::scene::envmap::Environment;
 use crate::scene::light::Light;
@@ -36,6 +36,17 @@ fn small(spp: u32, seed: u64) -> RenderSettings {
     }
 }
 
+/// A noise target no render here reaches: the render takes every spp, pass by pass, and
+/// estimates its noise.
+const UNREACHED: f32 = 1e-6;
+
+fn estimating(base: RenderSettings) -> RenderSettings {
+    RenderSettings {
+        noise_target: Some(UNREACHED),
+        ..base
+    }
+}
+
 /// What a progress sink hears: the pixel counts and each pass's report.
 #[derive(Default)]
 struct Record {
@@ -55,7 +66,8 @@ impl Progress for Record {
 
 /// A noise target stops the render after the first pass whose estimate reaches it (the
 /// pass before did not), whatever the thread count, and the image is bit for bit the
-/// plain render of the samples taken. The progress sink hears every pass's estimate.
+/// plain render of the samples taken (which takes them at once, and estimates no noise).
+/// The progress sink hears every pass's estimate.
 #[test]
 fn a_noise_target_stops_at_the_first_pass_that_reaches_it_with_the_plain_renders_bits() {
     let world = lit_world();
@@ -99,7 +111,68 @@ fn a_noise_target_stops_at_the_first_pass_that_reaches_it_with_the_plain_renders
     assert_eq!(bits(one_thread.film.rgb()), bits(out.film.rgb()));
     let plain = run(&world, small(spp, 3), &NoProgress);
     assert_eq!(bits(plain.film.rgb()), bits(out.film.rgb()));
-    assert_eq!(plain.stats.noise, Some(noise));
+    assert_eq!((plain.stats.noise, plain.film.keep()), (None, Keep::Image));
+}
+
+/// A film keeps only what its render reads: a plain render its image alone (the sums too
+/// for a progress sink that keeps passes), one that may stop early the sums and the noise
+/// estimate's halves, the noise allocation the sums of its film and its pilot's squares and
+/// rays. The bytes per pixel are the layout's.
+#[test]
+fn a_film_keeps_only_what_its_render_reads() {
+    let world = lit_world();
+    let all = Aovs {
+        albedo: true,
+        depth: true,
+        strand_id: true,
+    };
+    // Image: rgb f32; sums: rgb f64 and a u32 count; halves: two f32 rgb and counts and a
+    // pass count; spread: rgb squares f64 and a u64 ray count.
+    let layout = [
+        (Keep::Image, 12, 12 + 12 + 4 + 4),
+        (Keep::Sums, 12 + 28, 32 + 28 + 24 + 4),
+        (Keep::Halves, 12 + 28 + 36, 32 + 28 + 24 + 4 + 36),
+        (Keep::Spread, 12 + 28 + 32, 32 + 28 + 24 + 4 + 32),
+    ];
+    for (keep, plain, with_aovs) in layout {
+        assert_eq!(keep.bytes_per_pixel(Aovs::default()), plain, "{keep:?}");
+        assert_eq!(keep.bytes_per_pixel(all), with_aovs, "{keep:?}");
+    }
+    let pixels = 24 * 24;
+    for (settings, keep) in [
+        (small(16, 1), Keep::Image),
+        (estimating(small(16, 1)), Keep::Halves),
+        (
+            RenderSettings {
+                time_budget: Some(1e3),
+                ..small(16, 1)
+            },
+            Keep::Halves,
+        ),
+        (allocated(small(16, 1)), Keep::Sums),
+    ] {
+        let out = render(&world, &camera(), &settings, all, &NoProgress).unwrap();
+        assert_eq!(out.film.keep(), keep);
+        assert_eq!(out.film.bytes(), pixels * keep.bytes_per_pixel(all));
+        let pilot = match settings.allocation {
+            Allocation::Uniform => 0,
+            Allocation::Noise => pixels * Keep::Spread.bytes_per_pixel(all),
+        };
+        assert_eq!(film_bytes(&settings, all, false), out.film.bytes() + pilot);
+    }
+    // A sink that keeps passes (the C ABI's callback) has a plain render keep the sums.
+    struct KeepsPasses;
+    impl Progress for KeepsPasses {
+        fn update(&self, _: u64, _: u64) -> bool {
+            true
+        }
+        fn keeps_passes(&self) -> bool {
+            true
+        }
+    }
+    let out = render(&world, &camera(), &small(16, 1), all, &KeepsPasses).unwrap();
+    assert_eq!(out.film.keep(), Keep::Sums);
+    assert_eq!(film_bytes(&small(16, 1), all, true), out.film.bytes());
 }
 
 /// A time budget far below one pass's time (a microsecond) still renders the first pass,
@@ -131,7 +204,7 @@ fn the_estimated_noise_is_within_a_fifth_of_the_measured_one() {
     const SEEDS: u64 = 24;
     let world = lit_world();
     let renders: Vec<RenderOutput> = (0..SEEDS)
-        .map(|seed| run(&world, small(32, 100 + seed), &NoProgress))
+        .map(|seed| run(&world, estimating(small(32, 100 + seed)), &NoProgress))
         .collect();
     let n = renders[0].film.rgb().len();
     let (mut variance, mut sum) = (0.0, 0.0);
@@ -184,18 +257,19 @@ fn the_noise_allocation_keeps_the_quadrant_means_of_uniform_sampling() {
 }
 
 /// With the noise allocation, a crop across blocks renders the full frame's pixels bit for
-/// bit, one thread or two; the samples are the uniform render's count within the rounding
-/// of each pixel's share, and the estimated noise is no higher.
+/// bit, one thread or two, and pass by pass as at once; the samples are the uniform
+/// render's count within the rounding of each pixel's share, and the estimated noise is no
+/// higher.
 #[test]
 fn the_noise_allocation_is_crop_exact_and_thread_deterministic() {
     let world = lit_world();
-    let base = allocated(RenderSettings {
+    let base = estimating(allocated(RenderSettings {
         width: 40,
         height: 30,
         spp: 32,
         seed: 11,
         ..RenderSettings::default()
-    });
+    }));
     let one = run(
         &world,
         RenderSettings {
@@ -213,6 +287,12 @@ fn the_noise_allocation_is_crop_exact_and_thread_deterministic() {
         &NoProgress,
     );
     assert_eq!(bits(one.film.rgb()), bits(two.film.rgb()));
+    let at_once = RenderSettings {
+        noise_target: None,
+        ..base
+    };
+    let at_once = run(&world, at_once, &NoProgress);
+    assert_eq!(bits(one.film.rgb()), bits(at_once.film.rgb()));
     let crop = run(
         &world,
         RenderSettings {

@@ -53,7 +53,7 @@ fn check_static_host(exe: &Path) {
 
 #[test]
 fn cpp_hosts_build_against_the_installed_prefix() {
-    let prefix = install("prefix-full", false);
+    let prefix = install(false);
     let lib = prefix.join("lib");
     let version = env!("CARGO_PKG_VERSION");
 

@@ -104,7 +104,8 @@ pub struct HtRenderSettings {
 ///
 /// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
 /// crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
-/// deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
+/// deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03. Cannot fail; any
+/// thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
     let d = RenderSettings::default();
@@ -243,6 +244,9 @@ pub unsafe extern "C" fn ht_scene_build(
 ///
 /// Statuses: as `ht_scene_build`.
 ///
+/// One thread at a time per scene (the scene is not thread safe); `settings` may be read by
+/// other threads meanwhile.
+///
 /// # Safety
 /// As `ht_scene_build`; `settings` is NULL or a live handle from `ht_settings_new`.
 #[unsafe(no_mangle)]
@@ -372,6 +376,10 @@ pub unsafe extern "C" fn ht_render_aovs(
 /// may be NULL (not wanted).
 ///
 /// Statuses: as `ht_render_aovs`.
+///
+/// One thread at a time per scene; `settings` may be read by other threads meanwhile, not
+/// set. Blocks until the image is done or cancelled, rendering on worker threads it joins
+/// before it returns.
 ///
 /// # Safety
 /// As `ht_render_aovs`; `settings` is NULL or a live handle from `ht_settings_new`, not

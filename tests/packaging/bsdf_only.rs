@@ -18,9 +18,9 @@ fn bsdf_only_host_loads_neither_embree_nor_openimageio() {
     let lib = prefix.join("lib");
     // Its packages hide the render API from the header, so what it declares is exactly
     // what the library defines.
-    let cflags = pkg_config(&prefix, &["--cflags", "hairtrace"]);
+    let cflags = pkg_config(prefix, &["--cflags", "hairtrace"]);
     assert!(cflags.contains(&"-DHT_BSDF_ONLY".to_string()), "{cflags:?}");
-    let declared = declared_functions(&prefix, &["-DHT_BSDF_ONLY"]);
+    let declared = declared_functions(prefix, &["-DHT_BSDF_ONLY"]);
     assert!(declared.contains("ht_hair_eval"), "{declared:?}");
     assert!(!declared.contains("ht_device_new"), "{declared:?}");
     assert_eq!(declared, defined_functions(&lib.join("libhairtrace.a")));
@@ -31,7 +31,7 @@ fn bsdf_only_host_loads_neither_embree_nor_openimageio() {
         .args(["-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror"])
         .arg(root().join("tests/packaging/host.c"))
         .args(pkg_config(
-            &prefix,
+            prefix,
             &["--static", "--cflags", "--libs", "hairtrace-static"],
         ))
         .arg("-o")

@@ -94,24 +94,27 @@ extern "C" {
 #endif // __cplusplus
 
 /**
- * The ABI version this library was built with; compare with `HT_ABI_VERSION`.
+ * The ABI version this library was built with; compare with `HT_ABI_VERSION`. Cannot
+ * fail; any thread.
  */
 uint32_t ht_abi_version(void);
 
 /**
- * The library version, e.g. "0.1.0" (static storage).
+ * The library version, e.g. "0.1.0": never NULL, static storage (never freed, never
+ * changes). Cannot fail; any thread.
  */
 const char *ht_version(void);
 
 /**
- * A short static description of a status code (an `HtStatus` value); unknown codes
- * give "unknown status".
+ * A short description of a status code (an `HtStatus` value); unknown codes give
+ * "unknown status". Never NULL, static storage. Cannot fail; any thread.
  */
 const char *ht_status_str(int32_t status);
 
 /**
  * The message of the last failure on the calling thread ("" if none). Never NULL; valid
- * until the next failing call on this thread.
+ * until the next failing call on this thread (copy it to keep it). Cannot fail; any
+ * thread, each with its own message: one thread's failure is not seen on another.
  */
 const char *ht_last_error(void);
 
@@ -216,6 +219,7 @@ extern "C" {
 
 /**
  * Brown hair: sigma_a from eumelanin 1.3, eta 1.55, beta_m = beta_n = 0.3, alpha = 2.
+ * Cannot fail; any thread.
  */
 struct HtHairParams ht_hair_params_default(void);
 
@@ -391,10 +395,18 @@ enum HtStatus ht_hair_frame_to_local(const struct HtHairFrame *frame, const floa
 
 /**
  * Writes the local direction `w[3]` (e.g. a sampled wi) in world space to `out[3]`:
- * w.x x + w.y y + w.z z. Arguments and statuses as `ht_hair_frame_to_local`.
+ * w.x x + w.y y + w.z z. Lengths and senses are kept.
+ *
+ * - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
+ *   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
+ * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
+ *   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
+ *   untouched on error.
+ *
+ * Any thread.
  *
  * # Safety
- * As `ht_hair_frame_to_local`.
+ * `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
  */
 enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const float *w, float *out);
 
@@ -585,10 +597,18 @@ enum HtStatus ht_hair_point_eval(const struct HtHairPoint *point,
 /**
  * The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
  * `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
- * Arguments, statuses and thread safety as `ht_hair_point_eval`, without `f`.
+ *
+ * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
+ *   `HT_ERR_INVALID_ARG`.
+ * - `point`, `wi`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled by
+ *   an init and 16-byte aligned, the floats 4-byte aligned; `pdf` must not overlap `wi`
+ *   or the point (`HT_ERR_INVALID_ARG`). `*pdf` untouched on error.
+ *
+ * Any thread, concurrently on the same point.
  *
  * # Safety
- * As `ht_hair_point_eval`.
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `pdf`
+ * NULL or 1 writable float.
  */
 enum HtStatus ht_hair_point_pdf(const struct HtHairPoint *point, const float *wi, float *pdf);
 
@@ -618,11 +638,20 @@ enum HtStatus ht_hair_point_sample(const struct HtHairPoint *point,
  * One call for what a path vertex wants of a light direction: writes `f_cos[3]` =
  * f * |wi.z| (the `f` of `ht_hair_point_eval` times the cosine, in that order: the
  * fraction scattered per unit solid angle) and `*pdf`, the same pdf as
- * `ht_hair_point_eval`. Arguments, statuses and thread safety as `ht_hair_point_eval`
- * (`f_cos` in place of `f`).
+ * `ht_hair_point_eval`.
+ *
+ * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
+ *   `HT_ERR_INVALID_ARG`.
+ * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+ *   filled by an init and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf`
+ *   must not overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs
+ *   untouched on error.
+ *
+ * Any thread, concurrently on the same point.
  *
  * # Safety
- * As `ht_hair_point_eval`.
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
+ * floats, `pdf` NULL or 1 float; outputs writable.
  */
 enum HtStatus ht_hair_point_eval_cos(const struct HtHairPoint *point,
                                      const float *wi,
@@ -633,11 +662,19 @@ enum HtStatus ht_hair_point_eval_cos(const struct HtHairPoint *point,
  * One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
  * `ht_hair_point_sample`), `weight[3]` = f * |wi.z| / pdf (the path throughput factor,
  * from that call's f and pdf in that order) and `*pdf`. pdf = 0 (wi, weight zero) means
- * no direction, also when the weight would not be finite; still HT_OK. Arguments,
- * statuses and thread safety as `ht_hair_point_sample` (`weight` in place of `f`).
+ * no direction, also when the weight would not be finite; still HT_OK.
+ *
+ * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+ * - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
+ *   `point` filled by an init and 16-byte aligned, the floats 4-byte aligned; `wi`,
+ *   `weight` and `pdf` must not overlap each other, `u` or the point
+ *   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *
+ * Any thread, concurrently on the same point.
  *
  * # Safety
- * As `ht_hair_point_sample`.
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
+ * floats, `pdf` NULL or 1 float; outputs writable.
  */
 enum HtStatus ht_hair_point_sample_cos(const struct HtHairPoint *point,
                                        const float *u,
@@ -652,11 +689,18 @@ enum HtStatus ht_hair_point_sample_cos(const struct HtHairPoint *point,
  * a unit vector there (|length - 1| <= 1e-3). The same bits as `ht_hair_frame_to_local`
  * followed by `ht_hair_point_eval_cos`.
  *
- * - A point filled by `ht_hair_point_init` (no frame): `HT_ERR_INVALID_ARG`.
- * - Otherwise arguments, statuses and thread safety as `ht_hair_point_eval_cos`.
+ * - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
+ * - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+ *   `HT_ERR_INVALID_ARG`.
+ * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+ *   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
+ *   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *
+ * Any thread, concurrently on the same point.
  *
  * # Safety
- * As `ht_hair_point_eval`.
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
+ * floats, `pdf` NULL or 1 float; outputs writable.
  */
 enum HtStatus ht_hair_point_eval_world(const struct HtHairPoint *point,
                                        const float *wi,
@@ -669,11 +713,19 @@ enum HtStatus ht_hair_point_eval_world(const struct HtHairPoint *point,
  * frame, the same bits as `ht_hair_point_sample_cos` followed by `ht_hair_frame_to_world`
  * (weight and pdf are unchanged). pdf = 0 (wi, weight zero) means no direction.
  *
- * - A point filled by `ht_hair_point_init` (no frame): `HT_ERR_INVALID_ARG`.
- * - Otherwise arguments, statuses and thread safety as `ht_hair_point_sample_cos`.
+ * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+ * - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+ *   `HT_ERR_INVALID_ARG`.
+ * - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
+ *   `point` 16-byte and the floats 4-byte aligned; `wi`, `weight` and `pdf` must not
+ *   overlap each other, `u` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
+ *   error.
+ *
+ * Any thread, concurrently on the same point.
  *
  * # Safety
- * As `ht_hair_point_sample`.
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
+ * floats, `pdf` NULL or 1 float; outputs writable.
  */
 enum HtStatus ht_hair_point_sample_world(const struct HtHairPoint *point,
                                          const float *u,
@@ -707,8 +759,16 @@ enum HtStatus ht_hair_points_eval(const struct HtHairPoint *points,
 /**
  * `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
  * `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
- * `ht_hair_point_sample`. Checks and statuses as `ht_hair_points_eval` (every `u[i]` in
- * [0, 1)); `wi`, `f` and `pdf` must not overlap each other, `u` or `points`.
+ * `ht_hair_point_sample`. pdf[i] = 0 (wi, f zero) means no direction for point i.
+ *
+ * - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
+ *   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
+ *   "negative" `n`: `HT_ERR_INVALID_ARG`); `wi`, `f` and `pdf` must not overlap each
+ *   other, `u` or `points` (`HT_ERR_INVALID_ARG`).
+ * - Every point must be filled and every `u` in [0, 1) (`HT_ERR_INVALID_ARG`), all
+ *   checked before anything is written; the message names the first bad element.
+ *
+ * Any thread, concurrently on the same points.
  *
  * # Safety
  * Each array is NULL or holds the number of elements given above (outputs writable).
@@ -738,6 +798,9 @@ enum HtStatus ht_hair_points_sample(const struct HtHairPoint *points,
  * - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
  *   as `ht_hair_point_init`. On error `*point` is untouched.
  * - Cost: an init plus the preparation of the varied parameters (about one evaluation).
+ *
+ * Any thread; `prepared` and `variation` may be shared, `point` must not be read
+ * meanwhile. Not in the BSDF-only library.
  *
  * # Safety
  * As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
@@ -942,6 +1005,8 @@ enum HtStatus ht_device_new(uint32_t threads, struct HtDevice **out);
  * Statuses: those of `ht_device_new`, and `HT_ERR_INVALID_ARG` for another name or an
  * ISA this CPU cannot run.
  *
+ * Any thread: a device is thread safe.
+ *
  * # Safety
  * `isa` is NULL or a NUL-terminated string; `out` is NULL or points to a writable
  * `HtDevice*`.
@@ -951,6 +1016,8 @@ enum HtStatus ht_device_new_pinned(uint32_t threads, const char *isa, struct HtD
 /**
  * Releases a device handle (NULL: nothing to do, `HT_OK`). Scenes made on it stay valid
  * and release the device with the last of them. Always `HT_OK`.
+ *
+ * Any thread, once no other thread uses this handle (scenes may still hold the device).
  *
  * # Safety
  * `device` is NULL or a handle from `ht_device_new` not yet freed; it is invalid after
@@ -964,6 +1031,8 @@ enum HtStatus ht_device_free(struct HtDevice *device);
  *
  * Statuses: `HT_ERR_NULL_ARG` (`device` or `out` NULL); `HT_ERR_INVALID_ARG` (`out`
  * misaligned). `*out` is written on `HT_OK` only.
+ *
+ * Any thread: the device may be shared; the new scene is used from one thread at a time.
  *
  * # Safety
  * `device` is NULL or a live handle from `ht_device_new`; `out` is NULL or points to a
@@ -1079,6 +1148,9 @@ enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
  *
  * Statuses: as `ht_scene_add_curves_xyzr`; `desc->points` not aligned to 16 bytes is
  * `HT_ERR_INVALID_ARG` (use `ht_scene_add_curves_xyzr`, which copies, for such memory).
+ *
+ * One thread at a time per scene; no thread may write `desc->points` while the scene
+ * lives.
  *
  * # Safety
  * As `ht_scene_add_curves_xyzr`, and `desc->points` stays allocated and unchanged until
@@ -1255,7 +1327,8 @@ enum HtStatus ht_scene_add_rect_light(struct HtScene *scene,
                                       bool two_sided);
 
 /**
- * No variation: every strand has the material's parameters, and seed 0.
+ * No variation: every strand has the material's parameters, and seed 0. Cannot fail;
+ * any thread.
  */
 struct HtHairVariation ht_hair_variation_default(void);
 
@@ -1282,6 +1355,8 @@ enum HtStatus ht_scene_add_hair_material(struct HtScene *scene,
  *
  * Statuses: as `ht_scene_add_hair_material`, and `HT_ERR_NULL_ARG` for `variation` NULL,
  * `HT_ERR_INVALID_ARG` for a variation out of range (`use_vertex_colors` not 0 or 1).
+ *
+ * One thread at a time per scene.
  *
  * # Safety
  * As `ht_scene_add_hair_material`; `variation` is NULL or readable.
@@ -1390,6 +1465,8 @@ extern "C" {
  *
  * Statuses: `HT_ERR_NULL_ARG` (`out` NULL); `HT_ERR_INVALID_ARG` (`out` misaligned).
  *
+ * Any thread.
+ *
  * # Safety
  * `out` is NULL or writable.
  */
@@ -1397,6 +1474,8 @@ enum HtStatus ht_settings_new(struct HtSettings **out);
 
 /**
  * Releases settings (NULL: nothing to do; returns HT_OK).
+ *
+ * Any thread, once no other thread uses the handle.
  *
  * # Safety
  * `settings` is NULL or a live handle from `ht_settings_new`, not used after this call.
@@ -1429,6 +1508,8 @@ enum HtStatus ht_settings_set(struct HtSettings *settings, const char *key, cons
  * `HT_ERR_INVALID_ARG` (an unknown key, or `buf_len` too small: nothing is written to
  * `buf` then, and `*len` says what it needs).
  *
+ * Any thread; several may read one handle at once, but not while one sets it.
+ *
  * # Safety
  * `settings` is NULL or a live handle; `key` is NULL or NUL-terminated; `buf` is NULL or
  * `buf_len` writable bytes; `len` is NULL or writable.
@@ -1441,7 +1522,7 @@ enum HtStatus ht_settings_get(const struct HtSettings *settings,
 
 /**
  * The name of setting number `index` (0, 1, ... in the order of docs/settings.md), or NULL
- * past the last: how a host lists every setting. Static storage.
+ * past the last: how a host lists every setting. Static storage. Cannot fail; any thread.
  */
 const char *ht_settings_key(size_t index);
 
@@ -1594,7 +1675,8 @@ extern "C" {
  *
  * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
  * crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
- * deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
+ * deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03. Cannot fail; any
+ * thread.
  */
 struct HtRenderSettings ht_render_settings_default(void);
 
@@ -1633,10 +1715,17 @@ enum HtStatus ht_scene_build(struct HtScene *scene,
 /**
  * As `ht_scene_build` (deprecated), with settings by name.
  *
- * Statuses: as `ht_scene_build`.
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
+ * out of range, a scene with no light, or no camera and no geometry to frame);
+ * `HT_ERR_EMBREE` (the build failed); `HT_ERR_CANCELLED` (`progress` returned false: the
+ * scene is left unbuilt, and the next build or render starts over).
+ *
+ * One thread at a time per scene (the scene is not thread safe); `settings` may be read by
+ * other threads meanwhile.
  *
  * # Safety
- * As `ht_scene_build`; `settings` is NULL or a live handle from `ht_settings_new`.
+ * `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+ * `settings` is NULL or a live handle from `ht_settings_new`.
  */
 enum HtStatus ht_scene_build_with(struct HtScene *scene,
                                   const struct HtSettings *settings,
@@ -1713,11 +1802,21 @@ enum HtStatus ht_render_aovs(struct HtScene *scene,
  * (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
  * may be NULL (not wanted).
  *
- * Statuses: as `ht_render_aovs`.
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
+ * (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer
+ * misaligned, any two buffers overlapping, a scene with no light, or no camera and no
+ * geometry to frame); `HT_ERR_EMBREE` (the scene build failed); `HT_ERR_CANCELLED` (the
+ * progress callback returned false).
+ *
+ * One thread at a time per scene; `settings` may be read by other threads meanwhile, not
+ * set. Blocks until the image is done or cancelled, rendering on worker threads it joins
+ * before it returns.
  *
  * # Safety
- * As `ht_render_aovs`; `settings` is NULL or a live handle from `ht_settings_new`, not
- * set during the call.
+ * `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+ * `settings` is NULL or a live handle from `ht_settings_new`, not set during the call;
+ * each non-NULL buffer holds the floats its length says, writable, and nothing else reads
+ * or writes it during the call.
  */
 enum HtStatus ht_render_with(struct HtScene *scene,
                              const struct HtSettings *settings,

@@ -24,6 +24,7 @@ use crate::math::fast::atan2;
 use crate::math::{Lanes, cos_from_sin};
 use glam::Vec3;
 use std::f32::consts::{FRAC_1_PI, TAU};
+use std::mem::MaybeUninit;
 use wide::{f32x4, f32x8};
 
 /// Number of explicit lobes (R, TT, TRT); the residual lobe comes after them.
@@ -454,10 +455,16 @@ pub(crate) struct OwnedPoint {
 }
 
 impl OwnedPoint {
-    pub(crate) fn new(bsdf: &HairBsdf, h: f32, wo: Vec3) -> Self {
-        Self {
-            bsdf: *bsdf,
-            at: bsdf.vertex(h, wo, Lobes::All),
+    /// Writes the point of `bsdf` at (h, wo) into `dst` field by field: the (h, wo) work
+    /// lands where it stays, instead of in a whole point on the stack that is then copied.
+    #[inline(never)]
+    pub(crate) fn fill(dst: &mut MaybeUninit<Self>, bsdf: &HairBsdf, h: f32, wo: Vec3) {
+        let dst = dst.as_mut_ptr();
+        // SAFETY: `dst` is a valid, aligned `OwnedPoint` place (from a `&mut`); writing its
+        // fields initialises it.
+        unsafe {
+            (&raw mut (*dst).bsdf).write(*bsdf);
+            (&raw mut (*dst).at).write(bsdf.vertex(h, wo, Lobes::All));
         }
     }
 

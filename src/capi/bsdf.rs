@@ -143,12 +143,22 @@ pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
     Ok(h)
 }
 
-/// Checks three uniform numbers in [0, 1).
+/// Checks three uniform numbers in [0, 1): inline compares on the sample calls' hot path,
+/// the message out of line.
+#[inline(always)]
 pub(super) fn check_u(u: [f32; 3], name: &str) -> Result<[f32; 3], Failure> {
-    if let Some(bad) = u.iter().position(|x| !(0.0..1.0).contains(x)) {
-        return Err(invalid_arg!("{name}[{bad}] = {}: must be in [0, 1)", u[bad]).into());
+    if u.iter().all(|x| (0.0..1.0).contains(x)) {
+        Ok(u)
+    } else {
+        Err(not_uniform(u, name))
     }
-    Ok(u)
+}
+
+#[cold]
+#[inline(never)]
+fn not_uniform(u: [f32; 3], name: &str) -> Failure {
+    let bad = u.iter().position(|x| !(0.0..1.0).contains(x)).unwrap_or(0);
+    invalid_arg!("{name}[{bad}] = {}: must be in [0, 1)", u[bad]).into()
 }
 
 /// NULL-checks every pointer of a call before anything else, so that a NULL pointer is
@@ -247,6 +257,7 @@ pub(super) fn vec3(s: &[f32]) -> Vec3 {
 }
 
 /// Brown hair: sigma_a from eumelanin 1.3, eta 1.55, beta_m = beta_n = 0.3, alpha = 2.
+/// Cannot fail; any thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_hair_params_default() -> HtHairParams {
     HairParams::default().into()

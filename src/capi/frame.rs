@@ -213,10 +213,18 @@ pub unsafe extern "C" fn ht_hair_frame_to_local(
 }
 
 /// Writes the local direction `w[3]` (e.g. a sampled wi) in world space to `out[3]`:
-/// w.x x + w.y y + w.z z. Arguments and statuses as `ht_hair_frame_to_local`.
+/// w.x x + w.y y + w.z z. Lengths and senses are kept.
+///
+/// - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
+///   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
+/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
+///   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
+///   untouched on error.
+///
+/// Any thread.
 ///
 /// # Safety
-/// As `ht_hair_frame_to_local`.
+/// `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_frame_to_world(
     frame: *const HtHairFrame,

@@ -242,6 +242,9 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr(
 /// Statuses: as `ht_scene_add_curves_xyzr`; `desc->points` not aligned to 16 bytes is
 /// `HT_ERR_INVALID_ARG` (use `ht_scene_add_curves_xyzr`, which copies, for such memory).
 ///
+/// One thread at a time per scene; no thread may write `desc->points` while the scene
+/// lives.
+///
 /// # Safety
 /// As `ht_scene_add_curves_xyzr`, and `desc->points` stays allocated and unchanged until
 /// `ht_scene_free` returns.

@@ -30,7 +30,8 @@ pub struct HtHairVariation {
     pub seed: u64,
 }
 
-/// No variation: every strand has the material's parameters, and seed 0.
+/// No variation: every strand has the material's parameters, and seed 0. Cannot fail;
+/// any thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_hair_variation_default() -> HtHairVariation {
     let m = HairMaterial::default();
@@ -70,6 +71,8 @@ pub unsafe extern "C" fn ht_scene_add_hair_material(
 ///
 /// Statuses: as `ht_scene_add_hair_material`, and `HT_ERR_NULL_ARG` for `variation` NULL,
 /// `HT_ERR_INVALID_ARG` for a variation out of range (`use_vertex_colors` not 0 or 1).
+///
+/// One thread at a time per scene.
 ///
 /// # Safety
 /// As `ht_scene_add_hair_material`; `variation` is NULL or readable.

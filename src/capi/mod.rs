@@ -357,13 +357,15 @@ pub(crate) fn read_path(ptr: *const c_char, name: &str) -> Result<PathBuf, Failu
     Ok(PathBuf::from(s))
 }
 
-/// The ABI version this library was built with; compare with `HT_ABI_VERSION`.
+/// The ABI version this library was built with; compare with `HT_ABI_VERSION`. Cannot
+/// fail; any thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_abi_version() -> u32 {
     HT_ABI_VERSION
 }
 
-/// The library version, e.g. "0.1.0" (static storage).
+/// The library version, e.g. "0.1.0": never NULL, static storage (never freed, never
+/// changes). Cannot fail; any thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_version() -> *const c_char {
     static VERSION: &CStr =
@@ -374,8 +376,8 @@ pub extern "C" fn ht_version() -> *const c_char {
     VERSION.as_ptr()
 }
 
-/// A short static description of a status code (an `HtStatus` value); unknown codes
-/// give "unknown status".
+/// A short description of a status code (an `HtStatus` value); unknown codes give
+/// "unknown status". Never NULL, static storage. Cannot fail; any thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_status_str(status: i32) -> *const c_char {
     HtStatus::ALL
@@ -386,7 +388,8 @@ pub extern "C" fn ht_status_str(status: i32) -> *const c_char {
 }
 
 /// The message of the last failure on the calling thread ("" if none). Never NULL; valid
-/// until the next failing call on this thread.
+/// until the next failing call on this thread (copy it to keep it). Cannot fail; any
+/// thread, each with its own message: one thread's failure is not seen on another.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_last_error() -> *const c_char {
     LAST_ERROR.with(|e| e.borrow().as_ptr())

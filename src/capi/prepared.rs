@@ -220,9 +220,9 @@ pub unsafe extern "C" fn ht_hair_point_init(
         check_init(prepared, wo, None, point)?;
         let h = check_h(h)?;
         let wo = check_dir(read3(wo), "wo")?;
-        // SAFETY: non-NULL and aligned (checked), `HT_HAIR_POINT_SIZE` writable bytes that
-        // hold a `Stored` (asserted above).
-        unsafe { point.cast::<Stored>().write(stored(prepared, h, wo, TAG)) };
+        // SAFETY: non-NULL, aligned and clear of `wo` (checked); a live handle (the
+        // caller's promise).
+        unsafe { fill(point, &(*prepared).bsdf, h, wo, TAG) };
         Ok(())
     })
 }
@@ -265,14 +265,20 @@ fn check_init(
     check_disjoint(&[Span::of("point", point, 1)], &inputs)
 }
 
-/// The point of `prepared` at (h, wo), tagged `tag`.
+/// Writes the point of `bsdf` at (h, wo), tagged `tag`, into the host's storage in place:
+/// built on the stack and copied, the same point cost init a third more (docs/c-abi.md,
+/// "What a vertex costs").
+///
+/// # Safety
+/// `point` is non-NULL, aligned, writable and not read by anyone meanwhile.
 #[inline(always)]
-fn stored(prepared: *const HtHairPrepared, h: f32, wo: Vec3, tag: u64) -> Stored {
-    // SAFETY: non-NULL (checked), a live handle (the caller's promise).
-    let bsdf = unsafe { &(*prepared).bsdf };
-    Stored {
-        tag,
-        point: OwnedPoint::new(bsdf, h, wo),
+unsafe fn fill(point: *mut HtHairPoint, bsdf: &HairBsdf, h: f32, wo: Vec3, tag: u64) {
+    let stored = point.cast::<Stored>();
+    // SAFETY: the caller's promise; `HtHairPoint` holds a `Stored` (asserted above), whose
+    // fields are plain numbers valid once written.
+    unsafe {
+        (&raw mut (*stored).tag).write(tag);
+        OwnedPoint::fill(&mut *(&raw mut (*stored).point).cast(), bsdf, h, wo);
     }
 }
 
@@ -312,12 +318,11 @@ pub unsafe extern "C" fn ht_hair_point_init_world(
         let (axes, h) = (checked_axes(&frame)?, frame.h);
         let h = check_h(h)?;
         let wo = check_dir(axes.to_local(read3(wo)), "wo")?;
-        let framed = Framed {
-            stored: stored(prepared, h, wo, TAG_FRAMED),
-            frame: axes,
-        };
-        // SAFETY: as in `ht_hair_point_init`, for a `Framed`.
-        unsafe { point.cast::<Framed>().write(framed) };
+        // SAFETY: as in `ht_hair_point_init`; the storage holds a `Framed` (asserted above).
+        unsafe {
+            fill(point, &(*prepared).bsdf, h, wo, TAG_FRAMED);
+            (&raw mut (*point.cast::<Framed>()).frame).write(axes);
+        }
         Ok(())
     })
 }
@@ -337,6 +342,9 @@ pub unsafe extern "C" fn ht_hair_point_init_world(
 /// - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
 ///   as `ht_hair_point_init`. On error `*point` is untouched.
 /// - Cost: an init plus the preparation of the varied parameters (about one evaluation).
+///
+/// Any thread; `prepared` and `variation` may be shared, `point` must not be read
+/// meanwhile. Not in the BSDF-only library.
 ///
 /// # Safety
 /// As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
@@ -378,10 +386,8 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
         let material = super::materials::varied_material(base, &v)?;
         material.check_variation()?;
         let bsdf = HairBsdf::new(&material.varied(base, strand, s, groom))?;
-        let prepared = HtHairPrepared { bsdf };
-        // SAFETY: non-NULL and aligned (checked), `HT_HAIR_POINT_SIZE` writable bytes that
-        // hold a `Stored` (asserted above).
-        unsafe { point.cast::<Stored>().write(stored(&prepared, h, wo, TAG)) };
+        // SAFETY: non-NULL, aligned and clear of `wo` (checked).
+        unsafe { fill(point, &bsdf, h, wo, TAG) };
         Ok(())
     })
 }
@@ -418,10 +424,18 @@ pub unsafe extern "C" fn ht_hair_point_eval(
 
 /// The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
 /// `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
-/// Arguments, statuses and thread safety as `ht_hair_point_eval`, without `f`.
+///
+/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
+///   `HT_ERR_INVALID_ARG`.
+/// - `point`, `wi`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled by
+///   an init and 16-byte aligned, the floats 4-byte aligned; `pdf` must not overlap `wi`
+///   or the point (`HT_ERR_INVALID_ARG`). `*pdf` untouched on error.
+///
+/// Any thread, concurrently on the same point.
 ///
 /// # Safety
-/// As `ht_hair_point_eval`.
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `pdf`
+/// NULL or 1 writable float.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_point_pdf(
     point: *const HtHairPoint,
@@ -494,11 +508,20 @@ fn weighted(s: Option<BsdfSample>) -> Option<BsdfSample> {
 /// One call for what a path vertex wants of a light direction: writes `f_cos[3]` =
 /// f * |wi.z| (the `f` of `ht_hair_point_eval` times the cosine, in that order: the
 /// fraction scattered per unit solid angle) and `*pdf`, the same pdf as
-/// `ht_hair_point_eval`. Arguments, statuses and thread safety as `ht_hair_point_eval`
-/// (`f_cos` in place of `f`).
+/// `ht_hair_point_eval`.
+///
+/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
+///   `HT_ERR_INVALID_ARG`.
+/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+///   filled by an init and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf`
+///   must not overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs
+///   untouched on error.
+///
+/// Any thread, concurrently on the same point.
 ///
 /// # Safety
-/// As `ht_hair_point_eval`.
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
+/// floats, `pdf` NULL or 1 float; outputs writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_point_eval_cos(
     point: *const HtHairPoint,
@@ -512,11 +535,19 @@ pub unsafe extern "C" fn ht_hair_point_eval_cos(
 /// One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
 /// `ht_hair_point_sample`), `weight[3]` = f * |wi.z| / pdf (the path throughput factor,
 /// from that call's f and pdf in that order) and `*pdf`. pdf = 0 (wi, weight zero) means
-/// no direction, also when the weight would not be finite; still HT_OK. Arguments,
-/// statuses and thread safety as `ht_hair_point_sample` (`weight` in place of `f`).
+/// no direction, also when the weight would not be finite; still HT_OK.
+///
+/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+/// - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
+///   `point` filled by an init and 16-byte aligned, the floats 4-byte aligned; `wi`,
+///   `weight` and `pdf` must not overlap each other, `u` or the point
+///   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///
+/// Any thread, concurrently on the same point.
 ///
 /// # Safety
-/// As `ht_hair_point_sample`.
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
+/// floats, `pdf` NULL or 1 float; outputs writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_point_sample_cos(
     point: *const HtHairPoint,
@@ -534,11 +565,18 @@ pub unsafe extern "C" fn ht_hair_point_sample_cos(
 /// a unit vector there (|length - 1| <= 1e-3). The same bits as `ht_hair_frame_to_local`
 /// followed by `ht_hair_point_eval_cos`.
 ///
-/// - A point filled by `ht_hair_point_init` (no frame): `HT_ERR_INVALID_ARG`.
-/// - Otherwise arguments, statuses and thread safety as `ht_hair_point_eval_cos`.
+/// - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
+/// - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+///   `HT_ERR_INVALID_ARG`.
+/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+///   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
+///   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///
+/// Any thread, concurrently on the same point.
 ///
 /// # Safety
-/// As `ht_hair_point_eval`.
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
+/// floats, `pdf` NULL or 1 float; outputs writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_point_eval_world(
     point: *const HtHairPoint,
@@ -554,11 +592,19 @@ pub unsafe extern "C" fn ht_hair_point_eval_world(
 /// frame, the same bits as `ht_hair_point_sample_cos` followed by `ht_hair_frame_to_world`
 /// (weight and pdf are unchanged). pdf = 0 (wi, weight zero) means no direction.
 ///
-/// - A point filled by `ht_hair_point_init` (no frame): `HT_ERR_INVALID_ARG`.
-/// - Otherwise arguments, statuses and thread safety as `ht_hair_point_sample_cos`.
+/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+/// - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+///   `HT_ERR_INVALID_ARG`.
+/// - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
+///   `point` 16-byte and the floats 4-byte aligned; `wi`, `weight` and `pdf` must not
+///   overlap each other, `u` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
+///   error.
+///
+/// Any thread, concurrently on the same point.
 ///
 /// # Safety
-/// As `ht_hair_point_sample`.
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
+/// floats, `pdf` NULL or 1 float; outputs writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_point_sample_world(
     point: *const HtHairPoint,
@@ -745,8 +791,16 @@ pub unsafe extern "C" fn ht_hair_points_eval(
 
 /// `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
 /// `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
-/// `ht_hair_point_sample`. Checks and statuses as `ht_hair_points_eval` (every `u[i]` in
-/// [0, 1)); `wi`, `f` and `pdf` must not overlap each other, `u` or `points`.
+/// `ht_hair_point_sample`. pdf[i] = 0 (wi, f zero) means no direction for point i.
+///
+/// - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
+///   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
+///   "negative" `n`: `HT_ERR_INVALID_ARG`); `wi`, `f` and `pdf` must not overlap each
+///   other, `u` or `points` (`HT_ERR_INVALID_ARG`).
+/// - Every point must be filled and every `u` in [0, 1) (`HT_ERR_INVALID_ARG`), all
+///   checked before anything is written; the message names the first bad element.
+///
+/// Any thread, concurrently on the same points.
 ///
 /// # Safety
 /// Each array is NULL or holds the number of elements given above (outputs writable).

@@ -107,7 +107,8 @@ pub struct HtRenderSettings {
 ///
 /// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
 /// crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
-/// deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03.
+/// deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03. Cannot fail; any
+/// thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
     let d = RenderSettings::default();
@@ -279,10 +280,17 @@ pub unsafe extern "C" fn ht_scene_build(
 
 /// As `ht_scene_build` (deprecated), with settings by name.
 ///
-/// Statuses: as `ht_scene_build`.
+/// Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
+/// out of range, a scene with no light, or no camera and no geometry to frame);
+/// `HT_ERR_EMBREE` (the build failed); `HT_ERR_CANCELLED` (`progress` returned false: the
+/// scene is left unbuilt, and the next build or render starts over).
+///
+/// One thread at a time per scene (the scene is not thread safe); `settings` may be read by
+/// other threads meanwhile.
 ///
 /// # Safety
-/// As `ht_scene_build`; `settings` is NULL or a live handle from `ht_settings_new`.
+/// `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+/// `settings` is NULL or a live handle from `ht_settings_new`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_scene_build_with(
     scene: *mut HtScene,
@@ -409,11 +417,21 @@ pub unsafe extern "C" fn ht_render_aovs(
 /// (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
 /// may be NULL (not wanted).
 ///
-/// Statuses: as `ht_render_aovs`.
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
+/// (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer
+/// misaligned, any two buffers overlapping, a scene with no light, or no camera and no
+/// geometry to frame); `HT_ERR_EMBREE` (the scene build failed); `HT_ERR_CANCELLED` (the
+/// progress callback returned false).
+///
+/// One thread at a time per scene; `settings` may be read by other threads meanwhile, not
+/// set. Blocks until the image is done or cancelled, rendering on worker threads it joins
+/// before it returns.
 ///
 /// # Safety
-/// As `ht_render_aovs`; `settings` is NULL or a live handle from `ht_settings_new`, not
-/// set during the call.
+/// `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
+/// `settings` is NULL or a live handle from `ht_settings_new`, not set during the call;
+/// each non-NULL buffer holds the floats its length says, writable, and nothing else reads
+/// or writes it during the call.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)] // the C signature: one argument per buffer
 pub unsafe extern "C" fn ht_render_with(

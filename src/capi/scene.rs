@@ -268,6 +268,8 @@ pub unsafe extern "C" fn ht_device_new(threads: u32, out: *mut *mut HtDevice) ->
 /// Statuses: those of `ht_device_new`, and `HT_ERR_INVALID_ARG` for another name or an
 /// ISA this CPU cannot run.
 ///
+/// Any thread: a device is thread safe.
+///
 /// # Safety
 /// `isa` is NULL or a NUL-terminated string; `out` is NULL or points to a writable
 /// `HtDevice*`.
@@ -297,6 +299,8 @@ pub unsafe extern "C" fn ht_device_new_pinned(
 /// Releases a device handle (NULL: nothing to do, `HT_OK`). Scenes made on it stay valid
 /// and release the device with the last of them. Always `HT_OK`.
 ///
+/// Any thread, once no other thread uses this handle (scenes may still hold the device).
+///
 /// # Safety
 /// `device` is NULL or a handle from `ht_device_new` not yet freed; it is invalid after
 /// the call.
@@ -313,6 +317,8 @@ pub unsafe extern "C" fn ht_device_free(device: *mut HtDevice) -> HtStatus {
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`device` or `out` NULL); `HT_ERR_INVALID_ARG` (`out`
 /// misaligned). `*out` is written on `HT_OK` only.
+///
+/// Any thread: the device may be shared; the new scene is used from one thread at a time.
 ///
 /// # Safety
 /// `device` is NULL or a live handle from `ht_device_new`; `out` is NULL or points to a

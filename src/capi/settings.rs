@@ -21,6 +21,8 @@ pub struct HtSettings {
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`out` NULL); `HT_ERR_INVALID_ARG` (`out` misaligned).
 ///
+/// Any thread.
+///
 /// # Safety
 /// `out` is NULL or writable.
 #[unsafe(no_mangle)]
@@ -35,6 +37,8 @@ pub unsafe extern "C" fn ht_settings_new(out: *mut *mut HtSettings) -> HtStatus 
 }
 
 /// Releases settings (NULL: nothing to do; returns HT_OK).
+///
+/// Any thread, once no other thread uses the handle.
 ///
 /// # Safety
 /// `settings` is NULL or a live handle from `ht_settings_new`, not used after this call.
@@ -85,6 +89,8 @@ pub unsafe extern "C" fn ht_settings_set(
 /// `HT_ERR_INVALID_ARG` (an unknown key, or `buf_len` too small: nothing is written to
 /// `buf` then, and `*len` says what it needs).
 ///
+/// Any thread; several may read one handle at once, but not while one sets it.
+///
 /// # Safety
 /// `settings` is NULL or a live handle; `key` is NULL or NUL-terminated; `buf` is NULL or
 /// `buf_len` writable bytes; `len` is NULL or writable.
@@ -127,7 +133,7 @@ pub unsafe extern "C" fn ht_settings_get(
 }
 
 /// The name of setting number `index` (0, 1, ... in the order of docs/settings.md), or NULL
-/// past the last: how a host lists every setting. Static storage.
+/// past the last: how a host lists every setting. Static storage. Cannot fail; any thread.
 #[unsafe(no_mangle)]
 pub extern "C" fn ht_settings_key(index: usize) -> *const c_char {
     static KEYS: OnceLock<Vec<CString>> = OnceLock::new();

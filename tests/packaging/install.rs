@@ -53,7 +53,7 @@ fn check_static_host(exe: &Path) {
 
 #[test]
 fn cpp_hosts_build_against_the_installed_prefix() {
-    let prefix = install("prefix-full", false);
+    let prefix = install(false);
     let lib = prefix.join("lib");
     let version = env!("CARGO_PKG_VERSION");
 
@@ -70,11 +70,11 @@ fn cpp_hosts_build_against_the_installed_prefix() {
     assert!(lib.join("libhairtrace.a").is_file());
     // The header declares exactly what the library exports.
     assert_eq!(
-        declared_functions(&prefix, &[]),
+        declared_functions(prefix, &[]),
         defined_functions(&lib.join(&real))
     );
     assert_eq!(
-        pkg_config(&prefix, &["--modversion", "hairtrace"]),
+        pkg_config(prefix, &["--modversion", "hairtrace"]),
         [version]
     );
     assert_macros_prefixed(&prefix.join("include"));
@@ -92,15 +92,15 @@ fn cpp_hosts_build_against_the_installed_prefix() {
     };
     let out = fresh_dir("hosts-pkg-config");
     let shared = out.join("shared");
-    let mut flags = pkg_config(&prefix, &["--cflags", "--libs", "hairtrace"]);
+    let mut flags = pkg_config(prefix, &["--cflags", "--libs", "hairtrace"]);
     flags.push(format!("-Wl,-rpath,{}", lib.display()));
     compile(&shared, flags);
-    check_shared_host(&shared, &prefix);
+    check_shared_host(&shared, prefix);
     let static_exe = out.join("static");
     compile(
         &static_exe,
         pkg_config(
-            &prefix,
+            prefix,
             &["--static", "--cflags", "--libs", "hairtrace-static"],
         ),
     );
@@ -151,7 +151,7 @@ fn cpp_hosts_build_against_the_installed_prefix() {
         .arg(&build)
         .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix.display())));
     run(Command::new("cmake").arg("--build").arg(&build));
-    check_shared_host(&build.join("host_shared"), &prefix);
+    check_shared_host(&build.join("host_shared"), prefix);
     check_static_host(&build.join("host_static"));
     check_furnace(&run(&mut Command::new(build.join("furnace"))));
 }

@@ -1,9 +1,10 @@
 //! The library as C and C++ hosts get it: `scripts/install` into a temporary prefix, then
 //! `host.c` built out of tree against that prefix through pkg-config and CMake, shared and
 //! static (`install.rs`), and the BSDF-only library, which must load neither Embree nor
-//! OpenImageIO (`bsdf_only.rs`). The full library's install reuses the release build (the
-//! README's test command runs `cargo build --release` first); the BSDF-only one builds in
-//! target/bsdf-only.
+//! OpenImageIO (`bsdf_only.rs`), nor does a host of the full prefix's BSDF component. Each
+//! prefix is installed once per run. The full library's install reuses the release build
+//! (the README's test command runs `cargo build --release` first); the BSDF-only library
+//! builds in target/bsdf-only.
 
 mod bsdf_only;
 mod install;
@@ -13,6 +14,7 @@ use hairtrace::{HairBsdf, HairParams};
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -43,16 +45,26 @@ fn run(cmd: &mut Command) -> String {
     String::from_utf8(out.stdout).expect("UTF-8 output")
 }
 
-/// `scripts/install --prefix <fresh folder> [--bsdf-only]`; returns the prefix.
-fn install(name: &str, bsdf_only: bool) -> PathBuf {
-    let prefix = fresh_dir(name);
-    let mut cmd = Command::new(root().join("scripts/install"));
-    cmd.arg("--prefix").arg(&prefix);
-    if bsdf_only {
-        cmd.arg("--bsdf-only");
-    }
-    run(cmd.env("CARGO", env!("CARGO")));
-    prefix
+/// The prefix of `scripts/install --prefix <fresh folder> [--bsdf-only]`, installed once
+/// per test run and shared by the tests that read it (they only read it).
+fn install(bsdf_only: bool) -> &'static Path {
+    static FULL: OnceLock<PathBuf> = OnceLock::new();
+    static BSDF_ONLY: OnceLock<PathBuf> = OnceLock::new();
+    let (once, name) = if bsdf_only {
+        (&BSDF_ONLY, "prefix-bsdf-only")
+    } else {
+        (&FULL, "prefix-full")
+    };
+    once.get_or_init(|| {
+        let prefix = fresh_dir(name);
+        let mut cmd = Command::new(root().join("scripts/install"));
+        cmd.arg("--prefix").arg(&prefix);
+        if bsdf_only {
+            cmd.arg("--bsdf-only");
+        }
+        run(cmd.env("CARGO", env!("CARGO")));
+        prefix
+    })
 }
 
 /// pkg-config's words for `args` with the prefix's pkg-config files.

@@ -31,13 +31,24 @@ impl Named {
 
     /// Renders `scene` with these settings into a fresh RGB buffer of `pixels`.
     pub(super) fn render_rgb(&self, scene: *mut HtScene, pixels: usize) -> (HtStatus, Vec<f32>) {
+        self.render_reporting(scene, pixels, None, null_mut())
+    }
+
+    /// As [`Self::render_rgb`], telling `progress` with `user`.
+    fn render_reporting(
+        &self,
+        scene: *mut HtScene,
+        pixels: usize,
+        progress: HtProgressFn,
+        user: *mut std::ffi::c_void,
+    ) -> (HtStatus, Vec<f32>) {
         let mut rgb = vec![-1.0f32; 3 * pixels];
         let status = unsafe {
             ht_render_with(
                 scene,
                 self.0,
-                None,
-                null_mut(),
+                progress,
+                user,
                 rgb.as_mut_ptr(),
                 rgb.len(),
                 null_mut(),
@@ -219,24 +230,10 @@ extern "C" fn record_noise(_done: u64, _total: u64, user: *mut std::ffi::c_void)
 fn a_progress_callback_reads_the_estimated_noise() {
     let h = fur_scene(true);
     let run = |pairs: &[(&str, &str)]| {
-        let named = Named::new(pairs);
         let seen = std::sync::Mutex::new(Vec::new());
-        let pixels = 24 * 24;
-        let mut rgb = vec![-1.0f32; 3 * pixels];
-        let status = unsafe {
-            ht_render_with(
-                h.scene,
-                named.0,
-                Some(record_noise),
-                std::ptr::from_ref(&seen).cast_mut().cast(),
-                rgb.as_mut_ptr(),
-                rgb.len(),
-                null_mut(),
-                null_mut(),
-                null_mut(),
-                pixels,
-            )
-        };
+        let user = std::ptr::from_ref(&seen).cast_mut().cast();
+        let (status, _) =
+            Named::new(pairs).render_reporting(h.scene, 24 * 24, Some(record_noise), user);
         assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
         seen.into_inner().unwrap()
     };

@@ -504,6 +504,23 @@ mod tests {
     }
 
     #[test]
+    fn a_film_past_the_available_memory_is_refused_before_the_build() {
+        let mut big = scalp(1000, "catmull_rom", "round");
+        (big.render.width, big.render.height) = (32768, 32768);
+        let message = big.check_memory(Some(4 * GIB)).unwrap_err().to_string();
+        for part in [
+            "scalp.toml",
+            "film needs about 40960 MiB",
+            "4096 MiB are available",
+        ] {
+            assert!(message.contains(part), "{message:?} lacks {part:?}");
+        }
+        // A crop of the frame keeps a film of its own pixels only.
+        big.render.crop = Some([0, 0, 1024, 1024]);
+        big.check_memory(Some(4 * GIB)).unwrap();
+    }
+
+    #[test]
     fn the_estimate_grows_with_the_basis_and_the_auto_copy() {
         let at = |basis, shape| {
             scalp(10_000_000, basis, shape)

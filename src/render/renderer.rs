@@ -31,7 +31,8 @@ pub struct RenderStats {
     /// Samples per pixel taken: `spp`, or fewer where a noise target or a time budget
     /// stopped the render.
     pub spp: u32,
-    /// The estimated noise at the end ([`Film::noise`]); None after a single pass.
+    /// The estimated noise at the end ([`Film::noise`]); None after a single pass, and for
+    /// a render with neither a noise target nor a time budget, which estimates none.
     pub noise: Option<f32>,
     /// Rays traced: closest-hit and shadow.
     pub rays: u64,

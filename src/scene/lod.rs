@@ -26,11 +26,12 @@ use crate::scene::camera::Camera;
 use crate::scene::curves::{Curves, SegmentCurve};
 
 /// The default tolerance, in pixels, between a thin strand's curve and its polyline: the
-/// largest measured whose bias stays at flat ribbons' own (the bench scalp at 10^5
-/// strands, 160 pixels, 512 spp: RMSE 1.25x the noise at 0.1 px, 1.21x at 0.05, flat
-/// B-spline ribbons 1.24x), and at which every wavy strand of the scalp fits its
-/// budget of pieces (docs/large-grooms.md, "Level of detail").
-pub const DEFAULT_LOD_PIXELS: f32 = 0.1;
+/// largest measured whose bias stays below flat ribbons' own for every basis (fur ball,
+/// 256 spp, RMSE over the noise: Catmull-Rom 1.04x, B-spline 1.06x at 0.02 px, against
+/// 1.10x and 1.19x at 0.05 and 1.08x for flat ribbons; docs/large-grooms.md). Looser
+/// tolerances that make the bench scalp's wavy strands polylines add primitives, memory
+/// and, past 0.1 px, bias (docs/large-grooms.md, "Tolerance and budget").
+pub const DEFAULT_LOD_PIXELS: f32 = 0.02;
 
 /// The shortest piece, as a fraction of a segment: a bound on the points per segment
 /// whatever the tolerance.
@@ -39,9 +40,9 @@ const MIN_PIECE: f32 = 1.0 / 64.0;
 /// The most pieces a cubic strand's polyline may have per segment of its curve: past
 /// that, Embree builds the strand's own flat cubic ribbons faster (on the 10^6 scalp,
 /// about 3 to 5x a linear segment's build time per cubic segment) and in less memory.
-/// The bench scalp's wavy strands need 2.4 pieces per segment at 0.1 px (3.3 at 0.05):
-/// at 2, most stayed flat cubic curves and the level of detail changed little.
-const MAX_PIECES_PER_SEGMENT: usize = 4;
+/// With 4, the bench scalp's wavy strands (2.4 pieces per segment at 0.1 px) all became
+/// polylines, and at 10^6 strands they took 2.3x the memory and traced slower.
+const MAX_PIECES_PER_SEGMENT: usize = 2;
 
 /// Strands sampled per parallel task.
 const CHUNK: usize = 4096;
@@ -71,6 +72,11 @@ pub fn polylines(
     let sampler = Sampler {
         eye: camera.eye(),
         per_distance: pixels * camera.pixel_spread(height),
+        budget: if curves.basis() == CurveBasis::Linear {
+            usize::MAX
+        } else {
+            MAX_PIECES_PER_SEGMENT
+        },
     };
     let strands = curves.strands().strand_count();
     // Each chunk's points, parameters and counts, in strand order whatever the threads.
@@ -84,11 +90,6 @@ pub fn polylines(
             out
         })
         .collect();
-    let budget = if curves.basis() == CurveBasis::Linear {
-        usize::MAX
-    } else {
-        MAX_PIECES_PER_SEGMENT
-    };
     let mut all = Polylines::default();
     let total = |f: fn(&Polylines) -> usize| chunks.iter().map(f).sum::<usize>();
     all.points.reserve_exact(total(|c| c.points.len()) + 1);
@@ -98,9 +99,8 @@ pub fn polylines(
     let mut keep = Vec::with_capacity(strands);
     for chunk in chunks {
         let mut at = 0;
-        for (&count, &segments) in chunk.counts.iter().zip(&chunk.segments) {
+        for (&count, &kept) in chunk.counts.iter().zip(&chunk.kept) {
             let n = count as usize;
-            let kept = n <= budget.saturating_mul(segments as usize).saturating_add(1);
             if kept {
                 all.points.extend_from_slice(&chunk.points[at..at + n]);
                 all.params.extend_from_slice(&chunk.params[at..at + n]);
@@ -120,6 +120,11 @@ pub fn polylines(
             )?),
             None,
         ));
+    }
+    // No strand within its budget: the curves themselves, flat, without a second copy of
+    // the groom beside them (at 10^6 strands, 1.1 GiB more at the peak).
+    if keep.iter().all(|&k| !k) {
+        return Ok((None, Some(curves.with_shape(CurveShape::Flat))));
     }
     let native = curves.subset(
         &keep.iter().map(|k| !k).collect::<Vec<_>>(),
@@ -142,27 +147,31 @@ struct Polylines {
     points: Vec<[f32; 4]>,
     params: Vec<f32>,
     counts: Vec<u32>,
-    /// Segments of each strand's curve.
-    segments: Vec<u32>,
+    /// Whether each strand fits its budget (one past it leaves no points here).
+    kept: Vec<bool>,
 }
 
 struct Sampler {
     eye: Vec3,
     /// The tolerance per unit of distance from the eye.
     per_distance: f32,
+    /// The most pieces per segment.
+    budget: usize,
 }
 
 impl Sampler {
-    /// Appends strand `s`'s polyline to `out`.
+    /// Appends strand `s`'s polyline to `out`, or none past its budget: the points of
+    /// strands that stay curves are dropped as they are made, not once every strand is
+    /// sampled (at 10^6 strands, a gigabyte at the peak).
     fn strand(&self, curves: &Curves, s: usize, out: &mut Polylines) {
         let segments: Vec<SegmentCurve> = (curves.strands().first_segment(s))
             .into_iter()
             .flat_map(|first| first.prims())
             .filter_map(|prim| curves.segment_curve(prim))
             .collect();
-        out.segments.push(segments.len() as u32);
         if segments.is_empty() {
             out.counts.push(0);
+            out.kept.push(true);
             return;
         }
         let strand = Strand {
@@ -175,7 +184,14 @@ impl Sampler {
         out.points.push(root.to_array());
         out.params.push(0.0);
         strand.refine(0.0, root, end, tip, out);
-        out.counts.push((out.points.len() - before) as u32);
+        let n = out.points.len() - before;
+        let kept = n <= self.budget.saturating_mul(segments.len()).saturating_add(1);
+        if !kept {
+            out.points.truncate(before);
+            out.params.truncate(before);
+        }
+        out.counts.push(if kept { n as u32 } else { 0 });
+        out.kept.push(kept);
     }
 }
 
@@ -403,9 +419,8 @@ mod tests {
 
     /// The bench scalp's strands (bench/stages/scalp_1m.toml: 16 segments over four
     /// waves) from the bench camera at 160 pixels, every strand under a pixel wide: every
-    /// point of every curve stays within the tolerance of the polyline, at the tolerances
-    /// measured for the default; and at the default, every strand fits its budget of
-    /// pieces.
+    /// point of every curve stays within the tolerance of the polyline, whichever strands
+    /// fit their budget at each tolerance measured for the default (at 0.25 px, some).
     #[test]
     fn the_bench_scalps_polylines_stay_within_the_tolerance_at_the_views_footprint() {
         let scalp = crate::scene::ScalpPatch {
@@ -424,12 +439,12 @@ mod tests {
                 thin.iter().all(|&t| t),
                 "{basis:?}: a strand over a pixel wide"
             );
-            for pixels in [DEFAULT_LOD_PIXELS / 2.0, DEFAULT_LOD_PIXELS, 0.25] {
-                let (lines, native) = polylines(curves.clone(), &camera, height, pixels).unwrap();
-                let lines = lines.unwrap();
-                if pixels == DEFAULT_LOD_PIXELS {
-                    assert!(native.is_none(), "{basis:?}: strands past their budget");
+            for pixels in [DEFAULT_LOD_PIXELS, 0.05, 0.1, 0.25] {
+                let (lines, _) = polylines(curves.clone(), &camera, height, pixels).unwrap();
+                if pixels == 0.25 {
+                    assert!(lines.is_some(), "{basis:?}: every strand past its budget");
                 }
+                let Some(lines) = lines else { continue };
                 for s in 0..lines.strands().strand_count() {
                     let worst = worst_pixels(&lines, s, &camera, height);
                     assert!(

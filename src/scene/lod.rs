@@ -28,7 +28,9 @@ use crate::scene::curves::{Curves, SegmentCurve};
 /// The default tolerance, in pixels, between a thin strand's curve and its polyline: the
 /// largest measured whose bias stays below flat ribbons' own for every basis (fur ball,
 /// 256 spp, RMSE over the noise: Catmull-Rom 1.04x, B-spline 1.06x at 0.02 px, against
-/// 1.10x and 1.19x at 0.05 and 1.08x for flat ribbons; docs/large-grooms.md).
+/// 1.10x and 1.19x at 0.05 and 1.08x for flat ribbons; docs/large-grooms.md). Looser
+/// tolerances that make the bench scalp's wavy strands polylines add primitives, memory
+/// and, past 0.1 px, bias (docs/large-grooms.md, "Tolerance and budget").
 pub const DEFAULT_LOD_PIXELS: f32 = 0.02;
 
 /// The shortest piece, as a fraction of a segment: a bound on the points per segment
@@ -38,6 +40,8 @@ const MIN_PIECE: f32 = 1.0 / 64.0;
 /// The most pieces a cubic strand's polyline may have per segment of its curve: past
 /// that, Embree builds the strand's own flat cubic ribbons faster (on the 10^6 scalp,
 /// about 3 to 5x a linear segment's build time per cubic segment) and in less memory.
+/// With 4, the bench scalp's wavy strands (2.4 pieces per segment at 0.1 px) all became
+/// polylines, and at 10^6 strands they took 2.3x the memory and traced slower.
 const MAX_PIECES_PER_SEGMENT: usize = 2;
 
 /// Strands sampled per parallel task.
@@ -68,6 +72,11 @@ pub fn polylines(
     let sampler = Sampler {
         eye: camera.eye(),
         per_distance: pixels * camera.pixel_spread(height),
+        budget: if curves.basis() == CurveBasis::Linear {
+            usize::MAX
+        } else {
+            MAX_PIECES_PER_SEGMENT
+        },
     };
     let strands = curves.strands().strand_count();
     // Each chunk's points, parameters and counts, in strand order whatever the threads.
@@ -81,11 +90,6 @@ pub fn polylines(
             out
         })
         .collect();
-    let budget = if curves.basis() == CurveBasis::Linear {
-        usize::MAX
-    } else {
-        MAX_PIECES_PER_SEGMENT
-    };
     let mut all = Polylines::default();
     let total = |f: fn(&Polylines) -> usize| chunks.iter().map(f).sum::<usize>();
     all.points.reserve_exact(total(|c| c.points.len()) + 1);
@@ -95,9 +99,8 @@ pub fn polylines(
     let mut keep = Vec::with_capacity(strands);
     for chunk in chunks {
         let mut at = 0;
-        for (&count, &segments) in chunk.counts.iter().zip(&chunk.segments) {
+        for (&count, &kept) in chunk.counts.iter().zip(&chunk.kept) {
             let n = count as usize;
-            let kept = n <= budget.saturating_mul(segments as usize).saturating_add(1);
             if kept {
                 all.points.extend_from_slice(&chunk.points[at..at + n]);
                 all.params.extend_from_slice(&chunk.params[at..at + n]);
@@ -117,6 +120,11 @@ pub fn polylines(
             )?),
             None,
         ));
+    }
+    // No strand within its budget: the curves themselves, flat, without a second copy of
+    // the groom beside them (at 10^6 strands, 1.1 GiB more at the peak).
+    if keep.iter().all(|&k| !k) {
+        return Ok((None, Some(curves.with_shape(CurveShape::Flat))));
     }
     let native = curves.subset(
         &keep.iter().map(|k| !k).collect::<Vec<_>>(),
@@ -139,27 +147,31 @@ struct Polylines {
     points: Vec<[f32; 4]>,
     params: Vec<f32>,
     counts: Vec<u32>,
-    /// Segments of each strand's curve.
-    segments: Vec<u32>,
+    /// Whether each strand fits its budget (one past it leaves no points here).
+    kept: Vec<bool>,
 }
 
 struct Sampler {
     eye: Vec3,
     /// The tolerance per unit of distance from the eye.
     per_distance: f32,
+    /// The most pieces per segment.
+    budget: usize,
 }
 
 impl Sampler {
-    /// Appends strand `s`'s polyline to `out`.
+    /// Appends strand `s`'s polyline to `out`, or none past its budget: the points of
+    /// strands that stay curves are dropped as they are made, not once every strand is
+    /// sampled (at 10^6 strands, a gigabyte at the peak).
     fn strand(&self, curves: &Curves, s: usize, out: &mut Polylines) {
         let segments: Vec<SegmentCurve> = (curves.strands().first_segment(s))
             .into_iter()
             .flat_map(|first| first.prims())
             .filter_map(|prim| curves.segment_curve(prim))
             .collect();
-        out.segments.push(segments.len() as u32);
         if segments.is_empty() {
             out.counts.push(0);
+            out.kept.push(true);
             return;
         }
         let strand = Strand {
@@ -172,7 +184,14 @@ impl Sampler {
         out.points.push(root.to_array());
         out.params.push(0.0);
         strand.refine(0.0, root, end, tip, out);
-        out.counts.push((out.points.len() - before) as u32);
+        let n = out.points.len() - before;
+        let kept = n <= self.budget.saturating_mul(segments.len()).saturating_add(1);
+        if !kept {
+            out.points.truncate(before);
+            out.params.truncate(before);
+        }
+        out.counts.push(if kept { n as u32 } else { 0 });
+        out.kept.push(kept);
     }
 }
 
@@ -310,8 +329,9 @@ mod tests {
     }
 
     /// The curve at 64 points per segment against the polyline piece its parameter falls
-    /// in: the largest distance, in pixels at the point's distance from the eye.
-    fn worst_pixels(lines: &Curves, strand: usize) -> f32 {
+    /// in: the largest distance, in pixels of an image `height` pixels tall seen from
+    /// `camera`, at the point's distance from the eye.
+    fn worst_pixels(lines: &Curves, strand: usize, camera: &Camera, height: u32) -> f32 {
         let truth = lines.truth().unwrap();
         let curve = truth.curves();
         let first = curve.strands().first_segment(strand).unwrap();
@@ -320,7 +340,7 @@ mod tests {
             [lines.strands().first_segment(strand).unwrap().first_prim as usize]
             as usize;
         let params = &truth.params()[start..start + points.len()];
-        let spread = camera().pixel_spread(HEIGHT);
+        let spread = camera.pixel_spread(height);
         let mut worst = 0.0f32;
         for prim in first.prims() {
             let seg = curve.segment_curve(prim).unwrap();
@@ -333,7 +353,7 @@ mod tests {
                     .unwrap();
                 let p = seg.at(u).truncate();
                 let [a, b] = [piece, piece + 1].map(|i| Vec3::from_slice(&points[i][..3]));
-                worst = worst.max(to_segment(p, a, b) / (spread * p.length()));
+                worst = worst.max(to_segment(p, a, b) / (spread * p.distance(camera.eye())));
             }
         }
         worst
@@ -353,7 +373,7 @@ mod tests {
                 );
                 let n = pieces(&lines);
                 for s in 0..3 {
-                    let worst = worst_pixels(&lines, s);
+                    let worst = worst_pixels(&lines, s, &camera(), HEIGHT);
                     assert!(
                         worst <= pixels,
                         "{basis:?} strand {s} at {pixels} px: a curve point {worst} px off"
@@ -388,10 +408,50 @@ mod tests {
                         .collect::<Vec<_>>()
                 };
                 let lines = lines.unwrap();
-                assert!(pieces(&lines).iter().all(|&n| n <= 24), "{basis:?}");
+                let most = (MAX_PIECES_PER_SEGMENT * 12) as u32;
+                assert!(pieces(&lines).iter().all(|&n| n <= most), "{basis:?}");
                 let mut all = [ids(&lines), ids(&native)].concat();
                 all.sort();
                 assert_eq!(all, [0, 1, 2], "{basis:?}");
+            }
+        }
+    }
+
+    /// The bench scalp's strands (bench/stages/scalp_1m.toml: 16 segments over four
+    /// waves) from the bench camera at 160 pixels, every strand under a pixel wide: every
+    /// point of every curve stays within the tolerance of the polyline, whichever strands
+    /// fit their budget at each tolerance measured for the default (at 0.25 px, some).
+    #[test]
+    fn the_bench_scalps_polylines_stay_within_the_tolerance_at_the_views_footprint() {
+        let scalp = crate::scene::ScalpPatch {
+            strands: 200,
+            segments: 16,
+            ..Default::default()
+        };
+        let strands = scalp.build().unwrap();
+        let eye = Vec3::new(4.5, 0.2, 4.5);
+        let camera = Camera::new(eye, Vec3::new(0.0, -0.6, 0.0), Vec3::Y, 40.0, 1.0).unwrap();
+        let height = 160;
+        for basis in [CurveBasis::BSpline, CurveBasis::CatmullRom] {
+            let curves = Curves::from_strands(&strands, basis, CurveShape::Round).unwrap();
+            let thin = crate::scene::ribbons::thin_strands(&curves, &camera, height);
+            assert!(
+                thin.iter().all(|&t| t),
+                "{basis:?}: a strand over a pixel wide"
+            );
+            for pixels in [DEFAULT_LOD_PIXELS, 0.05, 0.1, 0.25] {
+                let (lines, _) = polylines(curves.clone(), &camera, height, pixels).unwrap();
+                if pixels == 0.25 {
+                    assert!(lines.is_some(), "{basis:?}: every strand past its budget");
+                }
+                let Some(lines) = lines else { continue };
+                for s in 0..lines.strands().strand_count() {
+                    let worst = worst_pixels(&lines, s, &camera, height);
+                    assert!(
+                        worst <= pixels,
+                        "{basis:?} {pixels} px, strand {s}: a curve point {worst} px off"
+                    );
+                }
             }
         }
     }

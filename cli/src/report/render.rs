@@ -73,7 +73,7 @@ fn set_basis(v: &mut Variant, basis: CurveBasis) -> Result<()> {
 
 /// The seed of every reference: no timed render uses it (a render sharing the
 /// reference's seed shares its first samples and looks too good).
-const REFERENCE_SEED: u64 = 1_000_003;
+pub const REFERENCE_SEED: u64 = 1_000_003;
 
 /// Sizes of one run: the sample counts of each curve and the reference's.
 struct Plan {

@@ -1,24 +1,70 @@
 //! Scale section: how building and tracing grow with the strand count, per curve basis and
-//! shape, and where the time before the first pixel goes (the library's build stages).
+//! shape with and without the level of detail, where the time before the first pixel goes
+//! (the library's build stages), and what each level of detail changes in the image.
 
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
+use super::render::{Built, REFERENCE_SEED, Variant};
 use super::{Context, scene_path};
 use hairtrace::description::{GroomSource, SceneDescription};
-use hairtrace::embree::{CurveBasis, CurveShape, MemoryMonitor};
-use hairtrace::scene::Stage;
+use hairtrace::embree::{CurveBasis, MemoryMonitor};
+use hairtrace::image::compare;
+use hairtrace::scene::lod::DEFAULT_LOD_PIXELS;
+use hairtrace::scene::{GroomShape, Stage};
 use hairtrace::{Aovs, NoProgress, Result};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// The curve types compared, by name.
-const CURVES: [(&str, CurveBasis, CurveShape); 4] = [
-    ("linear round", CurveBasis::Linear, CurveShape::Round),
-    ("linear flat", CurveBasis::Linear, CurveShape::Flat),
-    ("bspline round", CurveBasis::BSpline, CurveShape::Round),
-    ("bspline flat", CurveBasis::BSpline, CurveShape::Flat),
+/// A curve type: its name, basis, shape and level-of-detail tolerance (`lod_pixels`; it
+/// acts on `auto` grooms only).
+type CurveType = (&'static str, CurveBasis, GroomShape, f32);
+
+/// The curve types compared: every basis at full detail (round), flat ribbons, and the
+/// level of detail (`auto` at the default tolerance: at the section's 160 pixels every
+/// strand of the scalp is thinner than a pixel).
+const CURVES: [CurveType; 10] = [
+    ("linear round", CurveBasis::Linear, GroomShape::Round, 0.0),
+    ("linear flat", CurveBasis::Linear, GroomShape::Flat, 0.0),
+    ("bspline round", CurveBasis::BSpline, GroomShape::Round, 0.0),
+    ("bspline flat", CurveBasis::BSpline, GroomShape::Flat, 0.0),
+    (
+        "catmull_rom round",
+        CurveBasis::CatmullRom,
+        GroomShape::Round,
+        0.0,
+    ),
+    ("bezier round", CurveBasis::Bezier, GroomShape::Round, 0.0),
+    (
+        "linear lod",
+        CurveBasis::Linear,
+        GroomShape::Auto,
+        DEFAULT_LOD_PIXELS,
+    ),
+    (
+        "bspline lod",
+        CurveBasis::BSpline,
+        GroomShape::Auto,
+        DEFAULT_LOD_PIXELS,
+    ),
+    (
+        "catmull_rom lod",
+        CurveBasis::CatmullRom,
+        GroomShape::Auto,
+        DEFAULT_LOD_PIXELS,
+    ),
+    (
+        "bezier lod",
+        CurveBasis::Bezier,
+        GroomShape::Auto,
+        DEFAULT_LOD_PIXELS,
+    ),
 ];
+
+/// The bases and tolerances whose bias is measured (0: flat ribbons, `auto` without a
+/// level of detail), against round curves of the same basis.
+const BIAS_BASES: [CurveBasis; 2] = [CurveBasis::BSpline, CurveBasis::CatmullRom];
+const BIAS_TOLERANCES: [f32; 5] = [0.0, 0.02, 0.05, 0.1, 0.25];
 
 fn strand_counts(ctx: &Context) -> Vec<usize> {
     if ctx.quick {
@@ -63,12 +109,11 @@ pub fn scalp_path(scenes: &Path) -> PathBuf {
 fn scalp(
     ctx: &Context,
     strands: usize,
-    basis: CurveBasis,
-    shape: CurveShape,
+    (_, basis, shape, lod): CurveType,
 ) -> Result<SceneDescription> {
     let mut desc = SceneDescription::from_file(&scalp_path(&ctx.scenes))?;
     for g in &mut desc.grooms {
-        (g.basis, g.shape) = (basis, shape.into());
+        (g.basis, g.shape) = (basis, shape);
         if let GroomSource::Scalp(s) = &mut g.source {
             s.strands = strands;
         }
@@ -79,6 +124,7 @@ fn scalp(
     } else {
         (160, 160, 4)
     };
+    r.lod_pixels = lod;
     Ok(desc)
 }
 
@@ -104,21 +150,22 @@ fn measure(desc: &SceneDescription, strands: usize) -> Result<Point> {
 }
 
 pub fn steps(ctx: &Context) -> u64 {
-    (CURVES.len() * strand_counts(ctx).len()) as u64
+    (CURVES.len() * strand_counts(ctx).len() + BIAS_BASES.len() * (BIAS_TOLERANCES.len() + 1))
+        as u64
 }
 
 pub fn section(ctx: &Context) -> Result<String> {
     let mut results: Vec<(&str, Vec<Point>)> = Vec::new();
-    for (name, basis, shape) in CURVES {
+    for curve in CURVES {
         let mut points = Vec::new();
         for strands in strand_counts(ctx) {
-            ctx.step(format!("scale: {name}, {strands} strands"));
-            points.push(measure(&scalp(ctx, strands, basis, shape)?, strands)?);
+            ctx.step(format!("scale: {}, {strands} strands", curve.0));
+            points.push(measure(&scalp(ctx, strands, curve)?, strands)?);
             ctx.done();
         }
-        results.push((name, points));
+        results.push((curve.0, points));
     }
-    let probe = scalp(ctx, 0, CurveBasis::Linear, CurveShape::Round)?;
+    let probe = scalp(ctx, 0, CURVES[0])?;
     let caption = ctx.machine.caption(
         ctx.machine.threads,
         &format!(
@@ -211,7 +258,10 @@ pub fn section(ctx: &Context) -> Result<String> {
          curves, Embree's BVH build). Memory: Embree's own peak allocation during the build \
          (its memory monitor), and how much the process's resident memory grew (the \
          groom's buffers too; freed memory the allocator keeps makes it a lower bound after \
-         the first build).\n\n{}\n{}\n{figures}",
+         the first build). `lod` is the level of detail: `auto` curves with \
+         `lod_pixels = {DEFAULT_LOD_PIXELS}` (the default), every strand here thinner than \
+         a pixel and so traced as linear ribbons through points on its curve, or as flat \
+         curves of its basis where it needs more than the budget of pieces.\n\n{}\n{}\n{figures}\n{}",
         table(
             &[
                 "curves",
@@ -227,6 +277,72 @@ pub fn section(ctx: &Context) -> Result<String> {
             &rows
         ),
         advice(&results, ctx.machine.threads),
+        bias(ctx)?,
+    ))
+}
+
+/// The scalp's strands for the bias table: enough that a pixel holds many strands, as in
+/// the largest grooms, few enough for renders at many samples.
+fn bias_strands(ctx: &Context) -> usize {
+    if ctx.quick { 1_000 } else { 100_000 }
+}
+
+/// Each level of detail's bias: the scalp rendered at a tolerance against round curves of
+/// its basis at 4x the samples with the render section's reference seed, with the noise
+/// (round curves at the same samples and seed as the variants) taken out.
+fn bias(ctx: &Context) -> Result<String> {
+    let spp = if ctx.quick { 4 } else { 256 };
+    let strands = bias_strands(ctx);
+    let mut rows = Vec::new();
+    for basis in BIAS_BASES {
+        let name = format!("{basis:?}");
+        let round = ("round", basis, GroomShape::Round, 0.0);
+        ctx.step(format!("scale: {name} round reference, {} spp", 4 * spp));
+        let mut built = Built::new(&Variant {
+            desc: scalp(ctx, strands, round)?,
+        })?;
+        let (reference, _, _) = built.render(4 * spp, REFERENCE_SEED)?;
+        let (image, _, _) = built.render(spp, 1)?;
+        drop(built);
+        let noise = compare(&image, &reference)?.rmse;
+        ctx.done();
+        for lod in BIAS_TOLERANCES {
+            ctx.step(format!("scale: {name} bias at {lod} px"));
+            let desc = scalp(ctx, strands, ("auto", basis, GroomShape::Auto, lod))?;
+            let (image, _, _) = Built::new(&Variant { desc })?.render(spp, 1)?;
+            let c = compare(&image, &reference)?;
+            let bias = (c.rmse * c.rmse - noise * noise).max(0.0).sqrt();
+            rows.push(vec![
+                name.clone(),
+                if lod == 0.0 {
+                    "0 (flat ribbons)".to_owned()
+                } else {
+                    num(f64::from(lod), 3)
+                },
+                num(c.rmse / noise, 3),
+                num(bias / noise, 3),
+                num(100.0 * (c.mean / c.reference_mean - 1.0), 2),
+            ]);
+            ctx.done();
+        }
+    }
+    Ok(format!(
+        "**What the level of detail changes in the image.** The scalp at {strands} strands, \
+         `auto` curves at each tolerance (`lod_pixels`), {spp} spp seed 1, against round \
+         curves of the same basis at {} spp with seed {REFERENCE_SEED}; the noise is the \
+         round curves' own RMSE at {spp} spp seed 1 against that reference. The bias is \
+         what the RMSE has beyond the noise, sqrt(RMSE^2 - noise^2).\n\n{}\n",
+        4 * spp,
+        table(
+            &[
+                "basis",
+                "lod_pixels",
+                "RMSE / noise",
+                "bias / noise",
+                "mean vs round %"
+            ],
+            &rows
+        )
     ))
 }
 
@@ -301,6 +417,24 @@ fn advice(results: &[(&str, Vec<Point>)], threads: usize) -> String {
         ),
         "flat ribbons trace no faster than round curves here",
     );
+    if let Some(bl) = last("bspline lod") {
+        let (build_gain, trace_gain) = (br.build / bl.build, bl.mrays / br.mrays);
+        text += &suggest(
+            build_gain.max(trace_gain),
+            1.05,
+            format!(
+                "`shape = \"auto\"` with its level of detail (the default) reaches the first \
+                 pixel {}x sooner than round curves and traces {}x their rays per second \
+                 ({} against {} Mrays/s), where the strands are thinner than a pixel; the \
+                 bias table below gives what it changes in the image.",
+                num(build_gain, 2),
+                num(trace_gain, 2),
+                num(bl.mrays, 3),
+                num(br.mrays, 3)
+            ),
+            "the level of detail gains little here",
+        );
+    }
     if biggest == Stage::Bvh.name() && biggest_seconds > 0.5 * br.build {
         text += &format!(
             "\n- the BVH build, Embree's, runs on every thread the device has ({threads} here; \

@@ -9,56 +9,45 @@ use super::{Context, scene_path};
 use hairtrace::description::{GroomSource, SceneDescription};
 use hairtrace::embree::{CurveBasis, MemoryMonitor};
 use hairtrace::image::compare;
-use hairtrace::scene::lod::DEFAULT_LOD_PIXELS;
 use hairtrace::scene::{GroomShape, Stage};
 use hairtrace::{Aovs, NoProgress, Result};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-/// A curve type: its name, basis, shape and level-of-detail tolerance (`lod_pixels`; it
-/// acts on `auto` grooms only).
-type CurveType = (&'static str, CurveBasis, GroomShape, f32);
+/// A curve type: its name, basis, shape and level-of-detail tolerance (`lod_pixels`, None
+/// for the setting's default; it acts on `auto` grooms only).
+type CurveType = (&'static str, CurveBasis, GroomShape, Option<f32>);
 
 /// The curve types compared: every basis at full detail (round), flat ribbons, and the
 /// level of detail (`auto` at the default tolerance: at the section's 160 pixels every
 /// strand of the scalp is thinner than a pixel).
 const CURVES: [CurveType; 10] = [
-    ("linear round", CurveBasis::Linear, GroomShape::Round, 0.0),
-    ("linear flat", CurveBasis::Linear, GroomShape::Flat, 0.0),
-    ("bspline round", CurveBasis::BSpline, GroomShape::Round, 0.0),
-    ("bspline flat", CurveBasis::BSpline, GroomShape::Flat, 0.0),
+    ("linear round", CurveBasis::Linear, GroomShape::Round, None),
+    ("linear flat", CurveBasis::Linear, GroomShape::Flat, None),
+    (
+        "bspline round",
+        CurveBasis::BSpline,
+        GroomShape::Round,
+        None,
+    ),
+    ("bspline flat", CurveBasis::BSpline, GroomShape::Flat, None),
     (
         "catmull_rom round",
         CurveBasis::CatmullRom,
         GroomShape::Round,
-        0.0,
+        None,
     ),
-    ("bezier round", CurveBasis::Bezier, GroomShape::Round, 0.0),
-    (
-        "linear lod",
-        CurveBasis::Linear,
-        GroomShape::Auto,
-        DEFAULT_LOD_PIXELS,
-    ),
-    (
-        "bspline lod",
-        CurveBasis::BSpline,
-        GroomShape::Auto,
-        DEFAULT_LOD_PIXELS,
-    ),
+    ("bezier round", CurveBasis::Bezier, GroomShape::Round, None),
+    ("linear lod", CurveBasis::Linear, GroomShape::Auto, None),
+    ("bspline lod", CurveBasis::BSpline, GroomShape::Auto, None),
     (
         "catmull_rom lod",
         CurveBasis::CatmullRom,
         GroomShape::Auto,
-        DEFAULT_LOD_PIXELS,
+        None,
     ),
-    (
-        "bezier lod",
-        CurveBasis::Bezier,
-        GroomShape::Auto,
-        DEFAULT_LOD_PIXELS,
-    ),
+    ("bezier lod", CurveBasis::Bezier, GroomShape::Auto, None),
 ];
 
 /// The bases and tolerances whose bias is measured (0: flat ribbons, `auto` without a
@@ -124,7 +113,9 @@ fn scalp(
     } else {
         (160, 160, 4)
     };
-    r.lod_pixels = lod;
+    if let Some(lod) = lod {
+        r.lod_pixels = lod;
+    }
     Ok(desc)
 }
 
@@ -251,6 +242,7 @@ pub fn section(ctx: &Context) -> Result<String> {
             })
         })
         .collect();
+    let default_lod = hairtrace::RenderSettings::default().lod_pixels;
     Ok(format!(
         "The stage benchmark's scalp (16 segments per strand) built at each strand count \
          with each curve type, then rendered once. Time to first pixel is the whole build; \
@@ -259,7 +251,7 @@ pub fn section(ctx: &Context) -> Result<String> {
          (its memory monitor), and how much the process's resident memory grew (the \
          groom's buffers too; freed memory the allocator keeps makes it a lower bound after \
          the first build). `lod` is the level of detail: `auto` curves with \
-         `lod_pixels = {DEFAULT_LOD_PIXELS}` (the default), every strand here thinner than \
+         `lod_pixels = {default_lod}` (the default), every strand here thinner than \
          a pixel and so traced as linear ribbons through points on its curve, or as flat \
          curves of its basis where it needs more than the budget of pieces.\n\n{}\n{}\n{figures}\n{}",
         table(
@@ -296,7 +288,7 @@ fn bias(ctx: &Context) -> Result<String> {
     let mut rows = Vec::new();
     for basis in BIAS_BASES {
         let name = format!("{basis:?}");
-        let round = ("round", basis, GroomShape::Round, 0.0);
+        let round = ("round", basis, GroomShape::Round, None);
         ctx.step(format!("scale: {name} round reference, {} spp", 4 * spp));
         let mut built = Built::new(&Variant {
             desc: scalp(ctx, strands, round)?,
@@ -308,7 +300,7 @@ fn bias(ctx: &Context) -> Result<String> {
         ctx.done();
         for lod in BIAS_TOLERANCES {
             ctx.step(format!("scale: {name} bias at {lod} px"));
-            let desc = scalp(ctx, strands, ("auto", basis, GroomShape::Auto, lod))?;
+            let desc = scalp(ctx, strands, ("auto", basis, GroomShape::Auto, Some(lod)))?;
             let (image, _, _) = Built::new(&Variant { desc })?.render(spp, 1)?;
             let c = compare(&image, &reference)?;
             let bias = (c.rmse * c.rmse - noise * noise).max(0.0).sqrt();

@@ -791,7 +791,7 @@ pub unsafe extern "C" fn ht_hair_points_eval(
 
 /// `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
 /// `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
-/// `ht_hair_point_sample`. pdf[i] = 0 (wi, f zero) means no direction for point i.
+/// `ht_hair_point_sample`. `pdf[i]` = 0 (`wi`, `f` zero) means no direction for point i.
 ///
 /// - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
 ///   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or

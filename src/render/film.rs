@@ -310,7 +310,7 @@ pub enum Keep {
     /// render in passes.
     #[default]
     Sums,
-    /// The sums and the two halves of [`PixelAccumulator::variance_of_mean`]: a render in
+    /// The sums and the two halves of `PixelAccumulator::variance_of_mean`: a render in
     /// passes that estimates its noise.
     Halves,
     /// The sums, the squares and the rays of each pixel: its variance and cost per sample
@@ -378,7 +378,7 @@ pub struct Film {
     halves: Vec<Halves>,
     squares: Vec<[f64; 3]>,
     rays: Vec<u64>,
-    /// Over the whole film: samples taken, rejected ([`PixelAccumulator::add`]) and rays
+    /// Over the whole film: samples taken, rejected (`PixelAccumulator::add`) and rays
     /// traced by the samples of the pixels as stored.
     totals: Totals,
 }

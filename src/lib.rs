@@ -38,9 +38,9 @@
 //!   settings), [`BuiltScene::set_material`] and `set_lights` (edits without a new build);
 //! - images: [`write_image`], [`read_image`].
 //!
-//! The tracer, the film and the integrator are the crate's own: their tests live beside
-//! them (`src/<layer>/tests/`), and the groom benchmark opens them with the
-//! `bench-internals` feature, which is not an API.
+//! The tracer, the film's accumulators and the integrator are the crate's own; their tests
+//! live beside them (`src/<layer>/tests/`). The `bench-internals` feature opens the tracer
+//! and Embree's raw bindings to the groom benchmark alone: it is not an API.
 
 // The BSDF-only build compiles the lower layers without the render code that uses some of
 // their helpers; the default build (every feature) still reports code nothing uses.

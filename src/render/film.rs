@@ -21,6 +21,16 @@ pub struct Window {
 }
 
 impl Window {
+    /// The whole of a `width` x `height` frame.
+    pub fn full(width: u32, height: u32) -> Self {
+        Self {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        }
+    }
+
     pub fn width(&self) -> u32 {
         self.x1.saturating_sub(self.x0)
     }
@@ -410,12 +420,7 @@ impl Film {
                 "film size {width} x {height} must be at least 1 x 1"
             ));
         }
-        let crop = crop.unwrap_or(Window {
-            x0: 0,
-            y0: 0,
-            x1: width,
-            y1: height,
-        });
+        let crop = crop.unwrap_or(Window::full(width, height));
         if !(crop.x0 < crop.x1 && crop.y0 < crop.y1 && crop.x1 <= width && crop.y1 <= height) {
             return Err(invalid_arg!(
                 "crop window x [{}, {}) y [{}, {}) must be non-empty and inside the \

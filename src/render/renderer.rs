@@ -64,20 +64,19 @@ pub fn film_keep(settings: &RenderSettings, keeps_passes: bool) -> Keep {
     }
 }
 
+/// The window of the frame `settings` crop to, if they crop.
+fn crop(settings: &RenderSettings) -> Option<Window> {
+    settings
+        .crop
+        .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 })
+}
+
 /// The bytes of the films a render with `settings` and `aovs` holds, its progress sink
 /// keeping passes or not: its film's and the noise allocation's pilot's. Zero for settings
 /// whose crop is not inside the frame.
 pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> u64 {
     let (width, height) = (settings.width, settings.height);
-    let window = settings.crop.map_or(
-        Window {
-            x0: 0,
-            y0: 0,
-            x1: width,
-            y1: height,
-        },
-        |[x0, y0, x1, y1]| Window { x0, y0, x1, y1 },
-    );
+    let window = crop(settings).unwrap_or(Window::full(width, height));
     let film = window
         .pixel_count()
         .saturating_mul(film_keep(settings, keeps_passes).bytes_per_pixel(aovs));
@@ -127,11 +126,8 @@ pub fn render(
     let bytes = film_bytes(settings, aovs, progress.keeps_passes());
     footprint::check_film_fits(bytes, available_bytes())?;
     let (width, height) = (settings.width, settings.height);
-    let crop = settings
-        .crop
-        .map(|[x0, y0, x1, y1]| Window { x0, y0, x1, y1 });
     let keep = film_keep(settings, progress.keeps_passes());
-    let mut film = Film::keeping(width, height, crop, aovs, keep)?;
+    let mut film = Film::keeping(width, height, crop(settings), aovs, keep)?;
     // The noise allocation's pilot, over whole blocks around the crop.
     let mut pilot = match settings.allocation {
         Allocation::Uniform => None,

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """hairtrace against Blender Cycles on the bench scenes, on this machine, in one run.
 
-    bench/peer [--quick] [--scenes fur_ball,scalp] [--repeats 3] [--threads 2]
+    bench/peer [--quick] [--scenes fur_ball,scalp] [--repeats 3] [--threads 2] [--time-to-rmse]
 
 (bench/peer sets up the virtual environment, builds hairtrace and the ray-counting shim,
 then runs this file.) For each scene of bench/scenes/:
@@ -20,6 +20,9 @@ then runs this file.) For each scene of bench/scenes/:
    its most samples); hairtrace is compared with the better of the two on each scene, and
    the table says which. hairtrace renders with the scene's own settings (its
    `allocation` among them); `--allocation` renders it once more with that allocation.
+4. `--time-to-rmse`: each renderer's time to one RMSE, hairtrace stopping by its noise
+   target, Cycles by its adaptive threshold (`time_to_rmse`), with hairtrace's estimated
+   noise beside the measured one.
 
 RMSE against the mean of two references needs no pixel arithmetic here: for images x, a,
 b, |x - (a + b)/2|^2 = |x - a|^2 / 2 + |x - b|^2 / 2 - |a - b|^2 / 4 per pixel, so the
@@ -46,6 +49,8 @@ REFERENCE_SEED = 1_000_003
 REFERENCE_FACTOR = 16
 # Blender's default noise threshold for Cycles' adaptive sampling.
 CYCLES_ADAPTIVE = 0.01
+# The thresholds `--time-to-rmse` tries, coarsest first, until one reaches hairtrace's RMSE.
+CYCLES_LADDER = (0.8, 0.4, 0.2, 0.1, 0.05, 0.025, 0.0125, 0.00625)
 
 
 def run(cmd, env=None):
@@ -76,15 +81,18 @@ class Scene:
         os.makedirs(self.work, exist_ok=True)
         run([HAIRTRACE, "export", self.path, "-o", os.path.join(self.work, "peer")])
 
-    def hairtrace(self, spp, seed, out, allocation=None):
+    def hairtrace(self, spp, seed, out, allocation=None, noise_target=None):
         stats = out + ".json"
         extra = ["--allocation", allocation] if allocation else []
+        if noise_target:
+            extra += ["--noise-target", repr(noise_target)]
         run([HAIRTRACE, "render", self.path, "--spp", str(spp), "--seed", str(seed),
              "--threads", str(self.threads), "--max-depth", str(self.max_depth),
              "--filter", "box", "-o", out, "--stats", stats] + extra)
         with open(stats) as f:
             s = json.load(f)
-        return {"seconds": s["seconds"], "samples": s["samples"], "rays": s["rays"]}
+        return {"seconds": s["seconds"], "samples": s["samples"], "rays": s["rays"],
+                "spp": s["spp"], "noise": s["noise"]}
 
     def cycles(self, spp, seed, out, adaptive=0.0):
         stats = out + ".json"
@@ -104,31 +112,40 @@ class Scene:
         return {"seconds": s["render_seconds"], "samples": s["samples"], "rays": rays}
 
 
-def measure(scene, repeats, allocation, log):
-    references = {"hairtrace": scene.hairtrace, "Cycles": scene.cycles}
-    renderers = dict(references)
+class Reference:
+    """The two references of a scene, and the RMSE of an image against their mean."""
+
+    def __init__(self, scene, log):
+        self.spp = scene.spp * REFERENCE_FACTOR
+        self.paths = {}
+        for name, render in (("hairtrace", scene.hairtrace), ("Cycles", scene.cycles)):
+            self.paths[name] = os.path.join(scene.work, f"reference-{name}.exr")
+            t = time.time()
+            render(self.spp, REFERENCE_SEED, self.paths[name])
+            log(f"  {name} reference, {self.spp} spp: {time.time() - t:.0f} s wall")
+        self.mse_ab, self.mean_hairtrace, self.mean_cycles = mse(
+            self.paths["hairtrace"], self.paths["Cycles"])
+
+    def rmse(self, image):
+        """RMSE against the mean of the references, and the image's mean."""
+        ea, mean, _ = mse(image, self.paths["hairtrace"])
+        eb, _, _ = mse(image, self.paths["Cycles"])
+        return math.sqrt(max(0.0, (ea + eb) / 2 - self.mse_ab / 4)), mean
+
+
+def measure(scene, ref, repeats, allocation, log):
+    renderers = {"hairtrace": scene.hairtrace, "Cycles": scene.cycles}
     if allocation:
         renderers[f"hairtrace allocation {allocation}"] = (
             lambda spp, seed, out: scene.hairtrace(spp, seed, out, allocation))
     renderers["Cycles adaptive"] = (
         lambda spp, seed, out: scene.cycles(spp, seed, out, CYCLES_ADAPTIVE))
-    ref = {}
-    ref_spp = scene.spp * REFERENCE_FACTOR
-    for name, render in references.items():
-        ref[name] = os.path.join(scene.work, f"reference-{name}.exr")
-        t = time.time()
-        render(ref_spp, REFERENCE_SEED, ref[name])
-        log(f"  {name} reference, {ref_spp} spp: {time.time() - t:.0f} s wall")
-    ref_mse_ab, mean_h, mean_c = mse(ref["hairtrace"], ref["Cycles"])
     runs = {name: [] for name in renderers}
     for seed in range(1, repeats + 1):
         for name, render in renderers.items():
             out = os.path.join(scene.work, f"{name.replace(' ', '-')}-{seed}.exr")
             r = render(scene.spp, seed, out)
-            ea, mean, _ = mse(out, ref["hairtrace"])
-            eb, _, _ = mse(out, ref["Cycles"])
-            r["rmse"] = math.sqrt(max(0.0, (ea + eb) / 2 - ref_mse_ab / 4))
-            r["mean"] = mean
+            r["rmse"], r["mean"] = ref.rmse(out)
             runs[name].append(r)
             log(f"  {name} seed {seed}: {r['seconds']:.3f} s, RMSE {r['rmse']:.5f}")
     rows = {}
@@ -146,18 +163,99 @@ def measure(scene, repeats, allocation, log):
         }
     # Each reference carries the noise of a timed render divided by REFERENCE_FACTOR in
     # variance; the two differ by both.
-    expected = math.sqrt(sum(rows[n]["rmse"] ** 2 for n in references) / REFERENCE_FACTOR)
+    expected = math.sqrt(sum(rows[n]["rmse"] ** 2 for n in ("hairtrace", "Cycles"))
+                         / REFERENCE_FACTOR)
     best = max(("Cycles", "Cycles adaptive"), key=lambda n: rows[n]["efficiency"])
     converged = {
-        "rmse_between_references": math.sqrt(ref_mse_ab),
+        "rmse_between_references": math.sqrt(ref.mse_ab),
         "expected_from_noise": expected,
-        "mean_hairtrace": mean_h,
-        "mean_cycles": mean_c,
+        "mean_hairtrace": ref.mean_hairtrace,
+        "mean_cycles": ref.mean_cycles,
     }
-    return {"scene": scene.name, "spp": scene.spp, "reference_spp": ref_spp,
+    return {"scene": scene.name, "spp": scene.spp, "reference_spp": ref.spp,
             "size": [scene.width, scene.height], "max_depth": scene.max_depth,
             "threads": scene.threads, "renderers": rows, "converged": converged,
             "best_cycles": best}
+
+
+def time_to_rmse(scene, ref, fixed, repeats, log):
+    """Each renderer's time to the RMSE hairtrace's noise target reaches.
+
+    hairtrace renders with `noise_target` set to the relative RMSE its fixed-spp renders had,
+    and stops by its own estimate; its RMSE is then measured. Cycles renders with adaptive
+    sampling down a ladder of thresholds until one reaches that RMSE, and its time there is
+    interpolated in log-log between the two thresholds that bracket it. Both take the
+    reference's spp as their most samples, so that neither stops on the cap. Cycles with
+    adaptive sampling off is timed at that RMSE too, from its fixed-spp renders (variance in
+    proportion to 1/spp), and the better of the two is the one compared.
+    """
+    h = fixed["renderers"]["hairtrace"]
+    target = h["rmse"] / statistics.median(r["mean"] for r in h["runs"])
+    runs = []
+    for seed in range(1, repeats + 1):
+        out = os.path.join(scene.work, f"hairtrace-noise-target-{seed}.exr")
+        r = scene.hairtrace(ref.spp, seed, out, noise_target=target)
+        r["rmse"], r["mean"] = ref.rmse(out)
+        runs.append(r)
+        log(f"  hairtrace noise target {target:.4f} seed {seed}: {r['seconds']:.3f} s, "
+            f"{r['spp']} spp, RMSE {r['rmse']:.5f}, estimated {r['noise'] * r['mean']:.5f}")
+    rmse = statistics.median(r["rmse"] for r in runs)
+    ladder = []
+    for threshold in CYCLES_LADDER:
+        rs = []
+        for seed in range(1, repeats + 1):
+            out = os.path.join(scene.work, f"Cycles-threshold-{threshold}-{seed}.exr")
+            r = scene.cycles(ref.spp, seed, out, threshold)
+            r["rmse"], _ = ref.rmse(out)
+            rs.append(r)
+        step = {"threshold": threshold,
+                "seconds": statistics.median(r["seconds"] for r in rs),
+                "rmse": statistics.median(r["rmse"] for r in rs),
+                "spp": statistics.median(r["samples"] for r in rs) / (scene.width * scene.height)}
+        log(f"  Cycles threshold {threshold}: {step['seconds']:.3f} s, RMSE {step['rmse']:.5f}")
+        ladder.append(step)
+        if step["rmse"] <= rmse:
+            break
+    cycles_seconds = None
+    if len(ladder) >= 2 and ladder[-1]["rmse"] <= rmse < ladder[-2]["rmse"]:
+        a, b = ladder[-2], ladder[-1]
+        f = math.log(rmse / a["rmse"]) / math.log(b["rmse"] / a["rmse"])
+        cycles_seconds = math.exp(math.log(a["seconds"])
+                                  + f * math.log(b["seconds"] / a["seconds"]))
+    off = fixed["renderers"]["Cycles"]
+    return {
+        "noise_target": target,
+        "cycles_off_seconds": off["seconds"] * (off["rmse"] / rmse) ** 2,
+        "seconds": statistics.median(r["seconds"] for r in runs),
+        "spp": statistics.median(r["spp"] for r in runs),
+        "rmse": rmse,
+        "estimated_rmse": statistics.median(r["noise"] * r["mean"] for r in runs),
+        "runs": runs,
+        "cycles_ladder": ladder,
+        "cycles_seconds": cycles_seconds,
+    }
+
+
+def rmse_table(results):
+    lines = [
+        "| scene | noise target | hairtrace s | its spp | RMSE measured | RMSE estimated "
+        "| estimated / measured | Cycles thresholds (RMSE, s) | Cycles adaptive s at that RMSE "
+        "| Cycles off s at that RMSE | Cycles' better s / hairtrace s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for res in results:
+        t = res["time_to_rmse"]
+        ladder = ", ".join(f"{c['threshold']} ({c['rmse']:.5f}, {c['seconds']:.2f} s)"
+                           for c in t["cycles_ladder"])
+        adaptive = t["cycles_seconds"]
+        best = min(s for s in (adaptive, t["cycles_off_seconds"]) if s is not None)
+        cycles = "not bracketed" if adaptive is None else f"{adaptive:.2f}"
+        lines.append(
+            f"| {res['scene']} | {t['noise_target']:.4f} | {t['seconds']:.2f} | {t['spp']:.0f} "
+            f"| {t['rmse']:.5f} | {t['estimated_rmse']:.5f} "
+            f"| {t['estimated_rmse'] / t['rmse']:.2f} | {ladder} | {cycles} "
+            f"| {t['cycles_off_seconds']:.2f} | {best / t['seconds']:.2f}x |")
+    return "\n".join(lines)
 
 
 def table(results):
@@ -198,6 +296,9 @@ def main():
     parser.add_argument("--work", default=os.path.join(ROOT, "target", "bench-peer"))
     parser.add_argument("--shim", help="the ray-counting LD_PRELOAD library for Cycles")
     parser.add_argument("--json", help="also write the results here")
+    parser.add_argument("--time-to-rmse", action="store_true",
+                        help="also time each renderer to a given RMSE: hairtrace by its noise "
+                             "target, Cycles by its adaptive threshold")
     parser.add_argument("--allocation", choices=["uniform", "noise"],
                         help="also render hairtrace with this allocation")
     args = parser.parse_args()
@@ -210,7 +311,12 @@ def main():
     results = []
     for name in names:
         log(f"{name}:")
-        results.append(measure(Scene(name, args.work, args), args.repeats, args.allocation, log))
+        scene = Scene(name, args.work, args)
+        ref = Reference(scene, log)
+        result = measure(scene, ref, args.repeats, args.allocation, log)
+        if args.time_to_rmse:
+            result["time_to_rmse"] = time_to_rmse(scene, ref, result, args.repeats, log)
+        results.append(result)
     cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
                 if l.startswith("model name")), platform.processor())
     print(f"Machine: {cpu}, {os.cpu_count()} cores; {args.threads} threads; "
@@ -219,6 +325,9 @@ def main():
           f"{CYCLES_ADAPTIVE}; vs Cycles' better: against "
           + ", ".join(f"{r['scene']}: {r['best_cycles']}" for r in results) + ".\n")
     print(table(results))
+    if args.time_to_rmse:
+        print("\nTime to a given RMSE (medians of the same seeds):\n")
+        print(rmse_table(results))
     if args.json:
         with open(args.json, "w") as f:
             json.dump(results, f, indent=1)

@@ -98,11 +98,13 @@ impl Assembly {
                     1
                 }
                 Shape::Curves(c) => {
+                    let c = c.spatially_ordered().map_err(labelled)?;
                     sizes.push(CurvesSize::of(&c));
                     tracer.add_curves(c).map_err(labelled)?;
                     1
                 }
                 Shape::AutoCurves(c) => {
+                    let c = c.spatially_ordered().map_err(labelled)?;
                     let pieces = ribbons::share_out(c, &view.camera, view.height, view.lod_pixels)
                         .map_err(labelled)?;
                     let n = pieces.len();

@@ -206,6 +206,11 @@ impl<T> SharedBuffer<T> {
         self.len
     }
 
+    /// Whether the buffer holds its own copy (not memory an `Arc` or a host shares).
+    pub fn is_owned(&self) -> bool {
+        matches!(self.storage, Storage::Owned(_))
+    }
+
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }

@@ -7,7 +7,8 @@
 //! per-segment figure measured on the bench scalp: its primitive references, nodes and
 //! leaves; see docs/large-grooms.md), plus what the process needs besides. A groom made
 //! here (procedural, or read from a `.hair` file) also briefly holds its polylines next to
-//! its converted copy; [`conversion_bytes`] is that moment. Level of detail changes only
+//! its converted copy, and its curves next to their copy in spatial order;
+//! [`conversion_bytes`] is the larger of those moments. Level of detail changes only
 //! the sizes it passes in: fewer segments, a cheaper basis or shape per part.
 
 use crate::embree::{CurveBasis, CurveShape};
@@ -60,13 +61,14 @@ impl CurvesSize {
     }
 
     /// Bytes of the buffers hairtrace keeps for these curves: float4 control points, one
-    /// u32 index per segment, the strand table (a u32 per strand and per 32 segments).
+    /// u32 index per segment, the strand table (two u32 per strand, its first segment and,
+    /// in spatial order, its number; one per 32 segments).
     pub fn curve_bytes(&self) -> u64 {
         let points = self.control_points.saturating_mul(16);
         let segments = self.segments.saturating_mul(4) + self.segments / 8;
         points
             .saturating_add(segments)
-            .saturating_add(self.strands.saturating_mul(4))
+            .saturating_add(self.strands.saturating_mul(8))
     }
 
     /// Bytes Embree holds at the peak of the BVH build over these curves.
@@ -111,12 +113,15 @@ pub fn build_bytes(parts: &[CurvesSize]) -> u64 {
 }
 
 /// Peak bytes while polylines of `points` points (xyz and radius, 16 bytes each) and
-/// `strands` strands are converted into `copies` copies of `part`: all are alive.
-pub fn conversion_bytes(points: u64, strands: u64, part: &CurvesSize, copies: u64) -> u64 {
-    BASE_BYTES
-        .saturating_add(points.saturating_mul(16))
+/// `strands` strands are converted into `part`, and then while `part` is copied (into
+/// spatial order, or shared out between shapes): at each moment both are alive.
+pub fn conversion_bytes(points: u64, strands: u64, part: &CurvesSize) -> u64 {
+    let curves = part.curve_bytes();
+    let conversion = points
+        .saturating_mul(16)
         .saturating_add(strands.saturating_mul(4))
-        .saturating_add(part.curve_bytes().saturating_mul(copies))
+        .saturating_add(curves);
+    BASE_BYTES.saturating_add(conversion.max(curves.saturating_mul(2)))
 }
 
 /// Bytes this process may still take before the system runs out: Linux's `MemAvailable`,

@@ -41,6 +41,16 @@ impl Shape {
     }
 }
 
+/// The curves a part is traced with: in spatial order (`Curves::spatially_ordered`) and,
+/// for an `auto` part, shared out for `view`.
+fn traced_curves(curves: Curves, auto: bool, view: &DetailView) -> Result<Vec<Curves>> {
+    let curves = curves.spatially_ordered()?;
+    if !auto {
+        return Ok(vec![curves]);
+    }
+    ribbons::share_out(curves, &view.camera, view.height, view.lod_pixels)
+}
+
 /// What a build is made of, in geometry order.
 #[derive(Default)]
 pub(crate) struct Assembly {
@@ -84,7 +94,9 @@ impl Assembly {
     ) -> Result<Assembled> {
         let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
         let (mut materials, mut built_from, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
+        let parts = self.parts.len();
         for (i, part) in self.parts.into_iter().enumerate() {
+            let auto = matches!(part.shape, Shape::AutoCurves(_));
             let labelled = |e: Error| {
                 if part.label.is_empty() {
                     e
@@ -97,20 +109,20 @@ impl Assembly {
                     tracer.add_mesh(m).map_err(labelled)?;
                     1
                 }
-                Shape::Curves(c) => {
-                    let c = c.spatially_ordered().map_err(labelled)?;
-                    sizes.push(CurvesSize::of(&c));
-                    tracer.add_curves(c).map_err(labelled)?;
-                    1
-                }
-                Shape::AutoCurves(c) => {
-                    let c = c.spatially_ordered().map_err(labelled)?;
-                    let pieces = ribbons::share_out(c, &view.camera, view.height, view.lod_pixels)
-                        .map_err(labelled)?;
+                Shape::Curves(c) | Shape::AutoCurves(c) => {
+                    // The build's part of the curves stage: timed with the conversion.
+                    let pieces = stages.run(Stage::Curves, (i, parts), |_| {
+                        traced_curves(c, auto, view).map_err(labelled)
+                    })?;
                     let n = pieces.len();
                     for piece in pieces {
                         sizes.push(CurvesSize::of(&piece));
-                        tracer.add_view_curves(piece, *view).map_err(labelled)?;
+                        let added = if auto {
+                            tracer.add_view_curves(piece, *view)
+                        } else {
+                            tracer.add_curves(piece)
+                        };
+                        added.map_err(labelled)?;
                     }
                     n
                 }
@@ -118,6 +130,7 @@ impl Assembly {
             materials.extend(std::iter::repeat_n(part.material, added));
             built_from.extend(std::iter::repeat_n(i, added));
         }
+        stages.report(Stage::Curves, 1.0)?;
         // What is built so far is held already: only Embree's part and the film are still
         // to come.
         let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum::<u64>();

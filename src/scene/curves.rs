@@ -373,9 +373,10 @@ impl Curves {
     /// its number here as its [`StrandSegment::id`]. Embree's build and traversal fetch the
     /// control points of neighbouring strands together, and a groom in another order (the
     /// bench scalp's roots follow a low-discrepancy sequence, so consecutive strands are far
-    /// apart) misses the cache on each: on the bench scalp the build takes 0.76x the time at
-    /// 2.5 x 10^5 strands and 0.6x-0.7x at 10^6 (docs/large-grooms.md). Control points shared with the caller
-    /// (a C host's memory) are kept where they are, as are curves already in order.
+    /// apart) misses the cache on each: on the bench scalp the build takes 0.76x the time
+    /// at 2.5 x 10^5 strands and 0.6x-0.7x at 10^6 (docs/large-grooms.md). Control points
+    /// shared with the caller (a C host's memory) are kept where they are, as are curves
+    /// already in order.
     pub fn spatially_ordered(self) -> Result<Curves> {
         if !self.vertices.is_owned() {
             return Ok(self);

@@ -12,7 +12,8 @@ use crate::error::Result;
 pub enum Stage {
     /// Reading groom and mesh files, or generating procedural grooms and shapes.
     Read,
-    /// Converting strands into the curve buffers Embree reads (`Curves::from_strands`).
+    /// Converting strands into the curve buffers Embree reads (`Curves::from_strands`),
+    /// then the build's part: spatial order, and `auto` grooms shared out for the view.
     Curves,
     /// Embree's BVH build (`rtcCommitScene`).
     Bvh,

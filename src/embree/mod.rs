@@ -19,6 +19,7 @@ mod device;
 mod geometry;
 mod isa;
 mod memory;
+mod order;
 mod query;
 mod scene;
 #[cfg(feature = "bench-internals")]
@@ -28,9 +29,12 @@ mod sys;
 
 pub use device::Device;
 pub use geometry::{CurveBasis, CurveShape};
-pub(crate) use geometry::{CurveGeometry, CurvePoint, TriangleGeometry, padding_for};
+pub(crate) use geometry::{
+    CurveGeometry, CurvePoint, ORDERED_FROM_SEGMENTS, TriangleGeometry, padding_for,
+};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
+pub(crate) use order::morton_order;
 pub(crate) use query::Exclude;
 pub use scene::is_cancelled;
 pub(crate) use scene::{SceneBuilder, cancelled};

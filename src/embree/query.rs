@@ -8,6 +8,7 @@
 use glam::Vec3;
 
 use super::compat::{self, Filter, INVALID_ID, RawContext};
+use super::geometry::Geometry;
 use super::scene::Scene;
 use super::sys;
 
@@ -93,16 +94,19 @@ pub struct Exclude {
 
 /// Embree's context extended with the exclusion the filter reads.
 #[repr(C)]
-struct QueryContext {
+struct QueryContext<'a> {
     /// Must stay first: the filter receives a pointer to it and casts back to the whole.
     raw: RawContext,
     exclude: Exclude,
+    /// The excluded geometry's segment for each of Embree's primitives, when Embree reads
+    /// them in another order (`CurveGeometry::traversal_segments`).
+    segments: Option<&'a [u32]>,
 }
 
-impl QueryContext {
+impl<'a> QueryContext<'a> {
     /// The equivalent of Embree's inline `rtcInitIntersectContext`/`rtcInitRayQueryContext`,
     /// which bindgen cannot translate.
-    fn new(exclude: Option<&Exclude>) -> Self {
+    fn new(scene: &'a Scene, exclude: Option<&Exclude>) -> Self {
         let raw = compat::new_context(filter_for(exclude));
         QueryContext {
             raw,
@@ -112,6 +116,7 @@ impl QueryContext {
                 last_prim: 0,
                 max_t: 0.0,
             }),
+            segments: exclude.and_then(|e| scene.traversal_segments(e.geom_id)),
         }
     }
 }
@@ -125,7 +130,9 @@ unsafe extern "C" fn exclude_filter(args: *const sys::RTCFilterFunctionNArgument
     // SAFETY: Embree passes valid arguments for the duration of the call.
     let args = unsafe { &*args };
     // SAFETY: the context is the first field of a live `QueryContext` (see `query`).
-    let exclude = unsafe { &(*(args.context as *const QueryContext)).exclude };
+    let ctx = unsafe { &*(args.context as *const QueryContext<'_>) };
+    let exclude = &ctx.exclude;
+    let own = |prim: u32| own_segment(ctx.segments, prim);
     let n = args.N as usize;
     // SAFETY: `valid` holds N ints; ray and hit are SOA packets of N lanes: tfar is the 9th
     // float array of RTCRayN, primID and geomID the 6th and 7th u32 arrays of RTCHitN.
@@ -141,7 +148,7 @@ unsafe extern "C" fn exclude_filter(args: *const sys::RTCFilterFunctionNArgument
             let prim = *hit.add(5 * n + i);
             let geom = *hit.add(6 * n + i);
             if geom == exclude.geom_id
-                && (exclude.first_prim..=exclude.last_prim).contains(&prim)
+                && (exclude.first_prim..=exclude.last_prim).contains(&own(prim))
                 && t < exclude.max_t
             {
                 *valid = 0;
@@ -156,7 +163,7 @@ impl Scene {
         if !ray.is_valid() {
             return None;
         }
-        let mut ctx = QueryContext::new(exclude);
+        let mut ctx = QueryContext::new(self, exclude);
         let mut rayhit = sys::RTCRayHit {
             ray: ray.to_sys(),
             hit: sys::RTCHit {
@@ -173,7 +180,7 @@ impl Scene {
         (h.geomID != INVALID_ID).then(|| RayHit {
             t: rayhit.ray.tfar,
             geom_id: h.geomID,
-            prim_id: h.primID,
+            prim_id: own_segment(self.traversal_segments(h.geomID), h.primID),
             u: h.u,
             v: h.v,
             ng: Vec3::new(h.Ng_x, h.Ng_y, h.Ng_z),
@@ -185,12 +192,30 @@ impl Scene {
         if !ray.is_valid() {
             return false;
         }
-        let mut ctx = QueryContext::new(exclude);
+        let mut ctx = QueryContext::new(self, exclude);
         let mut r = ray.to_sys();
         // SAFETY: as in `intersect`.
         unsafe { compat::occluded1(self.raw(), &mut ctx.raw, &mut r, filter_for(exclude)) };
         // Embree marks an occluded ray by setting tfar to -infinity.
         r.tfar < 0.0 && ray.tfar >= 0.0
+    }
+}
+
+/// The geometry's own number of the primitive Embree calls `prim`, given the geometry's
+/// traversal order (`u32::MAX`, which names no segment, for an id Embree never returns).
+fn own_segment(segments: Option<&[u32]>, prim: u32) -> u32 {
+    segments.map_or(prim, |s| {
+        s.get(prim as usize).copied().unwrap_or(INVALID_ID)
+    })
+}
+
+impl Scene {
+    /// The traversal order of geometry `id`, when it has one.
+    fn traversal_segments(&self, id: u32) -> Option<&[u32]> {
+        match self.geometry(id)? {
+            Geometry::Curves(c) => c.traversal_segments(),
+            Geometry::Triangles(_) => None,
+        }
     }
 }
 

@@ -38,7 +38,7 @@ use std::sync::Arc;
 use glam::{Vec3, Vec4};
 
 use crate::bsdf::sigma_a_from_melanin;
-use crate::embree::{CurveBasis, CurveShape, SharedBuffer, padding_for};
+use crate::embree::{CurveBasis, CurveShape, SharedBuffer, morton_order, padding_for};
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
 use crate::scene::material::HairColor;
@@ -381,32 +381,17 @@ impl Curves {
         if !self.vertices.is_owned() {
             return Ok(self);
         }
-        let n = self.strands.strand_count();
-        let centroids: Vec<Vec3> = (0..n)
-            .map(|s| {
-                let points = self.strand_points(s);
-                let sum = points
-                    .iter()
-                    .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
-                sum / points.len().max(1) as f32
-            })
-            .collect();
-        let (lo, hi) = centroids
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), c| {
-                (lo.min(*c), hi.max(*c))
-            });
-        let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
-        let mut order: Vec<(u32, usize)> = centroids
-            .iter()
-            .enumerate()
-            .map(|(s, c)| (morton(((*c - lo) * scale).as_uvec3()), s))
-            .collect();
-        order.sort_unstable();
-        if order.windows(2).all(|w| w[0].1 < w[1].1) {
+        let order = morton_order(self.strands.strand_count(), |s| {
+            let points = self.strand_points(s);
+            let sum = points
+                .iter()
+                .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
+            sum / points.len().max(1) as f32
+        });
+        if order.windows(2).all(|w| w[0] < w[1]) {
             return Ok(self);
         }
-        let order: Vec<usize> = order.into_iter().map(|(_, s)| s).collect();
+        let order: Vec<usize> = order.into_iter().map(|s| s as usize).collect();
         let ordered = self.gathered(&order, self.shape)?;
         Ok(ordered.unwrap_or(self))
     }
@@ -704,18 +689,6 @@ fn power_basis(basis: CurveBasis) -> [[f32; 4]; 4] {
             [-0.5, 1.5, -1.5, 0.5],
         ],
     }
-}
-
-/// The 30-bit Morton code of a point on a 1024^3 grid: its coordinates' bits interleaved.
-fn morton(p: glam::UVec3) -> u32 {
-    let spread = |v: u32| {
-        let mut v = v.min(1023);
-        v = (v | (v << 16)) & 0x0300_00ff;
-        v = (v | (v << 8)) & 0x0300_f00f;
-        v = (v | (v << 4)) & 0x030c_30c3;
-        (v | (v << 2)) & 0x0924_9249
-    };
-    spread(p.x) | (spread(p.y) << 1) | (spread(p.z) << 2)
 }
 
 /// Embree indexes control points with u32.

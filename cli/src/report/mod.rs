@@ -12,6 +12,7 @@ mod peers;
 mod plots;
 mod render;
 mod scale;
+mod scale_cycles;
 
 use hairtrace::{Error, Result};
 use indicatif::{ProgressBar, ProgressStyle};

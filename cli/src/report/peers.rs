@@ -19,7 +19,7 @@ pub fn steps(_: &Context) -> u64 {
 }
 
 /// The venv's python if Blender's module imports there, else why not.
-fn blender_python() -> std::result::Result<PathBuf, String> {
+pub(super) fn blender_python() -> std::result::Result<PathBuf, String> {
     let venv = std::env::var_os(VENV).ok_or_else(|| format!("{VENV} is not set"))?;
     let python = PathBuf::from(venv).join("bin/python");
     let ok = Command::new(&python)

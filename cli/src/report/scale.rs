@@ -143,6 +143,7 @@ fn measure(desc: &SceneDescription, strands: usize) -> Result<Point> {
 pub fn steps(ctx: &Context) -> u64 {
     (CURVES.len() * strand_counts(ctx).len() + BIAS_BASES.len() * (BIAS_TOLERANCES.len() + 1))
         as u64
+        + super::scale_cycles::steps(ctx)
 }
 
 pub fn section(ctx: &Context) -> Result<String> {
@@ -253,7 +254,7 @@ pub fn section(ctx: &Context) -> Result<String> {
          the first build). `lod` is the level of detail: `auto` curves with \
          `lod_pixels = {default_lod}` (the default), every strand here thinner than \
          a pixel and so traced as linear ribbons through points on its curve, or as flat \
-         curves of its basis where it needs more than the budget of pieces.\n\n{}\n{}\n{figures}\n{}",
+         curves of its basis where it needs more than the budget of pieces.\n\n{}\n{}\n{}\n{figures}\n{}",
         table(
             &[
                 "curves",
@@ -269,6 +270,7 @@ pub fn section(ctx: &Context) -> Result<String> {
             &rows
         ),
         advice(&results, ctx.machine.threads),
+        super::scale_cycles::section(ctx)?,
         bias(ctx)?,
     ))
 }

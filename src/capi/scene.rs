@@ -11,9 +11,7 @@ use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
 use crate::description::assembly::{Assembly, Shape};
 use crate::embree::{CurveBasis, Device, Isa};
 use crate::error::{Result, invalid_arg};
-use crate::render::Aovs;
 use crate::render::integrator::World;
-use crate::render::renderer::film_bytes;
 use crate::render::settings::RenderSettings;
 use crate::scene::Strands;
 use crate::scene::camera::Camera;
@@ -200,7 +198,7 @@ impl HtScene {
                     self.device.clone(),
                     self.lights.clone(),
                     &view,
-                    film_bytes(settings, Aovs::default(), true),
+                    settings,
                     &mut StageRunner::new(progress),
                 )?;
                 self.world = Some(built.world);

@@ -9,7 +9,10 @@ use std::sync::Arc;
 
 use crate::embree::{Device, SceneOptions};
 use crate::error::{Error, Result};
+use crate::render::Aovs;
 use crate::render::integrator::World;
+use crate::render::renderer::film_bytes;
+use crate::render::settings::RenderSettings;
 use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
 use crate::scene::footprint::{self, CurvesSize, available_bytes};
@@ -81,18 +84,23 @@ impl Assembly {
         });
     }
 
-    /// Builds the world for `view`: `auto` curves shared out for it, the memory the BVH
-    /// build and then a render's `film` bytes (`renderer::film_bytes`) will need checked
-    /// against what is available, then the BVH built (timed as [`Stage::Bvh`] in `stages`).
+    /// Builds the world for `view` and a render of `settings`: `auto` curves shared out
+    /// for the view, the memory the BVH build and then the render's film
+    /// (`renderer::film_bytes`) will need checked against what is available, then the BVH
+    /// built (timed as [`Stage::Bvh`] in `stages`) for the render's camera samples
+    /// ([`SceneOptions::for_samples`]).
     pub fn build(
         self,
         device: Arc<Device>,
         lights: Vec<Light>,
         view: &DetailView,
-        film: u64,
+        settings: &RenderSettings,
         stages: &mut StageRunner,
     ) -> Result<Assembled> {
-        let mut tracer = TracerBuilder::new(device, SceneOptions::default())?;
+        let film = film_bytes(settings, Aovs::default(), true);
+        let samples =
+            u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp);
+        let mut tracer = TracerBuilder::new(device, SceneOptions::for_samples(samples))?;
         let (mut materials, mut built_from, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
         let parts = self.parts.len();
         for (i, part) in self.parts.into_iter().enumerate() {
@@ -109,22 +117,24 @@ impl Assembly {
                     tracer.add_mesh(m).map_err(labelled)?;
                     1
                 }
+                // The build's part of the curves stage, timed with the conversion: the
+                // spatial order, an `auto` groom's parts and Embree's geometries (a large
+                // one cut into parts of its own).
                 Shape::Curves(c) | Shape::AutoCurves(c) => {
-                    // The build's part of the curves stage: timed with the conversion.
-                    let pieces = stages.run(Stage::Curves, (i, parts), |_| {
-                        traced_curves(c, auto, view).map_err(labelled)
-                    })?;
-                    let n = pieces.len();
-                    for piece in pieces {
-                        sizes.push(CurvesSize::of(&piece));
-                        let added = if auto {
-                            tracer.add_view_curves(piece, *view)
-                        } else {
-                            tracer.add_curves(piece)
-                        };
-                        added.map_err(labelled)?;
-                    }
-                    n
+                    stages.run(Stage::Curves, (i, parts), |_| {
+                        let pieces = traced_curves(c, auto, view).map_err(labelled)?;
+                        let n = pieces.len();
+                        for piece in pieces {
+                            sizes.push(CurvesSize::of(&piece));
+                            let added = if auto {
+                                tracer.add_view_curves(piece, *view)
+                            } else {
+                                tracer.add_curves(piece)
+                            };
+                            added.map_err(labelled)?;
+                        }
+                        Ok(n)
+                    })?
                 }
             };
             materials.extend(std::iter::repeat_n(part.material, added));

@@ -125,8 +125,7 @@ impl SceneDescription {
             .build(&framing, aspect)
             .map_err(|e| self.error("camera", e))?;
         let view = DetailView::new(camera, settings.height, settings.lod_pixels);
-        let film = film_bytes(&settings, Aovs::default(), true);
-        let built = assembly.build(device, lights, &view, film, &mut stages)?;
+        let built = assembly.build(device, lights, &view, &settings, &mut stages)?;
         Ok(BuiltScene {
             world: built.world,
             camera,

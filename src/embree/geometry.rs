@@ -9,12 +9,13 @@
 //! long as Embree may read them.
 
 use std::ffi::c_void;
+use std::ops::Range;
 use std::ptr::NonNull;
 use std::sync::Arc;
 
 use glam::Vec3;
 
-use super::order::morton_order;
+use super::order::median_split;
 use super::{Device, sys};
 use crate::error::invalid_arg;
 use crate::{Error, Result};
@@ -242,7 +243,7 @@ impl<T: PartialEq> PartialEq for SharedBuffer<T> {
 
 /// One reference to an Embree geometry, released when dropped.
 #[derive(Debug)]
-struct RawGeometry(NonNull<sys::RTCGeometryTy>);
+pub(super) struct RawGeometry(NonNull<sys::RTCGeometryTy>);
 
 // SAFETY: Embree geometries may be used from any thread; after commit hairtrace only reads
 // them (rtcInterpolate), which Embree allows concurrently.
@@ -251,7 +252,7 @@ unsafe impl Send for RawGeometry {}
 unsafe impl Sync for RawGeometry {}
 
 impl RawGeometry {
-    fn new(device: &Device, kind: sys::RTCGeometryType) -> Result<Self> {
+    pub(super) fn new(device: &Device, kind: sys::RTCGeometryType) -> Result<Self> {
         // SAFETY: live device; an unsupported type returns null and records an error.
         let raw = unsafe { sys::rtcNewGeometry(device.raw(), kind) };
         match NonNull::new(raw) {
@@ -274,9 +275,26 @@ impl RawGeometry {
         format: sys::RTCFormat,
         buffer: &SharedBuffer<T>,
     ) {
-        // SAFETY: live geometry; pointer and count describe `len` initialised elements
-        // readable as Embree requires (padded, or of 16 bytes each), which the caller keeps
-        // alive.
+        // SAFETY: the caller's contract; the whole buffer.
+        unsafe { self.share_range(kind, format, buffer, 0..buffer.len()) }
+    }
+
+    /// Binds the elements `range` of `buffer` to `kind`, slot 0.
+    ///
+    /// # Safety
+    /// As for [`Self::share`]; `range` lies inside the buffer.
+    unsafe fn share_range<T>(
+        &self,
+        kind: sys::RTCBufferType,
+        format: sys::RTCFormat,
+        buffer: &SharedBuffer<T>,
+        range: Range<usize>,
+    ) {
+        debug_assert!(range.start <= range.end && range.end <= buffer.len());
+        // SAFETY: live geometry; offset and count describe initialised elements inside the
+        // buffer, readable as Embree requires (padded, or of 16 bytes each, and an element
+        // past the range is still inside the buffer or its padding), which the caller
+        // keeps alive.
         unsafe {
             sys::rtcSetSharedGeometryBuffer(
                 self.0.as_ptr(),
@@ -284,15 +302,15 @@ impl RawGeometry {
                 0,
                 format,
                 buffer.as_ptr().cast::<c_void>(),
-                0,
+                range.start * size_of::<T>(),
                 size_of::<T>(),
-                buffer.len(),
+                range.len(),
             );
         }
     }
 
     /// Sets the mask, commits the geometry and reports any error Embree recorded.
-    fn commit(&self, device: &Device, mask: u32) -> Result<()> {
+    pub(super) fn commit(&self, device: &Device, mask: u32) -> Result<()> {
         // SAFETY: live geometry whose buffers are set.
         unsafe {
             sys::rtcSetGeometryMask(self.0.as_ptr(), mask);
@@ -325,83 +343,66 @@ pub struct CurvePoint {
     pub d2p_du2: [f32; 3],
 }
 
-/// Geometries of at least this many segments hand them to Embree in spatial order
-/// ([`Traversal`]). On the bench scalp at 10^6 strands (already in spatial order by strand)
-/// the build then takes 0.78x the time and primary rays 0.83x (docs/large-grooms.md); below
-/// this size the control points stay in the cache and the order would only cost its 8 bytes
-/// per segment.
-pub(crate) const ORDERED_FROM_SEGMENTS: usize = 1 << 14;
+/// Geometries of at least this many segments may be cut into parts of at most
+/// [`PART_SEGMENTS`] ([`CurveGeometry::in_parts`]), which a scene builds as one small
+/// Embree scene each under a BVH of their instances ([`Parts`]). On the bench scalp at
+/// 10^6 strands x 16 segments the build then takes 0.6x-0.7x the time and rays 0.88x-0.91x
+/// (docs/large-grooms.md).
+pub(crate) const CLUSTERED_FROM_SEGMENTS: usize = 1 << 18;
 
-/// Embree's view of a curve geometry whose segments it reads in spatial order
-/// ([`morton_order`] of the segments' centres): its own handle on the same control points
-/// with the index buffer in that order, and for each of Embree's primitives the segment it
-/// is in the geometry's own order. Hits and the exclusion filter translate back, so no
-/// primitive id outside this module is Embree's: strands stay contiguous runs of segments
-/// for the strand table, the exclusion ranges and `rtcInterpolate` (on the geometry's own
-/// handle).
+/// The most segments of one part: small enough that a part's control points, index
+/// entries and Embree's primitive references stay in the cache while Embree builds it.
+pub(crate) const PART_SEGMENTS: usize = 1 << 14;
+
+/// A large curve geometry cut into compact parts by median splits of its segments'
+/// centres ([`median_split`]). Embree's hair builder fetches every segment's control
+/// points through the index buffer at each level of the tree it builds; over a whole
+/// large groom those fetches miss the cache, within a part they hit it. The index buffer
+/// Embree reads is in part order, each part a range of it; hits and the exclusion filter
+/// translate back through `segments`, so no primitive id outside this module is
+/// Embree's: strands stay contiguous runs of segments for the strand table, the
+/// exclusion ranges and `rtcInterpolate` (on the geometry's own handle).
 #[derive(Debug)]
-struct Traversal {
-    // Released before the index buffer it reads, which only Embree reads.
-    raw: RawGeometry,
-    _indices: SharedBuffer<u32>,
+struct Parts {
+    /// Read by Embree only, through the parts' handles (`SceneBuilder`'s).
+    indices: SharedBuffer<u32>,
+    /// The segment, in the geometry's own order, at each position of the part order.
     segments: Box<[u32]>,
+    ranges: Box<[Range<u32>]>,
 }
 
-impl Traversal {
-    fn new(
-        device: &Device,
-        kind: sys::RTCGeometryType,
-        span: usize,
-        vertices: &SharedBuffer<[f32; 4]>,
-        indices: &SharedBuffer<u32>,
-        mask: u32,
-    ) -> Result<Self> {
+impl Parts {
+    fn new(span: usize, vertices: &SharedBuffer<[f32; 4]>, indices: &SharedBuffer<u32>) -> Self {
         let (points, first) = (vertices.as_slice(), indices.as_slice());
-        let segments = morton_order(first.len(), |s| {
+        let (segments, ranges) = median_split(first.len(), PART_SEGMENTS, |s| {
             let f = first[s] as usize;
             let sum = points[f..f + span]
                 .iter()
                 .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
             sum / span as f32
         });
-        let reordered = SharedBuffer::new(segments.iter().map(|&s| first[s as usize]).collect());
-        let raw = RawGeometry::new(device, kind)?;
-        // SAFETY: the index buffer moves into the returned value next to `raw`, dropped
-        // first; the vertex buffer belongs to the `CurveGeometry` this is part of, which
-        // drops this first.
-        unsafe {
-            raw.share(
-                sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
-                sys::RTCFormat::RTC_FORMAT_FLOAT4,
-                vertices,
-            );
-            raw.share(
-                sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
-                sys::RTCFormat::RTC_FORMAT_UINT,
-                &reordered,
-            );
-        }
-        raw.commit(device, mask)?;
-        Ok(Traversal {
-            raw,
-            _indices: reordered,
+        Parts {
+            indices: SharedBuffer::new(segments.iter().map(|&s| first[s as usize]).collect()),
             segments: segments.into_boxed_slice(),
-        })
+            ranges: ranges.into_boxed_slice(),
+        }
     }
 }
 
 /// Curves: one Embree curve geometry and the buffers it reads.
 #[derive(Debug)]
 pub struct CurveGeometry {
-    // Field order matters: the handles are released before the buffers they read are freed.
-    traversal: Option<Traversal>,
+    // Field order matters: the handle is released before the buffers it reads are freed
+    // (the parts' handles belong to the scene, released before its geometries).
     /// The segments in their own order: what `rtcInterpolate` reads, and what a scene
-    /// attaches when there is no traversal order.
+    /// attaches when the geometry has no parts.
     raw: RawGeometry,
     basis: CurveBasis,
     shape: CurveShape,
+    mask: u32,
     vertices: SharedBuffer<[f32; 4]>,
     indices: SharedBuffer<u32>,
+    parts: Option<Parts>,
 }
 
 impl CurveGeometry {
@@ -440,8 +441,7 @@ impl CurveGeometry {
             let at = vertices.as_ptr();
             return Err(invalid_arg!("points at {at:?} are not aligned to 16 bytes"));
         }
-        let kind = curve_type(basis, shape);
-        let raw = RawGeometry::new(device, kind)?;
+        let raw = RawGeometry::new(device, curve_type(basis, shape))?;
         // SAFETY: both buffers move into the returned value next to `raw`, which is dropped
         // before them.
         unsafe {
@@ -457,18 +457,25 @@ impl CurveGeometry {
             );
         }
         raw.commit(device, mask)?;
-        let span = span as usize;
-        let traversal = (indices.len() >= ORDERED_FROM_SEGMENTS)
-            .then(|| Traversal::new(device, kind, span, &vertices, &indices, mask))
-            .transpose()?;
         Ok(CurveGeometry {
-            traversal,
             raw,
             basis,
             shape,
+            mask,
             vertices,
             indices,
+            parts: None,
         })
+    }
+
+    /// The same geometry, cut into parts that a scene builds as scenes of their own when
+    /// it has at least [`CLUSTERED_FROM_SEGMENTS`] segments (else unchanged).
+    pub fn in_parts(mut self) -> Self {
+        if self.indices.len() >= CLUSTERED_FROM_SEGMENTS {
+            let span = self.basis.points_per_segment() as usize;
+            self.parts = Some(Parts::new(span, &self.vertices, &self.indices));
+        }
+        self
     }
 
     pub fn basis(&self) -> CurveBasis {
@@ -477,6 +484,11 @@ impl CurveGeometry {
 
     pub fn shape(&self) -> CurveShape {
         self.shape
+    }
+
+    /// The geometry mask its handles carry.
+    pub(super) fn mask(&self) -> u32 {
+        self.mask
     }
 
     /// Control points (x, y, z, radius), as Embree reads them.
@@ -498,22 +510,67 @@ impl CurveGeometry {
     /// reported by [`super::MemoryMonitor`]).
     #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
-        let traversal = self
-            .traversal
-            .as_ref()
-            .map_or(0, |t| t._indices.heap_bytes() + t.segments.len() * 4);
-        self.vertices.heap_bytes() + self.indices.heap_bytes() + traversal
+        let parts = self.parts.as_ref().map_or(0, |p| {
+            p.indices.heap_bytes() + size_of_val(&*p.segments) + size_of_val(&*p.ranges)
+        });
+        self.vertices.heap_bytes() + self.indices.heap_bytes() + parts
     }
 
-    /// Whether Embree reads the segments in spatial order ([`ORDERED_FROM_SEGMENTS`]).
-    #[cfg(test)]
-    pub(crate) fn is_ordered(&self) -> bool {
-        self.traversal.is_some()
+    /// The parts a scene builds as scenes of their own ([`CLUSTERED_FROM_SEGMENTS`]), as
+    /// ranges of Embree's primitive order; `None` for a geometry built whole.
+    pub(super) fn parts(&self) -> Option<&[Range<u32>]> {
+        self.parts.as_ref().map(|p| &*p.ranges)
     }
 
-    /// For each of Embree's primitives, the segment it is here, when the two differ.
-    pub(super) fn traversal_segments(&self) -> Option<&[u32]> {
-        self.traversal.as_ref().map(|t| &*t.segments)
+    /// The segment, in this geometry's order, that Embree calls `prim` in the part
+    /// starting at `part_start`; `u32::MAX` (no segment) for an id Embree never returns.
+    pub(super) fn own_segment(&self, part_start: u32, prim: u32) -> u32 {
+        let own = self.parts.as_ref().and_then(|p| {
+            let at = part_start.checked_add(prim)?;
+            p.segments.get(at as usize).copied()
+        });
+        own.unwrap_or(u32::MAX)
+    }
+
+    /// A committed handle on the segments of `part` (one of [`Self::parts`]): the same
+    /// control points, that range of the part-ordered index buffer.
+    ///
+    /// # Safety
+    /// The handle reads this geometry's buffers: it must be released before `self` is
+    /// dropped.
+    pub(super) unsafe fn part_geometry(
+        &self,
+        device: &Device,
+        part: &Range<u32>,
+    ) -> Result<RawGeometry> {
+        let Some(parts) = &self.parts else {
+            return Err(invalid_arg!("a curve geometry without parts"));
+        };
+        let range = part.start as usize..part.end as usize;
+        if range.is_empty() || range.end > parts.segments.len() {
+            return Err(invalid_arg!(
+                "part {part:?} of {} segments",
+                parts.segments.len()
+            ));
+        }
+        let raw = RawGeometry::new(device, curve_type(self.basis, self.shape))?;
+        // SAFETY: the buffers belong to `self`, which the caller keeps alive for as long as
+        // the handle; the range lies inside the index buffer (checked).
+        unsafe {
+            raw.share(
+                sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
+                sys::RTCFormat::RTC_FORMAT_FLOAT4,
+                &self.vertices,
+            );
+            raw.share_range(
+                sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
+                sys::RTCFormat::RTC_FORMAT_UINT,
+                &parts.indices,
+                range,
+            );
+        }
+        raw.commit(device, self.mask)?;
+        Ok(raw)
     }
 
     /// The curve of segment `prim` at parameter `u` in [0, 1]: a lerp for linear curves,
@@ -568,9 +625,9 @@ impl CurveGeometry {
         })
     }
 
-    /// The handle a scene attaches.
+    /// The handle a scene attaches when the geometry has no parts.
     pub(super) fn raw(&self) -> sys::RTCGeometry {
-        self.traversal.as_ref().map_or(&self.raw, |t| &t.raw).raw()
+        self.raw.raw()
     }
 }
 
@@ -831,7 +888,7 @@ mod tests {
                     let segments = basis.segments_for(points.len()).unwrap();
                     let stride = basis.segment_stride() as u32;
                     let indices = (0..segments as u32).map(|i| i * stride).collect();
-                    let options = SceneOptions { compact: true };
+                    let options = SceneOptions::default();
                     let mut scene = SceneBuilder::new(device.clone(), options).unwrap();
                     // SAFETY: `guarded` outlives the scene and is not modified.
                     let vertices =
@@ -864,19 +921,20 @@ mod tests {
         }
     }
 
-    /// A geometry of `ORDERED_FROM_SEGMENTS` segments or more is traced in spatial order,
-    /// yet every hit and every exclusion names segments in the geometry's own order: each
-    /// hit lies on the segment it names, and excluding that segment lets the ray through
-    /// to the strand behind.
+    /// A geometry of `CLUSTERED_FROM_SEGMENTS` segments or more is built in parts, each a
+    /// scene of its own, yet every hit and every exclusion names segments in the
+    /// geometry's own order: each hit lies on the segment it names, and excluding that
+    /// segment lets the ray through to the strand behind.
     #[test]
-    fn segments_traced_in_spatial_order_keep_their_own_numbers() {
+    fn segments_built_in_parts_keep_their_own_numbers() {
         use crate::embree::{Exclude, Ray, SceneBuilder, SceneOptions};
         let device = Arc::new(Device::new(Some(2)).unwrap());
-        // 64 x 64 vertical strands 0.1 apart, numbered in a scrambled order, 4 segments each.
-        let (side, segments, radius) = (64u32, 4u32, 0.01f32);
+        // 256 x 256 vertical strands 0.1 apart, numbered in a scrambled order, 4 segments
+        // each.
+        let (side, segments, radius) = (256u32, 4u32, 0.01f32);
         let strands = side * side;
         let foot = |s: u32| {
-            let cell = (s * 1181) % strands;
+            let cell = (s * 40503) % strands;
             Vec3::new((cell % side) as f32 * 0.1, 0.0, (cell / side) as f32 * 0.1)
         };
         for basis in [CurveBasis::Linear, CurveBasis::CatmullRom] {
@@ -893,7 +951,7 @@ mod tests {
             let indices: Vec<u32> = (0..strands)
                 .flat_map(|s| (0..segments).map(move |j| s * per_strand + j))
                 .collect();
-            assert!(indices.len() >= ORDERED_FROM_SEGMENTS);
+            assert!(indices.len() >= CLUSTERED_FROM_SEGMENTS);
             let geometry = CurveGeometry::new(
                 &device,
                 basis,
@@ -902,10 +960,11 @@ mod tests {
                 indices.into(),
                 1,
             )
-            .unwrap();
-            assert!(geometry.is_ordered());
-            let order = geometry.traversal_segments().unwrap();
-            assert!(order.windows(2).any(|w| w[0] > w[1]), "not reordered");
+            .unwrap()
+            .in_parts();
+            let parts = geometry.parts().unwrap();
+            assert_eq!(parts.len(), geometry.indices().len() / PART_SEGMENTS);
+            assert!(parts.iter().all(|p| p.len() <= PART_SEGMENTS));
             let mut scene = SceneBuilder::new(device.clone(), SceneOptions::default()).unwrap();
             scene.attach(geometry).unwrap();
             let scene = scene.commit(&|_| true).unwrap();
@@ -941,7 +1000,8 @@ mod tests {
         let v = SharedBuffer::new(vec![[0.0, 0.0, 0.0, 0.1]; 2]);
         let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
         let small = CurveGeometry::new(&device, linear, round, v, vec![0].into(), 1).unwrap();
-        assert!(!small.is_ordered());
+        let small = small.in_parts();
+        assert!(small.parts().is_none());
     }
 
     #[test]

@@ -28,10 +28,10 @@ pub mod sys;
 mod sys;
 
 pub use device::Device;
-pub use geometry::{CurveBasis, CurveShape};
 pub(crate) use geometry::{
-    CurveGeometry, CurvePoint, ORDERED_FROM_SEGMENTS, TriangleGeometry, padding_for,
+    CLUSTERED_FROM_SEGMENTS, CurveGeometry, CurvePoint, TriangleGeometry, padding_for,
 };
+pub use geometry::{CurveBasis, CurveShape};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
 pub(crate) use order::morton_order;

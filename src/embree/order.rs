@@ -3,8 +3,11 @@
 //!
 //! Embree's curve build and traversal spend most of their time fetching control points
 //! (docs/large-grooms.md); fetched in an order unrelated to space, each fetch misses the
-//! cache. The strands of a groom (`Curves::spatially_ordered`) and the segments Embree is
-//! handed (`CurveGeometry`) both take this order.
+//! cache. The strands of a groom (`Curves::spatially_ordered`) follow a Morton curve; the
+//! segments of a large curve geometry are cut into compact parts by median splits, each
+//! built by Embree as a small scene of its own (`CurveGeometry`, `SceneBuilder`).
+
+use std::ops::Range;
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -38,6 +41,60 @@ pub(crate) fn morton_order(n: usize, centre: impl Fn(usize) -> Vec3 + Sync) -> V
         .collect();
     keys.par_sort_unstable();
     keys.into_par_iter().map(|k| k as u32).collect()
+}
+
+/// The indices `0..n` cut in two at the median of their centres along the longest axis of
+/// the centres' bounds, each half again, until every part holds at most `most`: the
+/// indices in that order, and the parts as ranges of it (in order, covering it). Ties are
+/// broken by index, so the result is a pure function of the centres (whatever the thread
+/// count); non-finite centres are left out of the bounds and sort by `f32::total_cmp`.
+/// `n` is at most `u32::MAX`.
+pub(crate) fn median_split(
+    n: usize,
+    most: usize,
+    centre: impl Fn(usize) -> Vec3 + Sync,
+) -> (Vec<u32>, Vec<Range<u32>>) {
+    debug_assert!(u32::try_from(n).is_ok());
+    // Each index beside its centre, so that every pass reads one contiguous array.
+    let mut items: Vec<(Vec3, u32)> = (0..n)
+        .into_par_iter()
+        .map(|i| (centre(i), i as u32))
+        .collect();
+    let parts = split(&mut items, most.max(1), 0);
+    (items.into_par_iter().map(|(_, i)| i).collect(), parts)
+}
+
+fn split(items: &mut [(Vec3, u32)], most: usize, start: u32) -> Vec<Range<u32>> {
+    let len = items.len() as u32;
+    if items.len() <= most {
+        return vec![start..start + len];
+    }
+    let empty = || (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    let (lo, hi) = items
+        .par_iter()
+        .map(|&(c, _)| c)
+        .filter(|c| c.is_finite())
+        .fold(empty, |(lo, hi), c| (lo.min(c), hi.max(c)))
+        .reduce(empty, |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let extent = (hi - lo).max(Vec3::ZERO);
+    let axis = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = items.len() / 2;
+    items.select_nth_unstable_by(mid, |a, b| {
+        a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
+    });
+    let (left, right) = items.split_at_mut(mid);
+    let (mut parts, rest) = rayon::join(
+        || split(left, most, start),
+        || split(right, most, start + mid as u32),
+    );
+    parts.extend(rest);
+    parts
 }
 
 /// The 30-bit Morton code of a cell of a 1024^3 grid: its coordinates' bits interleaved.
@@ -75,5 +132,35 @@ mod tests {
         assert_eq!(morton(glam::UVec3::new(0, 0, 1)), 4);
         assert_eq!(morton(glam::UVec3::splat(1023)), (1 << 30) - 1);
         assert!(morton_order(0, |_| Vec3::ZERO).is_empty());
+    }
+
+    #[test]
+    fn median_cuts_make_compact_parts_of_at_most_the_size() {
+        // 8 x 2 points on a grid, numbered column by column in a scrambled order.
+        let cell = |i: usize| {
+            let c = (i * 5) % 16;
+            Vec3::new((c % 8) as f32, (c / 8) as f32, 0.0)
+        };
+        let (order, parts) = median_split(16, 4, cell);
+        assert_eq!(parts, [0..4, 4..8, 8..12, 12..16]);
+        let mut sorted = order.clone();
+        sorted.sort_unstable();
+        assert_eq!(sorted, (0..16).collect::<Vec<u32>>());
+        // Cut along x (the longest axis) twice: each part is a 2 x 2 block of the grid.
+        for (k, part) in parts.iter().enumerate() {
+            for &i in &order[part.start as usize..part.end as usize] {
+                assert_eq!(cell(i as usize).x as usize / 2, k, "{order:?}");
+            }
+        }
+        // Equal centres are cut by index; a NaN goes last; a small set stays whole.
+        let (order, parts) = median_split(5, 2, |i| if i == 1 { Vec3::NAN } else { Vec3::ZERO });
+        assert_eq!(parts, [0..2, 2..3, 3..5]);
+        let mut first = [order[0], order[1]];
+        first.sort_unstable();
+        assert_eq!((first, &order[2..]), ([0, 2], &[3, 4, 1][..]));
+        assert_eq!(
+            median_split(3, 8, |_| Vec3::ONE),
+            (vec![0, 1, 2], vec![0..3])
+        );
     }
 }

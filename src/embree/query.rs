@@ -98,9 +98,8 @@ struct QueryContext<'a> {
     /// Must stay first: the filter receives a pointer to it and casts back to the whole.
     raw: RawContext,
     exclude: Exclude,
-    /// The excluded geometry's segment for each of Embree's primitives, when Embree reads
-    /// them in another order (`CurveGeometry::traversal_segments`).
-    segments: Option<&'a [u32]>,
+    /// The scene queried, which turns Embree's ids into its own ([`Scene::own_ids`]).
+    scene: &'a Scene,
 }
 
 impl<'a> QueryContext<'a> {
@@ -116,7 +115,7 @@ impl<'a> QueryContext<'a> {
                 last_prim: 0,
                 max_t: 0.0,
             }),
-            segments: exclude.and_then(|e| scene.traversal_segments(e.geom_id)),
+            scene,
         }
     }
 }
@@ -132,10 +131,10 @@ unsafe extern "C" fn exclude_filter(args: *const sys::RTCFilterFunctionNArgument
     // SAFETY: the context is the first field of a live `QueryContext` (see `query`).
     let ctx = unsafe { &*(args.context as *const QueryContext<'_>) };
     let exclude = &ctx.exclude;
-    let own = |prim: u32| own_segment(ctx.segments, prim);
     let n = args.N as usize;
     // SAFETY: `valid` holds N ints; ray and hit are SOA packets of N lanes: tfar is the 9th
-    // float array of RTCRayN, primID and geomID the 6th and 7th u32 arrays of RTCHitN.
+    // float array of RTCRayN, primID, geomID and instID[0] the 6th, 7th and 8th u32 arrays
+    // of RTCHitN.
     unsafe {
         let ray = args.ray as *const f32;
         let hit = args.hit as *const u32;
@@ -147,10 +146,14 @@ unsafe extern "C" fn exclude_filter(args: *const sys::RTCFilterFunctionNArgument
             let t = *ray.add(8 * n + i);
             let prim = *hit.add(5 * n + i);
             let geom = *hit.add(6 * n + i);
-            if geom == exclude.geom_id
-                && (exclude.first_prim..=exclude.last_prim).contains(&own(prim))
-                && t < exclude.max_t
-            {
+            let instance = *hit.add(7 * n + i);
+            let excluded = ctx
+                .scene
+                .own_ids(instance, geom, prim)
+                .is_some_and(|(g, p)| {
+                    g == exclude.geom_id && (exclude.first_prim..=exclude.last_prim).contains(&p)
+                });
+            if excluded && t < exclude.max_t {
                 *valid = 0;
             }
         }
@@ -177,10 +180,11 @@ impl Scene {
         // across the call; the filter reads the context as a `QueryContext`, which it is.
         unsafe { compat::intersect1(self.raw(), &mut ctx.raw, &mut rayhit, filter_for(exclude)) };
         let h = rayhit.hit;
-        (h.geomID != INVALID_ID).then(|| RayHit {
+        let (geom_id, prim_id) = self.own_ids(h.instID[0], h.geomID, h.primID)?;
+        Some(RayHit {
             t: rayhit.ray.tfar,
-            geom_id: h.geomID,
-            prim_id: own_segment(self.traversal_segments(h.geomID), h.primID),
+            geom_id,
+            prim_id,
             u: h.u,
             v: h.v,
             ng: Vec3::new(h.Ng_x, h.Ng_y, h.Ng_z),
@@ -201,19 +205,23 @@ impl Scene {
     }
 }
 
-/// The geometry's own number of the primitive Embree calls `prim`, given the geometry's
-/// traversal order (`u32::MAX`, which names no segment, for an id Embree never returns).
-fn own_segment(segments: Option<&[u32]>, prim: u32) -> u32 {
-    segments.map_or(prim, |s| {
-        s.get(prim as usize).copied().unwrap_or(INVALID_ID)
-    })
-}
-
 impl Scene {
-    /// The traversal order of geometry `id`, when it has one.
-    fn traversal_segments(&self, id: u32) -> Option<&[u32]> {
-        match self.geometry(id)? {
-            Geometry::Curves(c) => c.traversal_segments(),
+    /// The geometry and primitive, in this scene's numbering, of Embree's hit on primitive
+    /// `prim` of geometry `geom`, inside instance `instance` when that is not
+    /// `INVALID_ID` (a part of a large geometry: `SceneBuilder::attach`). `None` for no
+    /// hit, or ids Embree never returns.
+    fn own_ids(&self, instance: u32, geom: u32, prim: u32) -> Option<(u32, u32)> {
+        let top = if instance == INVALID_ID {
+            geom
+        } else {
+            instance
+        };
+        let slot = self.slot(top)?;
+        let Some(start) = slot.part_start else {
+            return Some((slot.geometry, prim));
+        };
+        match self.geometry(slot.geometry)? {
+            Geometry::Curves(c) => Some((slot.geometry, c.own_segment(start, prim))),
             Geometry::Triangles(_) => None,
         }
     }

@@ -104,6 +104,7 @@ impl TracerBuilder {
     /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
     pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
         let (basis, shape, vertices, indices, strands, truth) = curves.into_parts();
+        let in_parts = self.scene.options().builds_in_parts(indices.len());
         let geometry = CurveGeometry::new(
             self.scene.device(),
             basis,
@@ -112,6 +113,11 @@ impl TracerBuilder {
             indices,
             HAIR_MASK,
         )?;
+        let geometry = if in_parts {
+            geometry.in_parts()
+        } else {
+            geometry
+        };
         let id = self.scene.attach(geometry)?;
         self.tables.push(Table::Curves { strands, truth });
         Ok(id)

@@ -472,7 +472,7 @@ impl CurveGeometry {
     /// it has at least [`CLUSTERED_FROM_SEGMENTS`] segments (else unchanged).
     pub fn in_parts(mut self) -> Self {
         if self.indices.len() >= CLUSTERED_FROM_SEGMENTS {
-            let span = self.basis.points_per_segment() as usize;
+            let span = self.basis.points_per_segment();
             self.parts = Some(Parts::new(span, &self.vertices, &self.indices));
         }
         self

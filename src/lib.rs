@@ -70,6 +70,8 @@ pub mod render;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod scene;
+#[cfg(feature = "render")]
+mod threads;
 /// cbindgen:ignore
 mod validate;
 

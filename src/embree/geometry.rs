@@ -372,7 +372,11 @@ struct Parts {
 }
 
 impl Parts {
-    fn new(span: usize, vertices: &SharedBuffer<[f32; 4]>, indices: &SharedBuffer<u32>) -> Self {
+    fn new(
+        span: usize,
+        vertices: &SharedBuffer<[f32; 4]>,
+        indices: &SharedBuffer<u32>,
+    ) -> Result<Self> {
         let (points, first) = (vertices.as_slice(), indices.as_slice());
         let (segments, ranges) = median_split(first.len(), PART_SEGMENTS, |s| {
             let f = first[s] as usize;
@@ -380,12 +384,12 @@ impl Parts {
                 .iter()
                 .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
             sum / span as f32
-        });
-        Parts {
+        })?;
+        Ok(Parts {
             indices: SharedBuffer::new(segments.iter().map(|&s| first[s as usize]).collect()),
             segments: segments.into_boxed_slice(),
             ranges: ranges.into_boxed_slice(),
-        }
+        })
     }
 }
 
@@ -470,12 +474,12 @@ impl CurveGeometry {
 
     /// The same geometry, cut into parts that a scene builds as scenes of their own when
     /// it has at least [`CLUSTERED_FROM_SEGMENTS`] segments (else unchanged).
-    pub fn in_parts(mut self) -> Self {
+    pub fn in_parts(mut self) -> Result<Self> {
         if self.indices.len() >= CLUSTERED_FROM_SEGMENTS {
             let span = self.basis.points_per_segment();
-            self.parts = Some(Parts::new(span, &self.vertices, &self.indices));
+            self.parts = Some(Parts::new(span, &self.vertices, &self.indices)?);
         }
-        self
+        Ok(self)
     }
 
     pub fn basis(&self) -> CurveBasis {
@@ -961,7 +965,8 @@ mod tests {
                 1,
             )
             .unwrap()
-            .in_parts();
+            .in_parts()
+            .unwrap();
             let parts = geometry.parts().unwrap();
             assert_eq!(parts.len(), geometry.indices().len() / PART_SEGMENTS);
             assert!(parts.iter().all(|p| p.len() <= PART_SEGMENTS));
@@ -1000,7 +1005,7 @@ mod tests {
         let v = SharedBuffer::new(vec![[0.0, 0.0, 0.0, 0.1]; 2]);
         let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
         let small = CurveGeometry::new(&device, linear, round, v, vec![0].into(), 1).unwrap();
-        let small = small.in_parts();
+        let small = small.in_parts().unwrap();
         assert!(small.parts().is_none());
     }
 

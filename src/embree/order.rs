@@ -12,35 +12,44 @@ use std::ops::Range;
 use glam::Vec3;
 use rayon::prelude::*;
 
+use crate::Result;
+use crate::threads;
+
 /// The indices `0..n` sorted by the 30-bit Morton code of `centre(i)` on a 1024^3 grid
 /// over the centres' bounds; ties keep index order, so the order is a pure function of the
 /// centres (whatever the thread count). A non-finite centre sorts as the grid's corner.
-/// `n` is at most `u32::MAX`, as every count Embree indexes is.
-pub(crate) fn morton_order(n: usize, centre: impl Fn(usize) -> Vec3 + Sync) -> Vec<u32> {
+/// `n` is at most `u32::MAX`, as every count Embree indexes is. Runs on threads of its own
+/// ([`threads::scoped`]); fails only if they cannot start.
+pub(crate) fn morton_order(
+    n: usize,
+    centre: impl Fn(usize) -> Vec3 + Sync + Send,
+) -> Result<Vec<u32>> {
     debug_assert!(u32::try_from(n).is_ok());
-    let finite = |c: Vec3| c.is_finite().then_some(c);
-    let (lo, hi) = (0..n)
-        .into_par_iter()
-        .filter_map(|i| finite(centre(i)))
-        .fold(
-            || (Vec3::INFINITY, Vec3::NEG_INFINITY),
-            |(lo, hi), c| (lo.min(c), hi.max(c)),
-        )
-        .reduce(
-            || (Vec3::INFINITY, Vec3::NEG_INFINITY),
-            |a, b| (a.0.min(b.0), a.1.max(b.1)),
-        );
-    let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
-    let mut keys: Vec<u64> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let cell =
-                finite(centre(i)).map_or(glam::UVec3::ZERO, |c| ((c - lo) * scale).as_uvec3());
-            (u64::from(morton(cell)) << 32) | i as u64
-        })
-        .collect();
-    keys.par_sort_unstable();
-    keys.into_par_iter().map(|k| k as u32).collect()
+    threads::scoped(0, || {
+        let finite = |c: Vec3| c.is_finite().then_some(c);
+        let (lo, hi) = (0..n)
+            .into_par_iter()
+            .filter_map(|i| finite(centre(i)))
+            .fold(
+                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                |(lo, hi), c| (lo.min(c), hi.max(c)),
+            )
+            .reduce(
+                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                |a, b| (a.0.min(b.0), a.1.max(b.1)),
+            );
+        let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
+        let mut keys: Vec<u64> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let cell =
+                    finite(centre(i)).map_or(glam::UVec3::ZERO, |c| ((c - lo) * scale).as_uvec3());
+                (u64::from(morton(cell)) << 32) | i as u64
+            })
+            .collect();
+        keys.par_sort_unstable();
+        keys.into_par_iter().map(|k| k as u32).collect()
+    })
 }
 
 /// The indices `0..n` cut in two at the median of their centres along the longest axis of
@@ -52,16 +61,18 @@ pub(crate) fn morton_order(n: usize, centre: impl Fn(usize) -> Vec3 + Sync) -> V
 pub(crate) fn median_split(
     n: usize,
     most: usize,
-    centre: impl Fn(usize) -> Vec3 + Sync,
-) -> (Vec<u32>, Vec<Range<u32>>) {
+    centre: impl Fn(usize) -> Vec3 + Sync + Send,
+) -> Result<(Vec<u32>, Vec<Range<u32>>)> {
     debug_assert!(u32::try_from(n).is_ok());
-    // Each index beside its centre, so that every pass reads one contiguous array.
-    let mut items: Vec<(Vec3, u32)> = (0..n)
-        .into_par_iter()
-        .map(|i| (centre(i), i as u32))
-        .collect();
-    let parts = split(&mut items, most.max(1), 0);
-    (items.into_par_iter().map(|(_, i)| i).collect(), parts)
+    threads::scoped(0, || {
+        // Each index beside its centre, so that every pass reads one contiguous array.
+        let mut items: Vec<(Vec3, u32)> = (0..n)
+            .into_par_iter()
+            .map(|i| (centre(i), i as u32))
+            .collect();
+        let parts = split(&mut items, most.max(1), 0);
+        (items.into_par_iter().map(|(_, i)| i).collect(), parts)
+    })
 }
 
 fn split(items: &mut [(Vec3, u32)], most: usize, start: u32) -> Vec<Range<u32>> {
@@ -124,14 +135,14 @@ mod tests {
             Vec3::NAN,
             Vec3::new(f32::INFINITY, 0.0, 0.0),
         ];
-        let order = morton_order(centres.len(), |i| centres[i]);
+        let order = morton_order(centres.len(), |i| centres[i]).unwrap();
         assert_eq!(order, [2, 4, 5, 1, 3, 0]);
         // Cells of one octant come before the next: (0,0,0) < (1,0,0) < (0,1,0) < (0,0,1).
         assert_eq!(morton(glam::UVec3::new(1, 0, 0)), 1);
         assert_eq!(morton(glam::UVec3::new(0, 1, 0)), 2);
         assert_eq!(morton(glam::UVec3::new(0, 0, 1)), 4);
         assert_eq!(morton(glam::UVec3::splat(1023)), (1 << 30) - 1);
-        assert!(morton_order(0, |_| Vec3::ZERO).is_empty());
+        assert!(morton_order(0, |_| Vec3::ZERO).unwrap().is_empty());
     }
 
     #[test]
@@ -141,7 +152,7 @@ mod tests {
             let c = (i * 5) % 16;
             Vec3::new((c % 8) as f32, (c / 8) as f32, 0.0)
         };
-        let (order, parts) = median_split(16, 4, cell);
+        let (order, parts) = median_split(16, 4, cell).unwrap();
         assert_eq!(parts, [0..4, 4..8, 8..12, 12..16]);
         let mut sorted = order.clone();
         sorted.sort_unstable();
@@ -153,12 +164,13 @@ mod tests {
             }
         }
         // Equal centres are cut by index; a NaN goes last; a small set stays whole.
-        let (order, parts) = median_split(5, 2, |i| if i == 1 { Vec3::NAN } else { Vec3::ZERO });
+        let (order, parts) =
+            median_split(5, 2, |i| if i == 1 { Vec3::NAN } else { Vec3::ZERO }).unwrap();
         assert_eq!(parts, [0..2, 2..3, 3..5]);
         let mut first = [order[0], order[1]];
         first.sort_unstable();
         assert_eq!((first, &order[2..]), ([0, 2], &[3, 4, 1][..]));
-        let (order, parts) = median_split(3, 8, |_| Vec3::ONE);
+        let (order, parts) = median_split(3, 8, |_| Vec3::ONE).unwrap();
         assert_eq!((order, parts.len(), &parts[0]), (vec![0, 1, 2], 1, &(0..3)));
     }
 }

@@ -16,7 +16,7 @@ use super::film::{Film, PixelAccumulator, Window};
 use super::progress::Progress;
 use crate::Result;
 use crate::error::invalid_arg;
-use crate::quiet_panic;
+use crate::threads;
 
 /// How the work is split and run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -167,17 +167,7 @@ where
             cancelled.store(true, Ordering::Relaxed);
         }
     };
-    // A pool of the render's own, joined when `build_scoped` returns: no thread outlives
-    // the render (a host may unload the library after it).
-    // The workers of a C call keep its panics quiet as the calling thread does.
-    let quiet = quiet_panic::is_quiet();
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(options.threads)
-        .build_scoped(
-            |thread| quiet_panic::inherit(quiet, || thread.run()),
-            |pool| pool.install(|| work.par_iter().for_each(render_tile)),
-        )
-        .map_err(|e| invalid_arg!("cannot start {} render threads: {e}", options.threads))?;
+    threads::scoped(options.threads, || work.par_iter().for_each(render_tile))?;
     Ok(if cancelled.into_inner() {
         RenderStatus::Cancelled
     } else {

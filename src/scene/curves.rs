@@ -387,7 +387,7 @@ impl Curves {
                 .iter()
                 .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
             sum / points.len().max(1) as f32
-        });
+        })?;
         if order.windows(2).all(|w| w[0] < w[1]) {
             return Ok(self);
         }

@@ -24,6 +24,7 @@ use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
 use crate::scene::curves::{Curves, SegmentCurve};
+use crate::threads;
 
 /// The default tolerance, in pixels, between a thin strand's curve and its polyline: the
 /// largest measured whose bias stays below flat ribbons' own for every basis (fur ball,
@@ -80,16 +81,18 @@ pub fn polylines(
     };
     let strands = curves.strands().strand_count();
     // Each chunk's points, parameters and counts, in strand order whatever the threads.
-    let chunks: Vec<Polylines> = (0..strands.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| {
-            let mut out = Polylines::default();
-            for s in c * CHUNK..strands.min((c + 1) * CHUNK) {
-                sampler.strand(&curves, s, &mut out);
-            }
-            out
-        })
-        .collect();
+    let chunks: Vec<Polylines> = threads::scoped(0, || {
+        (0..strands.div_ceil(CHUNK))
+            .into_par_iter()
+            .map(|c| {
+                let mut out = Polylines::default();
+                for s in c * CHUNK..strands.min((c + 1) * CHUNK) {
+                    sampler.strand(&curves, s, &mut out);
+                }
+                out
+            })
+            .collect()
+    })?;
     let mut all = Polylines::default();
     let total = |f: fn(&Polylines) -> usize| chunks.iter().map(f).sum::<usize>();
     all.points.reserve_exact(total(|c| c.points.len()) + 1);

@@ -114,7 +114,7 @@ impl TracerBuilder {
             HAIR_MASK,
         )?;
         let geometry = if in_parts {
-            geometry.in_parts()
+            geometry.in_parts()?
         } else {
             geometry
         };

@@ -8,7 +8,7 @@ use std::path::Path;
 
 /// Top-level modules from the bottom up; a module may use its own layer and those below.
 const LAYERS: [&[&str]; 7] = [
-    &["error", "quiet_panic", "validate"],
+    &["error", "quiet_panic", "threads", "validate"],
     &["math"],
     &["bsdf", "embree", "image"],
     &["scene"],

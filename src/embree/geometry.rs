@@ -13,9 +13,7 @@ use std::ops::Range;
 use std::ptr::NonNull;
 use std::sync::Arc;
 
-use glam::Vec3;
-
-use super::order::median_split;
+use super::order::{centroid, median_split};
 use super::{Device, sys};
 use crate::error::invalid_arg;
 use crate::{Error, Result};
@@ -348,7 +346,7 @@ pub struct CurvePoint {
 /// Embree scene each under a BVH of their instances ([`Parts`]). On the bench scalp at
 /// 10^6 strands x 16 segments the build then takes 0.6x-0.7x the time and rays 0.88x-0.91x
 /// (docs/large-grooms.md).
-pub(crate) const CLUSTERED_FROM_SEGMENTS: usize = 1 << 18;
+pub(crate) const PARTS_FROM_SEGMENTS: usize = 1 << 18;
 
 /// The most segments of one part: small enough that a part's control points, index
 /// entries and Embree's primitive references stay in the cache while Embree builds it.
@@ -380,10 +378,7 @@ impl Parts {
         let (points, first) = (vertices.as_slice(), indices.as_slice());
         let (segments, ranges) = median_split(first.len(), PART_SEGMENTS, |s| {
             let f = first[s] as usize;
-            let sum = points[f..f + span]
-                .iter()
-                .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
-            sum / span as f32
+            centroid(&points[f..f + span])
         })?;
         Ok(Parts {
             indices: SharedBuffer::new(segments.iter().map(|&s| first[s as usize]).collect()),
@@ -473,9 +468,9 @@ impl CurveGeometry {
     }
 
     /// The same geometry, cut into parts that a scene builds as scenes of their own when
-    /// it has at least [`CLUSTERED_FROM_SEGMENTS`] segments (else unchanged).
+    /// it has at least [`PARTS_FROM_SEGMENTS`] segments (else unchanged).
     pub fn in_parts(mut self) -> Result<Self> {
-        if self.indices.len() >= CLUSTERED_FROM_SEGMENTS {
+        if self.indices.len() >= PARTS_FROM_SEGMENTS {
             let span = self.basis.points_per_segment();
             self.parts = Some(Parts::new(span, &self.vertices, &self.indices)?);
         }
@@ -520,20 +515,17 @@ impl CurveGeometry {
         self.vertices.heap_bytes() + self.indices.heap_bytes() + parts
     }
 
-    /// The parts a scene builds as scenes of their own ([`CLUSTERED_FROM_SEGMENTS`]), as
+    /// The parts a scene builds as scenes of their own ([`PARTS_FROM_SEGMENTS`]), as
     /// ranges of Embree's primitive order; `None` for a geometry built whole.
     pub(super) fn parts(&self) -> Option<&[Range<u32>]> {
         self.parts.as_ref().map(|p| &*p.ranges)
     }
 
     /// The segment, in this geometry's order, that Embree calls `prim` in the part
-    /// starting at `part_start`; `u32::MAX` (no segment) for an id Embree never returns.
-    pub(super) fn own_segment(&self, part_start: u32, prim: u32) -> u32 {
-        let own = self.parts.as_ref().and_then(|p| {
-            let at = part_start.checked_add(prim)?;
-            p.segments.get(at as usize).copied()
-        });
-        own.unwrap_or(u32::MAX)
+    /// starting at `part_start`; `None` for an id Embree never returns.
+    pub(super) fn own_segment(&self, part_start: u32, prim: u32) -> Option<u32> {
+        let at = part_start.checked_add(prim)?;
+        self.parts.as_ref()?.segments.get(at as usize).copied()
     }
 
     /// A committed handle on the segments of `part` (one of [`Self::parts`]): the same
@@ -925,13 +917,14 @@ mod tests {
         }
     }
 
-    /// A geometry of `CLUSTERED_FROM_SEGMENTS` segments or more is built in parts, each a
+    /// A geometry of `PARTS_FROM_SEGMENTS` segments or more is built in parts, each a
     /// scene of its own, yet every hit and every exclusion names segments in the
     /// geometry's own order: each hit lies on the segment it names, and excluding that
     /// segment lets the ray through to the strand behind.
     #[test]
     fn segments_built_in_parts_keep_their_own_numbers() {
         use crate::embree::{Exclude, Ray, SceneBuilder, SceneOptions};
+        use glam::Vec3;
         let device = Arc::new(Device::new(Some(2)).unwrap());
         // 256 x 256 vertical strands 0.1 apart, numbered in a scrambled order, 4 segments
         // each.
@@ -955,7 +948,7 @@ mod tests {
             let indices: Vec<u32> = (0..strands)
                 .flat_map(|s| (0..segments).map(move |j| s * per_strand + j))
                 .collect();
-            assert!(indices.len() >= CLUSTERED_FROM_SEGMENTS);
+            assert!(indices.len() >= PARTS_FROM_SEGMENTS);
             let geometry = CurveGeometry::new(
                 &device,
                 basis,

@@ -28,13 +28,13 @@ pub mod sys;
 mod sys;
 
 pub use device::Device;
-pub(crate) use geometry::{
-    CLUSTERED_FROM_SEGMENTS, CurveGeometry, CurvePoint, TriangleGeometry, padding_for,
-};
 pub use geometry::{CurveBasis, CurveShape};
+pub(crate) use geometry::{
+    CurveGeometry, CurvePoint, PARTS_FROM_SEGMENTS, TriangleGeometry, padding_for,
+};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
-pub(crate) use order::morton_order;
+pub(crate) use order::{centroid, morton_order};
 pub(crate) use query::Exclude;
 pub use scene::is_cancelled;
 pub(crate) use scene::{SceneBuilder, cancelled};

@@ -27,17 +27,7 @@ pub(crate) fn morton_order(
     debug_assert!(u32::try_from(n).is_ok());
     threads::scoped(0, || {
         let finite = |c: Vec3| c.is_finite().then_some(c);
-        let (lo, hi) = (0..n)
-            .into_par_iter()
-            .filter_map(|i| finite(centre(i)))
-            .fold(
-                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
-                |(lo, hi), c| (lo.min(c), hi.max(c)),
-            )
-            .reduce(
-                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
-                |a, b| (a.0.min(b.0), a.1.max(b.1)),
-            );
+        let (lo, hi) = finite_bounds((0..n).into_par_iter().map(&centre));
         let scale = 1023.0 / (hi - lo).max_element().max(f32::MIN_POSITIVE);
         let mut keys: Vec<u64> = (0..n)
             .into_par_iter()
@@ -80,13 +70,7 @@ fn split(items: &mut [(Vec3, u32)], most: usize, start: u32) -> Vec<Range<u32>> 
     if items.len() <= most {
         return std::iter::once(start..start + len).collect();
     }
-    let empty = || (Vec3::INFINITY, Vec3::NEG_INFINITY);
-    let (lo, hi) = items
-        .par_iter()
-        .map(|&(c, _)| c)
-        .filter(|c| c.is_finite())
-        .fold(empty, |(lo, hi), c| (lo.min(c), hi.max(c)))
-        .reduce(empty, |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    let (lo, hi) = finite_bounds(items.par_iter().map(|&(c, _)| c));
     let extent = (hi - lo).max(Vec3::ZERO);
     let axis = if extent.x >= extent.y && extent.x >= extent.z {
         0
@@ -106,6 +90,25 @@ fn split(items: &mut [(Vec3, u32)], most: usize, start: u32) -> Vec<Range<u32>> 
     );
     parts.extend(rest);
     parts
+}
+
+/// The bounds (lower, upper) of the finite points among `points`; empty (lower above
+/// upper) when there is none.
+fn finite_bounds(points: impl ParallelIterator<Item = Vec3>) -> (Vec3, Vec3) {
+    let empty = || (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    points
+        .filter(|c| c.is_finite())
+        .fold(empty, |(lo, hi), c| (lo.min(c), hi.max(c)))
+        .reduce(empty, |a, b| (a.0.min(b.0), a.1.max(b.1)))
+}
+
+/// The mean position of control points (x, y, z, radius): the centre a strand or a
+/// segment is ordered by. The origin for no points.
+pub(crate) fn centroid(points: &[[f32; 4]]) -> Vec3 {
+    let sum = points
+        .iter()
+        .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
+    sum / points.len().max(1) as f32
 }
 
 /// The 30-bit Morton code of a cell of a 1024^3 grid: its coordinates' bits interleaved.

@@ -221,7 +221,7 @@ impl Scene {
             return Some((slot.geometry, prim));
         };
         match self.geometry(slot.geometry)? {
-            Geometry::Curves(c) => Some((slot.geometry, c.own_segment(start, prim))),
+            Geometry::Curves(c) => Some((slot.geometry, c.own_segment(start, prim)?)),
             Geometry::Triangles(_) => None,
         }
     }

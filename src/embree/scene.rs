@@ -61,6 +61,15 @@ impl SceneOptions {
         }
     }
 
+    /// Embree's flags for a scene built with these options (a part's scene too).
+    fn flags(&self) -> sys::RTCSceneFlags {
+        let mut flags = FILTER_SCENE_FLAG;
+        if self.compact {
+            flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_COMPACT;
+        }
+        flags
+    }
+
     /// Whether a curve geometry of `segments` segments is built in parts.
     pub(crate) fn builds_in_parts(&self, segments: usize) -> bool {
         self.samples
@@ -114,9 +123,17 @@ pub struct SceneBuilder {
     parts: Vec<Part>,
     slots: Vec<Slot>,
     geometries: Vec<Geometry>,
-    flags: sys::RTCSceneFlags,
     options: SceneOptions,
     device: Arc<Device>,
+}
+
+/// The id of the `n`-th geometry (from 0), refused where Embree's ids end (`u32::MAX`
+/// means no geometry).
+fn embree_id(n: usize) -> Result<u32> {
+    u32::try_from(n)
+        .ok()
+        .filter(|&id| id != u32::MAX)
+        .ok_or_else(|| invalid_arg!("too many geometries in one scene"))
 }
 
 /// A new scene with `flags`.
@@ -152,16 +169,11 @@ fn commit_scene(device: &Device, scene: &RawScene, progress: &BuildMonitor<'_>) 
 
 impl SceneBuilder {
     pub fn new(device: Arc<Device>, options: SceneOptions) -> Result<Self> {
-        let mut flags = FILTER_SCENE_FLAG;
-        if options.compact {
-            flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_COMPACT;
-        }
         Ok(SceneBuilder {
-            raw: new_scene(&device, flags)?,
+            raw: new_scene(&device, options.flags())?,
             parts: Vec::new(),
             slots: Vec::new(),
             geometries: Vec::new(),
-            flags,
             options,
             device,
         })
@@ -179,10 +191,7 @@ impl SceneBuilder {
     /// curve geometry with parts attaches an instance of a scene of its own per part.
     pub fn attach(&mut self, geometry: impl Into<Geometry>) -> Result<u32> {
         let geometry = geometry.into();
-        let id = u32::try_from(self.geometries.len())
-            .ok()
-            .filter(|&id| id != u32::MAX)
-            .ok_or_else(|| invalid_arg!("too many geometries in one scene"))?;
+        let id = embree_id(self.geometries.len())?;
         match &geometry {
             Geometry::Curves(c) if let Some(parts) = c.parts() => {
                 for range in parts {
@@ -210,10 +219,7 @@ impl SceneBuilder {
 
     /// Attaches `raw` to the top-level scene under the next slot's id.
     fn attach_raw(&self, raw: sys::RTCGeometry) -> Result<()> {
-        let slot = u32::try_from(self.slots.len())
-            .ok()
-            .filter(|&id| id != u32::MAX)
-            .ok_or_else(|| invalid_arg!("too many geometries in one scene"))?;
+        let slot = embree_id(self.slots.len())?;
         // SAFETY: live scene and geometry; the id is unused (slots are consecutive). The
         // scene retains the geometry, and we keep ours (and its buffers) until the scene is
         // gone.
@@ -225,7 +231,7 @@ impl SceneBuilder {
     /// instance of that scene, with `mask`, to the top level; the instance is committed
     /// with the whole scene (`commit`), once its scene is built.
     fn attach_part(&mut self, part: RawGeometry, mask: u32, range: &Range<u32>) -> Result<()> {
-        let scene = new_scene(&self.device, self.flags)?;
+        let scene = new_scene(&self.device, self.options.flags())?;
         // SAFETY: live scene and geometry; the scene retains the geometry.
         unsafe { sys::rtcAttachGeometryByID(scene.0.as_ptr(), part.raw(), 0) };
         self.device.check()?;
@@ -275,8 +281,11 @@ impl SceneBuilder {
             unsafe { sys::rtcCommitGeometry(part.instance.raw()) };
             self.device.check()?;
         }
-        let top: f64 = if self.parts.is_empty() { 0.0 } else { 1.0 };
-        commit_scene(&self.device, &self.raw, &|f| progress(top.max(f)))?;
+        // With parts, the top level (their instances) is built once they all are.
+        let whole = self.parts.is_empty();
+        commit_scene(&self.device, &self.raw, &|f| {
+            progress(if whole { f } else { 1.0 })
+        })?;
         Ok(Scene {
             raw: self.raw,
             _parts: self.parts,

@@ -38,7 +38,7 @@ use std::sync::Arc;
 use glam::{Vec3, Vec4};
 
 use crate::bsdf::sigma_a_from_melanin;
-use crate::embree::{CurveBasis, CurveShape, SharedBuffer, morton_order, padding_for};
+use crate::embree::{CurveBasis, CurveShape, SharedBuffer, centroid, morton_order, padding_for};
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
 use crate::scene::material::HairColor;
@@ -382,11 +382,7 @@ impl Curves {
             return Ok(self);
         }
         let order = morton_order(self.strands.strand_count(), |s| {
-            let points = self.strand_points(s);
-            let sum = points
-                .iter()
-                .fold(Vec3::ZERO, |a, p| a + Vec3::new(p[0], p[1], p[2]));
-            sum / points.len().max(1) as f32
+            centroid(self.strand_points(s))
         })?;
         if order.windows(2).all(|w| w[0] < w[1]) {
             return Ok(self);

@@ -11,7 +11,7 @@
 //! [`conversion_bytes`] is the larger of those moments. Level of detail changes only
 //! the sizes it passes in: fewer segments, a cheaper basis or shape per part.
 
-use crate::embree::{CLUSTERED_FROM_SEGMENTS, CurveBasis, CurveShape};
+use crate::embree::{CurveBasis, CurveShape, PARTS_FROM_SEGMENTS};
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
 
@@ -61,13 +61,13 @@ impl CurvesSize {
     }
 
     /// Bytes of the buffers hairtrace keeps for these curves: float4 control points, one
-    /// u32 index per segment (three from [`CLUSTERED_FROM_SEGMENTS`] segments: the index
+    /// u32 index per segment (three from [`PARTS_FROM_SEGMENTS`] segments: the index
     /// buffer in the order of Embree's parts and each of its segments' own number), the strand
     /// table (two u32 per strand, its first segment and, in spatial order, its number; one
     /// per 32 segments).
     pub fn curve_bytes(&self) -> u64 {
         let points = self.control_points.saturating_mul(16);
-        let indices = if self.segments >= CLUSTERED_FROM_SEGMENTS as u64 {
+        let indices = if self.segments >= PARTS_FROM_SEGMENTS as u64 {
             12
         } else {
             4

@@ -87,7 +87,6 @@ pub use glam;
 #[cfg(feature = "render")]
 pub use image::{read_image, write_image};
 #[cfg(feature = "render")]
-#[cfg(feature = "render")]
 pub use render::settings::RenderSettings;
 #[cfg(feature = "render")]
 pub use render::{Aovs, NoProgress, PixelFilter, Progress, RenderOutput};

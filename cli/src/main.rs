@@ -225,7 +225,7 @@ struct RenderArgs {
     /// One more image from the same build, after the main one: OUT with these settings
     /// changed (spp, seed, fidelity knobs, a noise target...), e.g. `--variant
     /// 'ref.exr:spp=1024 seed=9'`. Repeatable. Settings the build is made for (width,
-    /// height, isa, lod_pixels) are refused: they need a command of their own.
+    /// height, isa, lod_pixels, curve_parts) are refused: they need a command of their own.
     #[arg(long, value_name = "OUT:NAME=VALUE ...", value_parser = Variant::parse)]
     variant: Vec<Variant>,
     /// Render tile I of N (from 1; a grid over the frame, the same on every machine)

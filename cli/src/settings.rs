@@ -92,7 +92,7 @@ pub struct Variant {
 }
 
 /// The settings a build is made for: a variant that changes one needs a build of its own.
-const BUILD_SETTINGS: [&str; 4] = ["width", "height", "isa", "lod_pixels"];
+const BUILD_SETTINGS: [&str; 5] = ["width", "height", "isa", "lod_pixels", "curve_parts"];
 
 impl Variant {
     /// `OUT:NAME=VALUE NAME=VALUE ...`: the image, then settings separated by spaces (no

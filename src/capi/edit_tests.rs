@@ -8,9 +8,10 @@ use super::geometry::*;
 use super::lights::*;
 use super::materials::*;
 use super::render::*;
-use super::render_tests::{bits, light, render_c, settings};
+use super::render_tests::{bits, fur_scene, light, render_c, settings};
 use super::scene::*;
 use super::scene_tests::{Handles, curves_desc, fails, last_error, sized, small_fur};
+use super::settings_tests::Named;
 use crate::description::{
     GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc, MeshSource, SceneDescription,
 };
@@ -265,6 +266,23 @@ fn a_host_without_a_camera_builds_once() {
         assert_eq!(render_c(&h, &s).0, HtStatus::HT_OK);
         assert_eq!(render_c(&h, &s).0, HtStatus::HT_OK);
         assert_eq!(builds(&h), 1, "shape {shape}");
+    }
+}
+
+/// A build is kept for renders of other spp (the `auto` parts rule reads the first's), and
+/// made again when the host changes `curve_parts`.
+#[test]
+fn a_change_of_curve_parts_builds_again() {
+    let h = fur_scene(true);
+    for (parts, spp, builds_then) in [("auto", "1", 1), ("auto", "64", 1), ("off", "64", 2)] {
+        let named = Named::new(&[
+            ("width", "16"),
+            ("height", "16"),
+            ("spp", spp),
+            ("curve_parts", parts),
+        ]);
+        assert_eq!(named.render_rgb(h.scene, 16 * 16).0, HtStatus::HT_OK);
+        assert_eq!(builds(&h), builds_then, "{parts} at {spp} spp");
     }
 }
 

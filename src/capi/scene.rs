@@ -12,7 +12,7 @@ use crate::description::assembly::{Assembly, Shape};
 use crate::embree::{CurveBasis, Device, Isa};
 use crate::error::{Result, invalid_arg};
 use crate::render::integrator::World;
-use crate::render::settings::RenderSettings;
+use crate::render::settings::{CurveParts, RenderSettings};
 use crate::scene::Strands;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -59,6 +59,9 @@ pub struct HtScene {
     pub(super) built_from: Vec<usize>,
     /// Lights were added since `world` was built.
     pub(super) lights_changed: bool,
+    /// The `curve_parts` setting `world` was built with: a render asking another builds
+    /// again.
+    pub(super) built_parts: CurveParts,
 }
 
 pub(super) struct Geometry {
@@ -167,8 +170,8 @@ impl HtScene {
     /// The world to render, built or updated as needed (the BVH build reporting to
     /// `progress`), and the camera for an image of `width` x `height` pixels. One build
     /// at most: the automatic camera is framed without one. A build is kept while nothing
-    /// was added and the view still suits its `auto` curves' shapes (`Tracer::serves`);
-    /// new lights are weighed again on it.
+    /// was added, the view still suits its `auto` curves' shapes (`Tracer::serves`) and
+    /// `curve_parts` is unchanged; new lights are weighed again on it.
     pub(crate) fn prepare(
         &mut self,
         settings: &RenderSettings,
@@ -182,7 +185,9 @@ impl HtScene {
         }
         let camera = self.camera(width as f32 / height as f32)?;
         let view = DetailView::new(camera, height, settings.lod_pixels);
-        if (self.world.as_ref()).is_some_and(|w| !w.tracer.serves(&view)) {
+        if (self.world.as_ref())
+            .is_some_and(|w| !w.tracer.serves(&view) || self.built_parts != settings.curve_parts)
+        {
             self.world = None;
         }
         match &mut self.world {
@@ -203,6 +208,7 @@ impl HtScene {
                 )?;
                 self.world = Some(built.world);
                 self.built_from = built.built_from;
+                self.built_parts = settings.curve_parts;
             }
         }
         self.lights_changed = false;
@@ -337,6 +343,7 @@ pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut Ht
             framing: Framing::default(),
             world: None,
             built_from: Vec::new(),
+            built_parts: CurveParts::Auto,
             lights_changed: false,
         });
         // SAFETY: non-NULL (checked), the host's HtScene*.

@@ -7,12 +7,12 @@
 
 use std::sync::Arc;
 
-use crate::embree::{Device, SceneOptions};
+use crate::embree::{Device, PartsRule, SceneOptions};
 use crate::error::{Error, Result};
 use crate::render::Aovs;
 use crate::render::integrator::World;
 use crate::render::renderer::film_bytes;
-use crate::render::settings::RenderSettings;
+use crate::render::settings::{CurveParts, RenderSettings};
 use crate::scene::curves::Curves;
 use crate::scene::detail_view::DetailView;
 use crate::scene::footprint::{self, CurvesSize, available_bytes};
@@ -54,6 +54,19 @@ fn traced_curves(curves: Curves, auto: bool, view: &DetailView) -> Result<Vec<Cu
     ribbons::share_out(curves, &view.camera, view.height, view.lod_pixels)
 }
 
+/// When the build for a render of `settings` cuts a large groom into parts: for `auto`,
+/// from the whole frame's camera samples (width x height x spp, whatever the crop, so that
+/// every tile of a frame builds alike).
+pub(crate) fn parts_rule(settings: &RenderSettings) -> PartsRule {
+    match settings.curve_parts {
+        CurveParts::Auto => PartsRule::ForSamples(
+            u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp),
+        ),
+        CurveParts::On => PartsRule::Always,
+        CurveParts::Off => PartsRule::Never,
+    }
+}
+
 /// What a build is made of, in geometry order.
 #[derive(Default)]
 pub(crate) struct Assembly {
@@ -87,8 +100,8 @@ impl Assembly {
     /// Builds the world for `view` and a render of `settings`: `auto` curves shared out
     /// for the view, the memory the BVH build and then the render's film
     /// (`renderer::film_bytes`) will need checked against what is available, then the BVH
-    /// built (timed as [`Stage::Bvh`] in `stages`) for the render's camera samples
-    /// ([`SceneOptions::for_samples`]).
+    /// built (timed as [`Stage::Bvh`] in `stages`), large grooms in parts as `curve_parts`
+    /// says ([`parts_rule`]).
     pub fn build(
         self,
         device: Arc<Device>,
@@ -98,9 +111,11 @@ impl Assembly {
         stages: &mut StageRunner,
     ) -> Result<Assembled> {
         let film = film_bytes(settings, Aovs::default(), true);
-        let samples =
-            u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp);
-        let mut tracer = TracerBuilder::new(device, SceneOptions::for_samples(samples))?;
+        let options = SceneOptions {
+            parts: parts_rule(settings),
+            ..SceneOptions::default()
+        };
+        let mut tracer = TracerBuilder::new(device, options)?;
         let (mut materials, mut built_from, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
         let parts = self.parts.len();
         for (i, part) in self.parts.into_iter().enumerate() {

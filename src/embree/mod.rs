@@ -42,9 +42,9 @@ pub(crate) use scene::{SceneBuilder, cancelled};
 // The groom bench (`benches/groom.rs`) traces through Embree directly beside the tracer; the
 // `bench-internals` feature opens what it needs. No host should use them.
 #[cfg(feature = "bench-internals")]
-pub use scene::{Scene, SceneOptions};
+pub use scene::{PartsRule, Scene, SceneOptions};
 #[cfg(not(feature = "bench-internals"))]
-pub(crate) use scene::{Scene, SceneOptions};
+pub(crate) use scene::{PartsRule, Scene, SceneOptions};
 #[cfg(feature = "bench-internals")]
 pub use {geometry::Geometry, geometry::SharedBuffer, query::Ray, query::RayHit};
 #[cfg(not(feature = "bench-internals"))]

@@ -25,11 +25,21 @@ pub struct SceneOptions {
     /// instead of copying the control points (Curve8i leaves, about 28 against 92 bytes per
     /// segment). Default on.
     pub compact: bool,
-    /// The camera samples (pixels x spp of the whole frame) the scene is built to render,
-    /// when known: a large curve geometry with more than [`PARTS_PER_SAMPLE`] segments per
-    /// sample is built in parts (`CurveGeometry::in_parts`), which builds faster and
-    /// traces a little slower. `None`: every geometry whole.
-    pub samples: Option<u64>,
+    /// When a curve geometry large enough for parts is built in them.
+    pub parts: PartsRule,
+}
+
+/// When a curve geometry of at least `PARTS_FROM_SEGMENTS` segments is built in parts
+/// (`CurveGeometry::in_parts`), which builds faster and traces a little slower.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PartsRule {
+    /// Every geometry whole.
+    Never,
+    /// Every such geometry in parts.
+    Always,
+    /// For a render of this many camera samples (pixels x spp of the whole frame): in
+    /// parts when the geometry has more than [`PARTS_PER_SAMPLE`] segments per sample.
+    ForSamples(u64),
 }
 
 /// Compact by default: on the bench scalp it builds with 20% less CPU time and 43% less
@@ -43,24 +53,17 @@ pub const DEFAULT_COMPACT: bool = true;
 /// pay while the render has fewer than about 3 samples per segment.
 pub const PARTS_PER_SAMPLE: f64 = 1.0 / 3.0;
 
+/// Whole geometries: where the render is not known.
 impl Default for SceneOptions {
     fn default() -> Self {
         SceneOptions {
             compact: DEFAULT_COMPACT,
-            samples: None,
+            parts: PartsRule::Never,
         }
     }
 }
 
 impl SceneOptions {
-    /// The default options for a render of `samples` camera samples.
-    pub fn for_samples(samples: u64) -> Self {
-        SceneOptions {
-            samples: Some(samples),
-            ..SceneOptions::default()
-        }
-    }
-
     /// Embree's flags for a scene built with these options (a part's scene too).
     fn flags(&self) -> sys::RTCSceneFlags {
         let mut flags = FILTER_SCENE_FLAG;
@@ -72,8 +75,11 @@ impl SceneOptions {
 
     /// Whether a curve geometry of `segments` segments is built in parts.
     pub(crate) fn builds_in_parts(&self, segments: usize) -> bool {
-        self.samples
-            .is_some_and(|n| segments as f64 > PARTS_PER_SAMPLE * n as f64)
+        match self.parts {
+            PartsRule::Never => false,
+            PartsRule::Always => true,
+            PartsRule::ForSamples(n) => segments as f64 > PARTS_PER_SAMPLE * n as f64,
+        }
     }
 }
 
@@ -342,6 +348,12 @@ impl Scene {
         &self.geometries
     }
 
+    /// The scenes of its own each geometry's parts were built as.
+    #[cfg(test)]
+    pub(crate) fn part_count(&self) -> usize {
+        self._parts.len()
+    }
+
     /// What Embree's top-level geometry `id` stands for.
     pub(super) fn slot(&self, id: u32) -> Option<Slot> {
         self.slots.get(id as usize).copied()
@@ -383,10 +395,16 @@ mod tests {
     #[test]
     fn a_geometry_is_built_in_parts_only_for_a_render_of_few_samples_per_segment() {
         let segments = 1 << 20;
-        let short = SceneOptions::for_samples(segments as u64);
-        let long = SceneOptions::for_samples(4 * segments as u64);
+        let rule = |parts| SceneOptions {
+            parts,
+            ..SceneOptions::default()
+        };
+        let short = rule(PartsRule::ForSamples(segments as u64));
+        let long = rule(PartsRule::ForSamples(4 * segments as u64));
         assert!(short.builds_in_parts(segments));
         assert!(!long.builds_in_parts(segments));
+        assert!(rule(PartsRule::Always).builds_in_parts(segments));
+        assert!(!rule(PartsRule::Never).builds_in_parts(segments));
         assert!(!SceneOptions::default().builds_in_parts(segments));
         assert!(short.compact && SceneOptions::default().compact);
     }

@@ -123,6 +123,7 @@ named_value!(Roulette { SqrtThroughput = "sqrt", Throughput = "throughput" });
 named_value!(Strategy { Mis = "mis", LightOnly = "light", BsdfOnly = "bsdf" });
 named_value!(Filter { Tent = "tent", Box = "box" });
 named_value!(Allocation { Uniform = "uniform", Noise = "noise" });
+named_value!(CurveParts { Auto = "auto", On = "on", Off = "off" });
 
 /// By the names `Isa` itself gives Embree.
 impl Value for Isa {
@@ -337,6 +338,11 @@ settings! {
         /// Level of detail of `auto` grooms: the largest distance, in pixels, between a thin
         /// strand's curve and the linear ribbons traced in its place; 0: full detail.
         lod_pixels: f32 = DEFAULT_LOD_PIXELS, Range::AtLeast(0.0);
+        /// Whether a groom of 2^18 segments or more is built as parts of 2^14, each a BVH
+        /// of its own: auto (for a render of fewer than 3 camera samples per segment, where
+        /// the faster build outweighs the slower rays: docs/large-grooms.md), on or off.
+        /// Read by the build: a C ABI scene builds again when it changes.
+        curve_parts: CurveParts = CurveParts::Auto, Range::Any;
     }
 
     /// How paths are traced and ended, and the hair BSDF's fidelity knobs.
@@ -405,6 +411,15 @@ pub enum Allocation {
     Uniform,
     /// A pilot pass, then samples in proportion to each pixel's estimated noise.
     Noise,
+}
+
+/// When a large groom is built in parts (`crate::embree::PartsRule`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CurveParts {
+    /// For a render of few camera samples per segment.
+    Auto,
+    On,
+    Off,
 }
 
 /// The pixel filter's kind (its radius is `filter_radius`).

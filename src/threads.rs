@@ -7,8 +7,16 @@ use crate::quiet_panic;
 
 /// Runs `op` on a pool of `threads` threads (0: one per hardware thread), joined before
 /// this returns. Its workers keep the panics of a quiet call (the C ABI's) quiet, as the
-/// calling thread does.
+/// calling thread does. Called from a worker of a pool of that size, `op` runs on that
+/// pool: a render's passes share one pool instead of starting one each.
 pub(crate) fn scoped<T: Send>(threads: usize, op: impl FnOnce() -> T + Send) -> Result<T> {
+    let threads = match threads {
+        0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        n => n,
+    };
+    if rayon::current_thread_index().is_some() && rayon::current_num_threads() == threads {
+        return Ok(op());
+    }
     let quiet = quiet_panic::is_quiet();
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)

@@ -7,6 +7,7 @@ pub(crate) mod film;
 pub(crate) mod integrator;
 pub(crate) mod progress;
 pub(crate) mod renderer;
+mod rounds;
 pub(crate) mod sampler;
 pub mod settings;
 pub(crate) mod tiles;

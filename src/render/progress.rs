@@ -9,7 +9,8 @@ pub trait Progress: Sync {
     /// render returns [`RenderStatus::Cancelled`](super::RenderStatus::Cancelled).
     fn update(&self, done: u64, total: u64) -> bool;
 
-    /// Told, after each pass of a render, the samples per pixel so far and the estimated
+    /// Told, after each round of a render (a pass, or several where it may stop early),
+    /// the samples per pixel so far and the estimated
     /// noise then ([`Film::noise`](super::Film::noise)); by default, nothing.
     fn pass(&self, _samples_per_pixel: u32, _noise: Option<f32>) {}
 

@@ -1,12 +1,12 @@
 //! One render: camera samples per pixel through the integrator, over tiles in parallel.
 
-use std::ops::Range;
 use std::time::Instant;
 
 use super::allocation::{self, ALLOCATED};
 use super::film::{Aovs, Film, Keep, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
+use super::rounds::{Rounds, Stops, Taken};
 use super::sampler::PixelSampler;
 use super::settings::{Allocation, RenderSettings};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
@@ -14,6 +14,7 @@ use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
 use crate::scene::detail_view::DetailView;
 use crate::scene::footprint::{self, available_bytes};
+use crate::threads;
 
 /// A finished (or cancelled) render and what it cost.
 #[derive(Debug)]
@@ -38,16 +39,17 @@ pub struct RenderStats {
     pub rays: u64,
 }
 
-/// Samples per pixel of one pass. A render proceeds in passes and decides whether to stop
-/// only between two, so that its image is that of a plain render of the samples it took.
+/// Samples per pixel of one pass. A render proceeds in passes, grouped in rounds
+/// (`rounds.rs`), and decides whether to stop only between two rounds, so that its image is
+/// that of a plain render of the samples it took.
 /// A power of two, so that each pass is a block of the Sobol sequence stratified in itself
 /// (the noise estimate's halves, [`PixelAccumulator::variance_of_mean`]).
 ///
 /// [`PixelAccumulator::variance_of_mean`]: super::film::PixelAccumulator::variance_of_mean
 pub const PASS_SAMPLES: u32 = 8;
 
-/// Whether a render may stop before `spp`: it then renders pass by pass, and estimates its
-/// noise (to stop on it, or to tell what a time budget reached).
+/// Whether a render may stop before `spp`: it then renders in growing rounds of passes,
+/// and estimates its noise (to stop on it, or to tell what a time budget reached).
 fn stops_early(settings: &RenderSettings) -> bool {
     settings.noise_target.is_some() || settings.time_budget.is_some()
 }
@@ -96,14 +98,16 @@ pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> 
 /// any other is refused, to be built again for it.
 ///
 /// The samples are taken in passes of [`PASS_SAMPLES`] per pixel (on average, under the
-/// `noise` allocation, `src/render/allocation.rs`), in sample order. Between passes the render
-/// stops once the estimated noise of the window it renders is at most `noise_target`, or
-/// when the next pass (timed as the last one) would end past `time_budget`: the image is
-/// then, bit for bit, that of a render with `spp` = the samples taken
-/// ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`. A render
-/// with neither takes all its passes (after the pilot) at once, the same samples in the
-/// same order, so that its film need not keep them between passes ([`film_keep`]), unless
-/// `progress` [keeps passes](Progress::keeps_passes).
+/// `noise` allocation, `src/render/allocation.rs`), in sample order, in rounds over the
+/// tiles. Between rounds the render stops once the estimated noise of the window it renders
+/// is at most `noise_target`; no round starts that (timed as the last one) would end past
+/// `time_budget`, and none takes more passes than the noise estimate says the target needs
+/// (`rounds.rs`). The image is then, bit for bit, that of a render with `spp` = the samples
+/// taken ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`. A
+/// render with neither takes all its passes (after the pilot) in one round, the same
+/// samples in the same order, so that its film need not keep them between passes
+/// ([`film_keep`]), unless `progress` [keeps passes](Progress::keeps_passes): then a round
+/// is a pass.
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -122,7 +126,6 @@ pub fn render(
              or with fewer pixels): build the scene again for this camera and image height"
         ));
     }
-    let in_passes = stops_early(settings) || progress.keeps_passes();
     let bytes = film_bytes(settings, aovs, progress.keeps_passes());
     footprint::check_film_fits(bytes, available_bytes())?;
     let (width, height) = (settings.width, settings.height);
@@ -150,87 +153,89 @@ pub fn render(
     };
     let pixels = film.crop().pixel_count();
     let passes = settings.spp.div_ceil(PASS_SAMPLES);
-    // The passes each round of tiles takes: one at a time where the render may stop
-    // between them, else all at once (the pilot first).
-    let rounds: Vec<Range<u32>> = match (in_passes, &pilot) {
-        (true, _) => (0..passes).map(|p| p..p + 1).collect(),
-        (false, None) => std::iter::once(0..passes).collect(),
-        (false, Some(_)) => [0..1, 1..passes]
-            .into_iter()
-            .filter(|r| !r.is_empty())
-            .collect(),
+    let stops = match (stops_early(settings), progress.keeps_passes()) {
+        (true, _) => Stops::Early {
+            noise_target: settings.noise_target,
+            time_budget: settings.time_budget,
+        },
+        (false, true) => Stops::EveryPass,
+        (false, false) => Stops::Never,
     };
+    let mut rounds = Rounds::new(passes, pilot.is_some(), stops);
     let start = Instant::now();
-    let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);
-    let mut last_pass = 0.0;
-    for round in rounds {
-        let pass = round.start;
-        let elapsed = start.elapsed().as_secs_f64();
-        let good_enough = matches!((settings.noise_target, noise), (Some(t), Some(n)) if n <= t);
-        let out_of_time = settings
-            .time_budget
-            .is_some_and(|budget| spp > 0 && elapsed + last_pass > f64::from(budget));
-        if good_enough || out_of_time {
-            break;
-        }
-        let end = (round.end * PASS_SAMPLES).min(settings.spp);
-        // Sample indices of a pixel in this round.
-        let indices = |pixel| match &shares {
-            None => spp..end,
-            Some(shares) => {
-                let n = shares.of(pixel);
-                ALLOCATED + (pass - 1) * n..ALLOCATED + (round.end - 1) * n
-            }
-        };
-        let target = match (&mut pilot, pass) {
-            (Some(pilot), 0) => pilot,
-            _ => &mut film,
-        };
-        // Progress in pixels over every pass, the round's spread over its passes.
-        let (offset, total) = (u64::from(pass) * pixels, u64::from(passes) * pixels);
-        let round_pixels = u128::from(round.len() as u64 * pixels);
-        let in_pass = u128::from(target.crop().pixel_count());
-        let pass_progress = |done: u64, _| {
-            let done = u128::from(done) * round_pixels / in_pass;
-            progress.update(offset + done as u64, total)
-        };
-        status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
-            for index in indices(pixel) {
-                if !pulse.keep_going() {
-                    return;
+    // One pool of workers for every round: `render_tiles` runs on it.
+    let (spp, noise, status) = threads::scoped(options.threads, || -> Result<_> {
+        let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);
+        let mut taken = None;
+        while let Some(round) = rounds.next(taken) {
+            let began = start.elapsed().as_secs_f64();
+            let end = (round.end * PASS_SAMPLES).min(settings.spp);
+            // Sample indices of a pixel in a pass.
+            let indices = |pixel, pass: u32| match &shares {
+                None => pass * PASS_SAMPLES..((pass + 1) * PASS_SAMPLES).min(settings.spp),
+                Some(shares) => {
+                    let n = shares.of(pixel);
+                    ALLOCATED + (pass - 1) * n..ALLOCATED + pass * n
                 }
-                let mut sampler = PixelSampler::new(settings.seed, pixel, index);
-                let offset = filter.sample(sampler.next_2d());
-                let image_point = ndc(width, height, pixel, offset);
-                let lens = if camera.has_lens() {
-                    sampler.next_2d()
-                } else {
-                    sampler.skip();
-                    [0.5; 2]
-                };
-                let (org, dir) = camera.ray(image_point, lens);
-                let (radiance, first, traced) =
-                    world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
-                acc.add(radiance, first.as_ref());
-                acc.add_rays(traced);
+            };
+            let target = match (&mut pilot, round.start) {
+                (Some(pilot), 0) => pilot,
+                _ => &mut film,
+            };
+            // Progress in pixels over every pass, the round's spread over its passes.
+            let (offset, total) = (u64::from(round.start) * pixels, u64::from(passes) * pixels);
+            let round_pixels = u128::from(round.len() as u64 * pixels);
+            let in_pass = u128::from(target.crop().pixel_count());
+            let pass_progress = |done: u64, _| {
+                let done = u128::from(done) * round_pixels / in_pass;
+                progress.update(offset + done as u64, total)
+            };
+            status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
+                for pass in round.clone() {
+                    for index in indices(pixel, pass) {
+                        if !pulse.keep_going() {
+                            return;
+                        }
+                        let mut sampler = PixelSampler::new(settings.seed, pixel, index);
+                        let offset = filter.sample(sampler.next_2d());
+                        let image_point = ndc(width, height, pixel, offset);
+                        let lens = if camera.has_lens() {
+                            sampler.next_2d()
+                        } else {
+                            sampler.skip();
+                            [0.5; 2]
+                        };
+                        let (org, dir) = camera.ray(image_point, lens);
+                        let (radiance, first, traced) =
+                            world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
+                        acc.add(radiance, first.as_ref());
+                        acc.add_rays(traced);
+                    }
+                    acc.end_pass();
+                }
+            })?;
+            if status == RenderStatus::Cancelled {
+                break;
             }
-            acc.end_pass();
-        })?;
-        if status == RenderStatus::Cancelled {
-            break;
+            spp = end;
+            noise = match &pilot {
+                None => film.noise(),
+                Some(pilot) if round.start == 0 => {
+                    shares = Some(allocation::Shares::new(pilot, film.crop(), PASS_SAMPLES));
+                    None
+                }
+                Some(pilot) => allocation::blended_noise(&film, pilot),
+            };
+            let elapsed = start.elapsed().as_secs_f64();
+            taken = Some(Taken {
+                noise,
+                seconds: elapsed - began,
+                elapsed,
+            });
+            progress.pass(spp, noise);
         }
-        spp = end;
-        noise = match &pilot {
-            None => film.noise(),
-            Some(pilot) if pass == 0 => {
-                shares = Some(allocation::Shares::new(pilot, film.crop(), PASS_SAMPLES));
-                None
-            }
-            Some(pilot) => allocation::blended_noise(&film, pilot),
-        };
-        last_pass = start.elapsed().as_secs_f64() - elapsed;
-        progress.pass(spp, noise);
-    }
+        Ok((spp, noise, status))
+    })??;
     if let Some(pilot) = &pilot {
         allocation::blend(&mut film, pilot);
     }

@@ -64,12 +64,13 @@ impl Progress for Record {
     }
 }
 
-/// A noise target stops the render after the first pass whose estimate reaches it (the
-/// pass before did not), whatever the thread count, and the image is bit for bit the
+/// A noise target stops the render after the first round whose estimate reaches it (the
+/// round before did not), whatever the thread count, and the image is bit for bit the
 /// plain render of the samples taken (which takes them at once, and estimates no noise).
-/// The progress sink hears every pass's estimate.
+/// Rounds grow (`rounds.rs`): the first is one pass, each later one at most as many as
+/// were taken before it. The progress sink hears every round's estimate.
 #[test]
-fn a_noise_target_stops_at_the_first_pass_that_reaches_it_with_the_plain_renders_bits() {
+fn a_noise_target_stops_at_the_first_round_that_reaches_it_with_the_plain_renders_bits() {
     let world = lit_world();
     let target = 0.03;
     let aimed = RenderSettings {
@@ -83,9 +84,19 @@ fn a_noise_target_stops_at_the_first_pass_that_reaches_it_with_the_plain_renders
     println!("stopped at {spp} spp, noise {noise:.4} (target {target})");
     assert!(noise <= target && spp < 512 && spp % PASS_SAMPLES == 0 && spp > 2 * PASS_SAMPLES);
     let passes = record.passes.into_inner().unwrap();
-    assert_eq!(passes.len() as u32, spp / PASS_SAMPLES);
+    assert_eq!(
+        passes[0],
+        (PASS_SAMPLES, None),
+        "one pass has no spread of passes"
+    );
+    assert!(
+        passes
+            .windows(2)
+            .all(|w| w[0].0 < w[1].0 && w[1].0 <= 2 * w[0].0),
+        "{passes:?}"
+    );
+    assert!((passes.len() as u32) < spp / PASS_SAMPLES, "{passes:?}");
     assert_eq!(passes.last(), Some(&(spp, Some(noise))));
-    assert!(passes[0].1.is_none(), "one pass has no spread of passes");
     let before = passes[passes.len() - 2].1.unwrap();
     assert!(
         before > target,

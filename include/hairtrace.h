@@ -1547,12 +1547,12 @@ typedef uint32_t HtPixelFilter;
  * Told how far a render has got: `done` of `total` pixels, counted over the render's
  * passes of 8 spp (`total` is the pixels times the passes `spp` allows; a render that a
  * noise target or a time budget stops ends below it), `done` never decreasing from call to
- * call. It is called when a 16 x 16 tile finishes a pass (a round of several, in a render
- * that a noise target or a time budget may stop) and, while pixels take long (many
- * samples), also every 20 ms or so of work with an unchanged `done`, so that it can
- * cancel any render promptly. Return false to cancel: no new sample starts, the round of
- * unfinished tiles is dropped (their pixels keep the rounds they finished), and
- * `ht_render` returns `HT_ERR_CANCELLED`.
+ * call. A render with a callback goes in rounds of 1, 1, 2, 4... passes (fewer where a
+ * noise target or a time budget stops it). It is called when a 16 x 16 tile finishes a
+ * round and, while pixels take long (many samples), also every 20 ms or so of work with an
+ * unchanged `done`, so that it can cancel any render promptly. Return false to cancel: no
+ * new sample starts, the round of unfinished tiles is dropped (their pixels keep the
+ * rounds they finished), and `ht_render` returns `HT_ERR_CANCELLED`.
  *
  * Called from the render's worker threads (not necessarily the one that called
  * `ht_render`), but never two calls at once, so `user` needs no locking against itself.

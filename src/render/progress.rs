@@ -9,16 +9,15 @@ pub trait Progress: Sync {
     /// render returns [`RenderStatus::Cancelled`](super::RenderStatus::Cancelled).
     fn update(&self, done: u64, total: u64) -> bool;
 
-    /// Told, after each round of a render (a pass, or several where it may stop early),
-    /// the samples per pixel so far and the estimated
-    /// noise then ([`Film::noise`](super::Film::noise)); by default, nothing.
+    /// Told, after each round of passes of a render, the samples per pixel so far and the
+    /// estimated noise then ([`Film::noise`](super::Film::noise)); by default, nothing.
     fn pass(&self, _samples_per_pixel: u32, _noise: Option<f32>) {}
 
-    /// Whether a cancelled render should leave the whole frame at the passes its pixels
-    /// finished (8 spp each), rather than the finished tiles at every spp and black
-    /// elsewhere: the render then goes pass by pass even without a noise target or a
-    /// time budget, its film keeping each pixel's sums between passes (28 more bytes a
-    /// pixel). By default, no.
+    /// Whether a cancelled render should leave the whole frame at the rounds of passes its
+    /// pixels finished (8 spp each; rounds of 1, 1, 2, 4... passes), rather than the
+    /// finished tiles at every spp and black elsewhere: the render then goes in rounds even
+    /// without a noise target or a time budget, its film keeping each pixel's sums between
+    /// them (28 more bytes a pixel). By default, no.
     fn keeps_passes(&self) -> bool {
         false
     }

@@ -106,8 +106,8 @@ pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> 
 /// taken ([`RenderStats::spp`]). A crop's noise is its own, so farm tiles fix `spp`. A
 /// render with neither takes all its passes (after the pilot) in one round, the same
 /// samples in the same order, so that its film need not keep them between passes
-/// ([`film_keep`]), unless `progress` [keeps passes](Progress::keeps_passes): then a round
-/// is a pass.
+/// ([`film_keep`]), unless `progress` [keeps passes](Progress::keeps_passes): then in
+/// growing rounds, so that a cancel leaves the whole frame at the rounds it finished.
 pub fn render(
     world: &World,
     camera: &Camera,
@@ -153,13 +153,13 @@ pub fn render(
     };
     let pixels = film.crop().pixel_count();
     let passes = settings.spp.div_ceil(PASS_SAMPLES);
-    let stops = match (stops_early(settings), progress.keeps_passes()) {
-        (true, _) => Stops::Early {
+    let stops = if stops_early(settings) || progress.keeps_passes() {
+        Stops::Growing {
             noise_target: settings.noise_target,
             time_budget: settings.time_budget,
-        },
-        (false, true) => Stops::EveryPass,
-        (false, false) => Stops::Never,
+        }
+    } else {
+        Stops::Never
     };
     let mut rounds = Rounds::new(passes, pilot.is_some(), stops);
     let start = Instant::now();

@@ -2,9 +2,9 @@
 //! same whatever the grouping; a round is where the render may stop. Each round costs a
 //! sweep over the frame besides its samples (a 128x128 fur ball at 256 spp: 1.16x the time
 //! in rounds of one 8-spp pass, the plain render's time in rounds of four), so a render
-//! that may stop early grows its rounds: at most as many passes as it has taken, and no
-//! more than its noise estimate says the target needs, or than its time budget has room
-//! for.
+//! in rounds (one that may stop early, or whose progress sink keeps passes) grows them: at
+//! most as many passes as it has taken, and no more than its noise estimate says the
+//! target needs, or than its time budget has room for.
 
 use std::ops::Range;
 
@@ -13,11 +13,11 @@ use std::ops::Range;
 pub(super) enum Stops {
     /// At the pilot (if any), then once, at the end.
     Never,
-    /// After every pass: a progress sink that shows each one.
-    EveryPass,
-    /// Where the noise reaches `noise_target`, or before a round that would end past
-    /// `time_budget` seconds.
-    Early {
+    /// In growing rounds: where the noise reaches `noise_target`, before a round that
+    /// would end past `time_budget` seconds, or (with neither) only where a cancel
+    /// leaves the whole frame at the rounds its pixels finished (a progress sink that
+    /// keeps passes).
+    Growing {
         noise_target: Option<f32>,
         time_budget: Option<f32>,
     },
@@ -65,9 +65,9 @@ impl Rounds {
             _ if left == 0 => 0,
             (_, None) if self.pilot => 1,
             (Stops::Never, _) => left,
-            (Stops::EveryPass, _) | (Stops::Early { .. }, None) => 1,
+            (Stops::Growing { .. }, None) => 1,
             (
-                Stops::Early {
+                Stops::Growing {
                     noise_target,
                     time_budget,
                 },
@@ -127,15 +127,11 @@ mod tests {
     fn a_plain_render_is_one_round_after_its_pilot() {
         assert_eq!(sizes(Rounds::new(8, false, Stops::Never), |_| None), [8]);
         assert_eq!(sizes(Rounds::new(8, true, Stops::Never), |_| None), [1, 7]);
-        assert_eq!(
-            sizes(Rounds::new(3, false, Stops::EveryPass), |_| None),
-            [1; 3]
-        );
     }
 
     #[test]
     fn rounds_that_may_stop_double_up_to_what_the_noise_target_needs() {
-        let target = |t| Stops::Early {
+        let target = |t| Stops::Growing {
             noise_target: Some(t),
             time_budget: None,
         };
@@ -156,7 +152,7 @@ mod tests {
 
     #[test]
     fn a_time_budget_starts_no_round_that_would_end_past_it() {
-        let budget = Stops::Early {
+        let budget = Stops::Growing {
             noise_target: None,
             time_budget: Some(10.5),
         };

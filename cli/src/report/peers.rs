@@ -10,6 +10,7 @@ use hairtrace::{Error, Result};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::sync::OnceLock;
 
 /// The environment variable naming the peer benchmark's virtual environment.
 const VENV: &str = "HT_BENCH_VENV";
@@ -18,19 +19,25 @@ pub fn steps(_: &Context) -> u64 {
     1
 }
 
-/// The venv's python if Blender's module imports there, else why not.
+/// The venv's python if Blender's module imports there, else why not: asked once per
+/// process (the import takes seconds, and three sections ask).
 pub(super) fn blender_python() -> std::result::Result<PathBuf, String> {
-    let venv = std::env::var_os(VENV).ok_or_else(|| format!("{VENV} is not set"))?;
-    let python = PathBuf::from(venv).join("bin/python");
-    let ok = Command::new(&python)
-        .args(["-c", "import bpy"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if ok {
-        Ok(python)
-    } else {
-        Err(format!("{} cannot import bpy", python.display()))
-    }
+    static FOUND: OnceLock<std::result::Result<PathBuf, String>> = OnceLock::new();
+    FOUND
+        .get_or_init(|| {
+            let venv = std::env::var_os(VENV).ok_or_else(|| format!("{VENV} is not set"))?;
+            let python = PathBuf::from(venv).join("bin/python");
+            let ok = Command::new(&python)
+                .args(["-c", "import bpy"])
+                .output()
+                .is_ok_and(|o| o.status.success());
+            if ok {
+                Ok(python)
+            } else {
+                Err(format!("{} cannot import bpy", python.display()))
+            }
+        })
+        .clone()
 }
 
 pub fn section(ctx: &Context) -> Result<String> {

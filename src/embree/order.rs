@@ -71,14 +71,8 @@ fn split(items: &mut [(Vec3, u32)], most: usize, start: u32) -> Vec<Range<u32>> 
         return std::iter::once(start..start + len).collect();
     }
     let (lo, hi) = finite_bounds(items.par_iter().map(|&(c, _)| c));
-    let extent = (hi - lo).max(Vec3::ZERO);
-    let axis = if extent.x >= extent.y && extent.x >= extent.z {
-        0
-    } else if extent.y >= extent.z {
-        1
-    } else {
-        2
-    };
+    // The longest axis, the first of equal ones.
+    let axis = (hi - lo).max(Vec3::ZERO).max_position();
     let mid = items.len() / 2;
     items.select_nth_unstable_by(mid, |a, b| {
         a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))

@@ -90,7 +90,7 @@ impl Rounds {
                     }
                     None => left,
                 };
-                wanted.min(room).min(self.done).min(left)
+                wanted.min(room).min(self.done)
             }
         };
         if size == 0 {

@@ -551,6 +551,10 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
             let json = serde_json::json!({
                 "seconds": s.seconds,
                 "build_seconds": build_seconds,
+                // The build, then the render's first finished tile.
+                "first_pixel_seconds": s.first_tile_seconds.map(|t| build_seconds + t),
+                "parts_built": s.parts_built,
+                "part_build_seconds": s.part_build_seconds,
                 "stage_seconds": Stage::ALL
                     .iter()
                     .map(|&st| (st.name().to_owned(), built.stages.get(st).into()))

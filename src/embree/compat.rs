@@ -9,6 +9,9 @@
 //!   `RTC_RAY_QUERY_FLAG_INVOKE_ARGUMENT_FILTER` in Embree 4.
 //! - Geometry masks default to all bits in Embree 3 and to 1 in Embree 4; the geometry layer
 //!   always sets them and rays always carry one, so both behave the same.
+//! - A user geometry's callback continues a ray into another scene by tracing it again
+//!   with its id on the context's instance stack in Embree 3, and by
+//!   `rtcForwardIntersect1`/`rtcForwardOccluded1` in Embree 4, which allows no nested query.
 
 use super::sys;
 
@@ -120,4 +123,61 @@ fn query_flags(filtered: bool) -> sys::RTCRayQueryFlags {
     } else {
         sys::RTCRayQueryFlags::RTC_RAY_QUERY_FLAG_INCOHERENT
     }
+}
+
+/// Continues the traversal of the single ray of a user geometry's intersect callback
+/// (`args`) into `scene`, its hits reported as inside instance `args.geomID` (the
+/// callback's own id in the top level): Embree 3 traces it again from the callback with
+/// that id pushed on the context's instance stack, Embree 4 forwards it
+/// (`rtcForwardIntersect1`). The callback must return right after.
+///
+/// # Safety
+/// `args` are the live arguments of an intersect callback for one ray (`N == 1`) of an
+/// `rtcIntersect1` query; `scene` is committed.
+pub(super) unsafe fn forward_intersect1(
+    args: &sys::RTCIntersectFunctionNArguments,
+    scene: sys::RTCScene,
+) {
+    let rayhit = args.rayhit.cast::<sys::RTCRayHit>();
+    #[cfg(embree3)]
+    // SAFETY: the caller's contract: a live context and a single ray with its hit.
+    unsafe {
+        let ctx = args.context;
+        let outer = (*ctx).instID[0];
+        (*ctx).instID[0] = args.geomID;
+        sys::rtcIntersect1(scene, ctx, rayhit);
+        (*ctx).instID[0] = outer;
+    }
+    #[cfg(embree4)]
+    // SAFETY: the caller's contract; Embree reads the copy's origin and direction only.
+    unsafe {
+        let mut ray = (*rayhit).ray;
+        sys::rtcForwardIntersect1(args, scene, &mut ray, args.geomID)
+    };
+}
+
+/// [`forward_intersect1`] for an occlusion callback.
+///
+/// # Safety
+/// As for [`forward_intersect1`], for an `rtcOccluded1` query.
+pub(super) unsafe fn forward_occluded1(
+    args: &sys::RTCOccludedFunctionNArguments,
+    scene: sys::RTCScene,
+) {
+    let ray = args.ray.cast::<sys::RTCRay>();
+    #[cfg(embree3)]
+    // SAFETY: as in `forward_intersect1`.
+    unsafe {
+        let ctx = args.context;
+        let outer = (*ctx).instID[0];
+        (*ctx).instID[0] = args.geomID;
+        sys::rtcOccluded1(scene, ctx, ray);
+        (*ctx).instID[0] = outer;
+    }
+    #[cfg(embree4)]
+    // SAFETY: as in `forward_intersect1`.
+    unsafe {
+        let mut copy = *ray;
+        sys::rtcForwardOccluded1(args, scene, &mut copy, args.geomID)
+    };
 }

@@ -134,6 +134,21 @@ impl Device {
         self.builds.fetch_add(1, Ordering::Relaxed);
     }
 
+    /// Makes Embree fail every allocation from now on (`true`) with
+    /// `RTC_ERROR_OUT_OF_MEMORY`, or stops (`false`): how tests meet a build that fails
+    /// halfway. It takes the device's memory monitor slot ([`super::MemoryMonitor`]'s).
+    #[cfg(test)]
+    pub(crate) fn refuse_allocations(&self, refuse: bool) {
+        unsafe extern "C" fn refuse_all(_: *mut c_void, bytes: isize, _: bool) -> bool {
+            bytes <= 0
+        }
+        let monitor: sys::RTCMemoryMonitorFunction = if refuse { Some(refuse_all) } else { None };
+        // SAFETY: live device; the callback reads no user data.
+        unsafe {
+            sys::rtcSetDeviceMemoryMonitorFunction(self.raw(), monitor, std::ptr::null_mut())
+        };
+    }
+
     /// Reports, and clears, the last error Embree recorded on this device (from any
     /// thread) or, failing that, the pending error code of the calling thread.
     pub fn check(&self) -> Result<()> {

@@ -13,6 +13,8 @@ use std::ops::Range;
 use std::ptr::NonNull;
 use std::sync::Arc;
 
+use glam::Vec4;
+
 use super::order::{centroid, median_split};
 use super::{Device, sys};
 use crate::error::invalid_arg;
@@ -343,14 +345,18 @@ pub struct CurvePoint {
 
 /// Geometries of at least this many segments may be cut into parts of at most
 /// [`PART_SEGMENTS`] ([`CurveGeometry::in_parts`]), which a scene builds as one small
-/// Embree scene each under a BVH of their instances ([`Parts`]). On the bench scalp at
+/// Embree scene each, when a ray first reaches it (`lazy.rs`, [`Parts`]). On the bench scalp at
 /// 10^6 strands x 16 segments the build then takes 0.6x-0.7x the time and rays 0.88x-0.91x
 /// (docs/large-grooms.md).
 pub(crate) const PARTS_FROM_SEGMENTS: usize = 1 << 18;
 
-/// The most segments of one part: small enough that a part's control points, index
-/// entries and Embree's primitive references stay in the cache while Embree builds it.
-pub(crate) const PART_SEGMENTS: usize = 1 << 14;
+/// The most segments of one part. Parts are built as rays reach them (`lazy.rs`): the
+/// smaller they are, the fewer segments a render builds that its rays do not need, and
+/// a part this small builds on one thread while another thread builds another. On the
+/// bench scalp at 10^6 strands and 1080p x 1 spp, from 2^14 down to 2^10 segments the
+/// frame took 0.44x the time (43% of the segments built instead of 80%) and rays traced
+/// as fast; 2^9 traced slower (docs/large-grooms.md).
+pub(crate) const PART_SEGMENTS: usize = 1 << 10;
 
 /// A large curve geometry cut into compact parts by median splits of its segments'
 /// centres ([`median_split`]). Embree's hair builder fetches every segment's control
@@ -526,6 +532,45 @@ impl CurveGeometry {
     pub(super) fn own_segment(&self, part_start: u32, prim: u32) -> Option<u32> {
         let at = part_start.checked_add(prim)?;
         self.parts.as_ref()?.segments.get(at as usize).copied()
+    }
+
+    /// Bounds (lower, upper) that hold every surface point of the segments of `part` (one of
+    /// [`Self::parts`]): what a part's scene is entered by before it is built
+    /// (`lazy.rs`). Each segment lies in the convex hull of its Bezier control points
+    /// (for B-spline and Bezier segments their own; Catmull-Rom's from its end
+    /// tangents), within its largest Bezier radius of that hull, round or flat; a margin of
+    /// 1e-5 of the coordinates covers Embree's rounding. `None` for a geometry without
+    /// parts or a range outside them.
+    pub(super) fn part_bounds(&self, part: &Range<u32>) -> Option<([f32; 3], [f32; 3])> {
+        let parts = self.parts.as_ref()?;
+        let firsts = parts
+            .indices
+            .as_slice()
+            .get(part.start as usize..part.end as usize)?;
+        let points = self.vertices();
+        let (mut lo, mut hi) = (Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY));
+        let mut radius = 0.0f32;
+        for &first in firsts {
+            let p = |i: usize| Vec4::from_array(points[first as usize + i]);
+            let hull = match self.basis {
+                CurveBasis::Linear => [p(0), p(1), p(1), p(1)],
+                CurveBasis::Bezier | CurveBasis::BSpline => [p(0), p(1), p(2), p(3)],
+                CurveBasis::CatmullRom => [
+                    p(1),
+                    p(1) + (p(2) - p(0)) / 6.0,
+                    p(2) - (p(3) - p(1)) / 6.0,
+                    p(2),
+                ],
+            };
+            for h in hull {
+                lo = lo.min(h);
+                hi = hi.max(h);
+                radius = radius.max(h.w.abs());
+            }
+        }
+        let (lo, hi) = (lo.truncate(), hi.truncate());
+        let margin = radius + 1e-5 * lo.abs().max(hi.abs()).max_element();
+        Some(((lo - margin).to_array(), (hi + margin).to_array()))
     }
 
     /// A committed handle on the segments of `part` (one of [`Self::parts`]): the same
@@ -963,12 +1008,15 @@ mod tests {
             let parts = geometry.parts().unwrap();
             assert_eq!(parts.len(), geometry.indices().len() / PART_SEGMENTS);
             assert!(parts.iter().all(|p| p.len() <= PART_SEGMENTS));
+            let part_count = parts.len();
             let mut scene = SceneBuilder::new(device.clone(), SceneOptions::default()).unwrap();
             scene.attach(geometry).unwrap();
             let scene = scene.commit(&|_| true).unwrap();
             let Some(Geometry::Curves(geometry)) = scene.geometry(0) else {
                 panic!("curves")
             };
+            // No part is built before a ray reaches it.
+            assert_eq!(scene.parts_built().built, 0, "{basis:?}");
             let mut checked = 0;
             for column in 0..side {
                 for j in 0..segments {
@@ -993,6 +1041,11 @@ mod tests {
                 }
             }
             assert_eq!(checked, side * segments);
+            // The rays reached the first two rows of strands: the parts of the others
+            // were never built.
+            let built = scene.parts_built();
+            assert!(built.built > 0 && built.built < part_count / 2, "{built:?}");
+            assert!(scene.check_parts().is_ok());
         }
         // A smaller geometry is traced in its own order.
         let v = SharedBuffer::new(vec![[0.0, 0.0, 0.0, 0.1]; 2]);
@@ -1000,6 +1053,66 @@ mod tests {
         let small = CurveGeometry::new(&device, linear, round, v, vec![0].into(), 1).unwrap();
         let small = small.in_parts().unwrap();
         assert!(small.parts().is_none());
+    }
+
+    /// A part's bounds hold every point of its segments' surfaces, Catmull-Rom's bulges
+    /// past their control points included: a ray is let into a part wherever it could
+    /// hit it.
+    #[test]
+    fn part_bounds_hold_every_point_of_their_segments() {
+        use glam::Vec3;
+        let device = Device::new(Some(1)).unwrap();
+        let radius = 0.01;
+        for basis in CurveBasis::ALL {
+            // Zigzag strands: x runs 0, 1, 1, 0, 0, 1, 1, ... along y, so a Catmull-Rom
+            // segment between two points at x = 1 bulges past x = 1.
+            let per_strand = 67;
+            let segments = basis.segments_for(per_strand).unwrap();
+            let strands = PARTS_FROM_SEGMENTS.div_ceil(segments);
+            let points: Vec<[f32; 4]> = (0..strands * per_strand)
+                .map(|i| {
+                    let (s, k) = (i / per_strand, i % per_strand);
+                    let x = if (k + 1) % 4 < 2 { 0.0 } else { 1.0 };
+                    [x, k as f32 * 0.1, s as f32 * 0.05, radius]
+                })
+                .collect();
+            let stride = basis.segment_stride();
+            let indices: Vec<u32> = (0..strands)
+                .flat_map(|s| (0..segments).map(move |j| (s * per_strand + j * stride) as u32))
+                .collect();
+            let geometry = CurveGeometry::new(
+                &device,
+                basis,
+                CurveShape::Round,
+                points.into(),
+                indices.into(),
+                1,
+            )
+            .unwrap()
+            .in_parts()
+            .unwrap();
+            let parts = geometry.parts.as_ref().unwrap();
+            let mut widest = 0.0f32;
+            for range in geometry.parts().unwrap() {
+                let (lo, hi) = geometry.part_bounds(range).unwrap();
+                let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+                for at in range.clone().step_by(7) {
+                    let segment = parts.segments[at as usize];
+                    for k in 0..=16 {
+                        let c = geometry.interpolate(segment, k as f32 / 16.0).unwrap();
+                        let (p, r) = (Vec3::from(c.p), Vec3::splat(c.radius));
+                        assert!(
+                            (p - r).cmpge(lo).all() && (p + r).cmple(hi).all(),
+                            "{basis:?}"
+                        );
+                        widest = widest.max(c.p[0]);
+                    }
+                }
+            }
+            if basis == CurveBasis::CatmullRom {
+                assert!(widest > 1.05, "no bulge to hold: {widest}");
+            }
+        }
     }
 
     #[test]

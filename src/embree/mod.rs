@@ -18,6 +18,7 @@ mod compat;
 mod device;
 mod geometry;
 mod isa;
+mod lazy;
 mod memory;
 mod order;
 mod query;

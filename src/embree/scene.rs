@@ -5,15 +5,17 @@
 //! `rtcCommitScene` and must not change while queries run: [`SceneBuilder::commit`] consumes
 //! the builder and returns a [`Scene`] that is `Sync` and has no mutating methods.
 
-use std::ops::Range;
 use std::ptr::NonNull;
 use std::sync::Arc;
 
+use rayon::prelude::*;
+
 use super::compat::FILTER_SCENE_FLAG;
-use super::geometry::{Geometry, RawGeometry};
+use super::geometry::Geometry;
+use super::lazy::LazyPart;
 use super::{Device, sys};
 use crate::error::invalid_arg;
-use crate::{Error, Result};
+use crate::{Error, Result, threads};
 
 /// How a scene is built. Embree's build quality stays at its default (binned SAH): Low,
 /// High and `RTC_SCENE_FLAG_ROBUST` measured within 3% of it on fur grooms, so they are
@@ -85,7 +87,13 @@ impl SceneOptions {
 
 /// One reference to an Embree scene, released when dropped.
 #[derive(Debug)]
-struct RawScene(NonNull<sys::RTCSceneTy>);
+pub(super) struct RawScene(NonNull<sys::RTCSceneTy>);
+
+impl RawScene {
+    pub(super) fn raw(&self) -> sys::RTCScene {
+        self.0.as_ptr()
+    }
+}
 
 // SAFETY: Embree scenes may be used from any thread; mutation happens only through
 // `SceneBuilder` (owned, not shared), queries only on a committed `Scene`, which Embree
@@ -109,24 +117,13 @@ pub(super) struct Slot {
     pub(super) part_start: Option<u32>,
 }
 
-/// A part of a large curve geometry (`CurveGeometry::parts`): its own scene over its own
-/// handle on the geometry's buffers, and the instance of that scene in the top level.
-#[derive(Debug)]
-struct Part {
-    // Released in this order: the instance holds the scene, the scene the geometry.
-    instance: RawGeometry,
-    scene: RawScene,
-    _geometry: RawGeometry,
-    segments: usize,
-}
-
 /// A scene being assembled. Geometries get consecutive ids from 0 in attach order.
 #[derive(Debug)]
 pub struct SceneBuilder {
     // Released before the parts and the geometries (field order), which are released
     // before their buffers.
     raw: RawScene,
-    parts: Vec<Part>,
+    parts: Vec<LazyPart>,
     slots: Vec<Slot>,
     geometries: Vec<Geometry>,
     options: SceneOptions,
@@ -143,7 +140,7 @@ fn embree_id(n: usize) -> Result<u32> {
 }
 
 /// A new scene with `flags`.
-fn new_scene(device: &Device, flags: sys::RTCSceneFlags) -> Result<RawScene> {
+pub(super) fn new_scene(device: &Device, flags: sys::RTCSceneFlags) -> Result<RawScene> {
     // SAFETY: live device.
     let raw = unsafe { sys::rtcNewScene(device.raw()) };
     let Some(raw) = NonNull::new(raw) else {
@@ -194,17 +191,28 @@ impl SceneBuilder {
     }
 
     /// Attaches a committed geometry and returns its id (the `geom_id` of its hits). A
-    /// curve geometry with parts attaches an instance of a scene of its own per part.
+    /// curve geometry with parts attaches a stand-in per part, whose scene of its own is
+    /// built when a ray first reaches it (`lazy.rs`).
     pub fn attach(&mut self, geometry: impl Into<Geometry>) -> Result<u32> {
         let geometry = geometry.into();
         let id = embree_id(self.geometries.len())?;
         match &geometry {
             Geometry::Curves(c) if let Some(parts) = c.parts() => {
-                for range in parts {
+                // Every control point is read for them: in parallel.
+                let bounds: Vec<_> =
+                    threads::scoped(0, || parts.par_iter().map(|r| c.part_bounds(r)).collect())?;
+                for (range, bounds) in parts.iter().zip(bounds) {
                     // SAFETY: the part's handle is kept in `self.parts`, released before
                     // `self.geometries` (field order, here and in `Scene`).
-                    let part = unsafe { c.part_geometry(&self.device, range) }?;
-                    self.attach_part(part, c.mask(), range)?;
+                    let geometry = unsafe { c.part_geometry(&self.device, range) }?;
+                    let bounds =
+                        bounds.ok_or_else(|| invalid_arg!("part {range:?} out of range"))?;
+                    let flags = self.options.flags();
+                    // SAFETY: as above: the part is released before the geometry.
+                    let part =
+                        unsafe { LazyPart::new(&self.device, geometry, bounds, flags, c.mask()) }?;
+                    self.attach_raw(part.raw())?;
+                    self.parts.push(part);
                     self.slots.push(Slot {
                         geometry: id,
                         part_start: Some(range.start),
@@ -233,68 +241,18 @@ impl SceneBuilder {
         self.device.check()
     }
 
-    /// Puts `part` (of `range.len()` segments) in a scene of its own and attaches an
-    /// instance of that scene, with `mask`, to the top level; the instance is committed
-    /// with the whole scene (`commit`), once its scene is built.
-    fn attach_part(&mut self, part: RawGeometry, mask: u32, range: &Range<u32>) -> Result<()> {
-        let scene = new_scene(&self.device, self.options.flags())?;
-        // SAFETY: live scene and geometry; the scene retains the geometry.
-        unsafe { sys::rtcAttachGeometryByID(scene.0.as_ptr(), part.raw(), 0) };
-        self.device.check()?;
-        let kind = sys::RTCGeometryType::RTC_GEOMETRY_TYPE_INSTANCE;
-        let instance = RawGeometry::new(&self.device, kind)?;
-        const IDENTITY: [f32; 12] = [1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0];
-        // SAFETY: live instance and scene (retained by the instance); a 3x4 column-major
-        // matrix of 12 floats, copied by Embree.
-        unsafe {
-            sys::rtcSetGeometryInstancedScene(instance.raw(), scene.0.as_ptr());
-            sys::rtcSetGeometryTransform(
-                instance.raw(),
-                0,
-                sys::RTCFormat::RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR,
-                IDENTITY.as_ptr().cast(),
-            );
-            sys::rtcSetGeometryMask(instance.raw(), mask);
-        }
-        self.device.check()?;
-        self.attach_raw(instance.raw())?;
-        self.parts.push(Part {
-            instance,
-            scene,
-            _geometry: part,
-            segments: range.len(),
-        });
-        Ok(())
-    }
-
-    /// Builds the BVH (Embree's build uses the device's worker threads): each part's scene,
-    /// then the top level over the rest and the parts' instances, telling `progress` how
-    /// far the build has got (0 to 1, by segments). Embree may call it from several build
-    /// threads at once and out of order; `false` cancels the build, which then fails with
-    /// Embree's `RTC_ERROR_CANCELLED` (see [`is_cancelled`]). The monitor's signature is
-    /// the same in Embree 3 and 4.
+    /// Builds the top level's BVH (Embree's build uses the device's worker threads),
+    /// telling `progress` how far the build has got (0 to 1). Parts are built later, when
+    /// a ray first reaches them. Embree may call `progress` from several build threads at
+    /// once and out of order; `false` cancels the build, which then fails with Embree's
+    /// `RTC_ERROR_CANCELLED` (see [`is_cancelled`]). The monitor's signature is the same in
+    /// Embree 3 and 4.
     pub(crate) fn commit(self, progress: &BuildMonitor<'_>) -> Result<Scene> {
         self.device.count_build();
-        let in_parts: usize = self.parts.iter().map(|p| p.segments).sum();
-        let total = in_parts.max(1) as f64;
-        let mut done = 0;
-        for part in &self.parts {
-            let share = part.segments as f64 / total;
-            let before = done as f64 / total;
-            commit_scene(&self.device, &part.scene, &|f| progress(before + f * share))?;
-            done += part.segments;
-            // SAFETY: live instance of a committed scene.
-            unsafe { sys::rtcCommitGeometry(part.instance.raw()) };
-            self.device.check()?;
-        }
-        // With parts, the top level (their instances) is built once they all are.
-        let whole = self.parts.is_empty();
-        commit_scene(&self.device, &self.raw, &|f| {
-            progress(if whole { f } else { 1.0 })
-        })?;
+        commit_scene(&self.device, &self.raw, progress)?;
         Ok(Scene {
             raw: self.raw,
-            _parts: self.parts,
+            parts: self.parts,
             slots: self.slots,
             geometries: self.geometries,
             _device: self.device,
@@ -326,12 +284,20 @@ pub fn cancelled() -> Error {
     }
 }
 
+/// Parts built so far ([`Scene::parts_built`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PartsBuilt {
+    pub built: usize,
+    pub of: usize,
+    pub seconds: f64,
+}
+
 /// A committed scene: immutable, queried from any number of threads (see `query.rs`).
 #[derive(Debug)]
 pub struct Scene {
     // Released before the parts and the geometries, as in `SceneBuilder`.
     raw: RawScene,
-    _parts: Vec<Part>,
+    parts: Vec<LazyPart>,
     slots: Vec<Slot>,
     geometries: Vec<Geometry>,
     /// Held so that the device outlives every scene made on it.
@@ -348,10 +314,34 @@ impl Scene {
         &self.geometries
     }
 
-    /// The scenes of its own each geometry's parts were built as.
+    /// The parts the geometries were cut into, each a scene of its own (`lazy.rs`).
     #[cfg(test)]
     pub(crate) fn part_count(&self) -> usize {
-        self._parts.len()
+        self.parts.len()
+    }
+
+    /// How many parts have been built so far, and the seconds their builds took
+    /// (summed over the threads that built them).
+    pub(crate) fn parts_built(&self) -> PartsBuilt {
+        let seconds: Vec<f64> = self
+            .parts
+            .iter()
+            .filter_map(LazyPart::built_seconds)
+            .collect();
+        PartsBuilt {
+            built: seconds.len(),
+            of: self.parts.len(),
+            seconds: seconds.iter().sum(),
+        }
+    }
+
+    /// The error of a part whose build failed, through which rays then passed: a render
+    /// that met one must fail with it.
+    pub(crate) fn check_parts(&self) -> Result<()> {
+        match self.parts.iter().find_map(LazyPart::error) {
+            Some(e) => Err(e.clone()),
+            None => Ok(()),
+        }
     }
 
     /// What Embree's top-level geometry `id` stands for.

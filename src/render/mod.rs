@@ -18,4 +18,4 @@ pub use renderer::{RenderOutput, RenderStats};
 pub use tiles::RenderStatus;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -1,5 +1,6 @@
 //! One render: camera samples per pixel through the integrator, over tiles in parallel.
 
+use std::sync::OnceLock;
 use std::time::Instant;
 
 use super::allocation::{self, ALLOCATED};
@@ -37,6 +38,13 @@ pub struct RenderStats {
     pub noise: Option<f32>,
     /// Rays traced: closest-hit and shadow.
     pub rays: u64,
+    /// Seconds from the render's start to its first finished tile; `None` when it
+    /// finished none (cancelled at once).
+    pub first_tile_seconds: Option<f64>,
+    /// Parts of large curve geometries built during this render, when a ray first reached
+    /// them (`embree::lazy`), and the seconds their builds took, summed over threads.
+    pub parts_built: usize,
+    pub part_build_seconds: f64,
 }
 
 /// Samples per pixel of one pass. A render proceeds in passes, grouped in rounds
@@ -162,6 +170,8 @@ pub fn render(
         Stops::Never
     };
     let mut rounds = Rounds::new(passes, pilot.is_some(), stops);
+    let parts_before = world.tracer.scene().parts_built();
+    let first_tile = OnceLock::new();
     let start = Instant::now();
     // One pool of workers for every round: `render_tiles` runs on it.
     let (spp, noise, status) = threads::scoped(options.threads, || -> Result<_> {
@@ -187,6 +197,9 @@ pub fn render(
             let round_pixels = u128::from(round.len() as u64 * pixels);
             let in_pass = u128::from(target.crop().pixel_count());
             let pass_progress = |done: u64, _| {
+                if done > 0 {
+                    first_tile.get_or_init(|| start.elapsed().as_secs_f64());
+                }
                 let done = u128::from(done) * round_pixels / in_pass;
                 progress.update(offset + done as u64, total)
             };
@@ -236,15 +249,21 @@ pub fn render(
         }
         Ok((spp, noise, status))
     })??;
+    // A part whose build failed let rays through: the image is wrong.
+    world.tracer.scene().check_parts()?;
     if let Some(pilot) = &pilot {
         allocation::blend(&mut film, pilot);
     }
+    let parts = world.tracer.scene().parts_built();
     let stats = RenderStats {
         seconds: start.elapsed().as_secs_f64(),
         samples: film.samples() + pilot.as_ref().map_or(0, Film::samples),
         spp,
         noise,
         rays: film.rays() + pilot.as_ref().map_or(0, Film::rays),
+        first_tile_seconds: first_tile.get().copied(),
+        parts_built: parts.built - parts_before.built,
+        part_build_seconds: parts.seconds - parts_before.seconds,
     };
     Ok(RenderOutput {
         film,

@@ -46,15 +46,21 @@ pub fn section(ctx: &Context) -> Result<String> {
         "**Against Blender Cycles.** `{SCENE}.toml` (Catmull-Rom round, 16 segments, \
          1920x1080 x 1 spp: at this view every strand is wider than a pixel, so `auto` \
          builds it all round) at each strand count, one run each, {threads} threads: \
-         hairtrace's time to the first pixel (its build, `--stats`) against Cycles' \
+         hairtrace's time to the first pixel (its build and its first finished tile, \
+         `--stats`; from 2^18 segments the groom is built in parts, each when a ray first \
+         reaches it, so its render includes their builds) against Cycles' \
          synchronisation time (its scene sync and BVH build, from the EXR header's \
-         stamps), and each process's peak resident memory (`/usr/bin/time`), Blender's \
-         own code and data included. Both renderers run Embree's curve build.\n\n{}",
+         stamps); the whole 1-spp frame (build and render) of each; and each process's \
+         peak resident memory (`/usr/bin/time`), Blender's own code and data included. \
+         Both renderers run Embree's curve build.\n\n{}",
         table(
             &[
                 "strands",
                 "hairtrace first pixel s",
                 "Cycles sync s",
+                "ratio",
+                "hairtrace frame s",
+                "Cycles frame s",
                 "ratio",
                 "hairtrace peak MiB",
                 "Cycles peak MiB",
@@ -99,7 +105,8 @@ fn compare(ctx: &Context, python: &Path, dir: &Path) -> Result<Vec<Vec<String>>>
             .arg("--stats")
             .arg(&ht_stats);
         let ht_peak = peak_mib(render, dir)?;
-        let first_pixel = seconds(&ht_stats, "build_seconds")?;
+        let first_pixel = seconds(&ht_stats, "first_pixel_seconds")?;
+        let frame = seconds(&ht_stats, "build_seconds")? + seconds(&ht_stats, "seconds")?;
         ctx.done();
 
         ctx.step(format!("scale: Cycles, {strands} strands at 1080p"));
@@ -119,12 +126,16 @@ fn compare(ctx: &Context, python: &Path, dir: &Path) -> Result<Vec<Vec<String>>>
             .arg(&cycles_stats);
         let cycles_peak = peak_mib(render, dir)?;
         let sync = seconds(&cycles_stats, "sync_seconds")?;
+        let cycles_frame = sync + seconds(&cycles_stats, "render_seconds")?;
         ctx.done();
         rows.push(vec![
             strands.to_string(),
             num(first_pixel, 3),
             num(sync, 3),
             num(first_pixel / sync, 2),
+            num(frame, 3),
+            num(cycles_frame, 3),
+            num(frame / cycles_frame, 2),
             num(ht_peak, 4),
             num(cycles_peak, 4),
             num(ht_peak / cycles_peak, 2),

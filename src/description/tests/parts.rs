@@ -5,11 +5,23 @@ use std::sync::Arc;
 
 use crate::description::SceneDescription;
 use crate::embree::Device;
+use crate::{Aovs, NoProgress};
 
-/// A fur ball of 2^18 round linear segments (the least a geometry is cut at), built for a
-/// `width` x `height` x 1 spp render with `curve_parts = parts`: the scenes its parts
-/// were built as.
+/// A fur ball of 2^18 round linear segments (the least a geometry is cut at, in parts of
+/// 2^10), built for a `width` x `height` x 1 spp render with `curve_parts = parts`: the
+/// scenes its parts are built as.
 fn parts_built(width: u32, height: u32, parts: &str) -> usize {
+    fur_ball(width, height, parts)
+        .build(Arc::new(Device::new(None).unwrap()))
+        .unwrap()
+        .world
+        .tracer
+        .scene()
+        .part_count()
+}
+
+/// The fur ball of [`parts_built`].
+fn fur_ball(width: u32, height: u32, parts: &str) -> SceneDescription {
     let text = format!(
         r#"
 [render]
@@ -37,17 +49,74 @@ type = "environment"
 radiance = [1, 1, 1]
 "#
     );
-    let scene = SceneDescription::from_toml(&text, Path::new("."), "parts test").unwrap();
-    let built = scene.build(Arc::new(Device::new(None).unwrap())).unwrap();
-    built.world.tracer.scene().part_count()
+    SceneDescription::from_toml(&text, Path::new("."), "parts test").unwrap()
 }
 
 #[test]
 fn a_large_groom_is_built_in_parts_as_the_setting_says() {
     // 2^18 segments: auto cuts them for 64 camera samples, not for 3 per segment.
-    let parts = 1 << 4;
+    let parts = (1 << 18) / (1 << 10);
     assert_eq!(parts_built(8, 8, "auto"), parts);
     assert_eq!(parts_built(1024, 768, "auto"), 0);
     assert_eq!(parts_built(1024, 768, "on"), parts);
     assert_eq!(parts_built(8, 8, "off"), 0);
+}
+
+/// Parts are built by the render whose rays first reach them, and a render that met a
+/// part whose build failed fails with its error instead of showing the hole.
+#[test]
+fn a_render_builds_the_parts_it_reaches_and_fails_with_one_that_fails() {
+    let device = Arc::new(Device::new(None).unwrap());
+    let built = fur_ball(8, 8, "on").build(device.clone()).unwrap();
+    let scene = built.world.tracer.scene();
+    assert_eq!(scene.parts_built().built, 0);
+    let first = built.render(Aovs::default(), &NoProgress).unwrap().stats;
+    assert!(
+        first.parts_built > 0 && first.part_build_seconds > 0.0,
+        "{first:?}"
+    );
+    assert_eq!(scene.parts_built().built, first.parts_built);
+    assert!(first.first_tile_seconds.is_some_and(|t| t <= first.seconds));
+    // A second render of the same view reaches no part the first did not.
+    let again = built.render(Aovs::default(), &NoProgress).unwrap().stats;
+    assert_eq!(again.parts_built, 0);
+
+    let built = fur_ball(8, 8, "on").build(device.clone()).unwrap();
+    device.refuse_allocations(true);
+    let failed = built.render(Aovs::default(), &NoProgress);
+    device.refuse_allocations(false);
+    let err = failed.unwrap_err().to_string();
+    assert!(err.contains("RTC_ERROR_OUT_OF_MEMORY"), "{err}");
+}
+
+/// Parts built in whatever order a render's threads reach them give the same pixels on
+/// one thread or two, and a crop (which reaches fewer parts) the full frame's.
+#[test]
+fn parts_built_as_rays_reach_them_keep_threads_and_crops_exact() {
+    use crate::render::tests::render::{CROP, assert_crop_of};
+    let device = Arc::new(Device::new(None).unwrap());
+    let desc = fur_ball(40, 30, "on");
+    let run = |threads, crop| {
+        let built = desc.build(device.clone()).unwrap();
+        let settings = crate::RenderSettings {
+            threads: Some(threads),
+            crop,
+            spp: 2,
+            ..built.settings
+        };
+        let out = built
+            .render_with(&settings, Aovs::default(), &NoProgress)
+            .unwrap();
+        (out.film.rgb().to_vec(), out.stats.parts_built)
+    };
+    let (one, all) = run(1, None);
+    let (two, _) = run(2, None);
+    assert!(
+        one.iter()
+            .zip(&two)
+            .all(|(a, b)| a.to_bits() == b.to_bits())
+    );
+    let (crop, some) = run(2, Some(CROP));
+    assert_crop_of(&one, &crop);
+    assert!(some <= all, "{some} of {all}");
 }

@@ -3,4 +3,4 @@
 
 mod adaptive;
 mod camera_film;
-mod render;
+pub(crate) mod render;

@@ -537,8 +537,9 @@ impl CurveGeometry {
     /// Bounds (lower, upper) that hold every surface point of the segments of `part` (one of
     /// [`Self::parts`]): what a part's scene is entered by before it is built
     /// (`lazy.rs`). Each segment lies in the convex hull of its Bezier control points
-    /// (for B-spline and Bezier segments their own; Catmull-Rom's from its end
-    /// tangents), within its largest Bezier radius of that hull, round or flat; a margin of
+    /// (a B-spline's or a Catmull-Rom's converted: much tighter than the hull of the
+    /// points a B-spline segment reads, which spans three segments), within its largest
+    /// Bezier radius of that hull, round or flat; a margin of
     /// 1e-5 of the coordinates covers Embree's rounding. `None` for a geometry without
     /// parts or a range outside them.
     pub(super) fn part_bounds(&self, part: &Range<u32>) -> Option<([f32; 3], [f32; 3])> {
@@ -554,7 +555,13 @@ impl CurveGeometry {
             let p = |i: usize| Vec4::from_array(points[first as usize + i]);
             let hull = match self.basis {
                 CurveBasis::Linear => [p(0), p(1), p(1), p(1)],
-                CurveBasis::Bezier | CurveBasis::BSpline => [p(0), p(1), p(2), p(3)],
+                CurveBasis::Bezier => [p(0), p(1), p(2), p(3)],
+                CurveBasis::BSpline => [
+                    (p(0) + 4.0 * p(1) + p(2)) / 6.0,
+                    (2.0 * p(1) + p(2)) / 3.0,
+                    (p(1) + 2.0 * p(2)) / 3.0,
+                    (p(1) + 4.0 * p(2) + p(3)) / 6.0,
+                ],
                 CurveBasis::CatmullRom => [
                     p(1),
                     p(1) + (p(2) - p(0)) / 6.0,

@@ -385,3 +385,21 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
         "the C image is not the description's"
     );
 }
+
+/// The `isa` setting cannot re-pin a C host's device: a render asking another ISA than
+/// the device's is refused, with how to pin the device; on a device pinned to it, the
+/// same render goes ahead.
+#[test]
+fn a_render_cannot_repin_its_device() {
+    let isa = crate::embree::Isa::widest_here().expect("an x86-64 CPU");
+    let named = Named::new(&[("width", "8"), ("height", "8"), ("isa", isa.name())]);
+    let unpinned = fur_scene(true);
+    let (status, _) = named.render_rgb(unpinned.scene, 64);
+    fails(status, HtStatus::HT_ERR_INVALID_ARG, "ht_device_new_pinned");
+    let name = std::ffi::CString::new(isa.name()).unwrap();
+    let pinned = Handles::on(|out| unsafe { ht_device_new_pinned(2, name.as_ptr(), out) });
+    let hair = pinned.hair_material();
+    assert_eq!(pinned.add_strands(&small_fur(), hair), HtStatus::HT_OK);
+    light(&pinned, true);
+    assert_eq!(named.render_rgb(pinned.scene, 64).0, HtStatus::HT_OK);
+}

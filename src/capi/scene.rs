@@ -183,6 +183,16 @@ impl HtScene {
                 "the scene has no light: add an environment, distant or rect light"
             ));
         }
+        // A C host's device is its own (`ht_device_new_pinned`): a render cannot re-pin it.
+        if let Some(isa) = settings.isa.filter(|&isa| Some(isa) != self.device.isa()) {
+            return Err(invalid_arg!(
+                "isa = {isa}: this scene's device runs {}; pin the device with \
+                 ht_device_new_pinned(threads, \"{isa}\", ...) instead",
+                self.device.isa().map_or("the widest kernels this CPU runs".into(), |d| {
+                    format!("{d} kernels")
+                })
+            ));
+        }
         let camera = self.camera(width as f32 / height as f32)?;
         let view = DetailView::new(camera, height, settings.lod_pixels);
         if (self.world.as_ref())

@@ -51,12 +51,16 @@ pub(crate) struct Handles {
 
 impl Handles {
     pub(crate) fn new() -> Self {
-        unsafe {
-            let (mut device, mut scene) = (null_mut(), null_mut());
-            assert_eq!(ht_device_new(2, &mut device), HtStatus::HT_OK);
-            assert_eq!(ht_scene_new(device, &mut scene), HtStatus::HT_OK);
-            Handles { device, scene }
-        }
+        Self::on(|out| unsafe { ht_device_new(2, out) })
+    }
+
+    /// A scene on the device `new_device` makes.
+    pub(crate) fn on(new_device: impl FnOnce(*mut *mut HtDevice) -> HtStatus) -> Self {
+        let (mut device, mut scene) = (null_mut(), null_mut());
+        assert_eq!(new_device(&mut device), HtStatus::HT_OK);
+        // SAFETY: a live device.
+        assert_eq!(unsafe { ht_scene_new(device, &mut scene) }, HtStatus::HT_OK);
+        Handles { device, scene }
     }
 
     pub(crate) fn scene(&self) -> &HtScene {

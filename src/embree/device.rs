@@ -22,6 +22,8 @@ pub struct Device {
     last_error: Box<ErrorSlot>,
     /// BVH builds started on this device ([`Device::builds`]).
     builds: AtomicU64,
+    /// The instruction set its kernels are pinned to ([`Device::isa`]).
+    isa: Option<Isa>,
 }
 
 /// The last error Embree reported: code and message. A mutex because Embree calls the
@@ -108,13 +110,25 @@ impl Device {
                 std::ptr::from_ref::<ErrorSlot>(&last_error) as *mut c_void,
             );
         }
+        // Embree reads the config left to right: the last `isa=` is the pin.
+        let isa = (config.split(','))
+            .filter_map(|key| key.trim().strip_prefix("isa="))
+            .next_back()
+            .and_then(|name| Isa::named(name).ok());
         let device = Device {
             raw,
             last_error,
             builds: AtomicU64::new(0),
+            isa,
         };
         abi_check::verify_once(device.raw())?;
         Ok(device)
+    }
+
+    /// The instruction set its kernels are pinned to (`isa=` in its config); `None`: the
+    /// widest this CPU runs.
+    pub fn isa(&self) -> Option<Isa> {
+        self.isa
     }
 
     /// The raw handle, for the scene and geometry layer. It is valid while `self` lives;
@@ -124,7 +138,9 @@ impl Device {
     }
 
     /// How many scenes this device has started to build (commits, finished or not): what
-    /// tells a host, and the tests, that an edit was applied without a BVH build.
+    /// tells a host, and the tests, that an edit was applied without a BVH build. A large
+    /// groom's part, built once when a ray first reaches it, is not counted: a render's
+    /// `RenderStats::parts_built` says how many it built.
     pub fn builds(&self) -> u64 {
         self.builds.load(Ordering::Relaxed)
     }

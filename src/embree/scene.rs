@@ -96,8 +96,9 @@ impl RawScene {
 }
 
 // SAFETY: Embree scenes may be used from any thread; mutation happens only through
-// `SceneBuilder` (owned, not shared), queries only on a committed `Scene`, which Embree
-// allows from many threads at once.
+// `SceneBuilder` (owned, not shared) or, for a part's scene, inside its `OnceLock` before
+// any query reaches it (`lazy.rs`); queries only on committed scenes, which Embree allows
+// from many threads at once.
 unsafe impl Send for RawScene {}
 // SAFETY: as above.
 unsafe impl Sync for RawScene {}
@@ -288,7 +289,6 @@ pub fn cancelled() -> Error {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct PartsBuilt {
     pub built: usize,
-    pub of: usize,
     pub seconds: f64,
 }
 
@@ -330,7 +330,6 @@ impl Scene {
             .collect();
         PartsBuilt {
             built: seconds.len(),
-            of: self.parts.len(),
             seconds: seconds.iter().sum(),
         }
     }

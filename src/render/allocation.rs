@@ -28,6 +28,11 @@ const FLOOR: f64 = 0.1;
 /// scramble ([`super::sampler`]), independent of the pilot's samples.
 pub const ALLOCATED: u32 = 1 << 31;
 
+/// The most spp a render with this allocation takes (`RenderSettings::validate`): its
+/// passes' sample indices run from [`ALLOCATED`] up by at most a whole block's samples per
+/// pass, 2^11, and must stay within a u32: 2^22 spp reach 2^31 + 2^30.
+pub const MOST_SPP: u32 = 1 << 22;
+
 /// `crop` grown to whole blocks, inside the `width` x `height` frame: the pilot's window.
 pub(super) fn pilot_window(crop: Window, width: u32, height: u32) -> Window {
     let down = |v: u32| v / BLOCK * BLOCK;

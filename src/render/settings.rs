@@ -9,6 +9,7 @@
 
 use std::fmt;
 
+use super::allocation;
 use super::film::PixelFilter;
 use crate::embree::{Device, Isa};
 use crate::error::{Error, Result, invalid_arg};
@@ -309,7 +310,7 @@ settings! {
         /// Image height in pixels.
         height: u32 = 480, Range::Closed(1.0, MAX_SIDE as f64);
         /// Samples per pixel; with a noise target or a time budget, the most.
-        spp: u32 = 16, Range::AtLeast(1.0);
+        spp: u32 = 16, Range::Closed(1.0, MAX_SPP as f64);
         /// Stop once the estimated noise (RMSE relative to the image's mean) is at most this;
         /// none: render all spp.
         noise_target: Option<f32> = None, Range::Above(0.0);
@@ -325,7 +326,9 @@ settings! {
         /// Worker threads; none: one per hardware thread.
         threads: Option<usize> = None, Range::AtLeast(1.0);
         /// Pin Embree's kernels to one instruction set, so that crops rendered on different
-        /// CPUs assemble bit for bit (docs/farm.md); none: the widest this CPU runs.
+        /// CPUs assemble bit for bit (docs/farm.md); none: the widest this CPU runs. Through
+        /// the C ABI the device's pin decides (`ht_device_new_pinned`): a render asking
+        /// another is refused.
         isa: Option<Isa> = None, Range::Any;
         /// Render only the pixels [x0, x1) x [y0, y1) of the full frame, exactly as the full
         /// render has them; none: the full frame.
@@ -433,6 +436,10 @@ pub enum Filter {
 /// Largest accepted image side, so that a typo cannot ask for terabytes.
 pub(crate) const MAX_SIDE: u32 = 1 << 15;
 
+/// Most samples per pixel: a pixel's sample indices are u32s, and a pass's end past the
+/// last sample must still be one.
+const MAX_SPP: u32 = 1 << 31;
+
 impl RenderSettings {
     /// Every setting, in declaration order.
     pub fn schema() -> &'static [Setting] {
@@ -491,6 +498,14 @@ impl RenderSettings {
                     self.height
                 ));
             }
+        }
+        if self.allocation == Allocation::Noise && self.spp > allocation::MOST_SPP {
+            return Err(invalid_arg!(
+                "spp = {}: the noise allocation takes at most {} (its sample indices are \
+                 32-bit); use allocation = uniform",
+                self.spp,
+                allocation::MOST_SPP
+            ));
         }
         if let Some(n) = self.path.deep_bounce_depth {
             if n > self.path.max_depth {
@@ -559,7 +574,7 @@ mod tests {
             )
         );
         for (key, value, says) in [
-            ("spp", "0", "spp = 0: must be >= 1"),
+            ("spp", "0", "spp = 0: must be [1, 2147483648]"),
             ("spp", "1.5", "must be an integer"),
             ("width", "40000", "must be [1, 32768]"),
             ("lobe_cull", "1", "must be [0, 1)"),
@@ -602,6 +617,20 @@ mod tests {
                 .contains("at most max_depth")
         );
         r.path.deep_bounce_depth = Some(4);
+        r.validate().unwrap();
+        // Sample indices are u32s: spp past 2^31, or past 2^22 under the noise allocation
+        // (whose indices start at 2^31), would wrap around.
+        let mut r = RenderSettings {
+            spp: (1 << 31) + 1,
+            ..RenderSettings::default()
+        };
+        assert!(r.validate().unwrap_err().to_string().contains("spp = 2147483649"));
+        r.spp = 1 << 31;
+        r.validate().unwrap();
+        r.allocation = Allocation::Noise;
+        let err = r.validate().unwrap_err().to_string();
+        assert!(err.contains("at most 4194304"), "{err}");
+        r.spp = 1 << 22;
         r.validate().unwrap();
     }
 }

@@ -55,6 +55,10 @@ const CURVES: [CurveType; 10] = [
 const BIAS_BASES: [CurveBasis; 2] = [CurveBasis::BSpline, CurveBasis::CatmullRom];
 const BIAS_TOLERANCES: [f32; 5] = [0.0, 0.02, 0.05, 0.1, 0.25];
 
+/// Ten million strands, apart from the sweep (the groom takes a minute to make and 10 GiB
+/// of memory): the default curves (B-spline `auto`, the level of detail) and round tubes.
+const TEN_MILLION: [CurveType; 2] = [CURVES[7], CURVES[2]];
+
 fn strand_counts(ctx: &Context) -> Vec<usize> {
     if ctx.quick {
         vec![1_000, 10_000]
@@ -148,8 +152,10 @@ fn measure(desc: &SceneDescription, strands: usize) -> Result<Point> {
 }
 
 pub fn steps(ctx: &Context) -> u64 {
-    (CURVES.len() * strand_counts(ctx).len() + BIAS_BASES.len() * (BIAS_TOLERANCES.len() + 1))
-        as u64
+    let ten_million = if ctx.quick { 0 } else { TEN_MILLION.len() };
+    (CURVES.len() * strand_counts(ctx).len()
+        + ten_million
+        + BIAS_BASES.len() * (BIAS_TOLERANCES.len() + 1)) as u64
         + super::scale_cycles::steps(ctx)
 }
 
@@ -236,21 +242,26 @@ pub fn section(ctx: &Context) -> Result<String> {
     )?;
     let rows: Vec<Vec<String>> = results
         .iter()
-        .flat_map(|(name, pts)| {
-            pts.iter().map(move |p| {
-                let mut row = vec![(*name).to_owned(), p.strands.to_string()];
-                row.extend(p.stages.iter().map(|s| num(*s, 3)));
-                row.extend([
-                    num(p.parts, 3),
-                    num(p.build, 3),
-                    num(p.embree_mib, 3),
-                    num(p.rss_mib, 3),
-                    num(p.mrays, 3),
-                ]);
-                row
-            })
-        })
+        .flat_map(|(name, pts)| pts.iter().map(move |p| row(name, p)))
         .collect();
+    let mut ten_million = Vec::new();
+    if !ctx.quick {
+        for curve in TEN_MILLION {
+            ctx.step(format!("scale: {}, 10^7 strands", curve.0));
+            ten_million.push(row(curve.0, &measure(&scalp(ctx, 10_000_000, curve)?, 10_000_000)?));
+            ctx.done();
+        }
+    }
+    let ten_million = if ten_million.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "**Ten million strands**, the same scalp and view, the default curves and round \
+             tubes (Cycles is not run at this size: its peak at 10^6 strands, below, \
+             extrapolates past 50 GB):\n\n{}\n",
+            table(&HEADER, &ten_million)
+        )
+    };
     let default_lod = hairtrace::RenderSettings::default().lod_pixels;
     Ok(format!(
         "The stage benchmark's scalp (16 segments per strand) built at each strand count \
@@ -265,26 +276,40 @@ pub fn section(ctx: &Context) -> Result<String> {
          build). Rays per second are the second render's. `lod` is the level of detail: `auto` curves with \
          `lod_pixels = {default_lod}` (the default), every strand here thinner than \
          a pixel and so traced as linear ribbons through points on its curve, or as flat \
-         curves of its basis where it needs more than the budget of pieces.\n\n{}\n{}\n{}\n{figures}\n{}",
-        table(
-            &[
-                "curves",
-                "strands",
-                "read s",
-                "curves s",
-                "BVH s",
-                "parts s",
-                "first pixel s",
-                "Embree MiB",
-                "RSS growth MiB",
-                "Mrays/s"
-            ],
-            &rows
-        ),
+         curves of its basis where it needs more than the budget of pieces.\n\n{}\n{ten_million}{}\n{}\n{figures}\n{}",
+        table(&HEADER, &rows),
         advice(&results, ctx.machine.threads),
         super::scale_cycles::section(ctx)?,
         bias(ctx)?,
     ))
+}
+
+/// The columns of a [`row`].
+const HEADER: [&str; 10] = [
+    "curves",
+    "strands",
+    "read s",
+    "curves s",
+    "BVH s",
+    "parts s",
+    "first pixel s",
+    "Embree MiB",
+    "RSS growth MiB",
+    "Mrays/s",
+];
+
+/// One build and render of curves `name`, as the table shows it.
+fn row(name: &str, p: &Point) -> Vec<String> {
+    let mut row = vec![name.to_owned(), p.strands.to_string()];
+    row.extend(p.stages.iter().map(|s| num(*s, 3)));
+    row.extend([
+        num(p.parts, 3),
+        num(p.build, 3),
+        num(p.embree_mib, 3),
+        num(p.rss_mib, 3),
+        num(p.mrays, 3),
+    ]);
+    row
 }
 
 /// The scalp's strands for the bias table: enough that a pixel holds many strands, as in

@@ -277,7 +277,8 @@ pub unsafe extern "C" fn ht_device_new(threads: u32, out: *mut *mut HtDevice) ->
 /// ("sse2", "avx", "avx2" or "avx512"; NULL: not pinned, the widest this CPU runs).
 /// Embree's kernels for different instruction sets round differently, so a frame whose
 /// crop pieces render on different CPUs assembles bit for bit only when every piece pins
-/// the same ISA.
+/// the same ISA. The device's pin is what its scenes render with: a build or render whose
+/// settings name another `isa` is refused.
 ///
 /// Statuses: those of `ht_device_new`, and `HT_ERR_INVALID_ARG` for another name or an
 /// ISA this CPU cannot run.

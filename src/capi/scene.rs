@@ -188,9 +188,11 @@ impl HtScene {
             return Err(invalid_arg!(
                 "isa = {isa}: this scene's device runs {}; pin the device with \
                  ht_device_new_pinned(threads, \"{isa}\", ...) instead",
-                self.device.isa().map_or("the widest kernels this CPU runs".into(), |d| {
-                    format!("{d} kernels")
-                })
+                self.device
+                    .isa()
+                    .map_or("the widest kernels this CPU runs".into(), |d| {
+                        format!("{d} kernels")
+                    })
             ));
         }
         let camera = self.camera(width as f32 / height as f32)?;

@@ -783,8 +783,28 @@ impl From<TriangleGeometry> for Geometry {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    /// Round curves of `basis` over `points` and `indices`, cut into parts.
+    pub(crate) fn round_in_parts(
+        device: &Device,
+        basis: CurveBasis,
+        points: Vec<[f32; 4]>,
+        indices: Vec<u32>,
+    ) -> CurveGeometry {
+        CurveGeometry::new(
+            device,
+            basis,
+            CurveShape::Round,
+            points.into(),
+            indices.into(),
+            1,
+        )
+        .unwrap()
+        .in_parts()
+        .unwrap()
+    }
 
     #[test]
     fn segments_per_basis() {
@@ -1001,17 +1021,7 @@ mod tests {
                 .flat_map(|s| (0..segments).map(move |j| s * per_strand + j))
                 .collect();
             assert!(indices.len() >= PARTS_FROM_SEGMENTS);
-            let geometry = CurveGeometry::new(
-                &device,
-                basis,
-                CurveShape::Round,
-                points.into(),
-                indices.into(),
-                1,
-            )
-            .unwrap()
-            .in_parts()
-            .unwrap();
+            let geometry = round_in_parts(&device, basis, points, indices);
             let parts = geometry.parts().unwrap();
             assert_eq!(parts.len(), geometry.indices().len() / PART_SEGMENTS);
             assert!(parts.iter().all(|p| p.len() <= PART_SEGMENTS));
@@ -1087,17 +1097,7 @@ mod tests {
             let indices: Vec<u32> = (0..strands)
                 .flat_map(|s| (0..segments).map(move |j| (s * per_strand + j * stride) as u32))
                 .collect();
-            let geometry = CurveGeometry::new(
-                &device,
-                basis,
-                CurveShape::Round,
-                points.into(),
-                indices.into(),
-                1,
-            )
-            .unwrap()
-            .in_parts()
-            .unwrap();
+            let geometry = round_in_parts(&device, basis, points, indices);
             let parts = geometry.parts.as_ref().unwrap();
             let mut widest = 0.0f32;
             for range in geometry.parts().unwrap() {

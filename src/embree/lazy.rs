@@ -194,9 +194,8 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
-    use crate::embree::{
-        CurveBasis, CurveGeometry, CurveShape, PARTS_FROM_SEGMENTS, Ray, SceneBuilder, SceneOptions,
-    };
+    use crate::embree::geometry::tests::round_in_parts;
+    use crate::embree::{CurveBasis, PARTS_FROM_SEGMENTS, Ray, SceneBuilder, SceneOptions};
 
     /// A part whose build fails lets rays through, and the scene says why, so that the
     /// render that met it fails (`render::renderer`) rather than show a hole.
@@ -211,11 +210,7 @@ mod tests {
         let indices: Vec<u32> = (0..strands as u32)
             .flat_map(|s| (0..4).map(move |j| s * 5 + j))
             .collect();
-        let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
-        let geometry = CurveGeometry::new(&device, linear, round, points.into(), indices.into(), 1)
-            .unwrap()
-            .in_parts()
-            .unwrap();
+        let geometry = round_in_parts(&device, CurveBasis::Linear, points, indices);
         let mut scene = SceneBuilder::new(device.clone(), SceneOptions::default()).unwrap();
         scene.attach(geometry).unwrap();
         let scene = scene.commit(&|_| true).unwrap();

@@ -624,7 +624,12 @@ mod tests {
             spp: (1 << 31) + 1,
             ..RenderSettings::default()
         };
-        assert!(r.validate().unwrap_err().to_string().contains("spp = 2147483649"));
+        assert!(
+            r.validate()
+                .unwrap_err()
+                .to_string()
+                .contains("spp = 2147483649")
+        );
         r.spp = 1 << 31;
         r.validate().unwrap();
         r.allocation = Allocation::Noise;

@@ -248,7 +248,10 @@ pub fn section(ctx: &Context) -> Result<String> {
     if !ctx.quick {
         for curve in TEN_MILLION {
             ctx.step(format!("scale: {}, 10^7 strands", curve.0));
-            ten_million.push(row(curve.0, &measure(&scalp(ctx, 10_000_000, curve)?, 10_000_000)?));
+            ten_million.push(row(
+                curve.0,
+                &measure(&scalp(ctx, 10_000_000, curve)?, 10_000_000)?,
+            ));
             ctx.done();
         }
     }

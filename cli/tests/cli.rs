@@ -595,7 +595,7 @@ fn render_takes_the_fidelity_knobs() {
         ("--deep-bounce-depth", "0", "deep_bounce_depth = 0"),
         ("--lobe-cull", "1", "lobe_cull = 1"),
         ("--light-threshold", "inf", "light_threshold = inf"),
-        ("--set", "spp=0", "spp = 0: must be [1, 2147483648]"),
+        ("--set", "spp=0", "spp = 0: must be >= 1"),
         ("--set", "spp", "NAME=VALUE"),
         (
             "--set",

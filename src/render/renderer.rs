@@ -179,10 +179,13 @@ pub fn render(
         let mut taken = None;
         while let Some(round) = rounds.next(taken) {
             let began = start.elapsed().as_secs_f64();
-            let end = (round.end * PASS_SAMPLES).min(settings.spp);
+            // Saturating: a host may ask u32::MAX spp and cancel when it has enough.
+            let end = round.end.saturating_mul(PASS_SAMPLES).min(settings.spp);
             // Sample indices of a pixel in a pass.
             let indices = |pixel, pass: u32| match &shares {
-                None => pass * PASS_SAMPLES..((pass + 1) * PASS_SAMPLES).min(settings.spp),
+                None => {
+                    pass * PASS_SAMPLES..(pass + 1).saturating_mul(PASS_SAMPLES).min(settings.spp)
+                }
                 Some(shares) => {
                     let n = shares.of(pixel);
                     ALLOCATED + (pass - 1) * n..ALLOCATED + pass * n

@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use super::compat;
 use super::geometry::RawGeometry;
-use super::scene::{RawScene, new_scene};
+use super::raw_scene::{RawScene, new_scene};
 use super::{Device, sys};
 use crate::Result;
 

@@ -22,6 +22,7 @@ mod lazy;
 mod memory;
 mod order;
 mod query;
+mod raw_scene;
 mod scene;
 #[cfg(feature = "bench-internals")]
 pub mod sys;

@@ -5,7 +5,6 @@
 //! `rtcCommitScene` and must not change while queries run: [`SceneBuilder::commit`] consumes
 //! the builder and returns a [`Scene`] that is `Sync` and has no mutating methods.
 
-use std::ptr::NonNull;
 use std::sync::Arc;
 
 use rayon::prelude::*;
@@ -13,6 +12,7 @@ use rayon::prelude::*;
 use super::compat::FILTER_SCENE_FLAG;
 use super::geometry::Geometry;
 use super::lazy::LazyPart;
+use super::raw_scene::{RawScene, new_scene};
 use super::{Device, sys};
 use crate::error::invalid_arg;
 use crate::{Error, Result, threads};
@@ -85,31 +85,6 @@ impl SceneOptions {
     }
 }
 
-/// One reference to an Embree scene, released when dropped.
-#[derive(Debug)]
-pub(super) struct RawScene(NonNull<sys::RTCSceneTy>);
-
-impl RawScene {
-    pub(super) fn raw(&self) -> sys::RTCScene {
-        self.0.as_ptr()
-    }
-}
-
-// SAFETY: Embree scenes may be used from any thread; mutation happens only through
-// `SceneBuilder` (owned, not shared) or, for a part's scene, inside its `OnceLock` before
-// any query reaches it (`lazy.rs`); queries only on committed scenes, which Embree allows
-// from many threads at once.
-unsafe impl Send for RawScene {}
-// SAFETY: as above.
-unsafe impl Sync for RawScene {}
-
-impl Drop for RawScene {
-    fn drop(&mut self) {
-        // SAFETY: we own one reference.
-        unsafe { sys::rtcReleaseScene(self.0.as_ptr()) };
-    }
-}
-
 /// What one geometry of Embree's top-level scene stands for: geometry `geometry` of the
 /// scene, whole, or the part of it whose primitives start at `part_start`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -140,26 +115,9 @@ fn embree_id(n: usize) -> Result<u32> {
         .ok_or_else(|| invalid_arg!("too many geometries in one scene"))
 }
 
-/// A new scene with `flags`.
-pub(super) fn new_scene(device: &Device, flags: sys::RTCSceneFlags) -> Result<RawScene> {
-    // SAFETY: live device.
-    let raw = unsafe { sys::rtcNewScene(device.raw()) };
-    let Some(raw) = NonNull::new(raw) else {
-        return Err(device.check().err().unwrap_or_else(|| Error::Embree {
-            code: sys::RTCError::RTC_ERROR_UNKNOWN.0,
-            message: "rtcNewScene returned null".into(),
-        }));
-    };
-    let raw = RawScene(raw);
-    // SAFETY: live scene, valid flags.
-    unsafe { sys::rtcSetSceneFlags(raw.0.as_ptr(), flags) };
-    device.check()?;
-    Ok(raw)
-}
-
 /// Commits `scene`, telling `progress` how far its build has got.
 fn commit_scene(device: &Device, scene: &RawScene, progress: &BuildMonitor<'_>) -> Result<()> {
-    let scene = scene.0.as_ptr();
+    let scene = scene.raw();
     let user = (&raw const progress).cast_mut().cast::<std::ffi::c_void>();
     // SAFETY: live scene; `user` points at `progress`, which outlives the commit, and the
     // monitor is removed before this function returns.
@@ -238,7 +196,7 @@ impl SceneBuilder {
         // SAFETY: live scene and geometry; the id is unused (slots are consecutive). The
         // scene retains the geometry, and we keep ours (and its buffers) until the scene is
         // gone.
-        unsafe { sys::rtcAttachGeometryByID(self.raw.0.as_ptr(), raw, slot) };
+        unsafe { sys::rtcAttachGeometryByID(self.raw.raw(), raw, slot) };
         self.device.check()
     }
 
@@ -358,7 +316,7 @@ impl Scene {
     pub fn bounds(&self) -> ([f32; 3], [f32; 3]) {
         let mut b = sys::RTCBounds::default();
         // SAFETY: committed scene, valid output (RTCBounds is 16-byte aligned by bindgen).
-        unsafe { sys::rtcGetSceneBounds(self.raw.0.as_ptr(), &mut b) };
+        unsafe { sys::rtcGetSceneBounds(self.raw.raw(), &mut b) };
         (
             [b.lower_x, b.lower_y, b.lower_z],
             [b.upper_x, b.upper_y, b.upper_z],
@@ -367,7 +325,7 @@ impl Scene {
 
     /// The raw handle. Valid while `self` lives; do not release or modify it.
     pub(crate) fn raw(&self) -> sys::RTCScene {
-        self.raw.0.as_ptr()
+        self.raw.raw()
     }
 
     /// The raw handle, for the groom benchmark's direct Embree calls only.

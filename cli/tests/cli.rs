@@ -406,6 +406,15 @@ fn render_stats_compare_and_export() {
         built > 0.0 && built <= s["build_seconds"].as_f64().unwrap(),
         "{s}"
     );
+    // The first pixel: the build and the first finished tile, within the render. A groom
+    // this small is built whole: no part built in the render.
+    let (build, render) = (s["build_seconds"].as_f64().unwrap(), stage("render"));
+    let first = s["first_pixel_seconds"].as_f64().unwrap_or(-1.0);
+    assert!(build <= first && first <= build + render, "{s}");
+    assert_eq!(
+        (s["parts_built"].as_u64(), s["part_build_seconds"].as_f64()),
+        (Some(0), Some(0.0))
+    );
 
     let o = hairtrace(&["compare", &a, &b, "--json"]);
     assert!(o.status.success(), "{o:?}");

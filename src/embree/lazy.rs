@@ -15,7 +15,7 @@
 //! renders. A part's scene is a pure function of its segments, whenever and on whichever
 //! thread it is built, so the pixels do not depend on the thread count.
 
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
@@ -44,6 +44,8 @@ struct PartBuild {
     scene: OnceLock<Result<RawScene>>,
     /// Nanoseconds its build took.
     nanos: AtomicU64,
+    /// Whether a build panicked (and left `scene` empty).
+    panicked: AtomicBool,
 }
 
 impl PartBuild {
@@ -61,7 +63,11 @@ impl PartBuild {
         }));
         match built {
             Ok(Ok(scene)) => Some(scene.raw()),
-            _ => None,
+            Ok(Err(_)) => None,
+            Err(_) => {
+                self.panicked.store(true, Ordering::Relaxed);
+                None
+            }
         }
     }
 
@@ -107,6 +113,7 @@ impl LazyPart {
             device: Arc::clone(device),
             scene: OnceLock::new(),
             nanos: AtomicU64::new(0),
+            panicked: AtomicBool::new(false),
         });
         let user = RawGeometry::new(device, sys::RTCGeometryType::RTC_GEOMETRY_TYPE_USER)?;
         let data = (&raw const *build).cast_mut().cast::<std::ffi::c_void>();
@@ -136,8 +143,14 @@ impl LazyPart {
     }
 
     /// Why its build failed, if it did: rays then pass through it.
-    pub(super) fn error(&self) -> Option<&crate::Error> {
-        self.build.scene.get()?.as_ref().err()
+    pub(super) fn error(&self) -> Option<crate::Error> {
+        if self.build.panicked.load(Ordering::Relaxed) {
+            return Some(crate::Error::Embree {
+                code: sys::RTCError::RTC_ERROR_UNKNOWN.0,
+                message: "a part's BVH build panicked".into(),
+            });
+        }
+        self.build.scene.get()?.as_ref().err().cloned()
     }
 }
 

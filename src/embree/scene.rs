@@ -296,7 +296,7 @@ impl Scene {
     /// that met one must fail with it.
     pub(crate) fn check_parts(&self) -> Result<()> {
         match self.parts.iter().find_map(LazyPart::error) {
-            Some(e) => Err(e.clone()),
+            Some(e) => Err(e),
             None => Ok(()),
         }
     }

@@ -354,7 +354,7 @@ pub(crate) const PARTS_FROM_SEGMENTS: usize = 1 << 18;
 /// smaller they are, the fewer segments a render builds that its rays do not need, and
 /// a part this small builds on one thread while another thread builds another. On the
 /// bench scalp at 10^6 strands and 1080p x 1 spp, from 2^14 down to 2^10 segments the
-/// frame took 0.44x the time (43% of the segments built instead of 80%) and rays traced
+/// frame took 0.45x the time (43% of the segments built instead of 80%) and rays traced
 /// as fast; 2^9 traced slower (docs/large-grooms.md).
 pub(crate) const PART_SEGMENTS: usize = 1 << 10;
 
@@ -539,9 +539,9 @@ impl CurveGeometry {
     /// (`lazy.rs`). Each segment lies in the convex hull of its Bezier control points
     /// (a B-spline's or a Catmull-Rom's converted: much tighter than the hull of the
     /// points a B-spline segment reads, which spans three segments), within its largest
-    /// Bezier radius of that hull, round or flat; a margin of
-    /// 1e-5 of the coordinates covers Embree's rounding. `None` for a geometry without
-    /// parts or a range outside them.
+    /// Bezier radius of that hull, round or flat; a margin of 1e-5 of the coordinates
+    /// covers Embree's rounding. `None` for a geometry without parts or a range outside
+    /// them.
     pub(super) fn part_bounds(&self, part: &Range<u32>) -> Option<([f32; 3], [f32; 3])> {
         let parts = self.parts.as_ref()?;
         let firsts = parts

@@ -295,10 +295,10 @@ impl Scene {
     /// The error of a part whose build failed, through which rays then passed: a render
     /// that met one must fail with it.
     pub(crate) fn check_parts(&self) -> Result<()> {
-        match self.parts.iter().find_map(LazyPart::error) {
-            Some(e) => Err(e),
-            None => Ok(()),
-        }
+        self.parts
+            .iter()
+            .find_map(LazyPart::error)
+            .map_or(Ok(()), Err)
     }
 
     /// What Embree's top-level geometry `id` stands for.

@@ -40,7 +40,8 @@ pub enum PartsRule {
     /// Every such geometry in parts.
     Always,
     /// For a render of this many camera samples (pixels x spp of the whole frame): in
-    /// parts when the geometry has more than [`PARTS_PER_SAMPLE`] segments per sample.
+    /// parts when the geometry has at least [`AUTO_PARTS_FROM_SEGMENTS`] segments and more
+    /// than [`PARTS_PER_SAMPLE`] segments per sample.
     ForSamples(u64),
 }
 
@@ -54,6 +55,14 @@ pub const DEFAULT_COMPACT: bool = true;
 /// cost about 0.2 of rendering per camera sample (2 threads, docs/large-grooms.md): they
 /// pay while the render has fewer than about 3 samples per segment.
 pub const PARTS_PER_SAMPLE: f64 = 1.0 / 3.0;
+
+/// The fewest segments [`PartsRule::ForSamples`] builds in parts. Below about a million
+/// segments one geometry builds fast enough (its build still fits the cache) that the
+/// parts' slower rays and the part builds inside the render cost more than they save: on
+/// the bench scalp at 4.8 x 10^5 segments and 32 spp the render took 1.3x as long in parts
+/// and build plus render 1.02x-1.18x; at 1.05 x 10^6 segments build plus render took
+/// 0.85x-0.89x (2 threads, docs/large-grooms.md).
+pub const AUTO_PARTS_FROM_SEGMENTS: usize = 1 << 20;
 
 /// Whole geometries: where the render is not known.
 impl Default for SceneOptions {
@@ -80,7 +89,10 @@ impl SceneOptions {
         match self.parts {
             PartsRule::Never => false,
             PartsRule::Always => true,
-            PartsRule::ForSamples(n) => segments as f64 > PARTS_PER_SAMPLE * n as f64,
+            PartsRule::ForSamples(n) => {
+                segments >= AUTO_PARTS_FROM_SEGMENTS
+                    && segments as f64 > PARTS_PER_SAMPLE * n as f64
+            }
         }
     }
 }
@@ -340,8 +352,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_geometry_is_built_in_parts_only_for_a_render_of_few_samples_per_segment() {
-        let segments = 1 << 20;
+    fn a_geometry_is_built_in_parts_only_when_large_and_for_few_samples_per_segment() {
+        let segments = AUTO_PARTS_FROM_SEGMENTS;
         let rule = |parts| SceneOptions {
             parts,
             ..SceneOptions::default()
@@ -353,6 +365,9 @@ mod tests {
         assert!(rule(PartsRule::Always).builds_in_parts(segments));
         assert!(!rule(PartsRule::Never).builds_in_parts(segments));
         assert!(!SceneOptions::default().builds_in_parts(segments));
+        // Below a million segments the rule keeps a geometry whole however few the samples.
+        assert!(!rule(PartsRule::ForSamples(1)).builds_in_parts(segments - 1));
+        assert!(rule(PartsRule::Always).builds_in_parts(segments - 1));
         assert!(short.compact && SceneOptions::default().compact);
     }
 }

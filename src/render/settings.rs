@@ -342,10 +342,10 @@ settings! {
         /// strand's curve and the linear ribbons traced in its place; 0: full detail.
         lod_pixels: f32 = DEFAULT_LOD_PIXELS, Range::AtLeast(0.0);
         /// Whether a groom of 2^18 segments or more is built as parts of 2^10, each a BVH
-        /// of its own built when a ray first reaches it: auto (for a render of fewer than 3
-        /// camera samples per segment, where the faster build outweighs the slower rays:
-        /// docs/large-grooms.md), on or off. Read by the build: a C ABI scene builds again
-        /// when it changes.
+        /// of its own built when a ray first reaches it: auto (from 2^20 segments, for a
+        /// render of fewer than 3 camera samples per segment, where the faster build
+        /// outweighs the slower rays: docs/large-grooms.md), on or off. Read by the build:
+        /// a C ABI scene builds again when it changes.
         curve_parts: CurveParts = CurveParts::Auto, Range::Any;
     }
 

@@ -271,7 +271,7 @@ pub fn section(ctx: &Context) -> Result<String> {
          with each curve type, then rendered twice. Time to first pixel is the whole build \
          and the first render's first finished tile; the build's stages are the library's \
          own (generating the strands, converting them to curves, Embree's BVH build). From \
-         2^18 segments a groom is built in parts, each when a ray first reaches it: `parts \
+         2^20 segments a groom is built in parts, each when a ray first reaches it: `parts \
          s` is what the first render spent on them, summed over its threads. Memory: \
          Embree's own peak allocation over the build and the first render (its memory \
          monitor), and how much the process's resident memory grew (the groom's buffers \

@@ -47,7 +47,7 @@ pub fn section(ctx: &Context) -> Result<String> {
          1920x1080 x 1 spp: at this view every strand is wider than a pixel, so `auto` \
          builds it all round) at each strand count, one run each, {threads} threads: \
          hairtrace's time to the first pixel (its build and its first finished tile, \
-         `--stats`; from 2^18 segments the groom is built in parts, each when a ray first \
+         `--stats`; from 2^20 segments the groom is built in parts, each when a ray first \
          reaches it, so its render includes their builds) against Cycles' \
          synchronisation time (its scene sync and BVH build, from the EXR header's \
          stamps); the whole 1-spp frame (build and render) of each; and each process's \

@@ -7,11 +7,11 @@ use crate::description::SceneDescription;
 use crate::embree::Device;
 use crate::{Aovs, NoProgress};
 
-/// A fur ball of 2^18 round linear segments (the least a geometry is cut at, in parts of
-/// 2^10), built for a `width` x `height` x 1 spp render with `curve_parts = parts`: the
-/// scenes its parts are built as.
-fn parts_built(width: u32, height: u32, parts: &str) -> usize {
-    fur_ball(width, height, parts)
+/// A fur ball of `strands` x 16 round linear segments, built for a `width` x `height` x 1
+/// spp render with `curve_parts = parts`: the scenes its parts are built as (none built
+/// yet, so this is cheap).
+fn parts_built(width: u32, height: u32, parts: &str, strands: usize) -> usize {
+    fur_ball_of(width, height, parts, strands)
         .build(Arc::new(Device::new(None).unwrap()))
         .unwrap()
         .world
@@ -20,8 +20,13 @@ fn parts_built(width: u32, height: u32, parts: &str) -> usize {
         .part_count()
 }
 
-/// The fur ball of [`parts_built`].
+/// The fur ball of [`parts_built`] at 2^18 segments, the least a geometry is cut at (in
+/// parts of 2^10).
 fn fur_ball(width: u32, height: u32, parts: &str) -> SceneDescription {
+    fur_ball_of(width, height, parts, 1 << 14)
+}
+
+fn fur_ball_of(width: u32, height: u32, parts: &str, strands: usize) -> SceneDescription {
     let text = format!(
         r#"
 [render]
@@ -41,7 +46,7 @@ shape = "round"
 material = "brown"
 
 [groom.params]
-strands = 16384
+strands = {strands}
 segments = 16
 
 [[light]]
@@ -54,12 +59,15 @@ radiance = [1, 1, 1]
 
 #[test]
 fn a_large_groom_is_built_in_parts_as_the_setting_says() {
-    // 2^18 segments: auto cuts them for 64 camera samples, not for 3 per segment.
+    // 2^20 segments: auto cuts them for 64 camera samples, not for 3 per segment.
+    let (large, small) = (1 << 16, 1 << 14);
+    assert_eq!(parts_built(8, 8, "auto", large), (1 << 20) / (1 << 10));
+    assert_eq!(parts_built(2048, 2048, "auto", large), 0);
+    // 2^18 segments: only `on` cuts them; auto keeps them whole whatever the samples.
     let parts = (1 << 18) / (1 << 10);
-    assert_eq!(parts_built(8, 8, "auto"), parts);
-    assert_eq!(parts_built(1024, 768, "auto"), 0);
-    assert_eq!(parts_built(1024, 768, "on"), parts);
-    assert_eq!(parts_built(8, 8, "off"), 0);
+    assert_eq!(parts_built(8, 8, "auto", small), 0);
+    assert_eq!(parts_built(1024, 768, "on", small), parts);
+    assert_eq!(parts_built(8, 8, "off", small), 0);
 }
 
 /// Parts are built by the render whose rays first reach them, and a render that met a

@@ -54,16 +54,20 @@ fn traced_curves(curves: Curves, auto: bool, view: &DetailView) -> Result<Vec<Cu
     ribbons::share_out(curves, &view.camera, view.height, view.lod_pixels)
 }
 
-/// When the build for a render of `settings` cuts a large groom into parts: for `auto`,
-/// from the whole frame's camera samples (width x height x spp, whatever the crop, so that
-/// every tile of a frame builds alike).
-pub(crate) fn parts_rule(settings: &RenderSettings) -> PartsRule {
-    match settings.curve_parts {
+/// How the build for a render of `settings` makes its scene: a large groom is cut into
+/// parts as `curve_parts` says, for `auto` from the whole frame's camera samples (width x
+/// height x spp, whatever the crop, so that every tile of a frame builds alike).
+pub(crate) fn scene_options(settings: &RenderSettings) -> SceneOptions {
+    let parts = match settings.curve_parts {
         CurveParts::Auto => PartsRule::ForSamples(
             u64::from(settings.width) * u64::from(settings.height) * u64::from(settings.spp),
         ),
         CurveParts::On => PartsRule::Always,
         CurveParts::Off => PartsRule::Never,
+    };
+    SceneOptions {
+        parts,
+        ..SceneOptions::default()
     }
 }
 
@@ -101,7 +105,7 @@ impl Assembly {
     /// for the view, the memory the BVH build and then the render's film
     /// (`renderer::film_bytes`) will need checked against what is available, then the BVH
     /// built (timed as [`Stage::Bvh`] in `stages`), large grooms in parts as `curve_parts`
-    /// says ([`parts_rule`]).
+    /// says ([`scene_options`]).
     pub fn build(
         self,
         device: Arc<Device>,
@@ -111,10 +115,7 @@ impl Assembly {
         stages: &mut StageRunner,
     ) -> Result<Assembled> {
         let film = film_bytes(settings, Aovs::default(), true);
-        let options = SceneOptions {
-            parts: parts_rule(settings),
-            ..SceneOptions::default()
-        };
+        let options = scene_options(settings);
         let mut tracer = TracerBuilder::new(device, options)?;
         let (mut materials, mut built_from, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
         let parts = self.parts.len();
@@ -140,7 +141,7 @@ impl Assembly {
                         let pieces = traced_curves(c, auto, view).map_err(labelled)?;
                         let n = pieces.len();
                         for piece in pieces {
-                            sizes.push(CurvesSize::of(&piece));
+                            sizes.push(CurvesSize::of(&piece, &options));
                             let added = if auto {
                                 tracer.add_view_curves(piece, *view)
                             } else {

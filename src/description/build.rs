@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use glam::{Mat3, Vec3};
 
-use super::assembly::{Assembly, Shape};
+use super::assembly::{Assembly, Shape, scene_options};
 use super::{
     BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
     MeshDesc, MeshSource, SceneDescription, Transform,
@@ -147,6 +147,7 @@ impl SceneDescription {
     pub(crate) fn check_memory(&self, available: Option<u64>) -> Result<()> {
         let film = film_bytes(&self.render, Aovs::default(), true);
         footprint::check_film_fits(film, available).map_err(|e| e.context(&self.origin))?;
+        let options = scene_options(&self.render);
         let (mut sizes, mut conversion) = (Vec::new(), 0);
         for g in &self.grooms {
             let (strands, segments) = match &g.source {
@@ -155,7 +156,7 @@ impl SceneDescription {
                 _ => continue,
             };
             let (strands, segments) = (strands as u64, u64::from(segments));
-            let size = CurvesSize::polylines(strands, segments, g.basis, g.shape.built());
+            let size = CurvesSize::polylines(strands, segments, g.basis, g.shape.built(), &options);
             let points = strands.saturating_mul(segments + 1);
             conversion = conversion.max(footprint::conversion_bytes(points, strands, &size));
             sizes.push(size);
@@ -485,6 +486,7 @@ mod tests {
             16,
             CurveBasis::CatmullRom,
             crate::embree::CurveShape::Round,
+            &scene_options(&big.render),
         )]);
         let gib = format!("{:.1} GiB of memory", needed as f64 / GIB as f64);
         assert!(message.contains(&gib), "{message:?} lacks {gib:?}");

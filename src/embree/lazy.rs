@@ -72,6 +72,10 @@ impl PartBuild {
     }
 
     fn commit(&self) -> Result<RawScene> {
+        #[cfg(test)]
+        if tests::PANIC_IN_BUILD.get() {
+            panic!("a part build's panic, provoked by a test");
+        }
         let scene = new_scene(&self.device, self.flags)?;
         // SAFETY: live scene and committed geometry; the scene retains the geometry, whose
         // buffers outlive it (`LazyPart`'s contract).
@@ -208,14 +212,16 @@ mod tests {
 
     use super::*;
     use crate::embree::geometry::tests::round_in_parts;
-    use crate::embree::{CurveBasis, PARTS_FROM_SEGMENTS, Ray, SceneBuilder, SceneOptions};
+    use crate::embree::{CurveBasis, PARTS_FROM_SEGMENTS, Ray, Scene, SceneBuilder, SceneOptions};
 
-    /// A part whose build fails lets rays through, and the scene says why, so that the
-    /// render that met it fails (`render::renderer`) rather than show a hole.
-    #[test]
-    fn a_part_whose_build_fails_is_reported() {
-        let device = Arc::new(Device::new(Some(1)).unwrap());
-        // Straight strands along y in a row along x, 4 linear segments each.
+    thread_local! {
+        /// Makes the part builds this thread runs panic.
+        pub(super) static PANIC_IN_BUILD: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    }
+
+    /// Straight strands along y in a row along x, 4 linear segments each, in parts, and a
+    /// ray at `x` into them; the last strand is at the returned x.
+    fn row_in_parts(device: &Arc<Device>) -> (Scene, impl Fn(f32) -> Ray, f32) {
         let strands = PARTS_FROM_SEGMENTS / 4;
         let points: Vec<[f32; 4]> = (0..strands * 5)
             .map(|i| [(i / 5) as f32 * 0.1, (i % 5) as f32 * 0.25, 0.0, 0.02])
@@ -223,15 +229,23 @@ mod tests {
         let indices: Vec<u32> = (0..strands as u32)
             .flat_map(|s| (0..4).map(move |j| s * 5 + j))
             .collect();
-        let geometry = round_in_parts(&device, CurveBasis::Linear, points, indices);
+        let geometry = round_in_parts(device, CurveBasis::Linear, points, indices);
         let mut scene = SceneBuilder::new(device.clone(), SceneOptions::default()).unwrap();
         scene.attach(geometry).unwrap();
         let scene = scene.commit(&|_| true).unwrap();
         let ray = |x: f32| Ray::new(Vec3::new(x, 0.5, -1.0), Vec3::Z);
+        (scene, ray, (strands - 1) as f32 * 0.1)
+    }
+
+    /// A part whose build fails lets rays through, and the scene says why, so that the
+    /// render that met it fails (`render::renderer`) rather than show a hole.
+    #[test]
+    fn a_part_whose_build_fails_is_reported() {
+        let device = Arc::new(Device::new(Some(1)).unwrap());
+        let (scene, ray, far) = row_in_parts(&device);
         assert!(scene.intersect(&ray(0.0), None).is_some());
         assert!(scene.check_parts().is_ok());
         device.refuse_allocations(true);
-        let far = (strands - 1) as f32 * 0.1;
         let through = scene.intersect(&ray(far), None);
         device.refuse_allocations(false);
         assert!(through.is_none());
@@ -239,5 +253,25 @@ mod tests {
         assert!(err.to_string().contains("RTC_ERROR_OUT_OF_MEMORY"), "{err}");
         // The part that was built still answers.
         assert!(scene.intersect(&ray(0.0), None).is_some());
+    }
+
+    /// A panic in a part's build stays inside the callback Embree called (it may not
+    /// unwind through Embree's C++ frames): the ray passes through and the scene reports
+    /// the panic, so the render fails, even once a later ray has built the part.
+    #[test]
+    fn a_part_whose_build_panics_is_reported() {
+        let device = Arc::new(Device::new(Some(1)).unwrap());
+        let (scene, ray, far) = row_in_parts(&device);
+        PANIC_IN_BUILD.set(true);
+        let through = scene.intersect(&ray(far), None);
+        PANIC_IN_BUILD.set(false);
+        assert!(through.is_none());
+        let err = scene.check_parts().unwrap_err();
+        assert!(
+            err.to_string().contains("a part's BVH build panicked"),
+            "{err}"
+        );
+        assert!(scene.intersect(&ray(far), None).is_some());
+        assert!(scene.check_parts().is_err());
     }
 }

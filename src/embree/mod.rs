@@ -30,10 +30,10 @@ pub mod sys;
 mod sys;
 
 pub use device::Device;
+#[cfg(test)]
+pub(crate) use geometry::PARTS_FROM_SEGMENTS;
 pub use geometry::{CurveBasis, CurveShape};
-pub(crate) use geometry::{
-    CurveGeometry, CurvePoint, PARTS_FROM_SEGMENTS, TriangleGeometry, padding_for,
-};
+pub(crate) use geometry::{CurveGeometry, CurvePoint, TriangleGeometry, padding_for};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
 pub(crate) use order::{centroid, morton_order};

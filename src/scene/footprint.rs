@@ -11,7 +11,7 @@
 //! [`conversion_bytes`] is the larger of those moments. Level of detail changes only
 //! the sizes it passes in: fewer segments, a cheaper basis or shape per part.
 
-use crate::embree::{CurveBasis, CurveShape, PARTS_FROM_SEGMENTS};
+use crate::embree::{CurveBasis, CurveShape, SceneOptions};
 use crate::error::{Result, invalid_arg};
 use crate::scene::curves::Curves;
 
@@ -29,49 +29,61 @@ pub struct CurvesSize {
     pub control_points: u64,
     pub basis: CurveBasis,
     pub shape: CurveShape,
+    /// Built in parts (`SceneOptions::builds_in_parts`): two more u32 per segment.
+    pub in_parts: bool,
+}
+
+/// Whether a scene built with `options` cuts a geometry of `segments` segments into parts.
+fn in_parts(options: &SceneOptions, segments: u64) -> bool {
+    options.builds_in_parts(usize::try_from(segments).unwrap_or(usize::MAX))
 }
 
 impl CurvesSize {
     /// `strands` polylines of `segments` segments each, laid out for `basis` as
-    /// [`Curves::from_strands`] lays them out.
-    pub fn polylines(strands: u64, segments: u64, basis: CurveBasis, shape: CurveShape) -> Self {
+    /// [`Curves::from_strands`] lays them out, in a scene built with `options`.
+    pub fn polylines(
+        strands: u64,
+        segments: u64,
+        basis: CurveBasis,
+        shape: CurveShape,
+        options: &SceneOptions,
+    ) -> Self {
         let per_strand = match basis {
             CurveBasis::Linear => segments + 1,
             CurveBasis::BSpline | CurveBasis::CatmullRom => segments + 3,
             CurveBasis::Bezier => 3 * segments + 1,
         };
+        let segments = strands.saturating_mul(segments);
         CurvesSize {
             strands,
-            segments: strands.saturating_mul(segments),
+            segments,
             control_points: strands.saturating_mul(per_strand),
             basis,
             shape,
+            in_parts: in_parts(options, segments),
         }
     }
 
-    /// The size of curves already built.
-    pub fn of(curves: &Curves) -> Self {
+    /// The size of curves already converted, in a scene built with `options`.
+    pub fn of(curves: &Curves, options: &SceneOptions) -> Self {
+        let segments = curves.indices().len() as u64;
         CurvesSize {
             strands: curves.strands().strand_count() as u64,
-            segments: curves.indices().len() as u64,
+            segments,
             control_points: curves.vertices().len() as u64,
             basis: curves.basis(),
             shape: curves.shape(),
+            in_parts: in_parts(options, segments),
         }
     }
 
     /// Bytes of the buffers hairtrace keeps for these curves: float4 control points, one
-    /// u32 index per segment (three from [`PARTS_FROM_SEGMENTS`] segments: the index
-    /// buffer in the order of Embree's parts and each of its segments' own number), the strand
-    /// table (two u32 per strand, its first segment and, in spatial order, its number; one
-    /// per 32 segments).
+    /// u32 index per segment (three in parts: the index buffer in the order of Embree's
+    /// parts and each of its segments' own number), the strand table (two u32 per strand,
+    /// its first segment and, in spatial order, its number; one per 32 segments).
     pub fn curve_bytes(&self) -> u64 {
         let points = self.control_points.saturating_mul(16);
-        let indices = if self.segments >= PARTS_FROM_SEGMENTS as u64 {
-            12
-        } else {
-            4
-        };
+        let indices = if self.in_parts { 12 } else { 4 };
         let segments = self.segments.saturating_mul(indices) + self.segments / 8;
         points
             .saturating_add(segments)
@@ -187,4 +199,67 @@ pub fn check_film_fits(bytes: u64, available: Option<u64>) -> Result<()> {
         mib(bytes),
         mib(available)
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::embree::{Device, PartsRule};
+    use crate::scene::FurBall;
+    use crate::scene::tracer::TracerBuilder;
+    use std::sync::Arc;
+
+    fn options(parts: PartsRule) -> SceneOptions {
+        SceneOptions {
+            parts,
+            ..SceneOptions::default()
+        }
+    }
+
+    /// The parts' two u32 per segment are counted where the scene's rule builds the
+    /// geometry in parts, and only there: an `auto` groom under 2^20 segments, or rendered
+    /// with many samples per segment, is built whole.
+    #[test]
+    fn the_parts_are_counted_only_where_the_rule_builds_in_parts() {
+        let bytes = |strands: u64, parts| {
+            let (basis, shape) = (CurveBasis::CatmullRom, CurveShape::Flat);
+            CurvesSize::polylines(strands, 16, basis, shape, &options(parts)).curve_bytes()
+        };
+        let (few_samples, many_samples) =
+            (PartsRule::ForSamples(1), PartsRule::ForSamples(1 << 40));
+        // 2^19 segments: in parts only when asked.
+        let whole = bytes(1 << 15, PartsRule::Never);
+        assert_eq!(bytes(1 << 15, PartsRule::Always) - whole, 8 << 19);
+        assert_eq!(bytes(1 << 15, few_samples), whole);
+        // 2^21 segments: `auto` cuts them for few samples per segment.
+        let whole = bytes(1 << 17, PartsRule::Never);
+        assert_eq!(bytes(1 << 17, few_samples) - whole, 8 << 21);
+        assert_eq!(bytes(1 << 17, many_samples), whole);
+    }
+
+    /// The estimate of the buffers is what a built scene holds, whole and in parts.
+    #[test]
+    fn the_curve_bytes_are_what_a_scene_of_the_curves_holds() {
+        let device = Arc::new(Device::new(Some(2)).unwrap());
+        let ball = FurBall {
+            strands: 1 << 14,
+            segments: 16,
+            ..FurBall::default()
+        };
+        let strands = ball.build().unwrap();
+        for parts in [PartsRule::Never, PartsRule::Always] {
+            // As a build holds them: in spatial order, with each strand's own number.
+            let curves = Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Flat)
+                .and_then(Curves::spatially_ordered)
+                .unwrap();
+            let estimate = CurvesSize::of(&curves, &options(parts)).curve_bytes() as f64;
+            let mut builder = TracerBuilder::new(device.clone(), options(parts)).unwrap();
+            builder.add_curves(curves).unwrap();
+            let held = builder.build().unwrap().heap_bytes() as f64;
+            assert!(
+                (held / estimate - 1.0).abs() < 2e-3,
+                "{parts:?}: {held} against {estimate}"
+            );
+        }
+    }
 }

@@ -347,13 +347,3 @@ fn quote(text: &str) -> String {
         format!("'{}'", text.replace('\'', r"'\''"))
     }
 }
-
-/// Writes `text` to `path` under a temporary name beside it, then renames it: a reader
-/// never sees half a file.
-pub fn write_file(path: &Path, text: &str) -> Result<()> {
-    let io = |e: std::io::Error| Error::io(path, e);
-    let mut file = hairtrace::image::temporary_beside(path).map_err(io)?;
-    std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
-    file.persist(path).map_err(|e| io(e.error))?;
-    Ok(())
-}

@@ -7,6 +7,7 @@
 
 mod export;
 mod farm;
+mod files;
 mod report;
 mod settings;
 
@@ -566,7 +567,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
                 "noise": s.noise,
                 "threads": settings.threads.unwrap_or_else(rayon::current_num_threads),
             });
-            farm::write_file(path, &format!("{json}\n"))?;
+            files::write_file(path, format!("{json}\n"))?;
         }
     }
     Ok(())
@@ -785,7 +786,7 @@ fn farm_job(args: &FarmArgs) -> hairtrace::Result<()> {
         let folder = std::path::absolute(path).map_err(|e| hairtrace::Error::io(path, e))?;
         let folder = folder.parent().unwrap_or(Path::new("/"));
         let (template, undefaulted) = job.openjd(folder);
-        farm::write_file(path, &template)?;
+        files::write_file(path, template)?;
         eprintln!(
             "{}: Open Job Description template ({})",
             path.display(),
@@ -799,7 +800,7 @@ fn farm_job(args: &FarmArgs) -> hairtrace::Result<()> {
         }
     }
     if let Some(path) = &args.slurm {
-        farm::write_file(path, &job.slurm())?;
+        files::write_file(path, job.slurm())?;
         eprintln!(
             "{}: Slurm job script, `bash {}` submits it ({})",
             path.display(),

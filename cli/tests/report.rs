@@ -53,6 +53,12 @@ fn quick_report_is_complete_and_finite() {
         .expect("run hairtrace report");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let text = std::fs::read_to_string(out.join("REPORT.md")).expect("REPORT.md written");
+    // The peers section was not measured in this run, and the header says so.
+    let header = text.lines().nth(2).unwrap();
+    assert!(
+        header.contains("earlier peer benchmark") && header.contains("report_quick_peers.json"),
+        "{header}"
+    );
     for (i, s) in SECTIONS.iter().enumerate() {
         assert!(
             text.contains(&format!("## {}. {s}", i + 1)),
@@ -135,4 +141,37 @@ fn report_without_the_bench_scenes_says_where_they_are() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(err.contains("--scenes"), "{err}");
     assert!(!out.exists(), "wrote {}", out.display());
+}
+
+/// A report killed while it writes a plot (here by the file-size limit, SIGXFSZ, after
+/// 4 kB) leaves no half-written file under a name of the report's: each is written under a
+/// temporary name and renamed once whole.
+#[test]
+fn a_report_killed_while_writing_leaves_no_partial_file() {
+    use std::os::unix::process::ExitStatusExt;
+    let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report_killed");
+    let _ = std::fs::remove_dir_all(&out);
+    let o = Command::new("sh")
+        .args(["-c", "ulimit -f 8 && exec \"$0\" \"$@\""])
+        .arg(env!("CARGO_BIN_EXE_hairtrace"))
+        .args(["report", "--quick", "--scenes"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes"))
+        .arg("-o")
+        .arg(&out)
+        .env_remove("HT_BENCH_VENV")
+        .output()
+        .expect("run hairtrace report");
+    assert_eq!(o.status.signal(), Some(25), "SIGXFSZ: {o:?}");
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    assert!(
+        names.iter().any(|n| n.starts_with('.')),
+        "killed before writing: {names:?}"
+    );
+    for name in names.iter().filter(|n| !n.starts_with('.')) {
+        assert_ne!(name, "REPORT.md");
+        image::open(out.join(name)).unwrap_or_else(|e| panic!("{name} left partial: {e}"));
+    }
 }

@@ -162,8 +162,7 @@ pub fn section(ctx: &Context) -> Result<String> {
         }
         root.present().map_err(|e| fail(&e))?;
     }
-    image::save_buffer(&path, &pixels, sheet_w, sheet_h, image::ColorType::Rgb8)
-        .map_err(|e| fail(&e))?;
+    crate::files::write_png(&path, &pixels, (sheet_w, sheet_h))?;
     ctx.step("gallery: sheet");
     ctx.done();
     let caption = ctx.machine.caption(

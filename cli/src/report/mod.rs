@@ -138,7 +138,7 @@ pub fn run(options: &ReportOptions) -> Result<()> {
     let report = format!(
         "# hairtrace: speed against error\n\n\
          Written by `hairtrace report{}` in {:.0} s on {}. Every figure below was measured \
-         in that run{}.\n{body}",
+         in that run{}.{}\n{body}",
         if ctx.quick { " --quick" } else { "" },
         start.elapsed().as_secs_f64(),
         ctx.machine.describe(),
@@ -148,9 +148,16 @@ pub fn run(options: &ReportOptions) -> Result<()> {
         } else {
             ""
         },
+        match &ctx.peers {
+            Some(peers) => format!(
+                " The peers section reads an earlier peer benchmark's run instead (`{}`).",
+                peers.display()
+            ),
+            None => String::new(),
+        },
     );
     let path = ctx.path("REPORT.md");
-    std::fs::write(&path, report).map_err(|e| Error::io(&path, e))?;
+    crate::files::write_file(&path, report)?;
     eprintln!("{}", path.display());
     Ok(())
 }

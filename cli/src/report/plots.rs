@@ -1,4 +1,4 @@
-//! The report's plots, drawn with plotters into PNG files. Text needs a font: plotters'
+//! The report's plots, drawn with plotters and written as PNG files. Text needs a font: plotters'
 //! `ab_glyph` route takes the bytes of a TrueType file, read here from Debian's
 //! `fonts-dejavu-core` (scripts/setup installs it), so no font is compiled in or shipped.
 
@@ -151,7 +151,21 @@ pub fn log_log(path: &Path, labels: &Labels, series: &[Series]) -> Result<()> {
     };
     let x_range = log_range(all().map(|p| p.0));
     let y_range = log_range(all().map(|p| p.1));
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    let mut rgb = vec![0u8; (SIZE.0 * SIZE.1 * 3) as usize];
+    draw(path, labels, series, &mut rgb, x_range, y_range)?;
+    crate::files::write_png(path, &rgb, SIZE)
+}
+
+/// Draws the plot of [`log_log`] into `rgb`, over `x_range` x `y_range`.
+fn draw(
+    path: &Path,
+    labels: &Labels,
+    series: &[Series],
+    rgb: &mut [u8],
+    x_range: (f64, f64),
+    y_range: (f64, f64),
+) -> Result<()> {
+    let root = BitMapBackend::with_buffer(rgb, SIZE).into_drawing_area();
     root.fill(&WHITE).map_err(|e| plot_error(path, e))?;
     let (upper, foot) = root.split_vertically(SIZE.1 - 44);
     let (plot, legend) = upper.split_horizontally(SIZE.0 - LEGEND_WIDTH);

@@ -1,6 +1,6 @@
 //! Files the command line writes, each whole or not at all: written under a temporary name
-//! beside the path, then renamed, so that a reader (or a job killed part way) never leaves
-//! half a file where a finished one was.
+//! beside the path, then renamed, so that a reader never sees half a file and a job killed
+//! part way leaves none where a finished one was.
 
 use std::path::Path;
 

@@ -1,5 +1,5 @@
-//! The report's plots, drawn with plotters and written as PNG files. Text needs a font: plotters'
-//! `ab_glyph` route takes the bytes of a TrueType file, read here from Debian's
+//! The report's plots, drawn with plotters and written as PNG files. Text needs a font:
+//! plotters' `ab_glyph` route takes the bytes of a TrueType file, read here from Debian's
 //! `fonts-dejavu-core` (scripts/setup installs it), so no font is compiled in or shipped.
 
 use super::markdown::num;

@@ -10,7 +10,8 @@
 //! curve's offset across the chord: at most the larger end offset plus 4/27 of the two end
 //! slopes (an arc's sagitta is overestimated by a fifth). A straight strand is one piece,
 //! a wavy one gets more pieces than segments where it bends; a Catmull-Rom strand whose
-//! segments pass keeps exactly its own points.
+//! segments pass keeps exactly its own points. A strand that would need more than its
+//! budget of pieces stops being cut as soon as it passes it, and stays a curve.
 //!
 //! The ribbons' hits are mapped back to the curve's parameter (`TrueCurves::locate`) and
 //! take its tangent, position along the strand and colours. The image moves by the
@@ -167,58 +168,114 @@ impl Sampler {
     /// strands that stay curves are dropped as they are made, not once every strand is
     /// sampled (at 10^6 strands, a gigabyte at the peak).
     fn strand(&self, curves: &Curves, s: usize, out: &mut Polylines) {
-        let segments: Vec<SegmentCurve> = (curves.strands().first_segment(s))
-            .into_iter()
-            .flat_map(|first| first.prims())
-            .filter_map(|prim| curves.segment_curve(prim))
-            .collect();
-        if segments.is_empty() {
-            out.counts.push(0);
-            out.kept.push(true);
-            return;
-        }
+        let segments = self.segments(curves, s);
+        let most = self.budget.saturating_mul(segments.len()).saturating_add(1);
         let strand = Strand {
             segments: &segments,
             sampler: self,
         };
-        let before = out.points.len();
-        let end = segments.len() as f32;
-        let (root, tip) = (strand.point(0.0), strand.point(end));
-        out.points.push(root.to_array());
-        out.params.push(0.0);
-        strand.refine(0.0, root, end, tip, out);
-        let n = out.points.len() - before;
-        let kept = n <= self.budget.saturating_mul(segments.len()).saturating_add(1);
-        if !kept {
-            out.points.truncate(before);
-            out.params.truncate(before);
+        let points = strand.polyline(out, most);
+        out.counts.push(points.unwrap_or(0) as u32);
+        out.kept.push(points.is_some());
+    }
+
+    /// Strand `s`'s segments, with what the refinement reads at their ends.
+    fn segments(&self, curves: &Curves, s: usize) -> Vec<Segment> {
+        (curves.strands().first_segment(s))
+            .into_iter()
+            .flat_map(|first| first.prims())
+            .filter_map(|prim| curves.segment_curve(prim))
+            .map(|curve| Segment::new(curve, self.eye))
+            .collect()
+    }
+}
+
+/// A segment's curve, with what [`Strand::fits`] reads at its two ends, which the
+/// refinement visits again at each level: computed once.
+struct Segment {
+    curve: SegmentCurve,
+    /// At u = 0 and u = 1: the point, the derivative and the distance from the eye.
+    ends: [End; 2],
+}
+
+#[derive(Clone, Copy)]
+struct End {
+    point: Vec4,
+    derivative: Vec4,
+    eye_distance: f32,
+}
+
+impl Segment {
+    fn new(curve: SegmentCurve, eye: Vec3) -> Self {
+        Segment {
+            curve,
+            ends: [0.0, 1.0].map(|u| End::on(&curve, u, eye)),
         }
-        out.counts.push(if kept { n as u32 } else { 0 });
-        out.kept.push(kept);
+    }
+
+    /// What [`End`] holds at `u`: the stored end where `u` is 0 or 1.
+    fn at(&self, u: f32, eye: Vec3) -> End {
+        match u {
+            0.0 => self.ends[0],
+            1.0 => self.ends[1],
+            _ => End::on(&self.curve, u, eye),
+        }
+    }
+}
+
+impl End {
+    fn on(curve: &SegmentCurve, u: f32, eye: Vec3) -> Self {
+        let point = curve.at(u);
+        End {
+            point,
+            derivative: curve.derivative(u),
+            eye_distance: eye.distance(point.truncate()),
+        }
     }
 }
 
 /// One strand's segments, with the tolerance.
 struct Strand<'a> {
-    segments: &'a [SegmentCurve],
+    segments: &'a [Segment],
     sampler: &'a Sampler,
 }
 
 impl Strand<'_> {
+    /// Appends the strand's polyline to `out` and returns its number of points, or appends
+    /// nothing and returns `None` when it would have more than `most`.
+    fn polyline(&self, out: &mut Polylines, most: usize) -> Option<usize> {
+        if self.segments.is_empty() {
+            return Some(0);
+        }
+        let before = out.points.len();
+        let end = self.segments.len() as f32;
+        let (root, tip) = (self.point(0.0), self.point(end));
+        out.points.push(root.to_array());
+        out.params.push(0.0);
+        if self.refine(0.0, root, end, tip, out, before.saturating_add(most)) {
+            return Some(out.points.len() - before);
+        }
+        out.points.truncate(before);
+        out.params.truncate(before);
+        None
+    }
+
     /// The segment holding parameter `t` (a segment end belongs to the segment it starts,
     /// the tip to the last), and `t`'s parameter in it.
-    fn segment(&self, t: f32) -> (&SegmentCurve, f32) {
+    fn segment(&self, t: f32) -> (&Segment, f32) {
         let j = (t as usize).min(self.segments.len() - 1);
         (&self.segments[j], t - j as f32)
     }
 
     fn point(&self, t: f32) -> Vec4 {
-        let (curve, u) = self.segment(t);
-        curve.at(u)
+        let (segment, u) = self.segment(t);
+        segment.at(u, self.sampler.eye).point
     }
 
-    /// Appends the points after `a` up to `b` (both on the curve, at `pa` and `pb`).
-    fn refine(&self, a: f32, pa: Vec4, b: f32, pb: Vec4, out: &mut Polylines) {
+    /// Appends the points after `a` up to `b` (both on the curve, at `pa` and `pb`), or
+    /// stops, returning false, once `out` would hold more than `most` points: a strand past
+    /// its budget is not refined further (down to `MIN_PIECE`) only to be dropped.
+    fn refine(&self, a: f32, pa: Vec4, b: f32, pb: Vec4, out: &mut Polylines, most: usize) -> bool {
         if b - a > MIN_PIECE && !self.fits(a, pa, b, pb) {
             // Segment ends are whole numbers: cut at the one nearest the middle first.
             let m = if b - a > 1.0 {
@@ -227,12 +284,14 @@ impl Strand<'_> {
                 (a + b) * 0.5
             };
             let pm = self.point(m);
-            self.refine(a, pa, m, pm, out);
-            self.refine(m, pm, b, pb, out);
-            return;
+            return self.refine(a, pa, m, pm, out, most) && self.refine(m, pm, b, pb, out, most);
+        }
+        if out.points.len() >= most {
+            return false;
         }
         out.points.push(pb.to_array());
         out.params.push(b);
+        true
     }
 
     /// Whether the curve from `a` to `b` stays within the tolerance of the chord `pa`-`pb`.
@@ -243,19 +302,16 @@ impl Strand<'_> {
             let v = v.truncate();
             (v - v.dot(along) * along).length()
         };
+        let eye = self.sampler.eye;
         let mut x = a;
         while x < b {
-            let (curve, u0) = self.segment(x);
+            let (segment, u0) = self.segment(x);
             let u1 = u0 + (b - x).min(1.0 - u0);
-            let (c0, c1) = (curve.at(u0), curve.at(u1));
+            let (e0, e1) = (segment.at(u0, eye), segment.at(u1, eye));
             let span = u1 - u0;
-            let offset = across(c0 - pa).max(across(c1 - pa));
-            let slopes = span * (across(curve.derivative(u0)) + across(curve.derivative(u1)));
-            let near = self
-                .sampler
-                .eye
-                .distance(c0.truncate())
-                .min(self.sampler.eye.distance(c1.truncate()));
+            let offset = across(e0.point - pa).max(across(e1.point - pa));
+            let slopes = span * (across(e0.derivative) + across(e1.derivative));
+            let near = e0.eye_distance.min(e1.eye_distance);
             if offset + 4.0 / 27.0 * slopes > self.sampler.per_distance * near {
                 return false;
             }
@@ -482,6 +538,39 @@ mod tests {
             }
         }
         assert!(whole >= 2, "{whole} points at segment ends");
+    }
+
+    /// A strand's refinement stops as soon as its polyline passes the most points it may
+    /// have, leaving nothing, and a strand at exactly that many is refined as without a
+    /// limit.
+    #[test]
+    fn the_refinement_stops_past_the_budget_and_not_at_it() {
+        let curves =
+            Curves::from_strands(&strands(), CurveBasis::CatmullRom, CurveShape::Flat).unwrap();
+        let sampler = Sampler {
+            eye: Vec3::ZERO,
+            per_distance: 0.02 * camera().pixel_spread(HEIGHT),
+            budget: usize::MAX,
+        };
+        for s in 0..3 {
+            let segments = sampler.segments(&curves, s);
+            let strand = Strand {
+                segments: &segments,
+                sampler: &sampler,
+            };
+            let mut free = Polylines::default();
+            let n = strand.polyline(&mut free, usize::MAX).unwrap();
+            assert_eq!(free.points.len(), n);
+            let mut at = Polylines::default();
+            assert_eq!(strand.polyline(&mut at, n), Some(n), "strand {s}");
+            assert_eq!((at.points, at.params), (free.points, free.params));
+            let mut past = Polylines::default();
+            assert_eq!(strand.polyline(&mut past, n - 1), None, "strand {s}");
+            assert!(past.points.is_empty() && past.params.is_empty());
+            // The curly strand has more points than segments: the limit falls inside its
+            // refinement.
+            assert!(s < 2 || n > segments.len(), "strand {s}: {n} points");
+        }
     }
 
     #[test]

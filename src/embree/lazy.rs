@@ -211,8 +211,9 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::embree::geometry::PARTS_FROM_SEGMENTS;
     use crate::embree::geometry::tests::round_in_parts;
-    use crate::embree::{CurveBasis, PARTS_FROM_SEGMENTS, Ray, Scene, SceneBuilder, SceneOptions};
+    use crate::embree::{CurveBasis, Ray, Scene, SceneBuilder, SceneOptions};
 
     thread_local! {
         /// Makes the part builds this thread runs panic.

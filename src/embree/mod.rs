@@ -30,8 +30,6 @@ pub mod sys;
 mod sys;
 
 pub use device::Device;
-#[cfg(test)]
-pub(crate) use geometry::PARTS_FROM_SEGMENTS;
 pub use geometry::{CurveBasis, CurveShape};
 pub(crate) use geometry::{CurveGeometry, CurvePoint, TriangleGeometry, padding_for};
 pub use isa::Isa;

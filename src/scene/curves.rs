@@ -172,10 +172,22 @@ impl StrandIndex {
             .map_or(self.strand_count() - 1, |&s| s as usize);
         let strand = lo + self.segment_starts[lo + 1..=hi].partition_point(|&start| start <= prim);
         let first_prim = self.segment_starts[strand];
+        self.segment(strand, prim - first_prim)
+    }
+
+    /// Segment `segment` of strand `strand` (the last one past it), without a search: a
+    /// hit whose strand is known reads one pair of starts, not the blocks' and a search's
+    /// cache lines (a tenth of the white fur ball's render went on such chains of misses).
+    pub fn segment(&self, strand: usize, segment: u32) -> Option<StrandSegment> {
+        let (&first_prim, &end) = (
+            self.segment_starts.get(strand)?,
+            self.segment_starts.get(strand + 1)?,
+        );
+        let segments = end.checked_sub(first_prim).filter(|&n| n > 0)?;
         Some(StrandSegment {
             strand: strand as u32,
-            segment: prim - first_prim,
-            segments: self.segment_starts[strand + 1] - first_prim,
+            segment: segment.min(segments - 1),
+            segments,
             first_prim,
             id: self.ids.as_ref().map_or(strand as u32, |ids| ids[strand]),
         })
@@ -183,8 +195,7 @@ impl StrandIndex {
 
     /// The first segment of strand `strand`.
     pub fn first_segment(&self, strand: usize) -> Option<StrandSegment> {
-        self.locate(*self.segment_starts.get(strand)?)
-            .filter(|at| at.strand as usize == strand)
+        self.segment(strand, 0)
     }
 
     /// The groom's absorption at parameter u of segment `at`, if it gives one: the colour
@@ -600,14 +611,11 @@ impl TrueCurves {
         let first = first as usize;
         let (a, b) = (*self.params.get(first)?, *self.params.get(first + 1)?);
         let t = a + u.clamp(0.0, 1.0) * (b - a);
-        let starts = &self.curves.strands.segment_starts;
-        let (start, end) = (
-            *starts.get(strand as usize)?,
-            *starts.get(strand as usize + 1)?,
-        );
-        let segment = (t.max(0.0) as u32).min(end.checked_sub(start + 1)?);
-        let at = self.curves.strands.locate(start + segment)?;
-        Some((at, (t - segment as f32).clamp(0.0, 1.0)))
+        let at = self
+            .curves
+            .strands
+            .segment(strand as usize, t.max(0.0) as u32)?;
+        Some((at, (t - at.segment as f32).clamp(0.0, 1.0)))
     }
 
     /// The true curve's derivative at parameter `u` of segment `at`.

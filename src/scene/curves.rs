@@ -176,8 +176,9 @@ impl StrandIndex {
     }
 
     /// Segment `segment` of strand `strand` (the last one past it), without a search: a
-    /// hit whose strand is known reads one pair of starts, not the blocks' and a search's
-    /// cache lines (a tenth of the white fur ball's render went on such chains of misses).
+    /// polyline hit, whose strand is known, reads one pair of starts instead of a block's
+    /// and a search's cache lines (such chains of misses are a fifth of the white fur
+    /// ball's render: docs/measurements.md).
     pub fn segment(&self, strand: usize, segment: u32) -> Option<StrandSegment> {
         let (&first_prim, &end) = (
             self.segment_starts.get(strand)?,
@@ -898,10 +899,19 @@ mod tests {
                         strand as u32
                     )
                 );
+                // The strand's own lookup, without the search, gives the same segment.
+                assert_eq!(index.segment(strand, segment), Some(at));
                 prim += 1;
             }
+            // Past the tip, the last segment: a parameter rounded up at the tip stays on it.
+            let tip = index.segment(strand, n as u32 + 3).unwrap();
+            assert_eq!(
+                (tip.segment, tip.first_prim),
+                (n as u32 - 1, prim - n as u32)
+            );
         }
         assert_eq!(index.locate(prim), None);
+        assert_eq!(index.segment(lengths.len(), 0), None);
     }
 
     #[test]

@@ -3,7 +3,7 @@
 use std::sync::OnceLock;
 use std::time::Instant;
 
-use super::allocation::{self, ALLOCATED};
+use super::allocation;
 use super::film::{Aovs, Film, Keep, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
@@ -186,10 +186,7 @@ pub fn render(
                 None => {
                     pass * PASS_SAMPLES..(pass + 1).saturating_mul(PASS_SAMPLES).min(settings.spp)
                 }
-                Some(shares) => {
-                    let n = shares.of(pixel);
-                    ALLOCATED + (pass - 1) * n..ALLOCATED + pass * n
-                }
+                Some(shares) => shares.indices(pixel, pass),
             };
             let target = match (&mut pilot, round.start) {
                 (Some(pilot), 0) => pilot,

@@ -318,8 +318,9 @@ settings! {
         /// limit.
         time_budget: Option<f32> = None, Range::Above(0.0);
         /// Where samples go: uniform (spp in every pixel) or noise (a pilot pass of 8 spp,
-        /// then each pixel's share in proportion to its noise over the square root of its
-        /// cost, unbiased; the same number of samples over each 16 x 16 block).
+        /// then, where the pilot says it pays, each pixel's share in proportion to its noise
+        /// over the square root of its cost, unbiased; the same number of samples over each
+        /// 16 x 16 block).
         allocation: Allocation = Allocation::Uniform, Range::Any;
         /// The image depends only on the scene, the settings and this seed.
         seed: u64 = 0, Range::Any;
@@ -614,8 +615,8 @@ mod tests {
         );
         r.path.deep_bounce_depth = Some(4);
         r.validate().unwrap();
-        // Sample indices are u32s: past 2^22 spp those of the noise allocation (which
-        // start at 2^31) would wrap around; uniform ones take every spp.
+        // Sample indices are u32s: past 2^22 spp those of the noise allocation (up to a
+        // block's samples a pass in one pixel) could wrap around; uniform ones take every spp.
         let mut r = RenderSettings {
             spp: u32::MAX,
             ..RenderSettings::default()

@@ -839,10 +839,12 @@ typedef struct HtDevice HtDevice;
  * be used concurrently).
  *
  * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
- * later additions, and a rendered scene holds a second copy in Embree's buffers plus the
- * BVH; control points added with `ht_scene_add_curves_xyzr_shared` are never copied, by
- * either. For the largest grooms, share them (or add everything before the first render)
- * and free the scene when done.
+ * later additions. The first render puts the scene's curves in spatial order and shares
+ * their control points with Embree's buffers, so a rendered scene holds one copy of them
+ * plus the BVH (an `auto` groom's level-of-detail ribbons and round/flat shares are
+ * copies of their own), and a rebuild neither sorts nor copies them again. Control points
+ * added with `ht_scene_add_curves_xyzr_shared` are never copied. For the largest grooms,
+ * share them (or add everything before the first render) and free the scene when done.
  */
 typedef struct HtScene HtScene;
 

@@ -48,6 +48,11 @@ impl Error {
     pub fn io(path: &std::path::Path, e: std::io::Error) -> Error {
         Error::Io(format!("{}: {e}", path.display()))
     }
+
+    /// An image `path` could not be encoded or drawn (`e` says why), naming it.
+    pub fn image(path: &std::path::Path, e: impl std::fmt::Display) -> Error {
+        Error::Image(format!("{}: {e}", path.display()))
+    }
 }
 
 /// Shorthand used across the crate.
@@ -83,5 +88,7 @@ mod tests {
         );
         assert_eq!(e.detail(), "/x.hair: gone");
         assert_eq!(e.context("a").to_string(), "i/o error: a: /x.hair: gone");
+        let e = Error::image(std::path::Path::new("/x.png"), "too wide");
+        assert_eq!(e.to_string(), "image error: /x.png: too wide");
     }
 }

@@ -22,6 +22,6 @@ pub fn write_png(path: &Path, rgb: &[u8], (width, height): (u32, u32)) -> Result
     let mut png = Vec::new();
     PngEncoder::new(&mut png)
         .write_image(rgb, width, height, image::ColorType::Rgb8)
-        .map_err(|e| Error::Image(format!("{}: {e}", path.display())))?;
+        .map_err(|e| Error::image(path, e))?;
     write_file(path, png)
 }

@@ -37,10 +37,12 @@ pub struct HtDevice {
 /// be used concurrently).
 ///
 /// Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
-/// later additions, and a rendered scene holds a second copy in Embree's buffers plus the
-/// BVH; control points added with `ht_scene_add_curves_xyzr_shared` are never copied, by
-/// either. For the largest grooms, share them (or add everything before the first render)
-/// and free the scene when done.
+/// later additions. The first render puts the scene's curves in spatial order and shares
+/// their control points with Embree's buffers, so a rendered scene holds one copy of them
+/// plus the BVH (an `auto` groom's level-of-detail ribbons and round/flat shares are
+/// copies of their own), and a rebuild neither sorts nor copies them again. Control points
+/// added with `ht_scene_add_curves_xyzr_shared` are never copied. For the largest grooms,
+/// share them (or add everything before the first render) and free the scene when done.
 pub struct HtScene {
     pub(super) device: Arc<Device>,
     pub(super) materials: Vec<Material>,
@@ -100,7 +102,8 @@ impl HtScene {
     }
 
     /// Adds a geometry; the next render builds again. A mesh is framed by its vertices,
-    /// curves by what `frame_curves` adds from the points the host gave (`Framing`).
+    /// curves by what `frame_curves` adds from the points the host gave (`Framing`). The
+    /// scene keeps the curves [shared](Shape::shared), so that a build's copy costs none.
     pub(super) fn add_geometry(
         &mut self,
         shape: Shape,
@@ -113,7 +116,10 @@ impl HtScene {
             Shape::Mesh(m) => self.framing.add_mesh(&m.positions),
             Shape::Curves(_) | Shape::AutoCurves(_) => frame_curves(&mut self.framing),
         }
-        self.geometries.push(Geometry { shape, material });
+        self.geometries.push(Geometry {
+            shape: shape.shared(),
+            material,
+        });
         self.world = None;
         Ok(id)
     }
@@ -206,7 +212,7 @@ impl HtScene {
             Some(world) if self.lights_changed => world.set_lights(self.lights.clone())?,
             Some(_) => {}
             None => {
-                let mut assembly = Assembly::default();
+                let mut assembly = Assembly::keeping_curves();
                 for g in &self.geometries {
                     let material = self.materials[g.material as usize].clone();
                     assembly.add(g.shape.clone(), material, "");
@@ -218,6 +224,9 @@ impl HtScene {
                     settings,
                     &mut StageRunner::new(progress),
                 )?;
+                for (g, kept) in self.geometries.iter_mut().zip(built.curves) {
+                    kept.into_iter().for_each(|c| g.shape.keep(c));
+                }
                 self.world = Some(built.world);
                 self.built_from = built.built_from;
                 self.built_parts = settings.curve_parts;

@@ -605,7 +605,7 @@ fn shared_xyzr_points_are_checked_then_read_in_place() {
 }
 
 /// Bytes hairtrace holds for a scene of curves: what it keeps to rebuild, and the built
-/// tracer.
+/// tracer (what the two share counted once, `SharedBuffer::heap_bytes`).
 fn held_bytes(scene: &HtScene) -> usize {
     let kept: usize = (scene.geometries.iter())
         .map(|g| match &g.shape {
@@ -616,8 +616,9 @@ fn held_bytes(scene: &HtScene) -> usize {
     kept + scene.world.as_ref().map_or(0, |w| w.tracer.heap_bytes())
 }
 
-/// Memory of a built groom through each entry point: sharing saves the scene's copy of
-/// the control points and the tracer's, and Embree copies them in neither case.
+/// Memory of a built groom through each entry point: sharing saves the one copy of the
+/// control points that the scene and the tracer share, and Embree copies them in neither
+/// case.
 /// `--nocapture` prints bytes per segment.
 #[test]
 fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
@@ -632,24 +633,37 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
         .unwrap();
         let points = xyzr(&strands);
         let desc = xyzr_desc(&points, &strands.counts);
-        let [copied, shared] =
-            [ht_scene_add_curves_xyzr, ht_scene_add_curves_xyzr_shared].map(|add| {
-                let h = Handles::new();
-                let monitor = MemoryMonitor::attach(h.scene().device.clone());
-                let hair = h.hair_material();
-                assert_eq!(add(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
-                let sky = [0.5f32; 3];
-                assert_eq!(
-                    ht_scene_add_environment(h.scene, sky.as_ptr()),
-                    HtStatus::HT_OK
-                );
-                scene_mut(h.scene)
-                    .ok()
-                    .unwrap()
-                    .prepare(&sized(1, 1), &NoStages)
-                    .unwrap();
-                (held_bytes(h.scene()), monitor.current() as usize)
-            });
+        let [copied, shared] = [false, true].map(|host_points| {
+            let add = if host_points {
+                ht_scene_add_curves_xyzr_shared
+            } else {
+                ht_scene_add_curves_xyzr
+            };
+            let h = Handles::new();
+            let monitor = MemoryMonitor::attach(h.scene().device.clone());
+            let hair = h.hair_material();
+            assert_eq!(add(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
+            let sky = [0.5f32; 3];
+            assert_eq!(
+                ht_scene_add_environment(h.scene, sky.as_ptr()),
+                HtStatus::HT_OK
+            );
+            scene_mut(h.scene)
+                .ok()
+                .unwrap()
+                .prepare(&sized(1, 1), &NoStages)
+                .unwrap();
+            let held = held_bytes(h.scene());
+            // The scene's curves and the tracer's read the same points: the host's,
+            // or, copied, one copy in spatial order behind an `Arc`.
+            let Shape::Curves(c) = &h.scene().geometries[0].shape else {
+                panic!("curves expected");
+            };
+            let at = c.vertices().as_ptr();
+            assert_eq!(tracer_points(h.scene()), at);
+            assert_eq!(at.cast() == desc.points, host_points);
+            (held, monitor.current() as usize)
+        });
         let segments = strands.segment_count() as f64;
         let per_segment = |(ours, embree): (usize, usize)| {
             let (o, e) = (ours as f64 / segments, embree as f64 / segments);
@@ -659,8 +673,9 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
         println!("copied: {}", per_segment(copied));
         println!("shared: {}", per_segment(shared));
         let vertex_bytes = (points.len() + padding_for::<[f32; 4]>()) * 16;
-        // The tracer's copy is in spatial order, and names each strand (4 bytes).
-        assert_eq!(copied.0 - shared.0, 2 * vertex_bytes + 4 * STRANDS);
+        // One copy of the points, and the strand tables (the scene's and the tracer's)
+        // name each strand in spatial order: 4 bytes each.
+        assert_eq!(copied.0 - shared.0, vertex_bytes + 2 * 4 * STRANDS);
         // Embree's total varies by a few percent from build to build (its per-thread
         // allocation blocks), far less than a copy of the points would add.
         let embree = copied.1.abs_diff(shared.1);
@@ -671,6 +686,69 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
             shared.1
         );
     }
+}
+
+/// The control points the built tracer's first geometry reads.
+fn tracer_points(scene: &HtScene) -> *const [f32; 4] {
+    let world = scene.world.as_ref().expect("built");
+    match world.tracer.scene().geometry(0) {
+        Some(crate::embree::Geometry::Curves(c)) => c.vertices().as_ptr(),
+        _ => panic!("curves expected"),
+    }
+}
+
+/// The first render orders a copied groom once and keeps it so: a rebuild (here for an
+/// added mesh) traces the same points, neither sorted nor copied again, and gives the
+/// image a scene built once gives.
+#[test]
+fn a_rebuild_reuses_the_ordered_points() {
+    let strands = small_fur();
+    let settings = crate::render::settings::RenderSettings {
+        spp: 2,
+        ..sized(16, 16)
+    };
+    let render = |h: &Handles| {
+        let scene = scene_mut(h.scene).ok().unwrap();
+        let (world, camera) = scene.prepare(&settings, &NoStages).unwrap();
+        let (aovs, quiet) = (crate::render::Aovs::default(), &crate::render::NoProgress);
+        let out = crate::render::renderer::render(world, &camera, &settings, aovs, quiet);
+        (out.unwrap().film.rgb().iter())
+            .map(|v| v.to_bits())
+            .collect::<Vec<_>>()
+    };
+    let h = Handles::new();
+    let hair = h.hair_material();
+    assert_eq!(h.add_strands(&strands, hair), HtStatus::HT_OK);
+    unsafe { ht_scene_add_environment(h.scene, [0.5f32; 3].as_ptr()) };
+    let given = match &h.scene().geometries[0].shape {
+        Shape::Curves(c) => c.vertices().to_vec(),
+        _ => panic!("curves expected"),
+    };
+    render(&h);
+    let ordered = tracer_points(h.scene());
+    let Shape::Curves(kept) = &h.scene().geometries[0].shape else {
+        panic!("curves expected");
+    };
+    assert_eq!(kept.vertices().as_ptr(), ordered);
+    assert_ne!(
+        kept.vertices(),
+        &given[..],
+        "the strands were put in spatial order"
+    );
+
+    let floor = h.diffuse_material([0.5; 3]);
+    assert_eq!(h.add_triangle(floor), HtStatus::HT_OK);
+    assert!(h.scene().world.is_none());
+    let rebuilt = render(&h);
+    assert_eq!(tracer_points(h.scene()), ordered);
+
+    let once = Handles::new();
+    let hair = once.hair_material();
+    assert_eq!(once.add_strands(&strands, hair), HtStatus::HT_OK);
+    unsafe { ht_scene_add_environment(once.scene, [0.5f32; 3].as_ptr()) };
+    let floor = once.diffuse_material([0.5; 3]);
+    assert_eq!(once.add_triangle(floor), HtStatus::HT_OK);
+    assert_eq!(rebuilt, render(&once));
 }
 
 #[test]

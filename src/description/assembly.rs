@@ -42,16 +42,46 @@ impl Shape {
             _ => Shape::Curves(curves),
         }
     }
+
+    /// The same shape, whose clones share its curves' points ([`Curves::shared`]): what
+    /// a caller that builds more than once (a C scene) keeps.
+    pub fn shared(self) -> Shape {
+        match self {
+            Shape::Curves(c) => Shape::Curves(c.shared()),
+            Shape::AutoCurves(c) => Shape::AutoCurves(c.shared()),
+            mesh => mesh,
+        }
+    }
+
+    /// Puts `kept` (these curves as a build gave them back, [`Assembled::curves`]) in the
+    /// place of a curves shape's own; a mesh stays as it is.
+    pub fn keep(&mut self, kept: Curves) {
+        if let Shape::Curves(c) | Shape::AutoCurves(c) = self {
+            *c = kept;
+        }
+    }
 }
 
 /// The curves a part is traced with: in spatial order (`Curves::spatially_ordered`) and,
-/// for an `auto` part, shared out for `view`.
-fn traced_curves(curves: Curves, auto: bool, view: &DetailView) -> Result<Vec<Curves>> {
-    let curves = curves.spatially_ordered()?;
-    if !auto {
-        return Ok(vec![curves]);
+/// for an `auto` part, shared out for `view`; with `keep`, the ordered curves too, their
+/// points shared with what is traced (`Curves::shared`).
+fn traced_curves(
+    curves: Curves,
+    auto: bool,
+    view: &DetailView,
+    keep: bool,
+) -> Result<(Vec<Curves>, Option<Curves>)> {
+    let mut curves = curves.spatially_ordered()?;
+    if keep {
+        curves = curves.shared();
     }
-    ribbons::share_out(curves, &view.camera, view.height, view.lod_pixels)
+    let kept = keep.then(|| curves.clone());
+    let traced = if auto {
+        ribbons::share_out(curves, &view.camera, view.height, view.lod_pixels)?
+    } else {
+        vec![curves]
+    };
+    Ok((traced, kept))
 }
 
 /// How the build for a render of `settings` makes its scene: a large groom is cut into
@@ -75,6 +105,8 @@ pub(crate) fn scene_options(settings: &RenderSettings) -> SceneOptions {
 #[derive(Default)]
 pub(crate) struct Assembly {
     parts: Vec<Part>,
+    /// Give the curves back ordered ([`Assembly::keeping_curves`]).
+    keep_curves: bool,
 }
 
 struct Part {
@@ -89,9 +121,24 @@ struct Part {
 pub(crate) struct Assembled {
     pub world: World,
     pub built_from: Vec<usize>,
+    /// For each part, its curves in spatial order with their points shared with `world`,
+    /// for a caller that builds again; None for a mesh, and for every part unless
+    /// [`Assembly::keeping_curves`].
+    pub curves: Vec<Option<Curves>>,
 }
 
 impl Assembly {
+    /// An assembly whose build gives its curves back ([`Assembled::curves`]): a caller
+    /// that keeps its geometry to build again (a C scene) keeps those instead, and its
+    /// later builds neither sort the strands nor copy their points again. Without it the
+    /// ordered curves live only in the world, as a one-off build wants (a scene file).
+    pub fn keeping_curves() -> Self {
+        Assembly {
+            keep_curves: true,
+            ..Assembly::default()
+        }
+    }
+
     /// Adds a geometry with its material; `label` names it in errors.
     pub fn add(&mut self, shape: Shape, material: Material, label: impl Into<String>) {
         self.parts.push(Part {
@@ -118,6 +165,7 @@ impl Assembly {
         let options = scene_options(settings);
         let mut tracer = TracerBuilder::new(device, options)?;
         let (mut materials, mut built_from, mut sizes) = (Vec::new(), Vec::new(), Vec::new());
+        let mut kept_curves = Vec::new();
         let parts = self.parts.len();
         for (i, part) in self.parts.into_iter().enumerate() {
             let auto = matches!(part.shape, Shape::AutoCurves(_));
@@ -131,6 +179,7 @@ impl Assembly {
             let added = match part.shape {
                 Shape::Mesh(m) => {
                     tracer.add_mesh(m).map_err(labelled)?;
+                    kept_curves.push(None);
                     1
                 }
                 // The build's part of the curves stage, timed with the conversion: the
@@ -138,7 +187,9 @@ impl Assembly {
                 // one cut into parts of its own).
                 Shape::Curves(c) | Shape::AutoCurves(c) => {
                     stages.run(Stage::Curves, (i, parts), |_| {
-                        let pieces = traced_curves(c, auto, view).map_err(labelled)?;
+                        let (pieces, kept) =
+                            traced_curves(c, auto, view, self.keep_curves).map_err(labelled)?;
+                        kept_curves.push(kept);
                         let n = pieces.len();
                         for piece in pieces {
                             sizes.push(CurvesSize::of(&piece, &options));
@@ -170,6 +221,7 @@ impl Assembly {
         Ok(Assembled {
             world: World::new(tracer, materials, lights)?,
             built_from,
+            curves: kept_curves,
         })
     }
 }

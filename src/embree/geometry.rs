@@ -124,6 +124,9 @@ enum Storage<T> {
     Owned(Vec<T>),
     /// Kept alive by the reference count; a slice behind an `Arc` never moves or changes.
     Arc(Arc<[T]>),
+    /// An owned buffer, padding and all, moved behind an `Arc` so that clones share it
+    /// ([`SharedBuffer::into_shared`]).
+    Kept(Arc<Vec<T>>),
     /// Someone else's memory, valid under the contract of [`SharedBuffer::from_raw_parts`].
     Borrowed(NonNull<T>),
 }
@@ -199,6 +202,7 @@ impl<T> SharedBuffer<T> {
     pub(crate) fn as_slice(&self) -> &[T] {
         match &self.storage {
             Storage::Owned(data) => &data[..self.len],
+            Storage::Kept(data) => &data[..self.len],
             Storage::Arc(data) => data,
             // SAFETY: the contract of `from_raw_parts`: aligned, `len` initialised elements,
             // unmodified while `self` lives.
@@ -210,20 +214,37 @@ impl<T> SharedBuffer<T> {
         self.len
     }
 
-    /// Whether the buffer holds its own copy (not memory an `Arc` or a host shares).
-    pub fn is_owned(&self) -> bool {
-        matches!(self.storage, Storage::Owned(_))
+    /// Whether the buffer's memory is hairtrace's own, shared by [`Self::into_shared`] or
+    /// not (rather than an `Arc` a caller made, or a host's).
+    pub fn is_ours(&self) -> bool {
+        matches!(self.storage, Storage::Owned(_) | Storage::Kept(_))
     }
 
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
 
-    /// Heap bytes this buffer allocated, padding and spare capacity included; 0 for memory
-    /// it shares, which its owner (the `Arc`'s creator, the host) accounts for.
+    /// The same buffer, its clones sharing its elements rather than copying them: an
+    /// owned one moved behind an `Arc` (no copy), a shared one as it is.
+    pub fn into_shared(self) -> Self {
+        let storage = match self.storage {
+            Storage::Owned(data) => Storage::Kept(Arc::new(data)),
+            shared => shared,
+        };
+        SharedBuffer {
+            storage,
+            len: self.len,
+        }
+    }
+
+    /// Heap bytes this buffer allocated, padding and spare capacity included: for memory
+    /// it keeps with others ([`Self::into_shared`]), its share, so that the holders' bytes
+    /// add up to it; 0 for memory a caller shares (an `Arc` it made, a host's), which
+    /// that caller accounts for.
     pub fn heap_bytes(&self) -> usize {
         match &self.storage {
             Storage::Owned(data) => data.capacity() * size_of::<T>(),
+            Storage::Kept(data) => data.capacity() * size_of::<T>() / Arc::strong_count(data),
             Storage::Arc(_) | Storage::Borrowed(_) => 0,
         }
     }
@@ -829,6 +850,26 @@ pub(crate) mod tests {
         assert_eq!(b.heap_bytes(), (5 + 2) * 12);
         assert_eq!(padding_for::<[f32; 4]>(), 1);
         assert_eq!(padding_for::<u32>(), 4);
+    }
+
+    /// A buffer made shared keeps its memory, padding and all, and its clones read it.
+    #[test]
+    fn shared_buffers_keep_their_memory_for_their_clones() {
+        let owned = SharedBuffer::new(vec![7u32; 5]);
+        let at = owned.as_ptr();
+        let shared = owned.into_shared();
+        let clone = shared.clone();
+        assert_eq!((shared.as_ptr(), clone.as_ptr()), (at, at));
+        assert_eq!(clone.as_slice(), &[7; 5]);
+        let Storage::Kept(data) = &clone.storage else {
+            panic!("kept behind an Arc")
+        };
+        assert_eq!(data[5..], [0; 4]);
+        assert!(clone.is_ours());
+        assert_eq!(shared.heap_bytes() + clone.heap_bytes(), (5 + 4) * 4);
+        drop(shared);
+        assert_eq!(clone.heap_bytes(), (5 + 4) * 4);
+        assert_eq!(clone.into_shared().as_ptr(), at);
     }
 
     /// The vertex buffer Embree holds for `c`.

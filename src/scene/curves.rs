@@ -54,6 +54,8 @@ pub struct Curves {
     strands: StrandIndex,
     /// The curves these `Curves::polylines` stand for.
     truth: Option<Arc<TrueCurves>>,
+    /// Already in spatial order: [`Curves::spatially_ordered`] keeps them as they are.
+    ordered: bool,
 }
 
 /// Where a primitive sits in its strand.
@@ -303,6 +305,7 @@ impl Curves {
             indices: SharedBuffer::new(indices),
             strands: strand_index,
             truth: None,
+            ordered: false,
         })
     }
 
@@ -361,6 +364,7 @@ impl Curves {
             indices: SharedBuffer::new(indices),
             strands: StrandIndex::new(segments.into_iter(), colors)?,
             truth: None,
+            ordered: false,
         })
     }
 
@@ -387,21 +391,32 @@ impl Curves {
     /// bench scalp's roots follow a low-discrepancy sequence, so consecutive strands are far
     /// apart) misses the cache on each: on the bench scalp the build takes 0.76x the time
     /// at 2.5 x 10^5 strands and 0.6x-0.7x at 10^6 (docs/large-grooms.md). Control points
-    /// shared with the caller (a C host's memory) are kept where they are, as are curves
-    /// already in order.
-    pub fn spatially_ordered(self) -> Result<Curves> {
-        if !self.vertices.is_owned() {
+    /// the caller shares (a C host's memory, an `Arc` it made) are kept where they are, as
+    /// are curves already in order (ordered here before, and kept: a C scene's rebuilds).
+    pub fn spatially_ordered(mut self) -> Result<Curves> {
+        if self.ordered || !self.vertices.is_ours() {
             return Ok(self);
         }
         let order = morton_order(self.strands.strand_count(), |s| {
             centroid(self.strand_points(s))
         })?;
-        if order.windows(2).all(|w| w[0] < w[1]) {
-            return Ok(self);
+        if !order.windows(2).all(|w| w[0] < w[1]) {
+            let order: Vec<usize> = order.into_iter().map(|s| s as usize).collect();
+            if let Some(ordered) = self.gathered(&order, self.shape)? {
+                self = ordered;
+            }
         }
-        let order: Vec<usize> = order.into_iter().map(|s| s as usize).collect();
-        let ordered = self.gathered(&order, self.shape)?;
-        Ok(ordered.unwrap_or(self))
+        self.ordered = true;
+        Ok(self)
+    }
+
+    /// The same curves, whose clones share the control points and the index buffer
+    /// rather than copy them ([`SharedBuffer::into_shared`], no copy here): a C scene
+    /// keeps its curves so, and hands each build a clone that costs no copy.
+    pub fn shared(mut self) -> Curves {
+        self.vertices = self.vertices.into_shared();
+        self.indices = self.indices.into_shared();
+        self
     }
 
     /// The strands `order` names, in that order, drawn with `shape`; each keeps its number

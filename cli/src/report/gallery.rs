@@ -149,7 +149,7 @@ pub fn section(ctx: &Context) -> Result<String> {
     }
     let file = "gallery.png";
     let path = ctx.path(file);
-    let fail = |e: &dyn std::fmt::Display| Error::Image(format!("{}: {e}", path.display()));
+    let fail = |e: &dyn std::fmt::Display| Error::image(&path, e);
     {
         let root = BitMapBackend::with_buffer(&mut pixels, (sheet_w, sheet_h)).into_drawing_area();
         for (text, x, y) in &labels {

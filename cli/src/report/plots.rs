@@ -58,10 +58,6 @@ pub struct Labels<'a> {
     pub caption: &'a str,
 }
 
-fn plot_error(path: &Path, e: impl std::fmt::Display) -> Error {
-    Error::Image(format!("{}: {e}", path.display()))
-}
-
 fn plottable(&(x, y): &(f64, f64)) -> bool {
     x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0
 }
@@ -166,7 +162,7 @@ fn draw(
     y_range: (f64, f64),
 ) -> Result<()> {
     let root = BitMapBackend::with_buffer(rgb, SIZE).into_drawing_area();
-    root.fill(&WHITE).map_err(|e| plot_error(path, e))?;
+    root.fill(&WHITE).map_err(|e| Error::image(path, e))?;
     let (upper, foot) = root.split_vertically(SIZE.1 - 44);
     let (plot, legend) = upper.split_horizontally(SIZE.0 - LEGEND_WIDTH);
     for (i, line) in wrap(labels.caption, 130).iter().enumerate() {
@@ -175,7 +171,7 @@ fn draw(
             &("sans-serif", 13).into_font().color(&BLACK.mix(0.7)),
             (10, 6 + 17 * i as i32),
         )
-        .map_err(|e| plot_error(path, e))?;
+        .map_err(|e| Error::image(path, e))?;
     }
     let mut chart = ChartBuilder::on(&plot)
         .caption(labels.title, ("sans-serif", 20))
@@ -190,7 +186,7 @@ fn draw(
                 .log_scale()
                 .with_key_points(log_ticks(y_range)),
         )
-        .map_err(|e| plot_error(path, e))?;
+        .map_err(|e| Error::image(path, e))?;
     chart
         .configure_mesh()
         .x_desc(labels.x)
@@ -199,7 +195,7 @@ fn draw(
         .y_label_formatter(&|v| num(*v, 1))
         .label_style(("sans-serif", 13))
         .draw()
-        .map_err(|e| plot_error(path, e))?;
+        .map_err(|e| Error::image(path, e))?;
     let shown = series.iter().filter(|s| s.points.iter().any(plottable));
     for (i, s) in shown.enumerate() {
         let color = COLORS[i % COLORS.len()].to_rgba();
@@ -207,22 +203,22 @@ fn draw(
         if s.line {
             chart
                 .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
-                .map_err(|e| plot_error(path, e))?;
+                .map_err(|e| Error::image(path, e))?;
         }
         chart
             .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
-            .map_err(|e| plot_error(path, e))?;
+            .map_err(|e| Error::image(path, e))?;
         let y = 50 + 20 * i as i32;
         legend
             .draw(&Circle::new((12, y), 5, color.filled()))
-            .map_err(|e| plot_error(path, e))?;
+            .map_err(|e| Error::image(path, e))?;
         legend
             .draw_text(
                 &s.name,
                 &("sans-serif", 13).into_font().color(&BLACK),
                 (24, y - 7),
             )
-            .map_err(|e| plot_error(path, e))?;
+            .map_err(|e| Error::image(path, e))?;
     }
-    root.present().map_err(|e| plot_error(path, e))
+    root.present().map_err(|e| Error::image(path, e))
 }

@@ -1,9 +1,10 @@
 //! A C host's scene built and built again: a fur ball of copied xyzr points (10^6 strands
 //! x 16 linear round segments unless `-- STRANDS` says otherwise), then a triangle added
 //! before each of a few more builds (added geometry makes the next build start over).
-//! Prints each `ht_scene_build`'s seconds and the rebuilds' median. What a rebuild costs
-//! beyond Embree's work is the scene's own: ordering the strands, copying them, cutting a
-//! large groom into parts (docs/c-abi.md, "Memory of a scene").
+//! Prints each `ht_scene_build`'s seconds and the rebuilds' median. The first build
+//! orders the strands, cuts the groom into parts and bounds them; the scene keeps all of
+//! it, so a rebuild is left with Embree's top-level scene (docs/large-grooms.md, "A C
+//! scene builds again without sorting or cutting").
 //!
 //! `cargo bench --bench rebuild [-- STRANDS]`
 

@@ -839,12 +839,14 @@ typedef struct HtDevice HtDevice;
  * be used concurrently).
  *
  * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
- * later additions. The first render puts the scene's curves in spatial order and shares
- * their control points with Embree's buffers, so a rendered scene holds one copy of them
- * plus the BVH (an `auto` groom's level-of-detail ribbons and round/flat shares are
- * copies of their own), and a rebuild neither sorts nor copies them again. Control points
- * added with `ht_scene_add_curves_xyzr_shared` are never copied. For the largest grooms,
- * share them (or add everything before the first render) and free the scene when done.
+ * later additions. Its first build (`ht_scene_build` or the first render) puts the
+ * scene's curves in spatial order and shares their control points with Embree's
+ * buffers, so a built scene holds one copy of them plus the BVH (an `auto` groom's
+ * level-of-detail ribbons and round/flat shares are copies of their own), and a rebuild
+ * neither sorts nor copies them again, nor cuts a large groom into parts again. Control
+ * points added with `ht_scene_add_curves_xyzr_shared` are never copied. For the largest
+ * grooms, share them (or add everything before the first render) and free the scene
+ * when done.
  */
 typedef struct HtScene HtScene;
 

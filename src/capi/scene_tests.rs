@@ -690,35 +690,58 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
 
 /// The control points the built tracer's first geometry reads.
 fn tracer_points(scene: &HtScene) -> *const [f32; 4] {
+    tracer_curves(scene).vertices().as_ptr()
+}
+
+/// The built tracer's first geometry.
+fn tracer_curves(scene: &HtScene) -> &crate::embree::CurveGeometry {
     let world = scene.world.as_ref().expect("built");
     match world.tracer.scene().geometry(0) {
-        Some(crate::embree::Geometry::Curves(c)) => c.vertices().as_ptr(),
+        Some(crate::embree::Geometry::Curves(c)) => c,
         _ => panic!("curves expected"),
     }
 }
 
 /// The first render orders a copied groom once and keeps it so: a rebuild (here for an
-/// added mesh) traces the same points, neither sorted nor copied again, and gives the
-/// image a scene built once gives.
+/// added mesh) traces the same points, neither sorted nor copied again, cut into the same
+/// parts where it is large (2^18 segments, `curve_parts = "on"`), and gives the image a
+/// scene built once gives.
 #[test]
 fn a_rebuild_reuses_the_ordered_points() {
-    let strands = small_fur();
-    let settings = crate::render::settings::RenderSettings {
-        spp: 2,
-        ..sized(16, 16)
+    use crate::render::settings::{CurveParts, RenderSettings};
+    let large = FurBall {
+        strands: 1 << 14,
+        segments: 16,
+        ..FurBall::default()
     };
+    for (strands, curve_parts) in [
+        (small_fur(), CurveParts::Auto),
+        (large.build().unwrap(), CurveParts::On),
+    ] {
+        rebuilt_as_built_once(
+            &strands,
+            &RenderSettings {
+                spp: 2,
+                curve_parts,
+                ..sized(16, 16)
+            },
+        );
+    }
+}
+
+fn rebuilt_as_built_once(strands: &Strands, settings: &crate::render::settings::RenderSettings) {
     let render = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
-        let (world, camera) = scene.prepare(&settings, &NoStages).unwrap();
+        let (world, camera) = scene.prepare(settings, &NoStages).unwrap();
         let (aovs, quiet) = (crate::render::Aovs::default(), &crate::render::NoProgress);
-        let out = crate::render::renderer::render(world, &camera, &settings, aovs, quiet);
+        let out = crate::render::renderer::render(world, &camera, settings, aovs, quiet);
         (out.unwrap().film.rgb().iter())
             .map(|v| v.to_bits())
             .collect::<Vec<_>>()
     };
     let h = Handles::new();
     let hair = h.hair_material();
-    assert_eq!(h.add_strands(&strands, hair), HtStatus::HT_OK);
+    assert_eq!(h.add_strands(strands, hair), HtStatus::HT_OK);
     unsafe { ht_scene_add_environment(h.scene, [0.5f32; 3].as_ptr()) };
     let given = match &h.scene().geometries[0].shape {
         Shape::Curves(c) => c.vertices().to_vec(),
@@ -726,6 +749,9 @@ fn a_rebuild_reuses_the_ordered_points() {
     };
     render(&h);
     let ordered = tracer_points(h.scene());
+    let parts = tracer_curves(h.scene()).parts().map(<[_]>::as_ptr);
+    let large = settings.curve_parts == crate::render::settings::CurveParts::On;
+    assert_eq!(parts.is_some(), large);
     let Shape::Curves(kept) = &h.scene().geometries[0].shape else {
         panic!("curves expected");
     };
@@ -741,10 +767,11 @@ fn a_rebuild_reuses_the_ordered_points() {
     assert!(h.scene().world.is_none());
     let rebuilt = render(&h);
     assert_eq!(tracer_points(h.scene()), ordered);
+    assert_eq!(tracer_curves(h.scene()).parts().map(<[_]>::as_ptr), parts);
 
     let once = Handles::new();
     let hair = once.hair_material();
-    assert_eq!(once.add_strands(&strands, hair), HtStatus::HT_OK);
+    assert_eq!(once.add_strands(strands, hair), HtStatus::HT_OK);
     unsafe { ht_scene_add_environment(once.scene, [0.5f32; 3].as_ptr()) };
     let floor = once.diffuse_material([0.5; 3]);
     assert_eq!(once.add_triangle(floor), HtStatus::HT_OK);

@@ -11,14 +11,15 @@
 use std::ffi::c_void;
 use std::ops::Range;
 use std::ptr::NonNull;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::Vec4;
+use rayon::prelude::*;
 
 use super::order::{centroid, median_split};
 use super::{Device, sys};
 use crate::error::invalid_arg;
-use crate::{Error, Result};
+use crate::{Error, Result, threads};
 
 /// How the control points of a curve segment are interpolated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -394,25 +395,77 @@ struct Parts {
     /// The segment, in the geometry's own order, at each position of the part order.
     segments: Box<[u32]>,
     ranges: Box<[Range<u32>]>,
+    /// Each part's bounds ([`hull_bounds`]), in the order of `ranges`.
+    bounds: Box<[Bounds]>,
 }
+
+/// Lower and upper corners of a box.
+pub(super) type Bounds = ([f32; 3], [f32; 3]);
 
 impl Parts {
     fn new(
-        span: usize,
+        basis: CurveBasis,
         vertices: &SharedBuffer<[f32; 4]>,
         indices: &SharedBuffer<u32>,
     ) -> Result<Self> {
         let (points, first) = (vertices.as_slice(), indices.as_slice());
+        let span = basis.points_per_segment();
         let (segments, ranges) = median_split(first.len(), PART_SEGMENTS, |s| {
             let f = first[s] as usize;
             centroid(&points[f..f + span])
         })?;
+        let ordered: Vec<u32> = segments.iter().map(|&s| first[s as usize]).collect();
+        // Every control point is read for them: in parallel.
+        let bounds = threads::scoped(0, || {
+            (ranges.par_iter())
+                .map(|r| hull_bounds(basis, points, &ordered[r.start as usize..r.end as usize]))
+                .collect()
+        })?;
         Ok(Parts {
-            indices: SharedBuffer::new(segments.iter().map(|&s| first[s as usize]).collect()),
+            indices: SharedBuffer::new(ordered),
             segments: segments.into_boxed_slice(),
             ranges: ranges.into_boxed_slice(),
+            bounds,
         })
     }
+}
+
+/// Bounds that hold every surface point of the segments starting at `firsts`: what a
+/// part's scene is entered by before it is built (`lazy.rs`). Each segment lies in the
+/// convex hull of its Bezier control points (a B-spline's or a Catmull-Rom's converted:
+/// much tighter than the hull of the points a B-spline segment reads, which spans three
+/// segments), within its largest Bezier radius of that hull, round or flat; a margin of
+/// 1e-5 of the coordinates covers Embree's rounding.
+fn hull_bounds(basis: CurveBasis, points: &[[f32; 4]], firsts: &[u32]) -> Bounds {
+    let (mut lo, mut hi) = (Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY));
+    let mut radius = 0.0f32;
+    for &first in firsts {
+        let p = |i: usize| Vec4::from_array(points[first as usize + i]);
+        let hull = match basis {
+            CurveBasis::Linear => [p(0), p(1), p(1), p(1)],
+            CurveBasis::Bezier => [p(0), p(1), p(2), p(3)],
+            CurveBasis::BSpline => [
+                (p(0) + 4.0 * p(1) + p(2)) / 6.0,
+                (2.0 * p(1) + p(2)) / 3.0,
+                (p(1) + 2.0 * p(2)) / 3.0,
+                (p(1) + 4.0 * p(2) + p(3)) / 6.0,
+            ],
+            CurveBasis::CatmullRom => [
+                p(1),
+                p(1) + (p(2) - p(0)) / 6.0,
+                p(2) - (p(3) - p(1)) / 6.0,
+                p(2),
+            ],
+        };
+        for h in hull {
+            lo = lo.min(h);
+            hi = hi.max(h);
+            radius = radius.max(h.w.abs());
+        }
+    }
+    let (lo, hi) = (lo.truncate(), hi.truncate());
+    let margin = radius + 1e-5 * lo.abs().max(hi.abs()).max_element();
+    ((lo - margin).to_array(), (hi + margin).to_array())
 }
 
 /// Curves: one Embree curve geometry and the buffers it reads.
@@ -428,7 +481,21 @@ pub struct CurveGeometry {
     mask: u32,
     vertices: SharedBuffer<[f32; 4]>,
     indices: SharedBuffer<u32>,
-    parts: Option<Parts>,
+    parts: Option<Arc<Parts>>,
+}
+
+/// The parts curves were cut into, kept with them for the next geometry over the same
+/// curves (a C scene's rebuild, `Curves::shared`): the median splits are a pure function
+/// of the points and the index buffer, which never change, and took about half of a
+/// rebuild at 10^6 strands. Clones share it; it is equal to any other, since it caches
+/// and does not describe.
+#[derive(Debug, Clone, Default)]
+pub struct PartsCache(Arc<OnceLock<Arc<Parts>>>);
+
+impl PartialEq for PartsCache {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 impl CurveGeometry {
@@ -495,12 +562,24 @@ impl CurveGeometry {
     }
 
     /// The same geometry, cut into parts that a scene builds as scenes of their own when
-    /// it has at least [`PARTS_FROM_SEGMENTS`] segments (else unchanged).
-    pub fn in_parts(mut self) -> Result<Self> {
-        if self.indices.len() >= PARTS_FROM_SEGMENTS {
-            let span = self.basis.points_per_segment();
-            self.parts = Some(Parts::new(span, &self.vertices, &self.indices)?);
+    /// it has at least [`PARTS_FROM_SEGMENTS`] segments (else unchanged): the parts
+    /// `cache` holds, or new ones it then keeps. `cache` is that of the curves this
+    /// geometry reads (`Curves::into_parts`), or a new one.
+    pub fn in_parts(mut self, cache: &PartsCache) -> Result<Self> {
+        if self.indices.len() < PARTS_FROM_SEGMENTS {
+            return Ok(self);
         }
+        let cached = (cache.0.get()).filter(|p| p.segments.len() == self.indices.len());
+        let parts = match cached {
+            Some(parts) => parts.clone(),
+            None => {
+                let parts = Arc::new(Parts::new(self.basis, &self.vertices, &self.indices)?);
+                // Already set (another build got there first): as good as this one.
+                let _ = cache.0.set(parts.clone());
+                parts
+            }
+        };
+        self.parts = Some(parts);
         Ok(self)
     }
 
@@ -537,14 +616,17 @@ impl CurveGeometry {
     #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
         let parts = self.parts.as_ref().map_or(0, |p| {
-            p.indices.heap_bytes() + size_of_val(&*p.segments) + size_of_val(&*p.ranges)
+            p.indices.heap_bytes()
+                + size_of_val(&*p.segments)
+                + size_of_val(&*p.ranges)
+                + size_of_val(&*p.bounds)
         });
         self.vertices.heap_bytes() + self.indices.heap_bytes() + parts
     }
 
     /// The parts a scene builds as scenes of their own ([`PARTS_FROM_SEGMENTS`]), as
     /// ranges of Embree's primitive order; `None` for a geometry built whole.
-    pub(super) fn parts(&self) -> Option<&[Range<u32>]> {
+    pub(crate) fn parts(&self) -> Option<&[Range<u32>]> {
         self.parts.as_ref().map(|p| &*p.ranges)
     }
 
@@ -555,50 +637,9 @@ impl CurveGeometry {
         self.parts.as_ref()?.segments.get(at as usize).copied()
     }
 
-    /// Bounds (lower, upper) that hold every surface point of the segments of `part` (one of
-    /// [`Self::parts`]): what a part's scene is entered by before it is built
-    /// (`lazy.rs`). Each segment lies in the convex hull of its Bezier control points
-    /// (a B-spline's or a Catmull-Rom's converted: much tighter than the hull of the
-    /// points a B-spline segment reads, which spans three segments), within its largest
-    /// Bezier radius of that hull, round or flat; a margin of 1e-5 of the coordinates
-    /// covers Embree's rounding. `None` for a geometry without parts or a range outside
-    /// them.
-    pub(super) fn part_bounds(&self, part: &Range<u32>) -> Option<([f32; 3], [f32; 3])> {
-        let parts = self.parts.as_ref()?;
-        let firsts = parts
-            .indices
-            .as_slice()
-            .get(part.start as usize..part.end as usize)?;
-        let points = self.vertices();
-        let (mut lo, mut hi) = (Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY));
-        let mut radius = 0.0f32;
-        for &first in firsts {
-            let p = |i: usize| Vec4::from_array(points[first as usize + i]);
-            let hull = match self.basis {
-                CurveBasis::Linear => [p(0), p(1), p(1), p(1)],
-                CurveBasis::Bezier => [p(0), p(1), p(2), p(3)],
-                CurveBasis::BSpline => [
-                    (p(0) + 4.0 * p(1) + p(2)) / 6.0,
-                    (2.0 * p(1) + p(2)) / 3.0,
-                    (p(1) + 2.0 * p(2)) / 3.0,
-                    (p(1) + 4.0 * p(2) + p(3)) / 6.0,
-                ],
-                CurveBasis::CatmullRom => [
-                    p(1),
-                    p(1) + (p(2) - p(0)) / 6.0,
-                    p(2) - (p(3) - p(1)) / 6.0,
-                    p(2),
-                ],
-            };
-            for h in hull {
-                lo = lo.min(h);
-                hi = hi.max(h);
-                radius = radius.max(h.w.abs());
-            }
-        }
-        let (lo, hi) = (lo.truncate(), hi.truncate());
-        let margin = radius + 1e-5 * lo.abs().max(hi.abs()).max_element();
-        Some(((lo - margin).to_array(), (hi + margin).to_array()))
+    /// The bounds of each of [`Self::parts`], in their order (`Parts::new`).
+    pub(super) fn part_bounds(&self) -> Option<&[Bounds]> {
+        self.parts.as_ref().map(|p| &*p.bounds)
     }
 
     /// A committed handle on the segments of `part` (one of [`Self::parts`]): the same
@@ -823,7 +864,7 @@ pub(crate) mod tests {
             1,
         )
         .unwrap()
-        .in_parts()
+        .in_parts(&PartsCache::default())
         .unwrap()
     }
 
@@ -1030,6 +1071,42 @@ pub(crate) mod tests {
         }
     }
 
+    /// Parts a cache keeps serve the next geometry over the same curves (a C scene's
+    /// rebuild) as they are, and are the parts that geometry would cut itself.
+    #[test]
+    fn a_cache_gives_the_next_geometry_the_same_parts() {
+        let device = Device::new(Some(2)).unwrap();
+        // Single-segment strands on a scrambled grid, PARTS_FROM_SEGMENTS of them.
+        let n = PARTS_FROM_SEGMENTS as u32;
+        let points: Vec<[f32; 4]> = (0..n)
+            .flat_map(|s| {
+                let cell = (s.wrapping_mul(40503) % n) as f32;
+                [0.0, 1.0].map(|y| [cell % 512.0, y, (cell / 512.0).floor(), 0.01])
+            })
+            .collect();
+        let indices: Vec<u32> = (0..n).map(|s| 2 * s).collect();
+        let (points, indices) = (
+            SharedBuffer::new(points).into_shared(),
+            SharedBuffer::new(indices).into_shared(),
+        );
+        let cut = |cache: &PartsCache| {
+            let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
+            CurveGeometry::new(&device, linear, round, points.clone(), indices.clone(), 1)
+                .and_then(|g| g.in_parts(cache))
+                .unwrap()
+        };
+        let cache = PartsCache::default();
+        let (first, again) = (cut(&cache), cut(&cache.clone()));
+        let parts = |g: &CurveGeometry| g.parts.clone().expect("in parts");
+        assert!(Arc::ptr_eq(&parts(&first), &parts(&again)));
+        let fresh = cut(&PartsCache::default());
+        assert!(!Arc::ptr_eq(&parts(&fresh), &parts(&again)));
+        assert_eq!(fresh.parts(), again.parts());
+        assert_eq!(fresh.part_bounds(), again.part_bounds());
+        assert_eq!(parts(&fresh).segments, parts(&again).segments);
+        assert_eq!(parts(&fresh).indices, parts(&again).indices);
+    }
+
     /// A geometry of `PARTS_FROM_SEGMENTS` segments or more is built in parts, each a
     /// scene of its own, yet every hit and every exclusion names segments in the
     /// geometry's own order: each hit lies on the segment it names, and excluding that
@@ -1109,7 +1186,7 @@ pub(crate) mod tests {
         let v = SharedBuffer::new(vec![[0.0, 0.0, 0.0, 0.1]; 2]);
         let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
         let small = CurveGeometry::new(&device, linear, round, v, vec![0].into(), 1).unwrap();
-        let small = small.in_parts().unwrap();
+        let small = small.in_parts(&PartsCache::default()).unwrap();
         assert!(small.parts().is_none());
     }
 
@@ -1141,8 +1218,8 @@ pub(crate) mod tests {
             let geometry = round_in_parts(&device, basis, points, indices);
             let parts = geometry.parts.as_ref().unwrap();
             let mut widest = 0.0f32;
-            for range in geometry.parts().unwrap() {
-                let (lo, hi) = geometry.part_bounds(range).unwrap();
+            let bounds = geometry.part_bounds().unwrap();
+            for (range, &(lo, hi)) in geometry.parts().unwrap().iter().zip(bounds) {
                 let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
                 for at in range.clone().step_by(7) {
                     let segment = parts.segments[at as usize];

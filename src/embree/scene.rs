@@ -7,15 +7,13 @@
 
 use std::sync::Arc;
 
-use rayon::prelude::*;
-
 use super::compat::FILTER_SCENE_FLAG;
 use super::geometry::Geometry;
 use super::lazy::LazyPart;
 use super::raw_scene::{RawScene, new_scene};
 use super::{Device, sys};
 use crate::error::invalid_arg;
-use crate::{Error, Result, threads};
+use crate::{Error, Result};
 
 /// How a scene is built. Embree's build quality stays at its default (binned SAH): Low,
 /// High and `RTC_SCENE_FLAG_ROBUST` measured within 3% of it on fur grooms, so they are
@@ -168,16 +166,13 @@ impl SceneBuilder {
         let geometry = geometry.into();
         let id = embree_id(self.geometries.len())?;
         match &geometry {
-            Geometry::Curves(c) if let Some(parts) = c.parts() => {
-                // Every control point is read for them: in parallel.
-                let bounds: Vec<_> =
-                    threads::scoped(0, || parts.par_iter().map(|r| c.part_bounds(r)).collect())?;
-                for (range, bounds) in parts.iter().zip(bounds) {
+            Geometry::Curves(c)
+                if let (Some(parts), Some(bounds)) = (c.parts(), c.part_bounds()) =>
+            {
+                for (range, &bounds) in parts.iter().zip(bounds) {
                     // SAFETY: the part's handle is kept in `self.parts`, released before
                     // `self.geometries` (field order, here and in `Scene`).
                     let geometry = unsafe { c.part_geometry(&self.device, range) }?;
-                    let bounds =
-                        bounds.ok_or_else(|| invalid_arg!("part {range:?} out of range"))?;
                     let flags = self.options.flags();
                     // SAFETY: as above: the part is released before the geometry.
                     let part =

@@ -32,8 +32,8 @@ const FLOOR: f64 = 0.1;
 const MIN_GAIN: f64 = 1.3;
 
 /// The most spp a render with this allocation takes (`RenderSettings::validate`): a pass
-/// gives a pixel at most a whole block's samples, 2^11, so its sample indices stay below
-/// 2^30, within a u32.
+/// gives a pixel at most its colour's half of a block's samples (128 pixels x 8, 2^10),
+/// so over 2^19 passes its sample indices stay below 2^29 plus the pilot's, within a u32.
 pub const MOST_SPP: u32 = 1 << 22;
 
 /// `crop` grown to whole blocks, inside the `width` x `height` frame: the pilot's window.

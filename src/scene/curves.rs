@@ -38,7 +38,9 @@ use std::sync::Arc;
 use glam::{Vec3, Vec4};
 
 use crate::bsdf::sigma_a_from_melanin;
-use crate::embree::{CurveBasis, CurveShape, SharedBuffer, centroid, morton_order, padding_for};
+use crate::embree::{
+    CurveBasis, CurveShape, PartsCache, SharedBuffer, centroid, morton_order, padding_for,
+};
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
 use crate::scene::material::HairColor;
@@ -56,6 +58,8 @@ pub struct Curves {
     truth: Option<Arc<TrueCurves>>,
     /// Already in spatial order: [`Curves::spatially_ordered`] keeps them as they are.
     ordered: bool,
+    /// The parts Embree's geometry over these curves was cut into, for the next one.
+    parts: PartsCache,
 }
 
 /// Where a primitive sits in its strand.
@@ -306,6 +310,7 @@ impl Curves {
             strands: strand_index,
             truth: None,
             ordered: false,
+            parts: PartsCache::default(),
         })
     }
 
@@ -365,6 +370,7 @@ impl Curves {
             strands: StrandIndex::new(segments.into_iter(), colors)?,
             truth: None,
             ordered: false,
+            parts: PartsCache::default(),
         })
     }
 
@@ -586,12 +592,13 @@ impl Curves {
             self.indices,
             self.strands,
             self.truth,
+            self.parts,
         )
     }
 }
 
 /// What [`Curves::into_parts`] gives: basis, shape, control points, index buffer, the
-/// strand table and the true curves of a polyline.
+/// strand table, the true curves of a polyline and the cache of Embree's parts.
 pub(crate) type CurveParts = (
     CurveBasis,
     CurveShape,
@@ -599,6 +606,7 @@ pub(crate) type CurveParts = (
     SharedBuffer<u32>,
     StrandIndex,
     Option<Arc<TrueCurves>>,
+    PartsCache,
 );
 
 /// The curves that `Curves::polylines` stand for, and where each polyline point lies on

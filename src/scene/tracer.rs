@@ -103,7 +103,7 @@ impl TracerBuilder {
 
     /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
     pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
-        let (basis, shape, vertices, indices, strands, truth) = curves.into_parts();
+        let (basis, shape, vertices, indices, strands, truth, parts) = curves.into_parts();
         let in_parts = self.scene.options().builds_in_parts(indices.len());
         let geometry = CurveGeometry::new(
             self.scene.device(),
@@ -114,7 +114,7 @@ impl TracerBuilder {
             HAIR_MASK,
         )?;
         let geometry = if in_parts {
-            geometry.in_parts()?
+            geometry.in_parts(&parts)?
         } else {
             geometry
         };

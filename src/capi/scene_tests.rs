@@ -643,11 +643,7 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
             let monitor = MemoryMonitor::attach(h.scene().device.clone());
             let hair = h.hair_material();
             assert_eq!(add(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
-            let sky = [0.5f32; 3];
-            assert_eq!(
-                ht_scene_add_environment(h.scene, sky.as_ptr()),
-                HtStatus::HT_OK
-            );
+            add_sky(&h);
             scene_mut(h.scene)
                 .ok()
                 .unwrap()
@@ -729,6 +725,13 @@ fn a_rebuild_reuses_the_ordered_points() {
     }
 }
 
+/// A uniform grey sky.
+fn add_sky(h: &Handles) {
+    // SAFETY: a live scene and three floats.
+    let status = unsafe { ht_scene_add_environment(h.scene, [0.5f32; 3].as_ptr()) };
+    assert_eq!(status, HtStatus::HT_OK);
+}
+
 fn rebuilt_as_built_once(strands: &Strands, settings: &crate::render::settings::RenderSettings) {
     let render = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
@@ -742,7 +745,7 @@ fn rebuilt_as_built_once(strands: &Strands, settings: &crate::render::settings::
     let h = Handles::new();
     let hair = h.hair_material();
     assert_eq!(h.add_strands(strands, hair), HtStatus::HT_OK);
-    unsafe { ht_scene_add_environment(h.scene, [0.5f32; 3].as_ptr()) };
+    add_sky(&h);
     let given = match &h.scene().geometries[0].shape {
         Shape::Curves(c) => c.vertices().to_vec(),
         _ => panic!("curves expected"),
@@ -772,7 +775,7 @@ fn rebuilt_as_built_once(strands: &Strands, settings: &crate::render::settings::
     let once = Handles::new();
     let hair = once.hair_material();
     assert_eq!(once.add_strands(strands, hair), HtStatus::HT_OK);
-    unsafe { ht_scene_add_environment(once.scene, [0.5f32; 3].as_ptr()) };
+    add_sky(&once);
     let floor = once.diffuse_material([0.5; 3]);
     assert_eq!(once.add_triangle(floor), HtStatus::HT_OK);
     assert_eq!(rebuilt, render(&once));

@@ -227,7 +227,9 @@ impl HtScene {
                     &mut StageRunner::new(progress),
                 )?;
                 for (g, kept) in self.geometries.iter_mut().zip(built.curves) {
-                    kept.into_iter().for_each(|c| g.shape.keep(c));
+                    if let Some(curves) = kept {
+                        g.shape.keep(curves);
+                    }
                 }
                 self.world = Some(built.world);
                 self.built_from = built.built_from;

@@ -37,6 +37,7 @@ use std::sync::Arc;
 
 use glam::{Vec3, Vec4};
 
+use super::ragged;
 use crate::bsdf::sigma_a_from_melanin;
 use crate::embree::{
     CurveBasis, CurveShape, PartsCache, SharedBuffer, centroid, morton_order, padding_for,
@@ -243,7 +244,8 @@ impl StrandIndex {
 
 impl Curves {
     /// Converts strands (radii, not diameters) for `basis`; see the module notes for what
-    /// each basis makes of the points. Copies the points once, into the buffer Embree reads.
+    /// each basis makes of the points. Copies the points once, into the buffer Embree reads,
+    /// strands in parallel.
     pub fn from_strands(strands: &Strands, basis: CurveBasis, shape: CurveShape) -> Result<Self> {
         strands.validate()?;
         let phantom = usize::from(basis != CurveBasis::Linear);
@@ -252,14 +254,11 @@ impl Curves {
             CurveBasis::BSpline | CurveBasis::CatmullRom => n + 2,
             CurveBasis::Bezier => 3 * (n - 1) + 1,
         };
-        let total: usize = strands.counts.iter().map(|&n| per_strand(n as usize)).sum();
-        check_vertex_count(total)?;
-        let mut vertices = Vec::with_capacity(total + padding_for::<[f32; 4]>());
-        let segments = strands.segment_count();
-        let mut indices = Vec::with_capacity(segments + padding_for::<u32>());
-
-        for (start, &n) in strands.offsets().zip(&strands.counts) {
-            let n = n as usize;
+        let laid_out = ragged::starts(strands.counts.iter().map(|&n| per_strand(n as usize)));
+        check_vertex_count(laid_out.last().copied().unwrap_or(0))?;
+        let first_point = ragged::starts(strands.counts.iter().map(|&n| n as usize));
+        let vertices = ragged::filled(&laid_out, padding_for::<[f32; 4]>(), |s, out| {
+            let (start, n) = (first_point[s], strands.counts[s] as usize);
             let point = |i: usize| {
                 let [x, y, z] = strands.points[start + i];
                 [x, y, z, strands.radii[start + i]]
@@ -274,15 +273,15 @@ impl Curves {
                 k if k == n + 1 => reflect(n - 1, n - 2),
                 k => point(k - 1),
             };
-            let base = vertices.len() as u32;
             match basis {
                 CurveBasis::Linear | CurveBasis::BSpline | CurveBasis::CatmullRom => {
-                    vertices.extend((1 - phantom..n + 1 + phantom).map(ext));
-                    indices.extend((0..n as u32 - 1).map(|i| base + i));
+                    for (k, o) in out.iter_mut().enumerate() {
+                        *o = ext(k + 1 - phantom);
+                    }
                 }
                 CurveBasis::Bezier => {
-                    vertices.push(ext(1));
-                    for i in 1..n {
+                    out[0] = ext(1);
+                    for (i, o) in (1..n).zip(out[1..].chunks_exact_mut(3)) {
                         let (pm, p0, p1, p2) = (ext(i - 1), ext(i), ext(i + 1), ext(i + 2));
                         let mut b1: [f32; 4] =
                             std::array::from_fn(|c| p0[c] + (p1[c] - pm[c]) / 6.0);
@@ -292,26 +291,18 @@ impl Curves {
                         // keep the interpolated radius >= 0, as Embree requires.
                         b1[3] = b1[3].max(0.0);
                         b2[3] = b2[3].max(0.0);
-                        vertices.extend([b1, b2, p1]);
+                        o.copy_from_slice(&[b1, b2, p1]);
                     }
-                    indices.extend((0..n as u32 - 1).map(|i| base + 3 * i));
                 }
             }
-        }
-        let strand_index = StrandIndex::new(
-            strands.counts.iter().map(|&n| n as usize - 1),
+        })?;
+        Self::assembled(
+            vertices.into(),
+            &laid_out,
             strands.colors.clone(),
-        )?;
-        Ok(Curves {
             basis,
             shape,
-            vertices: SharedBuffer::new(vertices),
-            indices: SharedBuffer::new(indices),
-            strands: strand_index,
-            truth: None,
-            ordered: false,
-            parts: PartsCache::default(),
-        })
+        )
     }
 
     /// Control points already laid out for `basis`, `counts[i]` of them for strand i, read by
@@ -346,28 +337,42 @@ impl Curves {
                 points[i]
             ));
         }
-        let mut segments = Vec::with_capacity(counts.len());
-        for (s, &n) in counts.iter().enumerate() {
-            segments.push(basis.segments_for(n as usize).ok_or_else(|| {
-                invalid_arg!(
-                    "strand {s} has {n} control points, which is not a whole number of \
-                     {basis:?} segments"
-                )
-            })?);
+        let starts = ragged::starts(counts.iter().map(|&n| n as usize));
+        Self::assembled(vertices, &starts, colors, basis, shape)
+    }
+
+    /// Curves over control points already checked, strand s's at `starts[s]..starts[s + 1]`
+    /// ([`ragged::starts`]): their index buffer (each strand's in parallel) and strand table.
+    fn assembled(
+        vertices: SharedBuffer<[f32; 4]>,
+        starts: &[usize],
+        colors: Option<Vec<[f32; 3]>>,
+        basis: CurveBasis,
+        shape: CurveShape,
+    ) -> Result<Self> {
+        let count = |s: usize| starts[s + 1] - starts[s];
+        let strands = starts.len().saturating_sub(1);
+        if let Some(s) = (0..strands).find(|&s| basis.segments_for(count(s)).is_none()) {
+            return Err(invalid_arg!(
+                "strand {s} has {} control points, which is not a whole number of {basis:?} \
+                 segments",
+                count(s)
+            ));
         }
-        let mut indices = Vec::with_capacity(segments.iter().sum::<usize>() + padding_for::<u32>());
+        let segments = |s: usize| basis.segments_for(count(s)).unwrap_or(0);
         let stride = basis.segment_stride() as u32;
-        let mut base = 0u32;
-        for (&n, &count) in segments.iter().zip(counts) {
-            indices.extend((0..n as u32).map(|i| base + stride * i));
-            base += count;
-        }
+        let firsts = ragged::starts((0..strands).map(segments));
+        let indices = ragged::filled(&firsts, padding_for::<u32>(), |s, out| {
+            for (i, o) in (0u32..).zip(out) {
+                *o = starts[s] as u32 + stride * i;
+            }
+        })?;
         Ok(Curves {
             basis,
             shape,
             vertices,
             indices: SharedBuffer::new(indices),
-            strands: StrandIndex::new(segments.into_iter(), colors)?,
+            strands: StrandIndex::new((0..strands).map(segments), colors)?,
             truth: None,
             ordered: false,
             parts: PartsCache::default(),
@@ -408,7 +413,8 @@ impl Curves {
         })?;
         if !order.windows(2).all(|w| w[0] < w[1]) {
             let order: Vec<usize> = order.into_iter().map(|s| s as usize).collect();
-            if let Some(ordered) = self.gathered(&order, self.shape)? {
+            let g = self.gathered(&order, self.shape)?;
+            if let Some(ordered) = g {
                 self = ordered;
             }
         }
@@ -426,41 +432,40 @@ impl Curves {
     }
 
     /// The strands `order` names, in that order, drawn with `shape`; each keeps its number
-    /// here as its [`StrandSegment::id`]. None when `order` is empty.
+    /// here as its [`StrandSegment::id`]. None when `order` is empty. The points were checked
+    /// when these curves were made: they are copied as they are, strands in parallel.
     fn gathered(&self, order: &[usize], shape: CurveShape) -> Result<Option<Curves>> {
-        let starts = &self.strands.segment_starts;
-        let points: usize = order.iter().map(|&s| self.strand_points(s).len()).sum();
-        let mut vertices = Vec::with_capacity(points + padding_for::<[f32; 4]>());
-        let (mut counts, mut ids) = (
-            Vec::with_capacity(order.len()),
-            Vec::with_capacity(order.len()),
-        );
-        let (mut colors, mut melanin) = (Vec::new(), Vec::new());
-        for &s in order {
-            let (a, b) = (starts[s] as usize, starts[s + 1] as usize);
-            let points = self.strand_points(s);
-            counts.push(points.len() as u32);
-            vertices.extend_from_slice(points);
-            ids.push(self.strands.ids.as_ref().map_or(s as u32, |i| i[s]));
-            match &self.strands.absorption {
-                // Segments + 1 colours per strand: s strands' extra ones come before.
-                Some(GroomAbsorption::Colors(all)) => {
-                    colors.extend_from_slice(&all[a + s..b + s + 1]);
-                }
-                Some(GroomAbsorption::Melanin(all)) => melanin.push(all[s]),
-                None => {}
-            }
-        }
-        if counts.is_empty() {
+        if order.is_empty() {
             return Ok(None);
         }
-        let colors =
-            matches!(self.strands.absorption, Some(GroomAbsorption::Colors(_))).then_some(colors);
-        let mut part = Curves::from_control_points(vertices, &counts, colors, self.basis, shape)?;
-        if matches!(self.strands.absorption, Some(GroomAbsorption::Melanin(_))) {
-            part = part.with_melanin(melanin)?;
+        let starts = &self.strands.segment_starts;
+        let sizes = ragged::starts(order.iter().map(|&s| self.strand_points(s).len()));
+        let vertices = ragged::filled(&sizes, padding_for::<[f32; 4]>(), |i, out| {
+            out.copy_from_slice(self.strand_points(order[i]));
+        })?;
+        let colors = match &self.strands.absorption {
+            // Segments + 1 colours per strand: s strands' extra ones come before.
+            Some(GroomAbsorption::Colors(all)) => {
+                let first = |s: usize| starts[s] as usize + s;
+                let sizes = ragged::starts(order.iter().map(|&s| first(s + 1) - first(s)));
+                Some(ragged::filled(&sizes, 0, |i, out| {
+                    let s = order[i];
+                    out.copy_from_slice(&all[first(s)..first(s + 1)]);
+                })?)
+            }
+            _ => None,
+        };
+        let mut part = Curves::assembled(vertices.into(), &sizes, colors, self.basis, shape)?;
+        if let Some(GroomAbsorption::Melanin(all)) = &self.strands.absorption {
+            part = part.with_melanin(order.iter().map(|&s| all[s]).collect())?;
         }
-        part.strands.ids = Some(ids);
+        let ids = self.strands.ids.as_ref();
+        part.strands.ids = Some(
+            order
+                .iter()
+                .map(|&s| ids.map_or(s as u32, |i| i[s]))
+                .collect(),
+        );
         Ok(Some(part))
     }
 
@@ -854,6 +859,51 @@ mod tests {
         assert_eq!(kept.strands().first_segment(1).unwrap().id, 1);
         let owned = linear(SharedBuffer::from(shared.to_vec()));
         assert_ne!(owned.strands().first_segment(1).unwrap().id, 1);
+    }
+
+    #[test]
+    fn many_strands_convert_and_reorder_as_each_strand_alone() {
+        // More strands than one thread's share (`ragged`), of 2 to 5 points each, scattered
+        // so that the spatial order moves them.
+        let counts: Vec<u32> = (0..10_000).map(|s| 2 + s % 4).collect();
+        let total: usize = counts.iter().map(|&n| n as usize).sum();
+        let points: Vec<[f32; 3]> = (0..total)
+            .map(|i| {
+                let h = (i as u32).wrapping_mul(2_654_435_761);
+                [(h % 1000) as f32, (h / 1000 % 1000) as f32, i as f32 * 1e-3]
+            })
+            .collect();
+        let s = Strands {
+            radii: (0..total).map(|i| 0.01 + (i % 7) as f32 * 1e-3).collect(),
+            colors: Some((0..total).map(|i| [(i % 11) as f32 / 11.0; 3]).collect()),
+            counts: counts.clone(),
+            points,
+        };
+        let first: Vec<usize> = ragged::starts(counts.iter().map(|&n| n as usize));
+        for basis in CurveBasis::ALL {
+            let whole = Curves::from_strands(&s, basis, CurveShape::Round).unwrap();
+            for k in [0, 1, 4095, 4096, 4097, 9999] {
+                let (a, b) = (first[k], first[k + 1]);
+                let alone = Strands {
+                    points: s.points[a..b].to_vec(),
+                    radii: s.radii[a..b].to_vec(),
+                    counts: vec![counts[k]],
+                    colors: None,
+                };
+                let alone = Curves::from_strands(&alone, basis, CurveShape::Round).unwrap();
+                assert_eq!(
+                    whole.strand_points(k),
+                    alone.strand_points(0),
+                    "{basis:?} {k}"
+                );
+            }
+            let ordered = whole.clone().spatially_ordered().unwrap();
+            let order: Vec<usize> = (0..counts.len())
+                .map(|k| ordered.strands().first_segment(k).unwrap().id as usize)
+                .collect();
+            assert_ne!(order, (0..counts.len()).collect::<Vec<_>>());
+            carries(&whole, &ordered, &order);
+        }
     }
 
     /// `part`'s strand k is `whole`'s strand `order[k]`: its points, its number, its

@@ -22,6 +22,7 @@ pub(crate) mod light_sample;
 pub(crate) mod lod;
 pub(crate) mod material;
 pub(crate) mod mesh;
+mod ragged;
 pub(crate) mod ribbons;
 pub(crate) mod shapes;
 pub(crate) mod stages;

@@ -413,8 +413,7 @@ impl Curves {
         })?;
         if !order.windows(2).all(|w| w[0] < w[1]) {
             let order: Vec<usize> = order.into_iter().map(|s| s as usize).collect();
-            let g = self.gathered(&order, self.shape)?;
-            if let Some(ordered) = g {
+            if let Some(ordered) = self.gathered(&order, self.shape)? {
                 self = ordered;
             }
         }

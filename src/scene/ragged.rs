@@ -24,9 +24,10 @@ pub(crate) fn starts(lengths: impl Iterator<Item = usize>) -> Vec<usize> {
 
 /// The array of `starts` (from [`starts`]) with `spare` elements of spare capacity, item
 /// `i`'s elements `starts[i]..starts[i + 1]` written by `fill(i, ..)`, items in parallel
-/// on threads of the library's own ([`threads::scoped`]). It starts zeroed, from fresh
-/// pages where it is large, so each page is first touched by the thread that fills it.
-/// Fails only if the threads cannot start.
+/// on threads of the library's own ([`threads::scoped`]) when there are more than one
+/// task's [`GRAIN`] (fewer are not worth starting threads for). It starts zeroed, from
+/// fresh pages where it is large, so each page is first touched by the thread that fills
+/// it. Fails only if the threads cannot start.
 pub(crate) fn filled<T: Copy + Default + Send>(
     starts: &[usize],
     spare: usize,
@@ -35,9 +36,11 @@ pub(crate) fn filled<T: Copy + Default + Send>(
     let len = starts.last().copied().unwrap_or(0);
     let mut out = vec![T::default(); len + spare];
     out.truncate(len);
-    if starts.len() > 1 {
-        let items = 0..starts.len() - 1;
+    let items = 0..starts.len().saturating_sub(1);
+    if items.len() > GRAIN {
         threads::scoped(0, || fill_items(items, starts, &mut out, &fill))?;
+    } else if !items.is_empty() {
+        fill_items(items, starts, &mut out, &fill);
     }
     Ok(out)
 }

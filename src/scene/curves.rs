@@ -319,8 +319,9 @@ impl Curves {
     ) -> Result<Self> {
         let vertices = vertices.into();
         let points = vertices.as_slice();
-        let total: u64 = counts.iter().map(|&c| u64::from(c)).sum();
-        if total != points.len() as u64 {
+        let starts = ragged::starts(counts.iter().map(|&n| n as usize));
+        let total = starts.last().copied().unwrap_or(0);
+        if total != points.len() {
             return Err(invalid_arg!(
                 "strand counts add up to {total} control points but {} are given",
                 points.len()
@@ -337,7 +338,6 @@ impl Curves {
                 points[i]
             ));
         }
-        let starts = ragged::starts(counts.iter().map(|&n| n as usize));
         Self::assembled(vertices, &starts, colors, basis, shape)
     }
 

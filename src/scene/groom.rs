@@ -4,14 +4,17 @@
 //! Strands come out as polylines of `segments + 1` control points each, written straight
 //! into the flat arrays of [`Strands`] (no per-strand allocation), with radii tapering
 //! linearly from root to tip. The same parameters and seed give the same strands, bit for
-//! bit, on every platform (PCG random numbers, no threads).
+//! bit, on every platform and any number of threads: each strand draws a fixed count of
+//! PCG random numbers, so a task of strands jumps the generator to its first strand's.
 
 use super::strands::Strands;
 use crate::error::{Result, invalid_arg};
+use crate::threads;
 use crate::validate::{non_negative, positive};
 use glam::{DVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
+use rayon::prelude::*;
 
 /// Most control points a procedural groom may have: 2^28 points take 4 GiB as points and
 /// radii, as much as a workstation can spare for one groom; more is surely a mistake in
@@ -171,6 +174,51 @@ fn taper(root: f32, tip: f32, segments: u32) -> Vec<f32> {
         .collect()
 }
 
+/// Strands per task of [`in_parallel`].
+const TASK_STRANDS: usize = 1024;
+
+/// A groom of `n` strands with the points of `radii` (root to tip) each, written in tasks
+/// side by side: strand `i`'s points by `strand(i, rng, points)`, with `rng` where a
+/// loop over the strands in turn from `rng` would have it, since each strand draws
+/// exactly `draws` numbers (every `random` of an `f32` or `f64` takes one step of PCG).
+fn in_parallel(
+    n: usize,
+    radii: &[f32],
+    (rng, draws): (&Pcg64Mcg, u128),
+    strand: impl Fn(usize, &mut Pcg64Mcg, &mut [[f32; 3]]) + Sync,
+) -> Result<Strands> {
+    let len = radii.len();
+    let at = |i: usize| {
+        let mut r = rng.clone();
+        r.advance(draws * i as u128);
+        r
+    };
+    let (points, radii) = threads::scoped(0, || {
+        // Zeroed memory, so that the pages are faulted in by the tasks that write them.
+        let mut points = vec![[0.0f32; 3]; n * len];
+        (points.par_chunks_mut(TASK_STRANDS * len).enumerate()).for_each(|(task, chunk)| {
+            let first = task * TASK_STRANDS;
+            let mut r = at(first);
+            for (k, p) in chunk.chunks_exact_mut(len).enumerate() {
+                strand(first + k, &mut r, p);
+            }
+            debug_assert!(
+                r == at(first + chunk.len() / len),
+                "a strand drew other than {draws}"
+            );
+        });
+        let mut all = vec![0.0f32; n * len];
+        (all.par_chunks_mut(len)).for_each(|r| r.copy_from_slice(radii));
+        (points, all)
+    })?;
+    Ok(Strands {
+        points,
+        radii,
+        counts: vec![len as u32; n],
+        colors: None,
+    })
+}
+
 /// Any unit vector perpendicular to the unit vector `n` (Duff et al. 2017, branchless).
 fn perpendicular(n: Vec3) -> (Vec3, Vec3) {
     let sign = 1.0f32.copysign(n.z);
@@ -289,7 +337,7 @@ impl FurBall {
     /// curl, a random walk), capped at 70 degrees: the tip lies between
     /// `radius + length * cos(70°)` and `radius + length` from the centre.
     pub fn build(&self) -> Result<Strands> {
-        let total = self.validate()?;
+        self.validate()?;
         let n = self.strands;
         let segs = self.segments as usize;
         let mut rng = Pcg64Mcg::seed_from_u64(self.seed);
@@ -307,9 +355,9 @@ impl FurBall {
         let spacing = (4.0 * std::f64::consts::PI / n as f64).sqrt();
         let golden_angle = std::f64::consts::PI * (3.0 - 5.0f64.sqrt());
 
-        let mut points = Vec::with_capacity(total);
-        let mut radii = Vec::with_capacity(total);
-        for i in 0..n {
+        // Each strand draws its root's two numbers, its curl phase and two a segment.
+        let draws = 3 + 2 * segs as u128;
+        in_parallel(n, &radii_one, (&rng, draws), |i, rng, points| {
             let y = 1.0 - 2.0 * (i as f64 + rng.random::<f64>()) / n as f64;
             let ring = (1.0 - y * y).max(0.0).sqrt();
             let phi = golden_angle * i as f64
@@ -325,8 +373,8 @@ impl FurBall {
             let mut curl = (phase.cos(), phase.sin());
             let mut wander = Vec3::ZERO;
 
-            points.push(p.to_array());
-            for k in 0..segs {
+            points[0] = p.to_array();
+            for (k, point) in points[1..].iter_mut().enumerate() {
                 let t = (k as f32 + 0.5) / segs as f32;
                 let r1 = rng.random::<f32>() * 2.0 - 1.0;
                 let r2 = rng.random::<f32>() * 2.0 - 1.0;
@@ -339,16 +387,9 @@ impl FurBall {
                 }
                 // v is perpendicular to n, so |n + v| >= 1: never degenerate.
                 p += (nrm + v).normalize() * step;
-                points.push(p.to_array());
+                *point = p.to_array();
                 curl = rotate(curl, turn);
             }
-            radii.extend_from_slice(&radii_one);
-        }
-        Ok(Strands {
-            points,
-            radii,
-            counts: vec![self.segments + 1; n],
-            colors: None,
         })
     }
 }
@@ -393,7 +434,7 @@ impl ScalpPatch {
     /// centre line; a final check keeps every point but the root outside the sphere by its
     /// own fibre radius.
     pub fn build(&self) -> Result<Strands> {
-        let total = self.validate()?;
+        self.validate()?;
         let n = self.strands;
         let segs = self.segments as usize;
         let mut rng = Pcg64Mcg::seed_from_u64(self.seed);
@@ -409,9 +450,8 @@ impl ScalpPatch {
         let shift: [f64; 2] = [rng.random(), rng.random()];
         let down = Vec3::NEG_Y;
 
-        let mut points = Vec::with_capacity(total);
-        let mut radii = Vec::with_capacity(total);
-        for i in 0..n {
+        // Each strand draws its gravity, period, phase and two for its tilt.
+        in_parallel(n, &radii_one, (&rng, 5), |i, rng, points| {
             let u = (shift[0] + R2[0] * i as f64).fract();
             let v = (shift[1] + R2[1] * i as f64).fract();
             let lon = (u * 2.0 - 1.0) * half;
@@ -434,8 +474,9 @@ impl ScalpPatch {
                 .normalize_or(t1);
             let mut farthest = self.radius;
 
-            points.push(centre.to_array());
-            for (k, &fibre_radius) in radii_one.iter().enumerate().skip(1) {
+            points[0] = centre.to_array();
+            for (k, (point, &fibre_radius)) in points.iter_mut().zip(&radii_one).enumerate().skip(1)
+            {
                 dir = (dir + down * gravity).normalize_or(dir);
                 let mut next = centre + dir * step;
                 let floor = farthest.min(clearance);
@@ -464,15 +505,8 @@ impl ScalpPatch {
                 if dist < min_dist {
                     q *= min_dist / dist;
                 }
-                points.push(q.to_array());
+                *point = q.to_array();
             }
-            radii.extend_from_slice(&radii_one);
-        }
-        Ok(Strands {
-            points,
-            radii,
-            counts: vec![self.segments + 1; n],
-            colors: None,
         })
     }
 }
@@ -501,5 +535,39 @@ mod tests {
             let cell = std::f32::consts::FRAC_PI_2 / clumps.g as f32;
             assert!(clumps.centre(d).angle_between(d) < 2.0 * cell);
         }
+    }
+
+    /// A digest of every bit of a groom's points and radii.
+    fn digest(strands: &Strands) -> u64 {
+        let bits = strands.points.iter().flatten().chain(&strands.radii);
+        bits.fold(0xcbf2_9ce4_8422_2325, |h: u64, x| {
+            (h ^ u64::from(x.to_bits())).wrapping_mul(0x0100_0000_01b3)
+        })
+    }
+
+    #[test]
+    fn grooms_written_in_tasks_are_the_bits_of_one_loop() {
+        // Recorded from the generators as one loop over the strands in turn, before they
+        // were written in tasks: three tasks, the last one short.
+        let strands = 2 * TASK_STRANDS + 953;
+        let fur = FurBall {
+            strands,
+            ..FurBall::default()
+        }
+        .build()
+        .unwrap();
+        let scalp = ScalpPatch {
+            strands,
+            ..ScalpPatch::default()
+        }
+        .build()
+        .unwrap();
+        assert_eq!(digest(&fur), 0x5829_3a93_7f5e_826b);
+        assert_eq!(digest(&scalp), 0xeebc_a09e_1242_2be5);
+        let points = ScalpPatch::default().segments + 1;
+        assert_eq!(
+            (scalp.counts.len(), scalp.counts[strands - 1]),
+            (strands, points)
+        );
     }
 }

@@ -75,7 +75,9 @@ mod threads;
 /// cbindgen:ignore
 mod validate;
 
-pub use bsdf::{BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf};
+pub use bsdf::{
+    ACROSS, AcrossEval, BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf,
+};
 #[cfg(feature = "render")]
 pub use description::{BuiltScene, SceneDescription};
 #[cfg(feature = "render")]

@@ -136,6 +136,7 @@ impl HairBsdf {
         HairPoint {
             bsdf: self,
             at: self.vertex(h, wo, lobes),
+            whole: (lobes == Lobes::All).then_some((h, wo)),
         }
     }
 
@@ -336,16 +337,8 @@ impl HairBsdf {
     /// lobes are summed in the same order, so the two agree bit for bit.
     #[inline(always)]
     fn eval_lobes_packed(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> ([f32; 3], f32) {
-        let sin_ti = wi[0].clamp(-1.0, 1.0);
-        let cos_ti = cos_from_sin(sin_ti);
+        let mp = self.mp_lobes(o, wi);
         let (wy, wz) = azimuth_i(o.azimuth, wi);
-
-        let [(s0, c0), (s1, c1), (s2, c2)] = o.tilted;
-        let sin_to = f32x4::new([s0, s1, s2, o.sin_to]);
-        let cos_to = f32x4::new([c0, c1, c2, o.cos_to]);
-        let mp = self
-            .mp_packed
-            .eval(f32x4::splat(sin_ti), f32x4::splat(cos_ti), sin_to, cos_to);
         let [(y0, z0), (y1, z1), (y2, z2)] = o.centre;
         let np = self.np.eval(offset(
             f32x4::new([y0, y1, y2, 0.0]),
@@ -367,6 +360,56 @@ impl HairBsdf {
         }
         let inv_cos = inv_cos(wi[2]);
         ([f[0] * inv_cos, f[1] * inv_cos, f[2] * inv_cos], pdf)
+    }
+}
+
+impl HairBsdf {
+    /// Mp of the four lobes toward wi, in the lanes of an f32x4: it depends on wo and wi
+    /// but not on h.
+    #[inline(always)]
+    fn mp_lobes(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> f32x4 {
+        let sin_ti = wi[0].clamp(-1.0, 1.0);
+        let cos_ti = cos_from_sin(sin_ti);
+        let [(s0, c0), (s1, c1), (s2, c2)] = o.tilted;
+        let sin_to = f32x4::new([s0, s1, s2, o.sin_to]);
+        let cos_to = f32x4::new([c0, c1, c2, o.cos_to]);
+        self.mp_packed
+            .eval(f32x4::splat(sin_ti), f32x4::splat(cos_ti), sin_to, cos_to)
+    }
+
+    /// [`HairPoint::eval_across`] at the vertex `at` of (h, wo): the (h, wo) stage again in
+    /// eight lanes, one offset each, then each lane's Np and Ap with the vertex's Mp.
+    fn eval_across_at(&self, at: &Vertex, h: f32, wo: Vec3, wi: Vec3) -> AcrossEval {
+        let step = 2.0 / ACROSS as f32;
+        let offsets = f32x8::new(std::array::from_fn(|k| {
+            let x = h + step * k as f32;
+            if x > 1.0 { x - 2.0 } else { x }
+        }));
+        let o = self.outgoing(offsets, wo.to_array().map(f32x8::splat));
+        let wi = wi.to_array();
+        let mp = self.mp_lobes(&at.o, wi).to_array();
+        let (wy, wz) = azimuth_i(at.o.azimuth, wi);
+        let (wy, wz) = (f32x8::splat(wy), f32x8::splat(wz));
+        let mut f = [f32x8::splat(0.0); 3];
+        let mut pdf = f32x8::splat(0.0);
+        for (p, &m) in mp.iter().enumerate() {
+            let weight = if p < EXPLICIT_LOBES {
+                let (cy, cz) = o.centre[p];
+                f32x8::splat(m) * self.np.eval(offset(cy, cz, wy, wz))
+            } else {
+                f32x8::splat(m * 0.5 * FRAC_1_PI)
+            };
+            for (f, &a) in f.iter_mut().zip(&o.ap[p]) {
+                *f += weight * a;
+            }
+            pdf += weight * o.lobe_pdf[p];
+        }
+        let inv_cos = inv_cos(wi[2]);
+        let f = f.map(|c| (c * f32x8::splat(inv_cos)).to_array());
+        AcrossEval {
+            f: std::array::from_fn(|k| Vec3::new(f[0][k], f[1][k], f[2][k])),
+            pdf: pdf.to_array(),
+        }
     }
 }
 
@@ -431,12 +474,40 @@ impl LocalBsdf for HairPoint<'_> {
 pub struct HairPoint<'a> {
     bsdf: &'a HairBsdf,
     at: Vertex,
+    /// (h, wo), kept where the point evaluates the whole model ([`Lobes::All`]), for
+    /// [`Self::eval_across`].
+    whole: Option<(f32, Vec3)>,
+}
+
+/// How many offsets across the fibre [`HairPoint::eval_across`] evaluates: one SIMD step.
+pub const ACROSS: usize = 8;
+
+/// f and pdf toward one wi at [`ACROSS`] offsets across the fibre (see
+/// [`HairPoint::eval_across`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AcrossEval {
+    pub f: [Vec3; ACROSS],
+    pub pdf: [f32; ACROSS],
 }
 
 impl HairPoint<'_> {
     /// f and pdf for the incident direction wi.
     pub fn eval(&self, wi: Vec3) -> BsdfEval {
         self.bsdf.eval_at(&self.at, wi)
+    }
+
+    /// f and pdf toward wi at the point's offset h and at its shifts by 2k / [`ACROSS`],
+    /// wrapped into [-1, 1]: a stratified sample of the fibre's width whose every member
+    /// is uniform over it when h is. Their mean is an unbiased estimate of the BSDF
+    /// averaged across the fibre, which is what a pixel sees of a strand narrower than
+    /// itself: next-event estimation weighs a light by it and keeps the highlights' noise
+    /// out of the image (docs/measurements.md, "Light across the fibre"). Costs one
+    /// eight-lane pass of the (h, wo) stage and of Np and Ap; Mp, which depends on
+    /// neither h, once. None for a point of fewer lobes ([`Lobes::Culled`],
+    /// [`Lobes::Merged`]).
+    pub fn eval_across(&self, wi: Vec3) -> Option<AcrossEval> {
+        let (h, wo) = self.whole?;
+        Some(self.bsdf.eval_across_at(&self.at, h, wo, wi))
     }
 
     /// Samples wi; see [`HairBsdf::sample`].

@@ -14,7 +14,7 @@ pub use absorption::{SIGMA_A_PRESETS, sigma_a_from_color, sigma_a_from_melanin, 
 pub use diffuse::Diffuse;
 pub use diffuse::DiffusePoint;
 pub(crate) use hair::OwnedPoint;
-pub use hair::{HairBsdf, HairPoint, Lobes};
+pub use hair::{ACROSS, AcrossEval, HairBsdf, HairPoint, Lobes};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
 pub use params::{DEFAULT_EUMELANIN, HairParams};
 

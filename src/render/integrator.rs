@@ -9,10 +9,10 @@ use glam::Vec3;
 
 use super::film::FirstHit;
 use super::sampler::PixelSampler;
-use super::settings::{PathSettings, Roulette, Strategy};
+use super::settings::{LightOffsets, PathSettings, Roulette, Strategy};
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
-use crate::bsdf::{DiffusePoint, HairBsdf, HairPoint, Lobes, LocalBsdf};
+use crate::bsdf::{ACROSS, DiffusePoint, HairBsdf, HairPoint, Lobes, LocalBsdf};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
@@ -145,7 +145,8 @@ impl World {
 
     /// Radiance arriving along the camera ray (org, dir), what its first hit reports for
     /// the AOVs (None when it escapes or when `aovs` is false), and the number of rays
-    /// traced.
+    /// traced. `pixel_spread` is the side of the ray's pixel per unit distance from the eye
+    /// (`Camera::pixel_spread`; `dir` is a unit vector).
     ///
     /// A path of at most `max_depth` scattering events traces up to `max_depth + 1`
     /// closest-hit rays: the last one only looks for emission, so that BSDF sampling
@@ -156,6 +157,7 @@ impl World {
         dir: Vec3,
         settings: &PathSettings,
         aovs: bool,
+        pixel_spread: f32,
         sampler: &mut PixelSampler,
     ) -> (Vec3, Option<FirstHit>, u32) {
         let mut first = None;
@@ -218,7 +220,9 @@ impl World {
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
                 (Hit::Hair(h), Some(Material::Hair(m))) => {
                     varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
-                    Shading::hair(h, &varied_bsdf, wo_world, settings.lobes(events))
+                    let across = settings.light_offsets == LightOffsets::Across
+                        && (events > 0 || 2.0 * h.radius <= pixel_spread * h.t);
+                    Shading::hair(h, &varied_bsdf, wo_world, settings.lobes(events), across)
                 }
                 (Hit::Surface(s), Some(Material::Diffuse(d))) => Shading::diffuse(s, *d, wo_world),
                 _ => break,
@@ -334,17 +338,21 @@ impl World {
         if ls.pdf.is_nan() || ls.pdf <= 0.0 || ls.radiance == Vec3::ZERO {
             return none;
         }
-        let (f_cos, bsdf_pdf) = shading.eval(ls.wi);
+        let light_pdf = ls.pdf * choice_pdf;
+        let weight = |bsdf_pdf: f32| {
+            if ls.is_delta || settings.strategy == Strategy::LightOnly {
+                1.0
+            } else {
+                power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
+            }
+        };
+        // Across the fibre each offset takes its own MIS weight: the BSDF-sampled ray
+        // that pairs with it comes from the hit's offset, which is any of them alike.
+        let f_cos = shading.light_eval(ls.wi, weight);
         if f_cos == Vec3::ZERO {
             return none;
         }
-        let light_pdf = ls.pdf * choice_pdf;
-        let weight = if ls.is_delta || settings.strategy == Strategy::LightOnly {
-            1.0
-        } else {
-            power_heuristic(1.0, light_pdf, 1.0, bsdf_pdf)
-        };
-        let mut contribution = beta * f_cos * ls.radiance * (weight / light_pdf);
+        let mut contribution = beta * f_cos * ls.radiance / light_pdf;
         let largest = contribution.max_element();
         // A degenerate (NaN) contribution traces nothing, as a zero one.
         if largest.is_nan() || largest <= 0.0 {
@@ -419,6 +427,9 @@ struct VertexSample {
 struct Shading<'a> {
     frame: Frame,
     point: Point<'a>,
+    /// Next-event estimation weighs a light by the hair BSDF across the fibre
+    /// (`HairPoint::eval_across`).
+    across: bool,
 }
 
 /// The BSDF at the vertex, its (h, wo) work done once and shared by next-event estimation
@@ -429,10 +440,11 @@ enum Point<'a> {
 }
 
 impl<'a> Shading<'a> {
-    fn hair(h: &HairHit, bsdf: &'a HairBsdf, wo_world: Vec3, lobes: Lobes) -> Self {
+    fn hair(h: &HairHit, bsdf: &'a HairBsdf, wo_world: Vec3, lobes: Lobes, across: bool) -> Self {
         Shading {
             frame: h.frame,
             point: Point::Hair(bsdf.at_lobes(h.h, h.frame.to_local(wo_world), lobes)),
+            across,
         }
     }
 
@@ -441,6 +453,7 @@ impl<'a> Shading<'a> {
         Shading {
             frame,
             point: Point::Diffuse(bsdf.at(frame.to_local(wo_world))),
+            across: false,
         }
     }
 
@@ -451,11 +464,27 @@ impl<'a> Shading<'a> {
         }
     }
 
-    /// f * |cos| and the BSDF pdf toward the world direction wi.
-    fn eval(&self, wi: Vec3) -> (Vec3, f32) {
+    /// f * |cos| toward the world direction wi of a light sample, each evaluation
+    /// weighted by `mis` of its pdf: across the fibre where the shading point says so (the
+    /// mean of the offsets' weighted values), at the hit's offset elsewhere.
+    fn light_eval(&self, wi: Vec3, mis: impl Fn(f32) -> f32) -> Vec3 {
         let local = self.frame.to_local(wi);
-        let e = self.local().eval(local);
-        (e.f * local.z.abs(), e.pdf)
+        let across = match &self.point {
+            Point::Hair(p) if self.across => p.eval_across(local),
+            _ => None,
+        };
+        let f = match across {
+            Some(a) => {
+                let sum =
+                    (a.f.iter().zip(a.pdf)).fold(Vec3::ZERO, |sum, (&f, pdf)| sum + f * mis(pdf));
+                sum / ACROSS as f32
+            }
+            None => {
+                let e = self.local().eval(local);
+                e.f * mis(e.pdf)
+            }
+        };
+        f * local.z.abs()
     }
 
     /// A direction and its path weight ([`LocalBsdf::sample_weight`]).

@@ -155,6 +155,7 @@ pub fn render(
     };
     let mut shares: Option<allocation::Shares> = None;
     let filter = settings.pixel_filter()?;
+    let pixel_spread = camera.pixel_spread(height);
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),
@@ -219,8 +220,14 @@ pub fn render(
                             [0.5; 2]
                         };
                         let (org, dir) = camera.ray(image_point, lens);
-                        let (radiance, first, traced) =
-                            world.radiance(org, dir, &settings.path, aovs.any(), &mut sampler);
+                        let (radiance, first, traced) = world.radiance(
+                            org,
+                            dir,
+                            &settings.path,
+                            aovs.any(),
+                            pixel_spread,
+                            &mut sampler,
+                        );
                         acc.add(radiance, first.as_ref());
                         acc.add_rays(traced);
                     }

@@ -5,6 +5,7 @@
 
 mod common;
 
+mod across;
 mod chi2;
 mod fidelity;
 mod furnace;

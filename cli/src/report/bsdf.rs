@@ -331,6 +331,24 @@ fn lobes_outputs(s: &Set, lobes: Lobes) -> Outputs {
         .collect()
 }
 
+/// Lane 0 of `eval_across`: the model at the input's own offset (the other lanes are at
+/// its shifts across the fibre).
+fn across_outputs(s: &mut Set) -> Outputs {
+    s.inputs
+        .iter()
+        .map(|x| {
+            let a = s.bsdf.at(x.h, x.wo).eval_across(x.wi)?;
+            Some((
+                x.wi,
+                BsdfEval {
+                    f: a.f[0],
+                    pdf: a.pdf[0],
+                },
+            ))
+        })
+        .collect()
+}
+
 fn batch_outputs(s: &mut Set) -> Outputs {
     run_batch(s);
     let b = &s.batch;
@@ -369,7 +387,7 @@ fn per_point<R>(s: &Set, call: impl Fn(&HairPoint, &Input, usize) -> R) -> usize
     s.inputs.len() * 8
 }
 
-const VARIANTS: [Variant; 11] = [
+const VARIANTS: [Variant; 12] = [
     Variant {
         name: "HairBsdf::eval",
         time: |s| each(s, |x| s.bsdf.eval(x.h, x.wo, x.wi)),
@@ -408,6 +426,15 @@ const VARIANTS: [Variant; 11] = [
             })
         },
         outputs: Some(sample_outputs),
+    },
+    Variant {
+        name: "HairPoint::eval_across (8 offsets; one at per 8 calls, per call)",
+        time: |s| {
+            per_point(s, |p, x, k| {
+                p.eval_across(if k % 2 == 0 { x.wi } else { -x.wi })
+            })
+        },
+        outputs: Some(across_outputs),
     },
     Variant {
         name: "HairPoint, lobes culled below 0.01: at + eval + sample",
@@ -554,7 +581,9 @@ pub fn section(ctx: &Context) -> Result<String> {
          sin(theta) = 0.99999 of the tangent, grazing, wi = +-wo and half a turn away. \
          Random: {} parameter sets over the valid ranges (eta from 1.05), uniform h, wo, wi. \
          The point rows time what a renderer's path vertex does; `HairBsdf::at` alone is \
-         the (h, wo) work a prepared point saves. The culled and merged rows are the \
+         the (h, wo) work a prepared point saves. `HairPoint::eval_across` is next-event \
+         estimation's evaluation at eight offsets across the fibre in one call, judged by \
+         its lane at the input's own offset. The culled and merged rows are the \
          renderer's fidelity knobs `lobe_cull` and `deep_bounce_depth` at one vertex, their \
          eval and sample both judged against the whole model (culling's error is the \
          dropped lobes'); the merged lobe keeps only each (h, wo)'s energy, not the \

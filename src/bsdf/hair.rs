@@ -136,7 +136,7 @@ impl HairBsdf {
         HairPoint {
             bsdf: self,
             at: self.vertex(h, wo, lobes),
-            whole: (lobes == Lobes::All).then_some((h, wo)),
+            whole_h: (lobes == Lobes::All).then_some(h),
         }
     }
 
@@ -378,14 +378,17 @@ impl HairBsdf {
     }
 
     /// [`HairPoint::eval_across`] at the vertex `at` of (h, wo): the (h, wo) stage again in
-    /// eight lanes, one offset each, then each lane's Np and Ap with the vertex's Mp.
-    fn eval_across_at(&self, at: &Vertex, h: f32, wo: Vec3, wi: Vec3) -> AcrossEval {
+    /// eight lanes, one offset each, then each lane's Np and Ap with the vertex's Mp. wo
+    /// comes back from the vertex: its sin theta and its azimuth, which [`azimuth_o`]
+    /// leaves as they are, are all the stage reads of it.
+    fn eval_across_at(&self, at: &Vertex, h: f32, wi: Vec3) -> AcrossEval {
         let step = 2.0 / ACROSS as f32;
         let offsets = f32x8::new(std::array::from_fn(|k| {
             let x = h + step * k as f32;
             if x > 1.0 { x - 2.0 } else { x }
         }));
-        let o = self.outgoing(offsets, wo.to_array().map(f32x8::splat));
+        let wo = [at.o.sin_to, at.o.azimuth.0, at.o.azimuth.1];
+        let o = self.outgoing(offsets, wo.map(f32x8::splat));
         let wi = wi.to_array();
         let mp = self.mp_lobes(&at.o, wi).to_array();
         let (wy, wz) = azimuth_i(at.o.azimuth, wi);
@@ -474,9 +477,9 @@ impl LocalBsdf for HairPoint<'_> {
 pub struct HairPoint<'a> {
     bsdf: &'a HairBsdf,
     at: Vertex,
-    /// (h, wo), kept where the point evaluates the whole model ([`Lobes::All`]), for
+    /// h, kept where the point evaluates the whole model ([`Lobes::All`]), for
     /// [`Self::eval_across`].
-    whole: Option<(f32, Vec3)>,
+    whole_h: Option<f32>,
 }
 
 /// How many offsets across the fibre [`HairPoint::eval_across`] evaluates: one SIMD step.
@@ -506,8 +509,7 @@ impl HairPoint<'_> {
     /// neither h, once. None for a point of fewer lobes ([`Lobes::Culled`],
     /// [`Lobes::Merged`]).
     pub fn eval_across(&self, wi: Vec3) -> Option<AcrossEval> {
-        let (h, wo) = self.whole?;
-        Some(self.bsdf.eval_across_at(&self.at, h, wo, wi))
+        Some(self.bsdf.eval_across_at(&self.at, self.whole_h?, wi))
     }
 
     /// Samples wi; see [`HairBsdf::sample`].
@@ -523,6 +525,8 @@ impl HairPoint<'_> {
 pub(crate) struct OwnedPoint {
     bsdf: HairBsdf,
     at: Vertex,
+    /// The point's h, for [`Self::eval_across`].
+    h: f32,
 }
 
 impl OwnedPoint {
@@ -536,7 +540,13 @@ impl OwnedPoint {
         unsafe {
             (&raw mut (*dst).bsdf).write(*bsdf);
             (&raw mut (*dst).at).write(bsdf.vertex(h, wo, Lobes::All));
+            (&raw mut (*dst).h).write(h);
         }
+    }
+
+    /// [`HairPoint::eval_across`] at this point.
+    pub(crate) fn eval_across(&self, wi: Vec3) -> AcrossEval {
+        self.bsdf.eval_across_at(&self.at, self.h, wi)
     }
 
     #[inline]

@@ -383,7 +383,7 @@ settings! {
         light_threshold: f32 = 0.03, Range::AtLeast(0.0);
         /// Where next-event estimation evaluates a hair BSDF across the fibre: across (the
         /// mean over eight offsets, the hit's among them: the same image in expectation,
-        /// 1.3-2.5x less noise per sample under small lights; not at a camera ray's hit on
+        /// 1.5-2.5x less variance per sample under small lights; not at a camera ray's hit on
         /// a strand wider than its pixel, whose highlights the image resolves) or hit (the
         /// hit's offset alone).
         light_offsets: LightOffsets = LightOffsets::Across, Range::Any;

@@ -179,6 +179,20 @@ int main(void) {
     ROW(NUL, "pdf is NULL", ht_hair_point_pdf(&pt, wi, NULL));
     ROW(BAD, "wi = [0, 0, 0]", ht_hair_point_pdf(&pt, zero3, &pdf));
     ROW(BAD, "pdf and wi overlap", ht_hair_point_pdf(&pt, f, f + 2));
+    float fa[3 * HT_ACROSS], pa[HT_ACROSS];
+    for (size_t k = 0; k < 3 * HT_ACROSS; ++k) fa[k] = 7.0f;
+    for (size_t k = 0; k < HT_ACROSS; ++k) pa[k] = 7.0f;
+    ROW(NUL, "f_cos is NULL", ht_hair_point_eval_across(&pt, wi, NULL, pa));
+    ROW(NUL, "pdf is NULL", ht_hair_point_eval_across(&pt, wi, fa, NULL));
+    ROW(BAD, "not filled by ht_hair_point_init", ht_hair_point_eval_across(&zeroed, wi, fa, pa));
+    ROW(BAD, "not aligned to 16", ht_hair_point_eval_across(odd_point, wi, fa, pa));
+    ROW(BAD, "wi = [0, 0, 1.01]", ht_hair_point_eval_across(&pt, long3, fa, pa));
+    ROW(BAD, "f_cos and pdf overlap", ht_hair_point_eval_across(&pt, wi, fa, fa + 3));
+    ROW(BAD, "pdf and point overlap",
+        ht_hair_point_eval_across(&pt, wi, fa, (float *)pt.opaque + 4));
+    UNTOUCHED(fa, 3 * HT_ACROSS);
+    UNTOUCHED(pa, HT_ACROSS);
+    ROW(OK, NULL, ht_hair_point_eval_across(&pt, wi, fa, pa));
     ROW(NUL, "u is NULL", ht_hair_point_sample(&pt, NULL, ws, f, &pdf));
     ROW(BAD, "u[0] = 1", ht_hair_point_sample(&pt, u_one, ws, f, &pdf));
     ROW(BAD, "u[2] = NaN", ht_hair_point_sample(&pt, u_nan, ws, f, &pdf));

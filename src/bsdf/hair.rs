@@ -505,8 +505,8 @@ impl HairPoint<'_> {
     /// averaged across the fibre, which is what a pixel sees of a strand narrower than
     /// itself: next-event estimation weighs a light by it and keeps the highlights' noise
     /// out of the image (docs/measurements.md, "Light across the fibre"). Costs one
-    /// eight-lane pass of the (h, wo) stage and of Np and Ap; Mp, which depends on
-    /// neither h, once. None for a point of fewer lobes ([`Lobes::Culled`],
+    /// eight-lane pass of the (h, wo) stage and of Np and Ap; Mp, which does not depend
+    /// on h, once. None for a point of fewer lobes ([`Lobes::Culled`],
     /// [`Lobes::Merged`]).
     pub fn eval_across(&self, wi: Vec3) -> Option<AcrossEval> {
         Some(self.bsdf.eval_across_at(&self.at, self.whole_h?, wi))

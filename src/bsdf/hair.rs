@@ -297,18 +297,31 @@ impl HairBsdf {
         let one = T::splat(1.0);
         let sin_ti = wi[0].max(-one).min(one);
         let cos_ti = cos_from_sin(sin_ti);
-        let (wy, wz) = azimuth_i(o.azimuth, wi);
+        let mp = std::array::from_fn(|p| {
+            let (sin_to, cos_to) = if p < EXPLICIT_LOBES {
+                o.tilted[p]
+            } else {
+                (o.sin_to, o.cos_to)
+            };
+            self.mp[p].eval(sin_ti, cos_ti, sin_to, cos_to)
+        });
+        self.sum_lobes(o, mp, wi)
+    }
 
+    /// The lobes' sum into (f, pdf) given each lobe's Mp toward wi: Np from the lobe
+    /// centres, Ap, the sampling weights and 1/|wi.z|.
+    #[inline(always)]
+    fn sum_lobes<T: Lanes>(&self, o: &Outgoing<T>, mp: [T; 4], wi: [T; 3]) -> ([T; 3], T) {
+        let one = T::splat(1.0);
+        let (wy, wz) = azimuth_i(o.azimuth, wi);
         let mut f = [T::splat(0.0); 3];
         let mut pdf = T::splat(0.0);
-        for p in 0..=EXPLICIT_LOBES {
+        for (p, &m) in mp.iter().enumerate() {
             let weight = if p < EXPLICIT_LOBES {
-                let (sin_to, cos_to) = o.tilted[p];
                 let (cy, cz) = o.centre[p];
-                self.mp[p].eval(sin_ti, cos_ti, sin_to, cos_to)
-                    * self.np.eval(offset(cy, cz, wy, wz))
+                m * self.np.eval(offset(cy, cz, wy, wz))
             } else {
-                self.mp[p].eval(sin_ti, cos_ti, o.sin_to, o.cos_to) * T::splat(0.5 * FRAC_1_PI)
+                m * T::splat(0.5 * FRAC_1_PI)
             };
             for (f, &a) in f.iter_mut().zip(&o.ap[p]) {
                 *f = *f + weight * a;
@@ -337,7 +350,7 @@ impl HairBsdf {
     /// lobes are summed in the same order, so the two agree bit for bit.
     #[inline(always)]
     fn eval_lobes_packed(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> ([f32; 3], f32) {
-        let mp = self.mp_lobes(o, wi);
+        let mp = self.mp_packed_at(o, wi);
         let (wy, wz) = azimuth_i(o.azimuth, wi);
         let [(y0, z0), (y1, z1), (y2, z2)] = o.centre;
         let np = self.np.eval(offset(
@@ -364,10 +377,10 @@ impl HairBsdf {
 }
 
 impl HairBsdf {
-    /// Mp of the four lobes toward wi, in the lanes of an f32x4: it depends on wo and wi
-    /// but not on h.
+    /// Mp of the four lobes toward wi, in the lanes of an f32x4 (the bits of
+    /// [`Self::eval_lobes`]' Mp): it depends on wo and wi, not on h.
     #[inline(always)]
-    fn mp_lobes(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> f32x4 {
+    fn mp_packed_at(&self, o: &Outgoing<f32>, wi: [f32; 3]) -> f32x4 {
         let sin_ti = wi[0].clamp(-1.0, 1.0);
         let cos_ti = cos_from_sin(sin_ti);
         let [(s0, c0), (s1, c1), (s2, c2)] = o.tilted;
@@ -377,10 +390,12 @@ impl HairBsdf {
             .eval(f32x4::splat(sin_ti), f32x4::splat(cos_ti), sin_to, cos_to)
     }
 
-    /// [`HairPoint::eval_across`] at the vertex `at` of (h, wo): the (h, wo) stage again in
-    /// eight lanes, one offset each, then each lane's Np and Ap with the vertex's Mp. wo
-    /// comes back from the vertex: its sin theta and its azimuth, which [`azimuth_o`]
-    /// leaves as they are, are all the stage reads of it.
+    /// [`HairPoint::eval_across`] at the vertex `at` of (h, wo): the (h, wo) stage in eight
+    /// lanes, one offset each, then the lobes' sum with the vertex's Mp, which does not
+    /// depend on h (Mp in the eight lanes cost 2% more of the scalp's render time). wo
+    /// comes back from the vertex: its sin theta and its azimuth, which
+    /// [`azimuth_o`] leaves as they are, are all the stage reads of it, so each lane has
+    /// the bits of [`HairBsdf::eval`] at its offset.
     fn eval_across_at(&self, at: &Vertex, h: f32, wi: Vec3) -> AcrossEval {
         let step = 2.0 / ACROSS as f32;
         let offsets = f32x8::new(std::array::from_fn(|k| {
@@ -390,25 +405,9 @@ impl HairBsdf {
         let wo = [at.o.sin_to, at.o.azimuth.0, at.o.azimuth.1];
         let o = self.outgoing(offsets, wo.map(f32x8::splat));
         let wi = wi.to_array();
-        let mp = self.mp_lobes(&at.o, wi).to_array();
-        let (wy, wz) = azimuth_i(at.o.azimuth, wi);
-        let (wy, wz) = (f32x8::splat(wy), f32x8::splat(wz));
-        let mut f = [f32x8::splat(0.0); 3];
-        let mut pdf = f32x8::splat(0.0);
-        for (p, &m) in mp.iter().enumerate() {
-            let weight = if p < EXPLICIT_LOBES {
-                let (cy, cz) = o.centre[p];
-                f32x8::splat(m) * self.np.eval(offset(cy, cz, wy, wz))
-            } else {
-                f32x8::splat(m * 0.5 * FRAC_1_PI)
-            };
-            for (f, &a) in f.iter_mut().zip(&o.ap[p]) {
-                *f += weight * a;
-            }
-            pdf += weight * o.lobe_pdf[p];
-        }
-        let inv_cos = inv_cos(wi[2]);
-        let f = f.map(|c| (c * f32x8::splat(inv_cos)).to_array());
+        let mp = self.mp_packed_at(&at.o, wi).to_array().map(f32x8::splat);
+        let (f, pdf) = self.sum_lobes(&o, mp, wi.map(f32x8::splat));
+        let f = f.map(f32x8::to_array);
         AcrossEval {
             f: std::array::from_fn(|k| Vec3::new(f[0][k], f[1][k], f[2][k])),
             pdf: pdf.to_array(),
@@ -505,9 +504,8 @@ impl HairPoint<'_> {
     /// averaged across the fibre, which is what a pixel sees of a strand narrower than
     /// itself: next-event estimation weighs a light by it and keeps the highlights' noise
     /// out of the image (docs/measurements.md, "Light across the fibre"). Costs one
-    /// eight-lane pass of the (h, wo) stage and of Np and Ap; Mp, which does not depend
-    /// on h, once. None for a point of fewer lobes ([`Lobes::Culled`],
-    /// [`Lobes::Merged`]).
+    /// eight-lane pass of the (h, wo) stage and of the lobes. None for a point of fewer
+    /// lobes ([`Lobes::Culled`], [`Lobes::Merged`]).
     pub fn eval_across(&self, wi: Vec3) -> Option<AcrossEval> {
         Some(self.bsdf.eval_across_at(&self.at, self.whole_h?, wi))
     }

@@ -19,7 +19,7 @@ use super::film::{Film, PixelAccumulator, Window, relative_rmse};
 
 /// Side of the square blocks, aligned on the full frame, among whose pixels each pass
 /// shares the samples a uniform pass would give them.
-pub const BLOCK: u32 = 16;
+pub const BLOCK: u32 = 32;
 
 /// A pixel's share is at least this fraction of its block's mean share (plus its own), so
 /// that a pixel whose pilot saw no noise (a strand its 8 samples missed) still converges.
@@ -32,8 +32,8 @@ const FLOOR: f64 = 0.1;
 const MIN_GAIN: f64 = 1.3;
 
 /// The most spp a render with this allocation takes (`RenderSettings::validate`): a pass
-/// gives a pixel at most its colour's half of a block's samples (128 pixels x 8, 2^10),
-/// so over 2^19 passes its sample indices stay below 2^29 plus the pilot's, within a u32.
+/// gives a pixel at most its colour's half of a block's samples (512 pixels x 8, 2^12),
+/// so over 2^19 passes its sample indices stay below 2^31 plus the pilot's, within a u32.
 pub const MOST_SPP: u32 = 1 << 22;
 
 /// `crop` grown to whole blocks, inside the `width` x `height` frame: the pilot's window.

@@ -62,12 +62,29 @@ fn stops_early(settings: &RenderSettings) -> bool {
     settings.noise_target.is_some() || settings.time_budget.is_some()
 }
 
+/// The allocation a render with `settings` takes: theirs where it has samples to share
+/// after the pilot pass and sample indices to share them with (spp in (`PASS_SAMPLES`,
+/// `allocation::MOST_SPP`]), uniform elsewhere. At `PASS_SAMPLES` or fewer the pilot is
+/// the whole render, and the uniform render's samples.
+pub(crate) fn allocation_taken(settings: &RenderSettings) -> Allocation {
+    let shares = (PASS_SAMPLES + 1..=allocation::MOST_SPP).contains(&settings.spp);
+    if shares {
+        settings.allocation
+    } else {
+        Allocation::Uniform
+    }
+}
+
 /// What the film of a render with `settings` keeps besides its image: the noise
 /// estimate's halves for one that may stop early, the sums for one in passes (whose
 /// progress sink [keeps passes](Progress::keeps_passes)) or whose pilot comes first, and
 /// nothing for one that takes each pixel's samples at once.
 pub fn film_keep(settings: &RenderSettings, keeps_passes: bool) -> Keep {
-    match (stops_early(settings), keeps_passes, settings.allocation) {
+    match (
+        stops_early(settings),
+        keeps_passes,
+        allocation_taken(settings),
+    ) {
         (true, _, _) => Keep::Halves,
         (false, true, _) | (false, false, Allocation::Noise) => Keep::Sums,
         (false, false, Allocation::Uniform) => Keep::Image,
@@ -90,7 +107,7 @@ pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> 
     let film = window
         .pixel_count()
         .saturating_mul(film_keep(settings, keeps_passes).bytes_per_pixel(aovs));
-    let pilot = match settings.allocation {
+    let pilot = match allocation_taken(settings) {
         Allocation::Uniform => 0,
         Allocation::Noise => allocation::pilot_window(window, width, height)
             .pixel_count()
@@ -140,7 +157,7 @@ pub fn render(
     let keep = film_keep(settings, progress.keeps_passes());
     let mut film = Film::keeping(width, height, crop(settings), aovs, keep)?;
     // The noise allocation's pilot, over whole blocks around the crop.
-    let mut pilot = match settings.allocation {
+    let mut pilot = match allocation_taken(settings) {
         Allocation::Uniform => None,
         Allocation::Noise => {
             let window = allocation::pilot_window(film.crop(), width, height);

@@ -9,7 +9,6 @@
 
 use std::fmt;
 
-use super::allocation;
 use super::film::PixelFilter;
 use crate::embree::{Device, Isa};
 use crate::error::{Error, Result, invalid_arg};
@@ -318,11 +317,11 @@ settings! {
         /// Stop before a pass that would end past this many seconds of rendering; none: no
         /// limit.
         time_budget: Option<f32> = None, Range::Above(0.0);
-        /// Where samples go: uniform (spp in every pixel) or noise (a pilot pass of 8 spp,
-        /// then, where the pilot says it pays, each pixel's share in proportion to its noise
-        /// over the square root of its cost, unbiased; the same number of samples over each
-        /// 16 x 16 block).
-        allocation: Allocation = Allocation::Uniform, Range::Any;
+        /// Where samples go: noise (a pilot pass of 8 spp, then, where the pilot says it
+        /// pays, each pixel's share in proportion to its noise over the square root of its
+        /// cost, unbiased; the same number of samples over each 32 x 32 block; taken from 9
+        /// to 2^22 spp, uniform outside) or uniform (spp in every pixel).
+        allocation: Allocation = Allocation::Noise, Range::Any;
         /// The image depends only on the scene, the settings and this seed.
         seed: u64 = 0, Range::Any;
         /// Worker threads; none: one per hardware thread.
@@ -513,14 +512,6 @@ impl RenderSettings {
                 ));
             }
         }
-        if self.allocation == Allocation::Noise && self.spp > allocation::MOST_SPP {
-            return Err(invalid_arg!(
-                "spp = {}: the noise allocation takes at most {} (its sample indices are \
-                 32-bit); use allocation = uniform",
-                self.spp,
-                allocation::MOST_SPP
-            ));
-        }
         if let Some(n) = self.path.deep_bounce_depth {
             if n > self.path.max_depth {
                 return Err(invalid_arg!(
@@ -632,17 +623,13 @@ mod tests {
         );
         r.path.deep_bounce_depth = Some(4);
         r.validate().unwrap();
-        // Sample indices are u32s: past 2^22 spp those of the noise allocation (up to a
-        // block's samples a pass in one pixel) could wrap around; uniform ones take every spp.
-        let mut r = RenderSettings {
+        // Sample indices are u32s, and every spp is valid: past 2^22 the noise allocation
+        // gives way to uniform sampling (`renderer::allocation_taken`).
+        RenderSettings {
             spp: u32::MAX,
             ..RenderSettings::default()
-        };
-        r.validate().unwrap();
-        r.allocation = Allocation::Noise;
-        let err = r.validate().unwrap_err().to_string();
-        assert!(err.contains("at most 4194304"), "{err}");
-        r.spp = 1 << 22;
-        r.validate().unwrap();
+        }
+        .validate()
+        .unwrap();
     }
 }

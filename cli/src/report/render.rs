@@ -53,7 +53,7 @@ const KNOBS: &[Knob] = &[
     knob("lobe_cull 0.1", |v| set(v, "lobe_cull", "0.1")),
     knob("light_threshold 0", |v| set(v, "light_threshold", "0")),
     knob("light_offsets hit", |v| set(v, "light_offsets", "hit")),
-    knob("allocation noise", |v| set(v, "allocation", "noise")),
+    knob("allocation uniform", |v| set(v, "allocation", "uniform")),
     knob("noise_target 0.05", |v| set(v, "noise_target", "0.05")),
 ];
 

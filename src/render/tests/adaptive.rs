@@ -4,7 +4,7 @@
 use std::sync::Mutex;
 
 use crate::render::integrator::World;
-use crate::render::renderer::{PASS_SAMPLES, RenderOutput, film_bytes, render};
+use crate::render::renderer::{PASS_SAMPLES, RenderOutput, allocation_taken, film_bytes, render};
 use crate::render::settings::{Allocation, PathSettings, RenderSettings};
 use crate::render::{Aovs, Keep, NoProgress, Progress};
 
@@ -26,12 +26,14 @@ fn bits(v: &[f32]) -> Vec<u32> {
     v.iter().map(|x| x.to_bits()).collect()
 }
 
+/// A small uniform render: the rounds and the noise estimate without the allocation's pilot.
 fn small(spp: u32, seed: u64) -> RenderSettings {
     RenderSettings {
         width: 24,
         height: 24,
         spp,
         seed,
+        allocation: Allocation::Uniform,
         ..RenderSettings::default()
     }
 }
@@ -161,11 +163,20 @@ fn a_film_keeps_only_what_its_render_reads() {
             Keep::Halves,
         ),
         (allocated(small(16, 1)), Keep::Sums),
+        // The default allocation is the noise allocation, but for the few spp of its pilot.
+        (
+            RenderSettings {
+                allocation: RenderSettings::default().allocation,
+                ..small(16, 1)
+            },
+            Keep::Sums,
+        ),
+        (allocated(small(8, 1)), Keep::Image),
     ] {
         let out = render(&world, &camera(), &settings, all, &NoProgress).unwrap();
         assert_eq!(out.film.keep(), keep);
         assert_eq!(out.film.bytes(), pixels * keep.bytes_per_pixel(all));
-        let pilot = match settings.allocation {
+        let pilot = match allocation_taken(&settings) {
             Allocation::Uniform => 0,
             Allocation::Noise => pixels * Keep::Spread.bytes_per_pixel(all),
         };
@@ -242,6 +253,36 @@ fn allocated(base: RenderSettings) -> RenderSettings {
     RenderSettings {
         allocation: Allocation::Noise,
         ..base
+    }
+}
+
+/// The noise allocation, the default, shares samples where there are samples to share
+/// after its pilot and 32-bit sample indices to share them with; uniform sampling takes
+/// every other spp, so that every spp is a valid render.
+#[test]
+fn the_noise_allocation_is_taken_between_its_pilot_and_its_indices_limit() {
+    assert_eq!(RenderSettings::default().allocation, Allocation::Noise);
+    let taken = |spp, allocation| {
+        allocation_taken(&RenderSettings {
+            spp,
+            allocation,
+            ..RenderSettings::default()
+        })
+    };
+    for (spp, expected) in [
+        (1, Allocation::Uniform),
+        (PASS_SAMPLES, Allocation::Uniform),
+        (PASS_SAMPLES + 1, Allocation::Noise),
+        (1 << 22, Allocation::Noise),
+        ((1 << 22) + 1, Allocation::Uniform),
+        (u32::MAX, Allocation::Uniform),
+    ] {
+        assert_eq!(taken(spp, Allocation::Noise), expected, "{spp} spp");
+        assert_eq!(
+            taken(spp, Allocation::Uniform),
+            Allocation::Uniform,
+            "{spp} spp"
+        );
     }
 }
 

@@ -1,9 +1,9 @@
 /* The hair BSDF from C++ through hairtrace.hpp: a white furnace over random hits, each
  * shaded as a path vertex is (the frame of the hit, a point, a sampled direction and its
- * weight, the pdf of light from that direction), next to the same vertex made with the C
- * calls a host used before the combined ones (the frame conversions, ht_hair_point_init,
- * _sample and _pdf, the weight computed by the host). With no absorption the mean weight
- * is 1; the two paths must agree bit for bit.
+ * weight, the pdf of light from that direction, and the BSDF toward it across the fibre),
+ * next to the same vertex made with the C calls a host used before the combined ones (the
+ * frame conversions, ht_hair_point_init, _sample and _pdf, the weight computed by the
+ * host). With no absorption the mean weight is 1; the two paths must agree bit for bit.
  * Prints "furnace MEAN", "mismatches M of N" and "error STATUS: MESSAGE". */
 #include "hairtrace.hpp"
 
@@ -106,9 +106,24 @@ int main() {
                 hairtrace::Point::world(material, frame, HostVec{-dir.x, -dir.y, -dir.z});
             const hairtrace::Sample s = point.sample_world(u);
             float light_pdf = 0.0f;
+            bool across_agrees = true;
             if (s) {
-                light_pdf = point.eval_world(hairtrace::as<HostVec>(s.wi)).pdf;
+                const hairtrace::Eval e = point.eval_world(hairtrace::as<HostVec>(s.wi));
+                light_pdf = e.pdf;
                 sum += s.weight[1];
+                /* Across the fibre: the world lanes are the local point's lanes through the
+                 * frame, and lane 0, the point's own offset, is the plain evaluation. */
+                const hairtrace::Across world = point.eval_across_world(hairtrace::as<HostVec>(s.wi));
+                const hairtrace::Point local(material, frame.h(),
+                                             frame.to_local(HostVec{-dir.x, -dir.y, -dir.z}));
+                const hairtrace::Across lanes = local.eval_across(frame.to_local(s.wi));
+                for (size_t k = 0; k < HT_ACROSS; ++k) {
+                    across_agrees = across_agrees &&
+                                    same_bits(world[k].f_cos.data(), lanes[k].f_cos.data(), 3) &&
+                                    same_bits(&world[k].pdf, &lanes[k].pdf, 1);
+                }
+                across_agrees = across_agrees && same_bits(world[0].f_cos.data(), e.f_cos.data(), 3) &&
+                                same_bits(&world[0].pdf, &e.pdf, 1);
             }
 
             const float t[3] = {tangent.x, tangent.y, tangent.z}, d[3] = {dir.x, dir.y, dir.z};
@@ -117,7 +132,8 @@ int main() {
                 hairtrace::check(HT_ERR_INVALID_ARG);
             }
             if (!same_bits(s.wi.data(), c_wi, 3) || !same_bits(s.weight.data(), c_weight, 3) ||
-                !same_bits(&s.pdf, &c_pdf, 1) || !same_bits(&light_pdf, &c_light_pdf, 1)) {
+                !same_bits(&s.pdf, &c_pdf, 1) || !same_bits(&light_pdf, &c_light_pdf, 1) ||
+                !across_agrees) {
                 ++mismatches;
             }
         }

@@ -632,6 +632,30 @@ enum HtStatus ht_hair_point_eval_across(const struct HtHairPoint *point,
                                         float *pdf);
 
 /**
+ * `ht_hair_point_eval_across` with `wi[3]` in *world* space, at a point filled by
+ * `ht_hair_point_init_world`: wi is taken to the point's frame, as
+ * `ht_hair_point_eval_world` takes it, and must be a unit vector there (|length - 1| <=
+ * 1e-3). The same bits as `ht_hair_frame_to_local` followed by `ht_hair_point_eval_across`.
+ *
+ * - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
+ * - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+ *   `HT_ERR_INVALID_ARG`.
+ * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+ *   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
+ *   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *
+ * Any thread, concurrently on the same point.
+ *
+ * # Safety
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
+ * NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
+ */
+enum HtStatus ht_hair_point_eval_across_world(const struct HtHairPoint *point,
+                                              const float *wi,
+                                              float *f_cos,
+                                              float *pdf);
+
+/**
  * The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
  * `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
  *

@@ -83,6 +83,9 @@ struct Eval {
     float pdf;
 };
 
+/** `Eval` at each of the `HT_ACROSS` offsets across the fibre, the point's own first. */
+using Across = std::array<Eval, HT_ACROSS>;
+
 /** A sampled direction, its weight f |cos| / pdf and its pdf; pdf 0: no direction. */
 struct Sample {
     Vec3 wi;
@@ -216,6 +219,16 @@ public:
     }
     /** A world direction from `u` in [0, 1)^3 (`ht_hair_point_sample_world`). */
     Sample sample_world(const Vec3 &u) const { return sample_with(ht_hair_point_sample_world, u); }
+    /** f |cos| and pdf toward the local `wi` at `HT_ACROSS` offsets across the fibre, the
+     * point's own first (`ht_hair_point_eval_across`): next-event estimation weighs a light
+     * by the lanes' mean, each lane with its own MIS weight (docs/c-abi.md). */
+    template <class V> Across eval_across(const V &wi) const {
+        return across_with(ht_hair_point_eval_across, wi);
+    }
+    /** The same toward the world `wi` (`ht_hair_point_eval_across_world`). */
+    template <class V> Across eval_across_world(const V &wi) const {
+        return across_with(ht_hair_point_eval_across_world, wi);
+    }
     const HtHairPoint &c() const noexcept { return point_; }
 
 private:
@@ -227,6 +240,19 @@ private:
         Eval e;
         check(call(&point_, w.data(), e.f_cos.data(), &e.pdf));
         return e;
+    }
+    template <class V>
+    Across across_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *),
+                       const V &wi) const {
+        const Vec3 w = vec3(wi);
+        std::array<float, 3 * HT_ACROSS> f_cos;
+        std::array<float, HT_ACROSS> pdf;
+        check(call(&point_, w.data(), f_cos.data(), pdf.data()));
+        Across lanes;
+        for (std::size_t k = 0; k < HT_ACROSS; ++k) {
+            lanes[k] = Eval{{f_cos[3 * k], f_cos[3 * k + 1], f_cos[3 * k + 2]}, pdf[k]};
+        }
+        return lanes;
     }
     Sample sample_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *,
                                         float *),

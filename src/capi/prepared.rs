@@ -459,23 +459,53 @@ pub unsafe extern "C" fn ht_hair_point_eval_across(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        let p = checked_point(
-            point,
-            &[(wi, "wi", 3)],
-            &[(f_cos, "f_cos", 3 * HT_ACROSS), (pdf, "pdf", HT_ACROSS)],
-        )?;
-        let wi = check_dir(read3(wi), "wi")?;
-        let a = p.point.eval_across(wi);
-        let cos = wi.z.abs();
-        for k in 0..HT_ACROSS {
-            // SAFETY: `f_cos` holds 3 * HT_ACROSS floats and `pdf` HT_ACROSS (checked).
-            unsafe {
-                write3(f_cos.add(3 * k), (a.f[k] * cos).to_array());
-                write1(pdf.add(k), a.pdf[k]);
-            }
-        }
-        Ok(())
+        point_and_wi(point, wi, (f_cos, pdf, HT_ACROSS), false)
+            .map(|(p, wi)| write_across(p, wi, f_cos, pdf))
     })
+}
+
+/// `ht_hair_point_eval_across` with `wi[3]` in *world* space, at a point filled by
+/// `ht_hair_point_init_world`: wi is taken to the point's frame, as
+/// `ht_hair_point_eval_world` takes it, and must be a unit vector there (|length - 1| <=
+/// 1e-3). The same bits as `ht_hair_frame_to_local` followed by `ht_hair_point_eval_across`.
+///
+/// - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
+/// - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+///   `HT_ERR_INVALID_ARG`.
+/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+///   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
+///   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///
+/// Any thread, concurrently on the same point.
+///
+/// # Safety
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
+/// NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_eval_across_world(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        point_and_wi(point, wi, (f_cos, pdf, HT_ACROSS), true)
+            .map(|(p, wi)| write_across(p, wi, f_cos, pdf))
+    })
+}
+
+/// Writes lane k's f |cos| toward the local `wi` to `f_cos[3k..3k+3]` and its pdf to
+/// `pdf[k]`, for the `HT_ACROSS` offsets across the fibre (checked outputs).
+fn write_across(p: &Stored, wi: Vec3, f_cos: *mut f32, pdf: *mut f32) {
+    let a = p.point.eval_across(wi);
+    let cos = wi.z.abs();
+    for k in 0..HT_ACROSS {
+        // SAFETY: `f_cos` holds 3 * HT_ACROSS floats and `pdf` HT_ACROSS (checked).
+        unsafe {
+            write3(f_cos.add(3 * k), (a.f[k] * cos).to_array());
+            write1(pdf.add(k), a.pdf[k]);
+        }
+    }
 }
 
 /// The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
@@ -585,7 +615,9 @@ pub unsafe extern "C" fn ht_hair_point_eval_cos(
     f_cos: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| eval_cos(point, wi, f_cos, pdf, false))
+    boundary(|| {
+        point_and_wi(point, wi, (f_cos, pdf, 1), false).map(|(p, wi)| write_cos(p, wi, f_cos, pdf))
+    })
 }
 
 /// One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
@@ -640,7 +672,9 @@ pub unsafe extern "C" fn ht_hair_point_eval_world(
     f_cos: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| eval_cos(point, wi, f_cos, pdf, true))
+    boundary(|| {
+        point_and_wi(point, wi, (f_cos, pdf, 1), true).map(|(p, wi)| write_cos(p, wi, f_cos, pdf))
+    })
 }
 
 /// `ht_hair_point_sample_cos` giving `wi[3]` in *world* space, at a point filled by
@@ -672,31 +706,34 @@ pub unsafe extern "C" fn ht_hair_point_sample_world(
     boundary(|| sample_cos(point, u, wi, weight, pdf, true))
 }
 
-/// The body of `ht_hair_point_eval_cos` and, with `world`, `ht_hair_point_eval_world`
-/// (`wi` in world space, taken to the point's frame).
+/// Writes f |cos| and the pdf toward the local `wi` (checked outputs).
+fn write_cos(p: &Stored, wi: Vec3, f_cos: *mut f32, pdf: *mut f32) {
+    write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
+}
+
+/// The checked point of an evaluation into `lanes` values of `f_cos` (3 floats each) and
+/// `pdf`, and `wi[3]` in its local frame: read as given, or, with `world`, in world space
+/// and taken to the frame of a point that holds one.
 #[inline(always)]
-fn eval_cos(
+fn point_and_wi<'a>(
     point: *const HtHairPoint,
     wi: *const f32,
-    f_cos: *mut f32,
-    pdf: *mut f32,
+    (f_cos, pdf, lanes): (*mut f32, *mut f32, usize),
     world: bool,
-) -> Result<(), Failure> {
+) -> Result<(&'a Stored, Vec3), Failure> {
     let inputs = [(wi, "wi", 3)];
     let outputs = [
-        (f_cos.cast_const(), "f_cos", 3),
-        (pdf.cast_const(), "pdf", 1),
+        (f_cos.cast_const(), "f_cos", 3 * lanes),
+        (pdf.cast_const(), "pdf", lanes),
     ];
-    let (p, wi) = if world {
+    if world {
         let p = checked_framed(point, &inputs, &outputs)?;
         let local = p.frame.to_local(read3(wi));
-        (&p.stored, check_dir(local, "wi (in the point's frame)")?)
+        Ok((&p.stored, check_dir(local, "wi (in the point's frame)")?))
     } else {
         let p = checked_point(point, &inputs, &outputs)?;
-        (p, check_dir(read3(wi), "wi")?)
-    };
-    write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
-    Ok(())
+        Ok((p, check_dir(read3(wi), "wi")?))
+    }
 }
 
 /// The body of `ht_hair_point_sample_cos` and, with `world`, `ht_hair_point_sample_world`
@@ -1043,6 +1080,24 @@ mod tests {
             }
             assert_eq!((f_w, pdf_w), (f_l, pdf_l), "eval at {k}");
             assert_eq!((d_w, wt_w, p_w), (d_back, wt_l, p_l), "sample at {k}");
+            // Across the fibre, lane 0 (the point's own h) being the plain evaluation.
+            type Across = unsafe extern "C" fn(
+                *const HtHairPoint,
+                *const f32,
+                *mut f32,
+                *mut f32,
+            ) -> HtStatus;
+            let lanes = |call: Across, p: &HtHairPoint, wi: &[f32; 3]| {
+                let (mut f, mut pdf) = ([0.0f32; 3 * HT_ACROSS], [0.0f32; HT_ACROSS]);
+                let s = unsafe { call(p, wi.as_ptr(), f.as_mut_ptr(), pdf.as_mut_ptr()) };
+                assert_eq!(s, HtStatus::HT_OK);
+                (f.map(f32::to_bits), pdf.map(f32::to_bits))
+            };
+            let across_w = lanes(ht_hair_point_eval_across_world, &world, &wi);
+            let across_l = lanes(ht_hair_point_eval_across, &local, &wi_local);
+            assert_eq!(across_w, across_l, "across at {k}");
+            assert_eq!(across_w.0[..3], f_w.map(f32::to_bits), "lane 0 at {k}");
+            assert_eq!(across_w.1[0], pdf_w.to_bits(), "lane 0 at {k}");
             assert!(pdf_w > 0.0 && p_w > 0.0, "{k}: a lobe toward every light");
         }
         unsafe { ht_hair_prepared_free(handle) };

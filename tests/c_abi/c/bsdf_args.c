@@ -290,6 +290,20 @@ int main(void) {
     UNTOUCHED(ws, 3);
     ROW(OK, NULL, ht_hair_point_eval_world(&framed, wi_world, f, &pdf));
     ROW(OK, NULL, ht_hair_point_sample_world(&framed, u, ws, f, &pdf));
+    for (size_t k = 0; k < 3 * HT_ACROSS; ++k) fa[k] = 7.0f;
+    for (size_t k = 0; k < HT_ACROSS; ++k) pa[k] = 7.0f;
+    ROW(NUL, "point is NULL", ht_hair_point_eval_across_world(NULL, wi_world, fa, pa));
+    ROW(NUL, "wi is NULL", ht_hair_point_eval_across_world(&framed, NULL, fa, pa));
+    ROW(BAD, "without a frame", ht_hair_point_eval_across_world(&pt, wi_world, fa, pa));
+    ROW(BAD, "not filled by ht_hair_point_init", ht_hair_point_eval_across_world(&zeroed, wi_world, fa, pa));
+    ROW(BAD, "wi (in the point's frame) = [0, 0, 0]",
+        ht_hair_point_eval_across_world(&framed, zero3, fa, pa));
+    ROW(BAD, "f_cos and pdf overlap", ht_hair_point_eval_across_world(&framed, wi_world, fa, fa + 5));
+    ROW(BAD, "f_cos and point overlap",
+        ht_hair_point_eval_across_world(&framed, wi_world, (float *)framed.opaque, pa));
+    UNTOUCHED(fa, 3 * HT_ACROSS);
+    UNTOUCHED(pa, HT_ACROSS);
+    ROW(OK, NULL, ht_hair_point_eval_across_world(&framed, wi_world, fa, pa));
 
     printf("checks %d failed %d\n", checks, failed);
     return failed ? 1 : 0;

@@ -15,7 +15,7 @@ use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device};
 use crate::error::{Error, Result, invalid_arg};
 use crate::render::Aovs;
-use crate::render::renderer::film_bytes;
+use crate::render::renderer::film_bytes_and_uniform;
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -145,8 +145,9 @@ impl SceneDescription {
     /// once read, before the BVH build. The film is counted without AOVs and as one in
     /// passes (the larger), as a render chooses those (and checks again).
     pub(crate) fn check_memory(&self, available: Option<u64>) -> Result<()> {
-        let film = film_bytes(&self.render, Aovs::default(), true);
-        footprint::check_film_fits(film, available).map_err(|e| e.context(&self.origin))?;
+        let (film, uniform) = film_bytes_and_uniform(&self.render, Aovs::default(), true);
+        footprint::check_film_fits(film, uniform, available)
+            .map_err(|e| e.context(&self.origin))?;
         let options = scene_options(&self.render);
         let (mut sizes, mut conversion) = (Vec::new(), 0);
         for g in &self.grooms {
@@ -512,6 +513,15 @@ mod tests {
         ] {
             assert!(message.contains(part), "{message:?} lacks {part:?}");
         }
+        // Sampled uniformly, the sums alone (40 bytes a pixel) do not fit either: not offered.
+        assert!(!message.contains("allocation = uniform"), "{message}");
+        // Where they fit, the refusal offers them.
+        let message = big.check_memory(Some(48 * GIB)).unwrap_err().to_string();
+        let offer = "or sample uniformly (allocation = uniform: about 40960 MiB)";
+        assert!(message.contains(offer), "{message:?} lacks {offer:?}");
+        big.render.allocation = crate::render::settings::Allocation::Uniform;
+        big.check_memory(Some(48 * GIB)).unwrap();
+        big.render.allocation = crate::render::settings::Allocation::Noise;
         // A crop of the frame keeps a film of its own pixels only.
         big.render.crop = Some([0, 0, 1024, 1024]);
         big.check_memory(Some(4 * GIB)).unwrap();

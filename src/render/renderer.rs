@@ -116,6 +116,23 @@ pub fn film_bytes(settings: &RenderSettings, aovs: Aovs, keeps_passes: bool) -> 
     film.saturating_add(pilot)
 }
 
+/// [`film_bytes`] of the render, and of the same render sampled uniformly: what
+/// [`footprint::check_film_fits`] suggests when the noise allocation's films do not fit.
+pub fn film_bytes_and_uniform(
+    settings: &RenderSettings,
+    aovs: Aovs,
+    keeps_passes: bool,
+) -> (u64, u64) {
+    let uniform = RenderSettings {
+        allocation: Allocation::Uniform,
+        ..*settings
+    };
+    (
+        film_bytes(settings, aovs, keeps_passes),
+        film_bytes(&uniform, aovs, keeps_passes),
+    )
+}
+
 /// Renders `world` through `camera`. Each sample's numbers depend only on the seed, the
 /// full-frame pixel and the sample index, so the image is the same for any thread count,
 /// tile order or crop. A world whose curves were shaped for a view (the `auto` shape)
@@ -151,8 +168,8 @@ pub fn render(
              or with fewer pixels): build the scene again for this camera and image height"
         ));
     }
-    let bytes = film_bytes(settings, aovs, progress.keeps_passes());
-    footprint::check_film_fits(bytes, available_bytes())?;
+    let (bytes, uniform) = film_bytes_and_uniform(settings, aovs, progress.keeps_passes());
+    footprint::check_film_fits(bytes, uniform, available_bytes())?;
     let (width, height) = (settings.width, settings.height);
     let keep = film_keep(settings, progress.keeps_passes());
     let mut film = Film::keeping(width, height, crop(settings), aovs, keep)?;

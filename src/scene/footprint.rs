@@ -187,15 +187,24 @@ pub fn check_fits(
 }
 
 /// Refuses a render whose films need `bytes` (`crate::render::renderer::film_bytes`) when
-/// that exceeds `available` (from [`available_bytes`]), before any is allocated.
-pub fn check_film_fits(bytes: u64, available: Option<u64>) -> Result<()> {
+/// that exceeds `available` (from [`available_bytes`]), before any is allocated. `uniform`
+/// is what the render would need sampled uniformly: the refusal suggests it where that fits.
+pub fn check_film_fits(bytes: u64, uniform: u64, available: Option<u64>) -> Result<()> {
     let Some(available) = available.filter(|&a| bytes > a) else {
         return Ok(());
     };
     let mib = |b: u64| b as f64 / f64::from(1u32 << 20);
+    let uniform = if uniform < bytes && uniform <= available {
+        format!(
+            ", or sample uniformly (allocation = uniform: about {:.0} MiB)",
+            mib(uniform)
+        )
+    } else {
+        String::new()
+    };
     Err(invalid_arg!(
         "the render's film needs about {:.0} MiB of memory, and {:.0} MiB are available: \
-         render fewer pixels (a crop, or the frame in tiles)",
+         render fewer pixels (a crop, or the frame in tiles){uniform}",
         mib(bytes),
         mib(available)
     ))

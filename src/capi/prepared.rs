@@ -707,6 +707,7 @@ pub unsafe extern "C" fn ht_hair_point_sample_world(
 }
 
 /// Writes f |cos| and the pdf toward the local `wi` (checked outputs).
+#[inline(always)]
 fn write_cos(p: &Stored, wi: Vec3, f_cos: *mut f32, pdf: *mut f32) {
     write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
 }

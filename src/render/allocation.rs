@@ -31,7 +31,7 @@ const FLOOR: f64 = 0.1;
 /// no scene lost (docs/measurements.md).
 const MIN_GAIN: f64 = 1.3;
 
-/// The most spp a render with this allocation takes (`RenderSettings::validate`): a pass
+/// The most spp a render takes with this allocation (`renderer::allocation_taken`): a pass
 /// gives a pixel at most its colour's half of a block's samples (512 pixels x 8, 2^12),
 /// so over 2^19 passes its sample indices stay below 2^31 plus the pilot's, within a u32.
 pub const MOST_SPP: u32 = 1 << 22;

@@ -210,7 +210,7 @@ impl Assembly {
         stages.report(Stage::Curves, 1.0)?;
         // What is built so far is held already: only Embree's part and the film are still
         // to come.
-        let bvh = sizes.iter().map(CurvesSize::bvh_bytes).sum::<u64>();
+        let bvh = footprint::bvh_bytes(&sizes, &options);
         footprint::check_fits(
             &sizes,
             bvh.saturating_add(film),

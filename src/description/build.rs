@@ -166,7 +166,7 @@ impl SceneDescription {
             return Ok(());
         }
         // The film comes after the build, beside what the build keeps (at most its peak).
-        let needed = footprint::build_bytes(&sizes)
+        let needed = footprint::build_bytes(&sizes, &options)
             .saturating_add(film)
             .max(conversion);
         footprint::check_fits(&sizes, needed, "at their peak", available)
@@ -482,13 +482,17 @@ mod tests {
             assert!(message.contains(part), "{message:?} lacks {part:?}");
         }
         // The figure it names is the estimate's.
-        let needed = footprint::build_bytes(&[CurvesSize::polylines(
-            10_000_000,
-            16,
-            CurveBasis::CatmullRom,
-            crate::embree::CurveShape::Round,
-            &scene_options(&big.render),
-        )]);
+        let options = scene_options(&big.render);
+        let needed = footprint::build_bytes(
+            &[CurvesSize::polylines(
+                10_000_000,
+                16,
+                CurveBasis::CatmullRom,
+                crate::embree::CurveShape::Round,
+                &options,
+            )],
+            &options,
+        );
         let gib = format!("{:.1} GiB of memory", needed as f64 / GIB as f64);
         assert!(message.contains(&gib), "{message:?} lacks {gib:?}");
         // The same groom fits where there is room, and so does a small one here.

@@ -627,7 +627,7 @@ impl CurveGeometry {
         self.indices.as_slice()
     }
 
-    #[cfg(any(test, feature = "bench-internals"))]
+    /// Curve segments: Embree's primitives.
     pub fn segment_count(&self) -> usize {
         self.indices.len()
     }
@@ -1054,40 +1054,50 @@ pub(crate) mod tests {
             let device = Arc::new(Device::new(Some(2)).unwrap());
             let points: Vec<[f32; 4]> = (0..7).map(|i| [i as f32, 0.0, 0.0, 0.2]).collect();
             let guarded = Guarded::new(&points);
-            for basis in CurveBasis::ALL {
-                for shape in CurveShape::ALL {
-                    let segments = basis.segments_for(points.len()).unwrap();
-                    let stride = basis.segment_stride() as u32;
-                    let indices = (0..segments as u32).map(|i| i * stride).collect();
-                    let options = SceneOptions::default();
-                    let mut scene = SceneBuilder::new(device.clone(), options).unwrap();
-                    // SAFETY: `guarded` outlives the scene and is not modified.
-                    let vertices =
-                        unsafe { SharedBuffer::from_raw_parts(guarded.data, points.len()) };
-                    let geometry = CurveGeometry::new(
-                        &device,
-                        basis,
-                        shape,
-                        vertices,
-                        SharedBuffer::new(indices),
-                        1,
-                    )
-                    .unwrap();
-                    let last = geometry.interpolate(segments as u32 - 1, 1.0).unwrap();
-                    assert!(last.p.iter().all(|v| v.is_finite()), "{basis:?}");
-                    scene.attach(geometry).unwrap();
-                    let scene = scene.commit(&|_| true).unwrap();
-                    // Rays across the whole strand, up to its tip: every segment is traced.
-                    let (lo, hi) = scene.bounds();
-                    let hits = (0..=32)
-                        .map(|k| lo[0] + (hi[0] - lo[0]) * k as f32 / 32.0)
-                        .filter(|&x| {
-                            let ray = Ray::new(Vec3::new(x, 0.0, 5.0), -Vec3::Z);
-                            scene.intersect(&ray, None).is_some()
-                        })
-                        .count();
-                    assert!(hits > 16, "{basis:?} {shape:?}: {hits} hits");
-                }
+            // Both BVHs: the compact one's leaves read the points at each query, the
+            // other's copy them at the build.
+            let cases = CurveBasis::ALL
+                .into_iter()
+                .flat_map(|b| CurveShape::ALL.map(|s| (b, s)))
+                .flat_map(|(b, s)| [(b, s, 0), (b, s, usize::MAX)]);
+            for (basis, shape, compact_from_segments) in cases {
+                let segments = basis.segments_for(points.len()).unwrap();
+                let stride = basis.segment_stride() as u32;
+                let indices = (0..segments as u32).map(|i| i * stride).collect();
+                let options = SceneOptions {
+                    compact_from_segments,
+                    ..SceneOptions::default()
+                };
+                let mut scene = SceneBuilder::new(device.clone(), options).unwrap();
+                // SAFETY: `guarded` outlives the scene and is not modified.
+                let vertices = unsafe { SharedBuffer::from_raw_parts(guarded.data, points.len()) };
+                let geometry = CurveGeometry::new(
+                    &device,
+                    basis,
+                    shape,
+                    vertices,
+                    SharedBuffer::new(indices),
+                    1,
+                )
+                .unwrap();
+                let last = geometry.interpolate(segments as u32 - 1, 1.0).unwrap();
+                assert!(last.p.iter().all(|v| v.is_finite()), "{basis:?}");
+                scene.attach(geometry).unwrap();
+                let scene = scene.commit(&|_| true).unwrap();
+                // SAFETY: a committed scene.
+                let flags = unsafe { sys::rtcGetSceneFlags(scene.raw()) };
+                let compact = sys::RTCSceneFlags::RTC_SCENE_FLAG_COMPACT;
+                assert_eq!(flags.0 & compact.0 != 0, compact_from_segments == 0);
+                // Rays across the whole strand, up to its tip: every segment is traced.
+                let (lo, hi) = scene.bounds();
+                let hits = (0..=32)
+                    .map(|k| lo[0] + (hi[0] - lo[0]) * k as f32 / 32.0)
+                    .filter(|&x| {
+                        let ray = Ray::new(Vec3::new(x, 0.0, 5.0), -Vec3::Z);
+                        scene.intersect(&ray, None).is_some()
+                    })
+                    .count();
+                assert!(hits > 16, "{basis:?} {shape:?}: {hits} hits");
             }
         }
     }

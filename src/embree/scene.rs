@@ -21,10 +21,9 @@ use crate::{Error, Result};
 /// docs/large-grooms.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SceneOptions {
-    /// `RTC_SCENE_FLAG_COMPACT`: a BVH whose curve leaves index into the vertex buffers
-    /// instead of copying the control points (Curve8i leaves, about 28 against 92 bytes per
-    /// segment). Default on.
-    pub compact: bool,
+    /// The fewest curve segments a BVH holds for it to be built with
+    /// `RTC_SCENE_FLAG_COMPACT` ([`Self::compacts`]). Default [`COMPACT_FROM_SEGMENTS`].
+    pub compact_from_segments: usize,
     /// When a curve geometry large enough for parts is built in them.
     pub parts: PartsRule,
 }
@@ -43,10 +42,13 @@ pub enum PartsRule {
     ForSamples(u64),
 }
 
-/// Compact by default: on the bench scalp it builds with 20% less CPU time and 43% less
-/// peak memory (docs/large-grooms.md); it is what lets 10^7 strands fit on a 24 GiB
-/// machine.
-pub const DEFAULT_COMPACT: bool = true;
+/// The fewest curve segments for which a BVH is compact (`RTC_SCENE_FLAG_COMPACT`: BVH4OBB
+/// with Curve8i leaves, which index the vertex buffers, against Embree's BVH8OBB with
+/// Curve8v leaves, which copy the control points). Compact builds the 10^6-strand scalp
+/// with 20% less CPU time and 43% less peak memory (what lets 10^7 strands fit on a 24
+/// GiB machine), and traces 1.08x-1.14x slower (bench scenes, 2 threads, Xeon;
+/// docs/large-grooms.md). From here the build's memory and time outweigh the rays'.
+pub const COMPACT_FROM_SEGMENTS: usize = 1 << 20;
 
 /// Segments per camera sample above which a large geometry is built in parts. On the
 /// bench scalp at 10^6 strands parts save about 0.6 microseconds of build per segment and
@@ -66,17 +68,22 @@ pub const AUTO_PARTS_FROM_SEGMENTS: usize = 1 << 20;
 impl Default for SceneOptions {
     fn default() -> Self {
         SceneOptions {
-            compact: DEFAULT_COMPACT,
+            compact_from_segments: COMPACT_FROM_SEGMENTS,
             parts: PartsRule::Never,
         }
     }
 }
 
 impl SceneOptions {
-    /// Embree's flags for a scene built with these options (a part's scene too).
-    fn flags(&self) -> sys::RTCSceneFlags {
+    /// Whether a BVH over `segments` curve segments is compact.
+    pub(crate) fn compacts(&self, segments: usize) -> bool {
+        segments >= self.compact_from_segments
+    }
+
+    /// Embree's flags for a scene (a part's too) whose BVH holds `segments` curve segments.
+    fn flags(&self, segments: usize) -> sys::RTCSceneFlags {
         let mut flags = FILTER_SCENE_FLAG;
-        if self.compact {
+        if self.compacts(segments) {
             flags |= sys::RTCSceneFlags::RTC_SCENE_FLAG_COMPACT;
         }
         flags
@@ -142,7 +149,7 @@ fn commit_scene(device: &Device, scene: &RawScene, progress: &BuildMonitor<'_>) 
 impl SceneBuilder {
     pub fn new(device: Arc<Device>, options: SceneOptions) -> Result<Self> {
         Ok(SceneBuilder {
-            raw: new_scene(&device, options.flags())?,
+            raw: new_scene(&device, options.flags(0))?,
             parts: Vec::new(),
             slots: Vec::new(),
             geometries: Vec::new(),
@@ -173,7 +180,8 @@ impl SceneBuilder {
                     // SAFETY: the part's handle is kept in `self.parts`, released before
                     // `self.geometries` (field order, here and in `Scene`).
                     let geometry = unsafe { c.part_geometry(&self.device, range) }?;
-                    let flags = self.options.flags();
+                    // A part is compact as its whole geometry would be.
+                    let flags = self.options.flags(c.segment_count());
                     // SAFETY: as above: the part is released before the geometry.
                     let part =
                         unsafe { LazyPart::new(&self.device, geometry, bounds, flags, c.mask()) }?;
@@ -215,6 +223,18 @@ impl SceneBuilder {
     /// Embree 3 and 4.
     pub(crate) fn commit(self, progress: &BuildMonitor<'_>) -> Result<Scene> {
         self.device.count_build();
+        // The top level's BVH holds the segments of the curves attached whole.
+        let segments = self
+            .slots
+            .iter()
+            .filter(|s| s.part_start.is_none())
+            .filter_map(|s| match &self.geometries[s.geometry as usize] {
+                Geometry::Curves(c) => Some(c.segment_count()),
+                Geometry::Triangles(_) => None,
+            })
+            .sum();
+        // SAFETY: live scene, not yet committed.
+        unsafe { sys::rtcSetSceneFlags(self.raw.raw(), self.options.flags(segments)) };
         commit_scene(&self.device, &self.raw, progress)?;
         Ok(Scene {
             raw: self.raw,
@@ -363,6 +383,7 @@ mod tests {
         // Below a million segments the rule keeps a geometry whole however few the samples.
         assert!(!rule(PartsRule::ForSamples(1)).builds_in_parts(segments - 1));
         assert!(rule(PartsRule::Always).builds_in_parts(segments - 1));
-        assert!(short.compact && SceneOptions::default().compact);
+        assert!(!SceneOptions::default().compacts(COMPACT_FROM_SEGMENTS - 1));
+        assert!(SceneOptions::default().compacts(COMPACT_FROM_SEGMENTS));
     }
 }

@@ -90,10 +90,10 @@ impl CurvesSize {
             .saturating_add(self.strands.saturating_mul(8))
     }
 
-    /// Bytes Embree holds at the peak of the BVH build over these curves.
-    pub fn bvh_bytes(&self) -> u64 {
+    /// Bytes Embree holds at the peak of the BVH build over these curves, `compact` or not.
+    pub fn bvh_bytes(&self, compact: bool) -> u64 {
         self.segments
-            .saturating_mul(bvh_bytes_per_segment(self.basis))
+            .saturating_mul(bvh_bytes_per_segment(self.basis, compact))
     }
 
     /// "1000000 strands x 16 segments, catmull_rom round".
@@ -113,22 +113,51 @@ impl CurvesSize {
     }
 }
 
-/// Embree's peak bytes per curve segment during a build of a compact scene (what
-/// `SceneBuilder` makes): 32-byte primitive references, then the BVH of index leaves, both
-/// alive at the end of the build. Cubic and linear leaves differ; round and flat share them.
-fn bvh_bytes_per_segment(basis: CurveBasis) -> u64 {
-    match basis {
-        CurveBasis::Linear => 35,
-        _ => 40,
+/// Embree's peak bytes per curve segment during a BVH build: 32-byte primitive references,
+/// then the BVH, both alive at the end of the build. A compact BVH's leaves index the
+/// control points; the other's copy them. Cubic and linear leaves differ; round and flat
+/// share them.
+fn bvh_bytes_per_segment(basis: CurveBasis, compact: bool) -> u64 {
+    match (basis, compact) {
+        (CurveBasis::Linear, true) => 35,
+        (CurveBasis::Linear, false) => 52,
+        (_, true) => 40,
+        (_, false) => 140,
     }
 }
 
-/// Peak bytes of a scene whose curves are `parts`, at its BVH build.
-pub fn build_bytes(parts: &[CurvesSize]) -> u64 {
-    parts.iter().fold(BASE_BYTES, |sum, p| {
-        sum.saturating_add(p.curve_bytes())
-            .saturating_add(p.bvh_bytes())
-    })
+/// Bytes Embree holds at the peak of the BVH builds of a scene built with `options` whose
+/// curves are `parts`: the curves attached whole share the top level's BVH, compact or not
+/// by their total; parts are compact or not by their geometry's size.
+pub fn bvh_bytes(parts: &[CurvesSize], options: &SceneOptions) -> u64 {
+    let compacts =
+        |segments: u64| options.compacts(usize::try_from(segments).unwrap_or(usize::MAX));
+    let whole = compacts(
+        parts
+            .iter()
+            .filter(|p| !p.in_parts)
+            .map(|p| p.segments)
+            .sum(),
+    );
+    parts
+        .iter()
+        .map(|p| {
+            p.bvh_bytes(if p.in_parts {
+                compacts(p.segments)
+            } else {
+                whole
+            })
+        })
+        .fold(0, u64::saturating_add)
+}
+
+/// Peak bytes of a scene built with `options` whose curves are `parts`, at its BVH build.
+pub fn build_bytes(parts: &[CurvesSize], options: &SceneOptions) -> u64 {
+    parts
+        .iter()
+        .map(CurvesSize::curve_bytes)
+        .fold(BASE_BYTES, u64::saturating_add)
+        .saturating_add(bvh_bytes(parts, options))
 }
 
 /// Peak bytes while polylines of `points` points (xyz and radius, 16 bytes each) and
@@ -270,5 +299,41 @@ mod tests {
                 "{parts:?}: {held} against {estimate}"
             );
         }
+    }
+
+    /// A BVH under the default threshold's segments is counted at the fast layout's bytes,
+    /// one at or past it at the compact layout's: the whole curves by their total, parts
+    /// by their geometry's size.
+    #[test]
+    fn the_bvh_is_counted_compact_from_its_threshold() {
+        let threshold = SceneOptions::default().compact_from_segments as u64;
+        let size = |strands: u64, basis| {
+            CurvesSize::polylines(
+                strands,
+                16,
+                basis,
+                CurveShape::Round,
+                &options(PartsRule::Never),
+            )
+        };
+        let below = size((threshold - 16) / 16, CurveBasis::CatmullRom);
+        let per_segment = |sizes: &[CurvesSize]| {
+            let segments: u64 = sizes.iter().map(|s| s.segments).sum();
+            bvh_bytes(sizes, &options(PartsRule::Never)) / segments
+        };
+        assert_eq!(per_segment(&[below]), 140);
+        let linear = size((threshold - 16) / 16, CurveBasis::Linear);
+        assert_eq!(per_segment(&[linear]), 52);
+        // Two grooms under the threshold that together pass it share a compact BVH.
+        assert_eq!(per_segment(&[below, below]), 40);
+        // A geometry in parts is compact or not by its own size, whatever the scene's.
+        let parts = CurvesSize {
+            in_parts: true,
+            ..below
+        };
+        assert_eq!(
+            bvh_bytes(&[parts, below, below], &options(PartsRule::Always)),
+            below.segments * (140 + 2 * 40)
+        );
     }
 }

@@ -115,6 +115,12 @@ pub fn polylines(
         }
     }
     if keep.iter().all(|&k| k) {
+        // Linear strands that keep every point are their own polylines: traced as they
+        // are, their hits need no mapping back onto a second copy (4% of the bench fur
+        // balls' render time, docs/measurements.md).
+        if curves.basis() == CurveBasis::Linear && all.points.as_slice() == curves.vertices() {
+            return Ok((Some(curves.with_shape(CurveShape::Flat)), None));
+        }
         return Ok((
             Some(Curves::polylines(
                 curves,
@@ -474,6 +480,30 @@ mod tests {
                 assert_eq!(all, [0, 1, 2], "{basis:?}");
             }
         }
+    }
+
+    /// Linear strands whose every point is kept are traced as themselves, flat, with no
+    /// copy to map hits back onto; one merged piece brings the mapping back.
+    #[test]
+    fn linear_strands_that_keep_every_point_are_their_own_polylines() {
+        let all = strands();
+        let bent = Strands {
+            points: all.points[13..].to_vec(),
+            radii: all.radii[13..].to_vec(),
+            colors: all.colors.as_ref().map(|c| c[13..].to_vec()),
+            counts: vec![13; 2],
+        };
+        let curves = Curves::from_strands(&bent, CurveBasis::Linear, CurveShape::Round).unwrap();
+        let lines = all_polylines(curves.clone(), 0.001);
+        assert!(lines.truth().is_none());
+        assert_eq!(lines.shape(), CurveShape::Flat);
+        assert_eq!(
+            (lines.vertices(), lines.indices()),
+            (curves.vertices(), curves.indices())
+        );
+        // The straight strand merges into one piece: its hits map back.
+        let curves = Curves::from_strands(&all, CurveBasis::Linear, CurveShape::Round).unwrap();
+        assert!(all_polylines(curves, 0.001).truth().is_some());
     }
 
     /// The bench scalp's strands (bench/stages/scalp_1m.toml: 16 segments over four

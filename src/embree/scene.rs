@@ -46,7 +46,7 @@ pub enum PartsRule {
 /// with Curve8i leaves, which index the vertex buffers, against Embree's BVH8OBB with
 /// Curve8v leaves, which copy the control points). Compact builds the 10^6-strand scalp
 /// with 20% less CPU time and 43% less peak memory (what lets 10^7 strands fit on a 24
-/// GiB machine), and traces 1.08x-1.14x slower (bench scenes, 2 threads, Xeon;
+/// GiB machine), and traces 1.05x-1.14x slower (bench scenes, 2 threads, Xeon;
 /// docs/large-grooms.md). From here the build's memory and time outweigh the rays'.
 pub const COMPACT_FROM_SEGMENTS: usize = 1 << 20;
 

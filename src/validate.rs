@@ -10,6 +10,31 @@ use glam::Vec3;
 /// renderer forms between them (camera, lens, hits, lights) well inside.
 pub const MAX_COORDINATE: f32 = 1e15;
 
+/// Relative difference between the scales of the three axes, and between their directions
+/// and right angles, above which a linear map is not a uniform scale.
+const UNIFORM_SCALE_TOLERANCE: f64 = 1e-4;
+
+/// The scale of a linear map given by the images of the three axes, when it scales them
+/// alike (turns and mirrors allowed): radii can follow such a scale and fibres stay round.
+/// Else an error naming `what` and the three scales.
+pub(crate) fn uniform_scale(what: &str, axes: [[f64; 3]; 3]) -> Result<f64> {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let s = axes.map(|a| dot(a, a).sqrt());
+    let mean = (s[0] + s[1] + s[2]) / 3.0;
+    let tol = UNIFORM_SCALE_TOLERANCE * mean;
+    let skew = [(0, 1), (1, 2), (0, 2)].map(|(i, j)| dot(axes[i], axes[j]).abs());
+    if !(mean.is_finite() && mean > 0.0)
+        || s.iter().any(|x| (x - mean).abs() > tol)
+        || skew.iter().any(|&d| d > tol * mean)
+    {
+        return Err(invalid_arg!(
+            "{what} scales the axes by {s:?} (or shears them): radii can follow a uniform \
+             scale only"
+        ));
+    }
+    Ok(mean)
+}
+
 /// `v` is finite and > 0.
 pub(crate) fn positive(name: &str, v: f32) -> Result<()> {
     if v.is_finite() && v > 0.0 {

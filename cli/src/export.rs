@@ -16,7 +16,9 @@ use serde::Serialize;
 
 use hairtrace::description::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
 use hairtrace::embree::CurveBasis;
-use hairtrace::formats::hair::{Thickness, write_hair_file};
+use hairtrace::formats::hair::{HairTag, Thickness, write_tagged_hair_file};
+use hairtrace::formats::units::StageUnits;
+use hairtrace::formats::usd::Wrap;
 use hairtrace::scene::{GroomShape, Mesh};
 use hairtrace::{Error, Result};
 
@@ -110,16 +112,6 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
     };
     let mut grooms = Vec::new();
     for (i, g) in d.grooms.iter().enumerate() {
-        let basis = match g.basis {
-            CurveBasis::Linear => "linear",
-            CurveBasis::CatmullRom => "catmull-rom",
-            other => {
-                return Err(invalid_arg!(
-                    "groom[{i}]: basis {other:?} has no Cycles equivalent (use linear or \
-                     catmull-rom)"
-                ));
-            }
-        };
         // `auto` is an approximation of round tubes, which the peer traces exactly.
         if g.shape == GroomShape::Flat {
             return Err(invalid_arg!("groom[{i}]: only round curves are exported"));
@@ -135,20 +127,54 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             ));
         }
         let p = prepared.params_at(0, 0.0, None);
-        let file = format!("groom{i}.hair");
-        write_hair_file(&dir.join(&file), &g.strands()?, Thickness::Diameter)?;
-        grooms.push(PeerGroom {
-            file,
-            basis,
-            shape: "round",
-            material: PeerHair {
-                sigma_a: p.sigma_a,
-                eta: p.eta,
-                beta_m: p.beta_m,
-                beta_n: p.beta_n,
-                alpha_deg: p.alpha,
-            },
-        });
+        let sets = g
+            .placed_strands()
+            .map_err(|e| e.context(format_args!("groom[{i}]")))?;
+        let many = sets.len() > 1;
+        for (k, set) in sets.iter().enumerate() {
+            let layout = set.curves.layout();
+            let basis = match (layout.basis, layout.wrap) {
+                (CurveBasis::Linear, Wrap::Nonperiodic | Wrap::Pinned) => "linear",
+                (CurveBasis::CatmullRom, Wrap::Pinned) => "catmull-rom",
+                _ => {
+                    let (kind, basis, wrap) = layout.tokens();
+                    return Err(invalid_arg!(
+                        "groom[{i}]{}: {kind} {basis} {wrap} curves have no Cycles equivalent \
+                         (linear, or pinned Catmull-Rom)",
+                        set.prim
+                            .as_deref()
+                            .map(|p| format!(" {p}"))
+                            .unwrap_or_default()
+                    ));
+                }
+            };
+            let file = match many {
+                true => format!("groom{i}_{k}.hair"),
+                false => format!("groom{i}.hair"),
+            };
+            let tag = HairTag {
+                layout,
+                units: StageUnits::WORLD,
+            };
+            write_tagged_hair_file(
+                &dir.join(&file),
+                &set.strands,
+                Thickness::Diameter,
+                Some(&tag),
+            )?;
+            grooms.push(PeerGroom {
+                file,
+                basis,
+                shape: "round",
+                material: PeerHair {
+                    sigma_a: p.sigma_a,
+                    eta: p.eta,
+                    beta_m: p.beta_m,
+                    beta_n: p.beta_n,
+                    alpha_deg: p.alpha,
+                },
+            });
+        }
     }
     let mut meshes = Vec::new();
     for (i, m) in d.meshes.iter().enumerate() {
@@ -251,130 +277,4 @@ fn obj_text(mesh: &Mesh) -> String {
         };
     }
     s
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use hairtrace::description::GroomSource;
-    use hairtrace::formats::hair::read_hair_file;
-
-    /// The peer benchmark's scenes (`bench/scenes`), with fewer strands, all export.
-    #[test]
-    fn bench_scenes_export_for_the_peer() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes");
-        let mut found = 0;
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.extension().is_some_and(|e| e == "toml") {
-                let mut desc = SceneDescription::load(&path).unwrap();
-                for g in &mut desc.grooms {
-                    match &mut g.source {
-                        GroomSource::FurBall(f) => f.strands = 300,
-                        GroomSource::Scalp(s) => s.strands = 300,
-                        _ => {}
-                    }
-                }
-                let out = std::env::temp_dir()
-                    .join(format!("hairtrace-peer-{}-{found}", std::process::id()));
-                export_for_peer(&desc, &out).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-                assert!(out.join("scene.json").is_file());
-                std::fs::remove_dir_all(&out).unwrap();
-                found += 1;
-            }
-        }
-        assert!(found >= 4, "only {found} bench scenes");
-    }
-
-    const SCENE: &str = r#"
-[render]
-width = 32
-height = 24
-[camera]
-eye = [0, 0, 5]
-target = [0, 0, 0]
-fov_deg = 30
-[materials.brown]
-type = "hair"
-melanin = [1.3, 0.0]
-[materials.floor]
-type = "diffuse"
-albedo = [0.5, 0.5, 0.5]
-[[groom]]
-procedural = "fur_ball"
-basis = "linear"
-material = "brown"
-[groom.params]
-strands = 50
-segments = 4
-[[mesh]]
-shape = "ground"
-y = -2
-half_size = 3
-material = "floor"
-[[light]]
-type = "environment"
-radiance = [0.5, 0.5, 0.5]
-scale = 2
-[[light]]
-type = "distant"
-direction = [0, 1, 0]
-irradiance = [3, 3, 3]
-angular_radius_deg = 2
-"#;
-
-    fn scratch(name: &str) -> std::path::PathBuf {
-        let dir =
-            std::env::temp_dir().join(format!("hairtrace-peer-{name}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        dir
-    }
-
-    #[test]
-    fn a_scene_goes_out_whole() {
-        let d = SceneDescription::from_toml(SCENE, Path::new("."), "test").unwrap();
-        let dir = scratch("whole");
-        export_for_peer(&d, &dir).unwrap();
-        let json: serde_json::Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join("scene.json")).unwrap())
-                .unwrap();
-        assert_eq!(json["width"], 32);
-        assert_eq!(json["camera"]["fov_y_deg"], 30.0);
-        let groom = &json["grooms"][0];
-        assert_eq!(groom["basis"], "linear");
-        let sigma_a = hairtrace::bsdf::sigma_a_from_melanin(1.3, 0.0).unwrap();
-        let exported = groom["material"]["sigma_a"][1].as_f64().unwrap() as f32;
-        assert_eq!(exported, sigma_a[1], "f32 values survive the text exactly");
-        // The environment's scale is folded into its radiance.
-        assert_eq!(json["lights"][0]["radiance"][0], 1.0);
-        assert_eq!(json["lights"][1]["type"], "distant");
-        let strands = read_hair_file(&dir.join("groom0.hair"), Thickness::Diameter).unwrap();
-        assert_eq!(strands, d.grooms[0].strands().unwrap());
-        let obj = std::fs::read_to_string(dir.join("mesh0.obj")).unwrap();
-        assert!(obj.lines().any(|l| l.starts_with("vn ")) && obj.contains("f 1//1"));
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn what_a_peer_cannot_render_is_refused() {
-        let refused = |from: &str, to: &str, expect: &str| {
-            let text = SCENE.replace(from, to);
-            let d = SceneDescription::from_toml(&text, Path::new("."), "test").unwrap();
-            let dir = scratch("refused");
-            let e = export_for_peer(&d, &dir).unwrap_err().to_string();
-            assert!(e.contains(expect), "{e}");
-            let _ = std::fs::remove_dir_all(&dir);
-        };
-        refused("eye = [0, 0, 5]\ntarget = [0, 0, 0]", "", "eye and target");
-        refused(
-            "basis = \"linear\"",
-            "basis = \"bspline\"",
-            "no Cycles equivalent",
-        );
-        refused(
-            "melanin = [1.3, 0.0]",
-            "melanin = [1.3, 0.0]\nabsorption_variation = 0.2",
-            "varies per strand",
-        );
-    }
 }

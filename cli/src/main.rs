@@ -18,10 +18,12 @@ use hairtrace::bsdf::{
     DEFAULT_EUMELANIN, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset,
 };
 use hairtrace::description::farm::{self as tiles, frame_path, tile_path};
-use hairtrace::description::{self, BuiltScene, MaterialDesc, SceneDescription, has_extension};
+use hairtrace::description::{
+    self, BuiltScene, GroomSource, MaterialDesc, SceneDescription, has_extension,
+};
 use hairtrace::embree::CurveBasis;
 use hairtrace::formats::convert::{self, ConvertOptions, ConvertSource};
-use hairtrace::formats::hair::{Thickness, info_report, read_hair_file};
+use hairtrace::formats::hair::{Thickness, info_report, read_hair_file, read_hair_tag};
 use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::formats::{SceneFormat, usd};
 use hairtrace::image::{self, Placement, WriteOptions};
@@ -159,11 +161,12 @@ struct ConvertArgs {
     /// A built-in scene's groom instead of a file: furball, furnace, scalp.
     #[arg(long)]
     demo: Option<String>,
-    /// The basis a .hair file's points are read with (as a scene's `basis`): bspline (the
-    /// default, as hairtrace renders a bare .hair), catmull_rom, bezier or linear. From USD,
-    /// linear samples cubic curves into polylines.
-    #[arg(long, default_value = "bspline", value_parser = parse_basis)]
-    basis: CurveBasis,
+    /// The curve drawn through a .hair file's points (as a scene's `basis`): linear, bezier,
+    /// bspline or catmull_rom; needed for a file that does not say its own (one that
+    /// `convert` did not write). From USD, linear samples cubic curves into polylines; by
+    /// default every prim keeps its own basis and wrap.
+    #[arg(long, value_parser = parse_basis)]
+    basis: Option<CurveBasis>,
     /// Read and write .hair thickness as a radius instead of a diameter (the default).
     #[arg(long)]
     thickness_is_radius: bool,
@@ -205,6 +208,11 @@ struct RenderArgs {
     /// ray where a strand is at most a pixel wide, a tube elsewhere), round or flat.
     #[arg(long, value_parser = ["auto", "round", "flat"])]
     shape: Option<String>,
+    /// The curve drawn through the points of every .hair and procedural groom, over the
+    /// scene's: linear, bezier, bspline or catmull_rom. A .hair file that does not say its
+    /// own (only `hairtrace convert` writes it) needs one.
+    #[arg(long, value_parser = parse_basis)]
+    basis: Option<CurveBasis>,
     /// Also write the render's figures (seconds of path tracing, scene build seconds,
     /// seconds of each stage: read, curves, bvh, render; camera samples, rays) to this
     /// JSON file: what benchmarks read.
@@ -509,6 +517,20 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
             }
         }
     }
+    if let Some(basis) = args.basis {
+        for g in &mut description.grooms {
+            match &g.source {
+                GroomSource::File { path, .. } if usd::is_usd_path(path) => {
+                    return Err(hairtrace::Error::InvalidArg(format!(
+                        "--basis: {} is USD, whose prims each say their own",
+                        path.display()
+                    )));
+                }
+                GroomSource::ControlPoints { .. } => {}
+                _ => g.basis = Some(basis),
+            }
+        }
+    }
     if let Some(shape) = &args.shape {
         let shape = match shape.as_str() {
             "round" => GroomShape::Round,
@@ -697,6 +719,13 @@ fn info(args: &InfoArgs) -> hairtrace::Result<()> {
     };
     let strands = read_hair_file(&args.file, thickness)?;
     print!("{}", info_report(&strands));
+    match read_hair_tag(&args.file)? {
+        Some(tag) => {
+            let (kind, basis, wrap) = tag.layout.tokens();
+            println!("curves:   {kind} {basis} {wrap}, {}", tag.units.describe());
+        }
+        None => println!("curves:   not said: render and convert it with --basis"),
+    }
     Ok(())
 }
 

@@ -1,7 +1,8 @@
 //! The command line as a user meets it: the main job prints its table, `info` describes
 //! a groom or a pbrt scene, and every error is one line on stderr with a non-zero exit.
 
-use hairtrace::formats::hair::{Thickness, write_hair_file};
+use hairtrace::formats::hair::{Thickness, read_hair_file, write_hair_file};
+use hairtrace::formats::usd::read_usd_file;
 use hairtrace::scene::FurBall;
 use std::process::{Command, Output};
 
@@ -129,8 +130,15 @@ fn render_a_bare_hair_file() {
     .unwrap();
     write_hair_file(std::path::Path::new(&path), &groom, Thickness::Diameter).unwrap();
     let out = tmp("cli_quick.exr");
+    // The file does not say which curve its points draw: no basis is assumed for it.
+    assert_one_line_error(
+        &hairtrace(&["render", &path, "--width", "32", "-o", &out]),
+        "does not say which curve its points draw",
+    );
+    assert!(stdout(&hairtrace(&["info", &path])).contains("curves:   not said"));
     let o = hairtrace(&[
-        "render", &path, "--width", "32", "--height", "32", "--spp", "2", "-o", &out,
+        "render", &path, "--basis", "bspline", "--width", "32", "--height", "32", "--spp", "2",
+        "-o", &out,
     ]);
     assert!(o.status.success(), "{o:?}");
     let img = hairtrace::image::read_image(std::path::Path::new(&out)).unwrap();
@@ -140,8 +148,8 @@ fn render_a_bare_hair_file() {
     let mean = |preset: &str| {
         let out = tmp(&format!("cli_quick_{preset}.exr"));
         let o = hairtrace(&[
-            "render", &path, "--width", "32", "--height", "32", "--spp", "2", "--preset", preset,
-            "--aov", "albedo", "-o", &out,
+            "render", &path, "--basis", "bspline", "--width", "32", "--height", "32", "--spp", "2",
+            "--preset", preset, "--aov", "albedo", "-o", &out,
         ]);
         assert!(o.status.success(), "{o:?}");
         let albedo = out.replace(".exr", ".albedo.exr");
@@ -524,7 +532,15 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
         "{info}"
     );
     assert!(hairtrace(&["convert", &usda, &hair]).status.success());
-    assert!(stdout(&hairtrace(&["info", &hair])).contains("strands:  50\npoints:   350\n"));
+    let info_hair = stdout(&hairtrace(&["info", &hair]));
+    assert!(
+        info_hair.contains("strands:  50\npoints:   350\n"),
+        "{info_hair}"
+    );
+    assert!(
+        info_hair.contains("curves:   cubic bspline pinned, upAxis Y, metersPerUnit 1"),
+        "{info_hair}"
+    );
     // And round again reads the same.
     assert!(hairtrace(&["convert", &hair, &again]).status.success());
     let info_again = stdout(&hairtrace(&["info", &again]));
@@ -546,7 +562,10 @@ fn convert_takes_a_procedural_groom_to_usd_and_back() {
         ),
         (vec![usda.as_str(), "/no/such/dir/x.hair"], "does not exist"),
         (vec!["--basis", "cubic", &hair, &usda], "unknown basis"),
-        (vec![&usd_fixture("case4.usda"), &hair], "--basis linear"),
+        (
+            vec!["--basis", "catmull_rom", &usd_fixture("case4.usda"), &hair],
+            "--basis linear",
+        ),
     ] {
         let mut all = vec!["convert"];
         all.extend(args);
@@ -634,4 +653,146 @@ fn the_settings_doc_is_the_schema() {
         doc.contains(&table),
         "docs/settings.md lacks the table `hairtrace settings` prints; paste it in:\n{table}"
     );
+}
+
+/// A scene for `export`: a linear fur ball, a ground, a sky and a sun.
+const PEER_SCENE: &str = r#"
+[render]
+width = 32
+height = 24
+[camera]
+eye = [0, 0, 5]
+target = [0, 0, 0]
+fov_deg = 30
+[materials.brown]
+type = "hair"
+melanin = [1.3, 0.0]
+[materials.floor]
+type = "diffuse"
+albedo = [0.5, 0.5, 0.5]
+[[groom]]
+procedural = "fur_ball"
+basis = "linear"
+material = "brown"
+[groom.params]
+strands = 50
+segments = 4
+[[mesh]]
+shape = "ground"
+y = -2
+half_size = 3
+material = "floor"
+[[light]]
+type = "environment"
+radiance = [0.5, 0.5, 0.5]
+scale = 2
+[[light]]
+type = "distant"
+direction = [0, 1, 0]
+irradiance = [3, 3, 3]
+angular_radius_deg = 2
+"#;
+
+/// `hairtrace export` of `text` (a scene file's) into a fresh folder `name`: the command's
+/// output, the folder, and the scene as the library reads it.
+fn export(text: &str, name: &str) -> (Output, String, hairtrace::SceneDescription) {
+    let (scene, dir) = (tmp(&format!("{name}.toml")), tmp(name));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::write(&scene, text).unwrap();
+    let description = hairtrace::SceneDescription::load(scene.as_ref()).unwrap();
+    (hairtrace(&["export", &scene, "-o", &dir]), dir, description)
+}
+
+fn scene_json(dir: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(format!("{dir}/scene.json")).unwrap()).unwrap()
+}
+
+/// Every committed bench scene exports for the peer (the real-groom scenes' files are made
+/// by bench/real_grooms.py; bench/peer exports them itself).
+#[test]
+fn bench_scenes_export_for_the_peer() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes");
+    let mut found = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        let name = path.file_stem().unwrap().to_string_lossy().into_owned();
+        if path.extension().is_some_and(|e| e == "toml") && !name.starts_with("real_") {
+            let out = tmp(&format!("cli_peer_{name}"));
+            let o = hairtrace(&["export", &path.to_string_lossy(), "-o", &out]);
+            assert!(o.status.success(), "{name}: {o:?}");
+            assert!(std::path::Path::new(&out).join("scene.json").is_file());
+            found += 1;
+        }
+    }
+    assert!(found >= 4, "only {found} bench scenes");
+}
+
+#[test]
+fn a_scene_goes_out_whole() {
+    let (o, dir, d) = export(PEER_SCENE, "cli_peer_whole");
+    assert!(o.status.success(), "{o:?}");
+    let json = scene_json(&dir);
+    assert_eq!(json["width"], 32);
+    assert_eq!(json["camera"]["fov_y_deg"], 30.0);
+    let groom = &json["grooms"][0];
+    assert_eq!(groom["basis"], "linear");
+    let sigma_a = hairtrace::bsdf::sigma_a_from_melanin(1.3, 0.0).unwrap();
+    let exported = groom["material"]["sigma_a"][1].as_f64().unwrap() as f32;
+    assert_eq!(exported, sigma_a[1], "f32 values survive the text exactly");
+    // The environment's scale is folded into its radiance.
+    assert_eq!(json["lights"][0]["radiance"][0], 1.0);
+    assert_eq!(json["lights"][1]["type"], "distant");
+    let path = format!("{dir}/groom0.hair");
+    let strands = read_hair_file(path.as_ref(), Thickness::Diameter).unwrap();
+    assert_eq!(strands, d.grooms[0].placed_strands().unwrap()[0].strands);
+    let obj = std::fs::read_to_string(format!("{dir}/mesh0.obj")).unwrap();
+    assert!(obj.lines().any(|l| l.starts_with("vn ")) && obj.contains("f 1//1"));
+}
+
+/// A USD groom goes out at its own basis (pinned Catmull-Rom, as Blender writes it), its
+/// authored points in the world (the stage's centimetres in metres); a prim Cycles cannot
+/// draw is named.
+#[test]
+fn usd_grooms_export_at_their_own_basis() {
+    let usd = usd_fixture("case8.usda");
+    let text = PEER_SCENE
+        .replace(
+            "procedural = \"fur_ball\"\nbasis = \"linear\"",
+            &format!("file = {usd:?}"),
+        )
+        .replace("[groom.params]\nstrands = 50\nsegments = 4\n", "");
+    let (o, dir, _) = export(&text, "cli_peer_usd");
+    assert!(o.status.success(), "{o:?}");
+    assert_eq!(scene_json(&dir)["grooms"][0]["basis"], "catmull-rom");
+    let path = format!("{dir}/groom0.hair");
+    let strands = read_hair_file(path.as_ref(), Thickness::Diameter).unwrap();
+    let prim = &read_usd_file(usd.as_ref()).unwrap().curves[0];
+    assert_eq!(strands.counts, prim.authored_counts);
+    assert_eq!(
+        strands.points[1],
+        prim.authored().points[1].map(|v| v * 0.01)
+    );
+    // Nonperiodic B-splines (case4) have no Cycles curve.
+    let (o, _, _) = export(&text.replace("case8.usda", "case4.usda"), "cli_peer_usd4");
+    assert_one_line_error(&o, "cubic bspline nonperiodic");
+}
+
+#[test]
+fn what_a_peer_cannot_render_is_refused() {
+    for (from, to, expect) in [
+        ("eye = [0, 0, 5]\ntarget = [0, 0, 0]", "", "eye and target"),
+        (
+            "basis = \"linear\"",
+            "basis = \"bspline\"",
+            "no Cycles equivalent",
+        ),
+        (
+            "melanin = [1.3, 0.0]",
+            "melanin = [1.3, 0.0]\nabsorption_variation = 0.2",
+            "varies per strand",
+        ),
+    ] {
+        let (o, _, _) = export(&PEER_SCENE.replace(from, to), "cli_peer_refused");
+        assert_one_line_error(&o, expect);
+    }
 }

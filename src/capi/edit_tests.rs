@@ -339,7 +339,10 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
         };
         assert_eq!(desc.basis, HT_CURVE_BSPLINE);
         assert_eq!(
-            GroomDesc::new(GroomSource::FurBall(fur), "").basis,
+            GroomDesc::new(GroomSource::FurBall(fur), "")
+                .strand_curves()
+                .unwrap()
+                .basis(),
             CurveBasis::BSpline
         );
         assert_eq!(

@@ -4,9 +4,10 @@
 use super::scene::{HtScene, add_with_id};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
 use crate::description::assembly::Shape;
+use crate::description::{GroomDesc, GroomSource};
 use crate::embree::{CurveBasis, SharedBuffer};
 use crate::error::{Result, invalid_arg};
-use crate::formats::hair::{Thickness, read_hair_file};
+use crate::formats::hair::Thickness;
 use crate::formats::mesh::read_mesh_file;
 use crate::formats::usd::read_usd_file;
 use crate::scene::GroomShape;
@@ -312,7 +313,9 @@ fn add_curves_xyzr(
 
 /// Adds the strands of a Cem Yuksel `.hair` file (read during the call) as polylines for
 /// `basis`, shaded by the hair material `material_id`; writes the geometry id. The file's
-/// thickness is a diameter unless `thickness_is_radius`.
+/// thickness is a diameter unless `thickness_is_radius`. A file that `hairtrace convert`
+/// wrote says its up axis and unit in its header, and is turned and scaled into +y up
+/// metres as a scene file reads it (docs/formats.md).
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `path` or `geom_id` NULL); `HT_ERR_IO` (the file
 /// is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or non-UTF-8 path, a
@@ -341,7 +344,13 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
         } else {
             Thickness::Diameter
         };
-        let strands = read_hair_file(&path, thickness)?;
+        // Read as a scene file reads it: in the units its header says, if it says them.
+        let groom = GroomDesc {
+            basis: Some(basis),
+            ..GroomDesc::new(GroomSource::File { path, thickness }, "")
+        };
+        let mut sets = groom.placed_strands()?;
+        let strands = sets.pop().map(|s| s.strands).unwrap_or_default();
         Ok(scene.add_strands(&strands, basis, shape, material_id)?)
     })
 }

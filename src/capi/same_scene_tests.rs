@@ -9,8 +9,8 @@ use super::scene::*;
 use super::scene_tests::{Handles, last_error, small_fur};
 use super::settings_tests::Named;
 use crate::bsdf::HairParams;
-use crate::description::SceneDescription;
-use crate::embree::Device;
+use crate::description::{SceneDescription, has_extension};
+use crate::embree::{CurveBasis, Device};
 use crate::formats::convert::{ConvertOptions, ConvertSource, convert};
 use crate::formats::hair::{Thickness, write_hair_file};
 use crate::render::{Aovs, NoProgress};
@@ -37,12 +37,11 @@ fn groom_files() -> (PathBuf, PathBuf) {
     std::fs::create_dir_all(&dir).unwrap();
     let (hair, usda) = (dir.join("fur.hair"), dir.join("fur.usda"));
     write_hair_file(&hair, &small_fur(), Thickness::Diameter).unwrap();
-    convert(
-        ConvertSource::File(&hair),
-        &usda,
-        &ConvertOptions::default(),
-    )
-    .unwrap();
+    let bspline = ConvertOptions {
+        basis: Some(CurveBasis::BSpline),
+        ..ConvertOptions::default()
+    };
+    convert(ConvertSource::File(&hair), &usda, &bspline).unwrap();
     (hair, usda)
 }
 
@@ -57,9 +56,14 @@ fn toml_render(file: &Path, camera: bool) -> Vec<u32> {
     if camera {
         text += &format!("[camera]\neye = {EYE:?}\ntarget = [0, 0, 0]\nfov_deg = 40\n");
     }
+    // A .hair file says no basis of its own; a USD file says its prims'.
+    let basis = match has_extension(file, "hair") {
+        true => "basis = \"bspline\"\n",
+        false => "",
+    };
     text += &format!(
         "[materials.hair]\ntype = \"hair\"\nsigma_a = [{r:?}, {g:?}, {b:?}]\n\
-         [[groom]]\nfile = {:?}\nmaterial = \"hair\"\n\
+         [[groom]]\nfile = {:?}\n{basis}material = \"hair\"\n\
          [[light]]\ntype = \"environment\"\nradiance = {SKY:?}\n\
          [[light]]\ntype = \"distant\"\ndirection = {SUN_DIR:?}\nirradiance = {SUN:?}\n",
         file.display().to_string()

@@ -4,12 +4,12 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use glam::{Mat3, Vec3};
+use glam::{Affine3A, EulerRot, Quat, Vec3};
 
 use super::assembly::{Assembly, Shape, scene_options};
 use super::{
-    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
-    MeshDesc, MeshSource, SceneDescription, Transform,
+    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, GroomStrands, LightDesc,
+    MaterialDesc, MeshDesc, MeshSource, SceneDescription, StrandCurves, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::{CurveBasis, Device};
@@ -18,7 +18,7 @@ use crate::render::Aovs;
 use crate::render::renderer::film_bytes_and_uniform;
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
-use crate::scene::curves::Curves;
+use crate::scene::curves::{Curves, placed};
 use crate::scene::detail_view::DetailView;
 use crate::scene::envmap::Environment;
 use crate::scene::footprint::{self, CurvesSize, available_bytes};
@@ -28,12 +28,12 @@ use crate::scene::material::Material;
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
 use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
-use crate::scene::strands::Strands;
-use crate::validate::positive;
+use crate::validate::{self, positive};
 
-use crate::formats::hair::read_hair_file;
+use crate::formats::hair::{read_hair_file, read_hair_tag};
 use crate::formats::mesh::read_mesh_file;
-use crate::formats::usd::{is_usd_path, read_usd_file};
+use crate::formats::units::StageUnits;
+use crate::formats::usd::{Layout, Wrap, is_usd_path, read_usd_file};
 
 impl SceneDescription {
     /// Checks every value, reads the files, builds the grooms and meshes into one Embree
@@ -157,7 +157,8 @@ impl SceneDescription {
                 _ => continue,
             };
             let (strands, segments) = (strands as u64, u64::from(segments));
-            let size = CurvesSize::polylines(strands, segments, g.basis, g.shape.built(), &options);
+            let basis = g.strand_curves()?.basis();
+            let size = CurvesSize::polylines(strands, segments, basis, g.shape.built(), &options);
             let points = strands.saturating_mul(segments + 1);
             conversion = conversion.max(footprint::conversion_bytes(points, strands, &size));
             sizes.push(size);
@@ -219,40 +220,100 @@ impl MaterialDesc {
 }
 
 impl Transform {
-    /// The linear part (the turn times the scale), once every field is checked.
-    fn linear(&self) -> Result<Mat3> {
-        if !self.translate.iter().all(|v| v.is_finite()) {
-            return Err(invalid_arg!(
-                "translate = {:?}: must be finite",
-                self.translate
-            ));
+    /// The transform as an affine map and the factor radii follow, once every field is
+    /// checked.
+    fn affine(&self) -> Result<(Affine3A, f32)> {
+        match *self {
+            Transform::Trs {
+                translate,
+                rotate_deg,
+                scale,
+            } => {
+                let finite = |what: &str, v: [f32; 3]| match v.iter().all(|x| x.is_finite()) {
+                    true => Ok(()),
+                    false => Err(invalid_arg!("{what} = {v:?}: must be finite")),
+                };
+                finite("translate", translate)?;
+                finite("rotate", rotate_deg)?;
+                positive("scale", scale)?;
+                let [x, y, z] = rotate_deg.map(f32::to_radians);
+                let turn = Quat::from_euler(EulerRot::ZYX, z, y, x);
+                let affine = Affine3A::from_scale_rotation_translation(
+                    Vec3::splat(scale),
+                    turn,
+                    Vec3::from_array(translate),
+                );
+                Ok((affine, scale))
+            }
+            Transform::Matrix(rows) => {
+                if !rows.iter().flatten().all(|v| v.is_finite()) || rows[3] != [0.0, 0.0, 0.0, 1.0]
+                {
+                    return Err(invalid_arg!(
+                        "matrix = {rows:?}: must be finite, its last row 0 0 0 1"
+                    ));
+                }
+                let column = |j: usize| Vec3::new(rows[0][j], rows[1][j], rows[2][j]);
+                let affine = Affine3A::from_cols(
+                    column(0).into(),
+                    column(1).into(),
+                    column(2).into(),
+                    column(3).into(),
+                );
+                let axes = [0, 1, 2].map(|j| column(j).as_dvec3().to_array());
+                let scale = validate::uniform_scale(&format!("matrix = {rows:?}"), axes)?;
+                Ok((affine, scale as f32))
+            }
         }
-        positive("scale", self.scale)?;
-        if !self.rotate_y_deg.is_finite() {
-            return Err(invalid_arg!(
-                "rotate_y_deg = {}: must be finite",
-                self.rotate_y_deg
-            ));
-        }
-        Ok(Mat3::from_rotation_y(self.rotate_y_deg.to_radians()) * self.scale)
-    }
-
-    fn point(&self, linear: Mat3, p: [f32; 3]) -> [f32; 3] {
-        (linear * Vec3::from_array(p) + Vec3::from_array(self.translate)).to_array()
     }
 }
 
 impl GroomDesc {
-    /// A groom with the defaults of a `[[groom]]` entry: B-spline round curves, no
-    /// transform.
+    /// A groom with the defaults of a `[[groom]]` entry: the source's own basis
+    /// ([`GroomDesc::strand_curves`]), the default shape, no transform.
     pub fn new(source: GroomSource, material: &str) -> Self {
         GroomDesc {
             source,
-            basis: CurveBasis::BSpline,
+            basis: None,
             shape: GroomShape::default(),
             radius_scale: 1.0,
             transform: Transform::default(),
             material: material.to_string(),
+        }
+    }
+
+    /// The curve the groom's strands draw: the entry's basis through them as polylines;
+    /// else what the source says (a `.hair` file's tag, B-spline for a procedural groom).
+    /// A `.hair` file that says nothing, with no basis given, is refused: its points could
+    /// be any curve's.
+    pub fn strand_curves(&self) -> Result<StrandCurves> {
+        if let Some(basis) = self.basis {
+            return Ok(StrandCurves::Polylines(basis));
+        }
+        match &self.source {
+            GroomSource::File { path, .. } if !is_usd_path(path) => {
+                let tag = read_hair_tag(path)?.ok_or_else(|| {
+                    invalid_arg!(
+                        "{}: a .hair file does not say which curve its points draw: give its \
+                         basis (linear, bezier, bspline or catmull_rom)",
+                        path.display()
+                    )
+                })?;
+                Ok(match tag.layout {
+                    l if l == Layout::of_polylines(l.basis) => StrandCurves::Polylines(l.basis),
+                    l => StrandCurves::Authored(l),
+                })
+            }
+            GroomSource::FurBall(_) | GroomSource::Scalp(_) => {
+                Ok(StrandCurves::Polylines(CurveBasis::BSpline))
+            }
+            GroomSource::File { path, .. } => Err(invalid_arg!(
+                "{}: a USD groom draws each prim with its own basis",
+                path.display()
+            )),
+            GroomSource::ControlPoints { basis, .. } => Ok(StrandCurves::Authored(Layout {
+                basis: *basis,
+                wrap: Wrap::Nonperiodic,
+            })),
         }
     }
 
@@ -266,10 +327,11 @@ impl GroomDesc {
         (i, grooms, reads): (usize, usize, usize),
         framing: &mut Framing,
     ) -> Result<Vec<Curves>> {
-        let linear = self.transform.linear()?;
+        let (affine, scale) = self.transform.affine()?;
         positive("radius_scale", self.radius_scale)?;
-        let radius_factor = self.transform.scale * self.radius_scale;
-        let place = |p| self.transform.point(linear, p);
+        let radius_factor = scale * self.radius_scale;
+        let place = |p: [f32; 3]| affine.transform_point3(Vec3::from_array(p)).to_array();
+        let shape = self.shape.built();
         match &self.source {
             GroomSource::File { path, .. } if is_usd_path(path) => {
                 let file = stages.run(Stage::Read, (i, reads), |_| read_usd_file(path))?;
@@ -278,68 +340,111 @@ impl GroomDesc {
                 }
                 stages.run(Stage::Curves, (i, grooms), |_| {
                     (file.curves.iter())
-                        .map(|c| c.curves(self.shape.built(), radius_factor, place))
+                        .map(|c| c.curves(shape, radius_factor, place))
                         .collect()
                 })
             }
             // Control points (a pbrt file's) were read with their file: there is only the
             // conversion to do.
-            GroomSource::ControlPoints { points, counts } => {
+            GroomSource::ControlPoints {
+                points,
+                counts,
+                basis,
+            } => {
                 let curves = stages.run(Stage::Curves, (i, grooms), |_| {
                     Curves::from_control_points(
-                        super::placed(points, place, radius_factor),
+                        placed(points, place, radius_factor),
                         counts,
                         None,
-                        self.basis,
-                        self.shape.built(),
+                        *basis,
+                        shape,
                     )
                 })?;
                 framing.add_control_points(curves.vertices());
                 Ok(vec![curves])
             }
             _ => {
-                let strands = stages.run(Stage::Read, (i, reads), |_| self.strands())?;
+                let read = stages.run(Stage::Read, (i, reads), |_| self.placed_strands())?;
+                // A file that is not USD, or a procedural groom, is one set of strands.
+                let GroomStrands {
+                    strands, curves, ..
+                } = read
+                    .into_iter()
+                    .next()
+                    .ok_or_else(|| invalid_arg!("no strands"))?;
                 framing.add_strands(&strands);
-                let curves = stages.run(Stage::Curves, (i, grooms), |_| {
-                    Curves::from_strands(&strands, self.basis, self.shape.built())
+                let curves = stages.run(Stage::Curves, (i, grooms), |_| match curves {
+                    StrandCurves::Polylines(basis) => Curves::from_strands(&strands, basis, shape),
+                    StrandCurves::Authored(layout) => {
+                        let (control, counts, colors) = layout.control_points(&strands)?;
+                        Curves::from_control_points(control, &counts, colors, layout.basis, shape)
+                    }
                 })?;
                 Ok(vec![curves])
             }
         }
     }
 
-    /// The strands, transformed and with their radii scaled.
-    pub fn strands(&self) -> Result<Strands> {
-        let linear = self.transform.linear()?;
-        positive("radius_scale", self.radius_scale)?;
-        let mut strands = match &self.source {
-            GroomSource::File { path, .. } if is_usd_path(path) => {
-                return Err(invalid_arg!(
-                    "{}: a USD groom keeps its own curve bases: it has no .hair strands",
-                    path.display()
-                ));
-            }
-            GroomSource::File { path, thickness } => read_hair_file(path, *thickness)?,
-            GroomSource::FurBall(f) => f.build()?,
-            GroomSource::Scalp(s) => s.build()?,
-            GroomSource::ControlPoints { .. } => {
-                return Err(invalid_arg!(
-                    "a groom of control points (from a pbrt file) has no polyline strands"
-                ));
-            }
+    /// The groom's strands as its source authors them, with the curve each set draws and
+    /// its units: one set for a `.hair` file (in the units its tag says) or a procedural
+    /// groom, one per BasisCurves prim of a USD stage (its points under its own transform,
+    /// in the stage's units).
+    pub fn authored_strands(&self) -> Result<Vec<GroomStrands>> {
+        let one = |strands, units| -> Result<Vec<GroomStrands>> {
+            Ok(vec![GroomStrands {
+                prim: None,
+                strands,
+                curves: self.strand_curves()?,
+                units,
+            }])
         };
-        if self.transform != Transform::default() {
-            for p in &mut strands.points {
-                *p = self.transform.point(linear, *p);
+        match &self.source {
+            GroomSource::File { path, .. } if is_usd_path(path) => {
+                let file = read_usd_file(path)?;
+                Ok((file.curves.iter())
+                    .map(|c| GroomStrands {
+                        prim: Some(c.path.clone()),
+                        strands: c.authored(),
+                        curves: StrandCurves::Authored(c.layout),
+                        units: file.units,
+                    })
+                    .collect())
+            }
+            GroomSource::File { path, thickness } => {
+                let units = read_hair_tag(path)?.map_or(StageUnits::WORLD, |t| t.units);
+                one(read_hair_file(path, *thickness)?, units)
+            }
+            GroomSource::FurBall(f) => one(f.build()?, StageUnits::WORLD),
+            GroomSource::Scalp(s) => one(s.build()?, StageUnits::WORLD),
+            GroomSource::ControlPoints { .. } => Err(invalid_arg!(
+                "a groom of control points (from a pbrt file) has no polyline strands"
+            )),
+        }
+    }
+
+    /// [`GroomDesc::authored_strands`] in the world: brought from their units, then placed
+    /// by the entry's transform, radii scaled.
+    pub fn placed_strands(&self) -> Result<Vec<GroomStrands>> {
+        let (affine, scale) = self.transform.affine()?;
+        positive("radius_scale", self.radius_scale)?;
+        let placed = self.transform != Transform::default();
+        let mut sets = self.authored_strands()?;
+        for set in &mut sets {
+            let units = std::mem::replace(&mut set.units, StageUnits::WORLD);
+            if placed || units != StageUnits::WORLD {
+                for p in &mut set.strands.points {
+                    let world = Vec3::from_array(units.to_world(*p));
+                    *p = affine.transform_point3(world).to_array();
+                }
+            }
+            let radius_factor = scale * self.radius_scale * units.scale();
+            if radius_factor != 1.0 {
+                for r in &mut set.strands.radii {
+                    *r *= radius_factor;
+                }
             }
         }
-        let radius_factor = self.transform.scale * self.radius_scale;
-        if radius_factor != 1.0 {
-            for r in &mut strands.radii {
-                *r *= radius_factor;
-            }
-        }
-        Ok(strands)
+        Ok(sets)
     }
 }
 
@@ -354,7 +459,7 @@ impl MeshDesc {
 
     /// The mesh, transformed.
     pub fn mesh(&self) -> Result<Mesh> {
-        let linear = self.transform.linear()?;
+        let (affine, _) = self.transform.affine()?;
         let mut mesh = match &self.source {
             MeshSource::File(path) => read_mesh_file(path)?,
             MeshSource::Sphere { centre, radius } => shapes::sphere(
@@ -370,11 +475,12 @@ impl MeshDesc {
         };
         if self.transform != Transform::default() {
             for p in &mut mesh.positions {
-                *p = self.transform.point(linear, *p);
+                *p = affine.transform_point3(Vec3::from_array(*p)).to_array();
             }
             // The scale is uniform, so the linear part maps normals to normals.
             for n in mesh.normals.iter_mut().flatten() {
-                *n = (linear * Vec3::from_array(*n))
+                *n = affine
+                    .transform_vector3(Vec3::from_array(*n))
                     .normalize_or_zero()
                     .to_array();
             }

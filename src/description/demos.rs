@@ -27,6 +27,7 @@ pub const DEMOS: [&str; 3] = ["furball", "furnace", "scalp"];
 /// ```no_run
 /// use std::sync::Arc;
 /// use hairtrace::description::{GroomDesc, GroomSource, demo};
+/// use hairtrace::embree::CurveBasis;
 /// use hairtrace::{Aovs, NoProgress};
 /// # fn main() -> hairtrace::Result<()> {
 /// let mut scene = demo("furball")?;
@@ -35,7 +36,8 @@ pub const DEMOS: [&str; 3] = ["furball", "furnace", "scalp"];
 ///     [0.0, 0.0, 0.0, 0.01], [0.0, 0.5, 0.1, 0.008], [0.0, 1.0, 0.0, 0.005],
 ///     [0.2, 0.0, 0.0, 0.01], [0.2, 0.5, 0.1, 0.008], [0.2, 1.0, 0.0, 0.005],
 /// ];
-/// let source = GroomSource::ControlPoints { points, counts: vec![3, 3] };
+/// let basis = CurveBasis::BSpline;
+/// let source = GroomSource::ControlPoints { points, counts: vec![3, 3], basis };
 /// scene.grooms = vec![GroomDesc::new(source, "hair")];
 /// scene.render.set("spp", "64")?;
 /// let built = scene.build(Arc::new(scene.render.device()?))?;
@@ -190,9 +192,10 @@ fn furnace_demo() -> SceneDescription {
 fn scalp_demo() -> SceneDescription {
     let scalp = ScalpPatch::default();
     // The patch faces +z: turned, the automatic camera sees the head beside the hair.
-    let three_quarter = Transform {
-        rotate_y_deg: 60.0,
-        ..Transform::default()
+    let three_quarter = Transform::Trs {
+        translate: [0.0; 3],
+        rotate_deg: [0.0, 60.0, 0.0],
+        scale: 1.0,
     };
     let auburn = HairMaterial {
         color: HairColor::Melanin {

@@ -34,12 +34,16 @@
 //! [[groom]]
 //! file = "curly.hair"      # relative to the scene file's folder
 //! thickness = "diameter"   # how the file's thickness is read: "diameter" (default) or "radius"
-//! basis = "bspline"        # "linear", "bezier", "bspline" (default) or "catmull_rom"
+//! basis = "bspline"        # "linear", "bezier", "bspline" or "catmull_rom": needed for a
+//!                          # .hair file that does not say its own (only `convert` writes it);
+//!                          # a procedural groom's default is "bspline"; USD prims say theirs
 //! shape = "auto"           # "auto" (default: flat where thinner than a pixel), "round" or "flat"
 //! radius_scale = 1.0       # multiplies every fibre radius
-//! translate = [0, 0, 0]    # the transform: points scaled, turned about +y, then moved;
-//! scale = 1.0              # radii scaled too
-//! rotate_y_deg = 0.0
+//! translate = [0, 0, 0]    # the transform: points scaled (radii too), turned about x, then
+//! scale = 1.0              # y, then z (degrees, Blender's XYZ Euler), then moved; or
+//! rotate = [0, 0, 0]       # matrix = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+//!                          # (rows, acting on column vectors, translation in the last column),
+//!                          # which must scale every axis alike: fibres stay round
 //! material = "brown"
 //!
 //! [[groom]]
@@ -52,7 +56,7 @@
 //! shape = "sphere"         # or file = "head.obj" (.obj or .ply)
 //! centre = [0, 0, 0]       # default the origin
 //! radius = 1.0
-//! material = "skin"        # plus translate, scale, rotate_y_deg as for grooms
+//! material = "skin"        # plus translate, scale, rotate or matrix as for grooms
 //!
 //! [[mesh]]
 //! shape = "ground"         # a square facing +y, from -half_size to half_size in x and z
@@ -99,6 +103,8 @@ use serde::Deserialize;
 use crate::embree::CurveBasis;
 use crate::error::{Result, invalid_arg};
 use crate::formats::hair::Thickness;
+use crate::formats::units::StageUnits;
+use crate::formats::usd::Layout;
 use crate::render::integrator::World;
 use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
@@ -109,6 +115,7 @@ use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::material::HairMaterial;
 use crate::scene::mesh::Mesh;
 use crate::scene::stages::StageTimes;
+use crate::scene::strands::Strands;
 
 pub use demos::{DEMOS, demo, quick_look};
 
@@ -165,20 +172,30 @@ pub enum MaterialDesc {
     Diffuse { albedo: [f32; 3] },
 }
 
-/// Scale (uniform, so fibres stay round), then a turn about +y, then a translation.
+/// Where a groom or mesh goes in the world. Radii follow the scale, which must be the same
+/// on every axis (fibres stay round); the build checks it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Transform {
-    pub translate: [f32; 3],
-    pub scale: f32,
-    pub rotate_y_deg: f32,
+pub enum Transform {
+    /// A uniform scale, then turns about x, y and z in that order (Blender's default XYZ
+    /// Euler), then a translation.
+    Trs {
+        translate: [f32; 3],
+        /// Degrees about x, y and z.
+        rotate_deg: [f32; 3],
+        scale: f32,
+    },
+    /// An affine matrix acting on column vectors (`p' = M p`), given by rows: the
+    /// translation is the last column and the last row is `0 0 0 1`, as Blender's
+    /// `matrix_world` prints.
+    Matrix([[f32; 4]; 4]),
 }
 
 impl Default for Transform {
     fn default() -> Self {
-        Transform {
+        Transform::Trs {
             translate: [0.0; 3],
+            rotate_deg: [0.0; 3],
             scale: 1.0,
-            rotate_y_deg: 0.0,
         }
     }
 }
@@ -187,7 +204,10 @@ impl Default for Transform {
 #[derive(Debug, Clone, PartialEq)]
 pub struct GroomDesc {
     pub source: GroomSource,
-    pub basis: CurveBasis,
+    /// The curve drawn through the source's polylines. None: the source's own
+    /// ([`GroomDesc::strand_curves`]); a `.hair` file that does not say its own is refused,
+    /// never read with a basis assumed for it.
+    pub basis: Option<CurveBasis>,
     pub shape: GroomShape,
     /// Multiplies every fibre radius, on top of the transform's scale: thins or thickens a
     /// groom without editing its file.
@@ -204,13 +224,56 @@ pub enum GroomSource {
     },
     FurBall(FurBall),
     Scalp(ScalpPatch),
-    /// Control points (x, y, z, radius) already laid out for the groom's basis, `counts[i]`
-    /// of them for strand i, as a pbrt file gives them: handed to Embree as they are, with
-    /// no polyline conversion (and so no `.hair` export).
+    /// Control points (x, y, z, radius) already laid out for `basis`, `counts[i]` of them
+    /// for strand i, as a pbrt file gives them: handed to Embree as they are, with no
+    /// polyline conversion (and so no `.hair` export).
     ControlPoints {
         points: Vec<[f32; 4]>,
         counts: Vec<u32>,
+        basis: CurveBasis,
     },
+}
+
+/// The curve a groom's strands draw.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StrandCurves {
+    /// hairtrace's curve of this basis through polylines (`Curves::from_strands`): phantom
+    /// end points `2 p0 - p1` for B-splines and Catmull-Rom, and Bezier as the Catmull-Rom
+    /// curve in Bezier form.
+    Polylines(CurveBasis),
+    /// The points are the authored points of USD curves of this layout (a `.hair` file that
+    /// `hairtrace convert` wrote from USD).
+    Authored(Layout),
+}
+
+impl StrandCurves {
+    /// The USD layout that draws the same curve.
+    pub fn layout(self) -> Layout {
+        match self {
+            StrandCurves::Polylines(basis) => Layout::of_polylines(basis),
+            StrandCurves::Authored(layout) => layout,
+        }
+    }
+
+    /// The basis Embree traces.
+    pub fn basis(self) -> CurveBasis {
+        match self {
+            StrandCurves::Polylines(basis) => basis,
+            StrandCurves::Authored(layout) => layout.basis,
+        }
+    }
+}
+
+/// A set of a groom's strands with the curve they draw and the units they are in: as its
+/// source authors them ([`GroomDesc::authored_strands`]), or in the world
+/// ([`GroomDesc::placed_strands`], where the units are [`StageUnits::WORLD`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GroomStrands {
+    /// The BasisCurves prim they come from, for a USD groom.
+    pub prim: Option<String>,
+    pub strands: Strands,
+    pub curves: StrandCurves,
+    pub units: StageUnits,
 }
 
 /// A `[[mesh]]` entry.
@@ -278,22 +341,6 @@ pub enum EnvironmentSource {
 pub fn has_extension(path: &std::path::Path, ext: &str) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case(ext))
-}
-
-/// Control points (x, y, z, radius) moved by `place`, radii multiplied by `radius_scale`:
-/// a groom's control points where its scene entry puts them.
-pub(crate) fn placed(
-    points: &[[f32; 4]],
-    place: impl Fn([f32; 3]) -> [f32; 3],
-    radius_scale: f32,
-) -> Vec<[f32; 4]> {
-    points
-        .iter()
-        .map(|&[x, y, z, r]| {
-            let [x, y, z] = place([x, y, z]);
-            [x, y, z, r * radius_scale]
-        })
-        .collect()
 }
 
 /// What a render needs, built from a description. Materials and lights can be changed

@@ -1,28 +1,27 @@
 //! `hairtrace convert`: grooms between Cem Yuksel's `.hair` and USD BasisCurves, so that a
 //! procedural groom can go to a DCC and come back (docs/formats.md, "Converting").
 //!
-//! A `.hair` file holds polylines and says nothing of the curve drawn through them; hairtrace
-//! reads its points with a groom's `basis` (B-spline by default), as
-//! the scene layer's `Curves::from_strands` lays them out. The
-//! conversion keeps that curve exactly, in both directions:
-//! - linear: a `linear` (`nonperiodic`) prim of the same points;
-//! - B-spline: a `cubic` `bspline` prim with `pinned` wrap, whose phantom end points
-//!   (`2 p0 - p1`) are the ones hairtrace adds;
-//! - Catmull-Rom and Bezier (the Catmull-Rom curve in Bezier form): `cubic` `catmullRom`,
-//!   `pinned`.
+//! Nothing is lost either way. A `.hair` file that this module writes carries, in its
+//! header's text ([`HairTag`]), the USD layout its points are the authored points of and the
+//! stage's up axis and unit; so a USD prim of any basis and wrap goes to `.hair` and back
+//! to the bit, and a tagged `.hair` file goes to USD as what it says. An untagged `.hair`
+//! file holds polylines and says nothing of the curve drawn through them: its reader must
+//! name a basis (`--basis`), and the stage gets the layout that draws hairtrace's curve of
+//! that basis through them ([`Layout::of_polylines`]).
 //!
-//! USD prims become `.hair` strands in world space when their curves are one of those forms
-//! for the chosen basis; with the linear basis, every cubic curve is sampled into a polyline
-//! of [`ConvertOptions::samples_per_segment`] segments per curve segment. Any other prim is
-//! refused with the way out named, never approximated silently.
+//! Several prims go into one `.hair` file only when they share their layout and units;
+//! `--basis linear` samples cubic curves into polylines of
+//! [`ConvertOptions::samples_per_segment`] segments per curve segment, the one lossy way,
+//! which a note names.
 
 use std::path::Path;
 
-use super::hair::{Thickness, read_hair_file, write_hair_file};
-use super::usd::{
-    CurvesToWrite, Layout, StageUnits, UsdCurves, Wrap, is_usd_path, read_usd_file, write_usd_file,
+use super::hair::{HairTag, Thickness, write_tagged_hair_file};
+use super::units::StageUnits;
+use super::usd::{CurvesToWrite, Layout, UsdCurves, is_usd_path, read_usd_file, write_usd_file};
+use crate::description::{
+    GroomDesc, GroomSource, GroomStrands, SceneDescription, StrandCurves, demo, has_extension,
 };
-use crate::description::{SceneDescription, demo, has_extension};
 use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::Strands;
@@ -39,9 +38,10 @@ pub enum ConvertSource<'a> {
 /// How `.hair` files are read and written.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConvertOptions {
-    /// The basis a `.hair` file's points are read with (hairtrace's default for a bare
-    /// `.hair` and a `[[groom]]` entry: B-spline).
-    pub basis: CurveBasis,
+    /// The basis drawn through a `.hair` file's points: needed for a file that does not say
+    /// its own. For a USD input, `linear` samples cubic curves into polylines; another basis
+    /// must be the prims' own.
+    pub basis: Option<CurveBasis>,
     pub thickness: Thickness,
     /// Polyline segments per curve segment when a cubic USD curve is written as linear
     /// `.hair` strands (the sampled points lie on the curve); at least 1.
@@ -55,7 +55,7 @@ const SAMPLES_PER_SEGMENT: u32 = 8;
 impl Default for ConvertOptions {
     fn default() -> Self {
         ConvertOptions {
-            basis: CurveBasis::BSpline,
+            basis: None,
             thickness: Thickness::Diameter,
             samples_per_segment: SAMPLES_PER_SEGMENT,
         }
@@ -73,11 +73,11 @@ pub struct Converted {
     pub notes: Vec<String>,
 }
 
-/// A groom on its way: polylines and the basis that draws its curve.
+/// A groom on its way: its points, the curve they draw and their units, named for the
+/// stage.
 struct Groom {
     name: String,
-    strands: Strands,
-    basis: CurveBasis,
+    set: GroomStrands,
 }
 
 /// Converts the grooms of `source` into `output`, whose extension picks the format: `.hair`
@@ -113,24 +113,21 @@ pub fn convert(source: ConvertSource, output: &Path, opts: &ConvertOptions) -> R
     let grooms = read_grooms(source, output, opts, &mut notes)?;
     let mut converted = Converted {
         prims: grooms.len(),
-        strands: grooms.iter().map(|g| g.strands.strand_count()).sum(),
-        points: grooms.iter().map(|g| g.strands.point_count()).sum(),
+        strands: grooms.iter().map(|g| g.set.strands.strand_count()).sum(),
+        points: grooms.iter().map(|g| g.set.strands.point_count()).sum(),
         notes,
     };
+    let units = shared_units(&grooms)?;
     if to_usd {
         let prims = grooms
             .iter()
             .map(curves_to_write)
             .collect::<Result<Vec<_>>>()?;
-        // A .hair file has no units or axes: hairtrace's +y up, and USD's own fallback unit.
-        let units = StageUnits {
-            up_axis: "Y".into(),
-            meters_per_unit: 0.01,
-        };
         write_usd_file(output, &prims, &units)?;
     } else {
-        let strands = joined(grooms, opts.basis, &mut converted.notes)?;
-        write_hair_file(output, &strands, opts.thickness)?;
+        let (strands, layout) = joined(grooms, &mut converted.notes)?;
+        let tag = HairTag { layout, units };
+        write_tagged_hair_file(output, &strands, opts.thickness, Some(&tag))?;
     }
     Ok(converted)
 }
@@ -156,14 +153,6 @@ fn read_grooms(
                     ));
                 }
                 let stage = read_usd_file(path)?;
-                if stage.up_axis != "Y" {
-                    notes.push(format!(
-                        "{}: the stage is {}-up; a .hair file has no up axis, and the points \
-                         are kept as authored",
-                        path.display(),
-                        stage.up_axis
-                    ));
-                }
                 (stage.curves.iter())
                     .map(|c| usd_groom(c, opts, notes))
                     .collect::<Result<_>>()
@@ -176,11 +165,20 @@ fn read_grooms(
                         output.display()
                     ));
                 }
-                vec![Groom {
-                    name: "groom0".into(),
-                    strands: read_hair_file(path, opts.thickness)?,
+                let file = GroomSource::File {
+                    path: path.to_path_buf(),
+                    thickness: opts.thickness,
+                };
+                let groom = GroomDesc {
                     basis: opts.basis,
-                }]
+                    ..GroomDesc::new(file, "")
+                };
+                (groom.authored_strands()?.into_iter())
+                    .map(|set| Groom {
+                        name: "groom0".into(),
+                        set,
+                    })
+                    .collect()
             } else if has_extension(path, "toml") {
                 scene_grooms(&SceneDescription::from_file(path)?)?
             } else {
@@ -194,42 +192,40 @@ fn read_grooms(
     })
 }
 
-/// The strand grooms of a scene, placed in world space, each with its basis.
+/// The strand grooms of a scene, placed in the world, each with its curve.
 fn scene_grooms(scene: &SceneDescription) -> Result<Vec<Groom>> {
-    (scene.grooms.iter().enumerate())
-        .map(|(i, g)| {
-            Ok(Groom {
-                name: format!("groom{i}"),
-                strands: g
-                    .strands()
-                    .map_err(|e| e.context(format_args!("{}: groom[{i}]", scene.origin)))?,
-                basis: g.basis,
-            })
-        })
-        .collect()
+    let mut grooms = Vec::new();
+    for (i, g) in scene.grooms.iter().enumerate() {
+        let sets = (g.placed_strands())
+            .map_err(|e| e.context(format_args!("{}: groom[{i}]", scene.origin)))?;
+        let many = sets.len() > 1;
+        for (k, set) in sets.into_iter().enumerate() {
+            let name = match many {
+                true => format!("groom{i}_{k}"),
+                false => format!("groom{i}"),
+            };
+            grooms.push(Groom { name, set });
+        }
+    }
+    Ok(grooms)
 }
 
-/// The USD layout that draws exactly the curve hairtrace draws through polylines read with
-/// `basis`.
-fn usd_layout(basis: CurveBasis) -> Layout {
-    match basis {
-        CurveBasis::Linear => Layout {
-            basis,
-            wrap: Wrap::Nonperiodic,
-        },
-        CurveBasis::BSpline => Layout {
-            basis,
-            wrap: Wrap::Pinned,
-        },
-        CurveBasis::CatmullRom | CurveBasis::Bezier => Layout {
-            basis: CurveBasis::CatmullRom,
-            wrap: Wrap::Pinned,
-        },
+/// The units every groom is in: a file holds one stage's.
+fn shared_units(grooms: &[Groom]) -> Result<StageUnits> {
+    let units = grooms.first().map_or(StageUnits::WORLD, |g| g.set.units);
+    match grooms.iter().find(|g| g.set.units != units) {
+        Some(g) => Err(invalid_arg!(
+            "{}: in {} where the first groom is in {}: one file holds one stage's units",
+            g.name,
+            g.set.units.describe(),
+            units.describe()
+        )),
+        None => Ok(units),
     }
 }
 
 fn curves_to_write(g: &Groom) -> Result<CurvesToWrite> {
-    let s = &g.strands;
+    let s = &g.set.strands;
     s.validate().map_err(|e| e.context(&g.name))?;
     let widths: Vec<f32> = s.radii.iter().map(|r| r * 2.0).collect();
     if let Some(i) = widths.iter().position(|w| !w.is_finite()) {
@@ -241,7 +237,7 @@ fn curves_to_write(g: &Groom) -> Result<CurvesToWrite> {
     }
     Ok(CurvesToWrite {
         name: g.name.clone(),
-        layout: usd_layout(g.basis),
+        layout: g.set.curves.layout(),
         points: s.points.clone(),
         counts: s.counts.clone(),
         widths,
@@ -249,10 +245,13 @@ fn curves_to_write(g: &Groom) -> Result<CurvesToWrite> {
     })
 }
 
-/// All grooms as one `.hair` groom, when each is drawn with `basis` as a `.hair` file will be.
+/// All grooms as one `.hair` groom, when they share one layout, and that layout.
 /// When only some have colours, none are written (a note says so).
-fn joined(grooms: Vec<Groom>, basis: CurveBasis, notes: &mut Vec<String>) -> Result<Strands> {
-    let coloured = grooms.iter().filter(|g| g.strands.colors.is_some()).count();
+fn joined(grooms: Vec<Groom>, notes: &mut Vec<String>) -> Result<(Strands, Layout)> {
+    let coloured = grooms
+        .iter()
+        .filter(|g| g.set.strands.colors.is_some())
+        .count();
     if coloured != 0 && coloured != grooms.len() {
         notes.push(format!(
             "colours not written: {coloured} of {} grooms have them, and a .hair file has a \
@@ -260,29 +259,35 @@ fn joined(grooms: Vec<Groom>, basis: CurveBasis, notes: &mut Vec<String>) -> Res
             grooms.len()
         ));
     }
+    let layout = grooms
+        .first()
+        .map_or(Layout::of_polylines(CurveBasis::Linear), |g| {
+            g.set.curves.layout()
+        });
     let mut all = Strands {
         colors: (coloured == grooms.len() && coloured != 0).then(Vec::new),
         ..Strands::default()
     };
     for g in grooms {
-        if usd_layout(g.basis) != usd_layout(basis) {
+        let own = g.set.curves.layout();
+        if own != layout {
+            let (kind, basis, wrap) = own.tokens();
+            let (first_kind, first_basis, first_wrap) = layout.tokens();
             return Err(invalid_arg!(
-                "{}: its basis is {:?}, but the .hair file's points will be read as {:?}: \
-                 convert it with --basis {}",
-                g.name,
-                g.basis,
-                basis,
-                basis_name(g.basis)
+                "{}: its curves are {kind} {basis} {wrap}, the first groom's {first_kind} \
+                 {first_basis} {first_wrap}: a .hair file holds one layout (convert each \
+                 alone, or sample all with --basis linear)",
+                g.name
             ));
         }
-        all.points.extend(g.strands.points);
-        all.radii.extend(g.strands.radii);
-        all.counts.extend(g.strands.counts);
-        if let (Some(out), Some(c)) = (&mut all.colors, g.strands.colors) {
+        all.points.extend(g.set.strands.points);
+        all.radii.extend(g.set.strands.radii);
+        all.counts.extend(g.set.strands.counts);
+        if let (Some(out), Some(c)) = (&mut all.colors, g.set.strands.colors) {
             out.extend(c);
         }
     }
-    Ok(all)
+    Ok((all, layout))
 }
 
 /// Names of the bases, as `--basis` and a `[[groom]]`'s `basis` spell them.
@@ -293,13 +298,6 @@ const BASIS_NAMES: [(&str, CurveBasis); 4] = [
     ("catmull_rom", CurveBasis::CatmullRom),
 ];
 
-fn basis_name(basis: CurveBasis) -> &'static str {
-    BASIS_NAMES
-        .iter()
-        .find(|(_, b)| *b == basis)
-        .map_or("", |(n, _)| n)
-}
-
 /// The basis called `name` (linear, bezier, bspline, catmull_rom).
 pub fn basis_named(name: &str) -> Result<CurveBasis> {
     (BASIS_NAMES.iter().find(|(n, _)| *n == name))
@@ -309,68 +307,69 @@ pub fn basis_named(name: &str) -> Result<CurveBasis> {
         })
 }
 
-/// One USD prim as polylines for `basis`: its own points when its curves are what `basis`
-/// draws through them, sampled curves when `basis` is linear, else an error.
+/// One USD prim for a `.hair` file: its authored points as they are (in the stage's units),
+/// or, with `--basis linear`, its curves sampled into polylines. Another basis must be the
+/// prim's own.
 fn usd_groom(c: &UsdCurves, opts: &ConvertOptions, notes: &mut Vec<String>) -> Result<Groom> {
-    let (layout, basis) = (c.layout, opts.basis);
-    let exact = usd_layout(basis) == layout
-        || (basis == CurveBasis::Linear && layout.basis == CurveBasis::Linear);
-    if !exact && basis != CurveBasis::Linear {
-        return Err(invalid_arg!(
-            "{}: {:?} {:?} curves are not what a .hair file read as {:?} draws: convert with \
-             --basis linear ({})",
-            c.path,
-            layout.basis,
-            layout.wrap,
-            basis,
-            if layout.basis == CurveBasis::Linear {
-                "exact"
-            } else {
-                "the curves are sampled into polylines"
-            }
-        ));
-    }
-    if !exact {
-        notes.push(format!(
-            "{}: {:?} {:?} curves sampled into polylines, {} segments per curve segment",
-            c.path, layout.basis, layout.wrap, opts.samples_per_segment
-        ));
-    }
+    let layout = c.layout;
     if c.melanin.is_some() {
         notes.push(format!(
             "{}: primvars:melanin is not written: a .hair file has no melanin",
             c.path
         ));
     }
-    // Pinned cubic curves carry a phantom point at each end that is not a strand point.
-    let trim =
-        usize::from(exact && layout.wrap == Wrap::Pinned && layout.basis != CurveBasis::Linear);
+    let linear = Layout::of_polylines(CurveBasis::Linear);
+    let sample = opts.basis == Some(CurveBasis::Linear) && layout != linear;
+    if let Some(basis) = opts.basis.filter(|_| !sample) {
+        if Layout::of_polylines(basis).basis != layout.basis {
+            let (kind, name, wrap) = layout.tokens();
+            return Err(invalid_arg!(
+                "{}: its curves are {kind} {name} {wrap}, not {basis:?}: leave --basis out to \
+                 keep them as they are, or sample them with --basis linear",
+                c.path
+            ));
+        }
+    }
+    let named = |strands, curves| Groom {
+        name: c.path.clone(),
+        set: GroomStrands {
+            prim: Some(c.path.clone()),
+            strands,
+            curves,
+            units: c.units,
+        },
+    };
+    if !sample {
+        return Ok(named(c.authored(), StrandCurves::Authored(layout)));
+    }
+    notes.push(match layout.basis {
+        CurveBasis::Linear => format!("{}: closed polylines written open", c.path),
+        _ => format!(
+            "{}: {:?} {:?} curves sampled into polylines, {} segments per curve segment",
+            c.path, layout.basis, layout.wrap, opts.samples_per_segment
+        ),
+    });
     let mut s = Strands {
         colors: c.colors.as_ref().map(|_| Vec::new()),
         ..Strands::default()
     };
-    let (mut start, mut ends_start, mut authored) = (0, 0, 0);
-    for (curve, &m) in c.control_counts.iter().enumerate() {
+    let (mut start, mut ends_start) = (0, 0);
+    for &m in &c.control_counts {
         let ctl = &c.control[start..start + m as usize];
-        let n = c.authored_counts[curve] as usize;
         let segments = layout.basis.segments_for(ctl.len()).unwrap_or(0);
         let ends = c
             .colors
             .as_ref()
             .map(|e| &e[ends_start..ends_start + segments + 1]);
         let before = s.points.len();
-        if exact {
-            for p in &ctl[trim..ctl.len() - trim] {
+        if layout.basis == CurveBasis::Linear {
+            // A closed polyline: its control points repeat the first at the end.
+            for p in ctl {
                 s.points.push([p[0], p[1], p[2]]);
                 s.radii.push(p[3]);
             }
-            // A pinned cubic curve's point colours are what the .hair file holds per point;
-            // elsewhere (linear, or `varying` colours) the segment ends are the points.
-            let points = c.point_colors.as_ref().filter(|_| trim == 1);
-            match (&mut s.colors, points, ends) {
-                (Some(out), Some(p), _) => out.extend_from_slice(&p[authored..authored + n]),
-                (Some(out), None, Some(e)) => out.extend_from_slice(e),
-                _ => {}
+            if let (Some(out), Some(e)) = (&mut s.colors, ends) {
+                out.extend_from_slice(e);
             }
         } else {
             sample_curve(
@@ -385,13 +384,8 @@ fn usd_groom(c: &UsdCurves, opts: &ConvertOptions, notes: &mut Vec<String>) -> R
         s.counts.push((s.points.len() - before) as u32);
         start += m as usize;
         ends_start += segments + 1;
-        authored += n;
     }
-    Ok(Groom {
-        name: c.path.clone(),
-        strands: s,
-        basis,
-    })
+    Ok(named(s, StrandCurves::Polylines(CurveBasis::Linear)))
 }
 
 /// The weights of a cubic segment's four control points at parameter t.

@@ -16,10 +16,16 @@
 //! - Bytes after the last array are an error that says how many there are: they mean the
 //!   header and the arrays disagree, and guessing which one is right would hide it.
 //! - Flag bits the format does not define are an error: an unknown array may follow.
+//! - The format says nothing of the curve its points draw, nor of units. A file that
+//!   `hairtrace convert` writes says both in the header's text ([`HairTag`]); any other
+//!   file's text is not read, and its reader must be given a basis.
 
+use super::units::{StageUnits, UpAxis};
+use super::usd::Layout;
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::strands::Strands;
 use std::fmt::Write as _;
+use std::io::Read as _;
 use std::path::Path;
 
 /// Size of the fixed header.
@@ -75,15 +81,92 @@ impl Thickness {
     }
 }
 
+/// What the header's text of a `.hair` file that `hairtrace convert` wrote says of its
+/// points: the USD layout of the curves they are the authored points of, and the units they
+/// are in. With it a groom goes from USD to `.hair` and back as it was, and a renderer
+/// reading the file needs no basis from its user.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HairTag {
+    pub layout: Layout,
+    pub units: StageUnits,
+}
+
+/// How a tag's text starts; text that does not is another tool's, and not read.
+const TAG_PREFIX: &str = "hairtrace curves:";
+
+impl HairTag {
+    /// `hairtrace curves: TYPE BASIS WRAP UPAXIS METERSPERUNIT`, in USD's spelling.
+    fn text(&self) -> String {
+        let (kind, basis, wrap) = self.layout.tokens();
+        let units = self.units;
+        format!(
+            "{TAG_PREFIX} {kind} {basis} {wrap} {} {}",
+            units.up_axis.name(),
+            units.meters_per_unit
+        )
+    }
+
+    /// The tag in a header's text, if the text is one.
+    fn parse(info: &[u8]) -> Result<Option<HairTag>> {
+        let end = info.iter().position(|&b| b == 0).unwrap_or(info.len());
+        let Some(rest) = std::str::from_utf8(&info[..end])
+            .ok()
+            .and_then(|t| t.strip_prefix(TAG_PREFIX))
+        else {
+            return Ok(None);
+        };
+        let bad = |why: String| invalid_arg!("the header's text {rest:?} is not a tag: {why}");
+        let words: Vec<&str> = rest.split_whitespace().collect();
+        let [kind, basis, wrap, up, mpu] = words[..] else {
+            return Err(bad("type, basis, wrap, up axis and unit expected".into()));
+        };
+        let mpu: f64 = mpu.parse().map_err(|e| bad(format!("{mpu:?}: {e}")))?;
+        let layout = Layout::named(kind, basis, wrap).map_err(|e| bad(e.to_string()))?;
+        let units = UpAxis::named(up)
+            .and_then(|up| StageUnits::new(up, mpu))
+            .map_err(|e| bad(e.to_string()))?;
+        Ok(Some(HairTag { layout, units }))
+    }
+}
+
 /// Reads a `.hair` file; see [`parse_hair`] for what is checked. Errors name the path.
 pub fn read_hair_file(path: &Path, thickness: Thickness) -> Result<Strands> {
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     parse_hair(&bytes, thickness).map_err(|e| e.context(path.display()))
 }
 
+/// The tag in a `.hair` file's header ([`HairTag`]), reading the header alone; None for a
+/// file another tool wrote, or one too short to hold a header ([`read_hair_file`] says
+/// what is wrong with it).
+pub fn read_hair_tag(path: &Path) -> Result<Option<HairTag>> {
+    let mut header = Vec::with_capacity(HEADER_BYTES);
+    std::fs::File::open(path)
+        .and_then(|f| f.take(HEADER_BYTES as u64).read_to_end(&mut header))
+        .map_err(|e| Error::io(path, e))?;
+    parse_hair_tag(&header).map_err(|e| e.context(path.display()))
+}
+
+/// The tag in the header of `.hair` bytes, if they have a header and it holds one.
+pub fn parse_hair_tag(bytes: &[u8]) -> Result<Option<HairTag>> {
+    match bytes.get(..HEADER_BYTES) {
+        Some(header) if header.starts_with(MAGIC) => HairTag::parse(&header[40..]),
+        _ => Ok(None),
+    }
+}
+
 /// Writes `strands` as a `.hair` file (see [`encode_hair`]). Errors name the path.
 pub fn write_hair_file(path: &Path, strands: &Strands, thickness: Thickness) -> Result<()> {
-    let bytes = encode_hair(strands, thickness)?;
+    write_tagged_hair_file(path, strands, thickness, None)
+}
+
+/// Writes `strands` as a `.hair` file whose header says `tag`. Errors name the path.
+pub fn write_tagged_hair_file(
+    path: &Path,
+    strands: &Strands,
+    thickness: Thickness,
+    tag: Option<&HairTag>,
+) -> Result<()> {
+    let bytes = encode_tagged_hair(strands, thickness, tag)?;
     std::fs::write(path, bytes).map_err(|e| Error::io(path, e))
 }
 
@@ -327,8 +410,17 @@ pub fn parse_hair(bytes: &[u8], thickness: Thickness) -> Result<Strands> {
 /// radius is the same (then the header's default thickness says it), and a colour array
 /// when the strands have colours. A strand of more than 65536 points cannot be encoded
 /// (segments are u16), nor can more than 2^32 - 1 strands or points, nor a radius whose
-/// diameter overflows f32.
+/// diameter overflows f32. The header's text names hairtrace.
 pub fn encode_hair(strands: &Strands, thickness: Thickness) -> Result<Vec<u8>> {
+    encode_tagged_hair(strands, thickness, None)
+}
+
+/// [`encode_hair`], with `tag` as the header's text when given.
+pub fn encode_tagged_hair(
+    strands: &Strands,
+    thickness: Thickness,
+    tag: Option<&HairTag>,
+) -> Result<Vec<u8>> {
     strands.validate()?;
     if let Some(s) = strands
         .counts
@@ -398,8 +490,14 @@ pub fn encode_hair(strands: &Strands, thickness: Thickness) -> Result<Vec<u8>> {
         out.extend_from_slice(&v.to_le_bytes());
     }
     let mut info = [0u8; HEADER_BYTES - 40];
-    let text = concat!("hairtrace ", env!("CARGO_PKG_VERSION"));
-    info[..text.len()].copy_from_slice(text.as_bytes());
+    let text = match tag {
+        Some(tag) => tag.text(),
+        None => concat!("hairtrace ", env!("CARGO_PKG_VERSION")).to_string(),
+    };
+    // The longest tag (a unit of 1e-9 written out in full) fits with room to spare.
+    info.get_mut(..text.len())
+        .ok_or_else(|| invalid_arg!("the header's text {text:?} is longer than its 88 bytes"))?
+        .copy_from_slice(text.as_bytes());
     out.extend_from_slice(&info);
 
     if flags & HAS_SEGMENTS != 0 {
@@ -485,6 +583,44 @@ mod tests {
                 assert_eq!(t.radius_of(t.thickness_of(r)).to_bits(), r.to_bits());
             }
         }
+    }
+
+    /// Every layout and units a tag can say come back from its text, and text that is not a
+    /// tag is not read as one.
+    #[test]
+    fn tags_read_back_and_other_text_is_ignored() {
+        use crate::embree::CurveBasis;
+        use crate::formats::usd::Wrap;
+        for basis in CurveBasis::ALL {
+            for wrap in [Wrap::Nonperiodic, Wrap::Pinned, Wrap::Periodic] {
+                for (up, mpu) in [
+                    (UpAxis::Y, 1.0),
+                    (UpAxis::Z, 0.01),
+                    (UpAxis::Z, 1.234_567_890_123_456_7e-9),
+                ] {
+                    let tag = HairTag {
+                        layout: Layout { basis, wrap },
+                        units: StageUnits::new(up, mpu).unwrap(),
+                    };
+                    let strands = Strands {
+                        points: vec![[0.0; 3], [1.0; 3]],
+                        radii: vec![0.5; 2],
+                        counts: vec![2],
+                        colors: None,
+                    };
+                    let bytes =
+                        encode_tagged_hair(&strands, Thickness::Diameter, Some(&tag)).unwrap();
+                    assert_eq!(parse_hair_tag(&bytes).unwrap(), Some(tag));
+                    assert_eq!(parse_hair(&bytes, Thickness::Diameter).unwrap(), strands);
+                }
+            }
+        }
+        assert_eq!(HairTag::parse(b"hairtrace 0.1.0\0\0").unwrap(), None);
+        assert_eq!(HairTag::parse(b"exported by a DCC").unwrap(), None);
+        let e = HairTag::parse(b"hairtrace curves: cubic spiral pinned Y 1").unwrap_err();
+        assert!(e.to_string().contains("spiral"), "{e}");
+        let e = HairTag::parse(b"hairtrace curves: cubic bspline pinned Y -1").unwrap_err();
+        assert!(e.to_string().contains("metersPerUnit"), "{e}");
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Every file format hairtrace reads or writes, one module each: TOML scene files
 //! (`toml_scene`), pbrt-v4 scenes (`pbrt`), USD grooms (`usd`), Cem Yuksel's `.hair`
-//! (`hair`), OBJ and PLY meshes (`mesh`), and the conversion between `.hair` and USD
-//! (`convert`). [`SceneDescription::load`] picks the reader for a path, so that every
+//! (`hair`), OBJ and PLY meshes (`mesh`), the conversion between `.hair` and USD
+//! (`convert`), and the up axes and units files are written in (`units`). [`SceneDescription::load`] picks the reader for a path, so that every
 //! front end opens a file the same way.
 
 pub mod convert;
@@ -9,6 +9,7 @@ pub mod hair;
 pub mod mesh;
 pub mod pbrt;
 mod toml_scene;
+pub mod units;
 pub mod usd;
 
 use std::io::Read;

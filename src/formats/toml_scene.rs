@@ -161,7 +161,8 @@ struct RawGroom {
     radius_scale: Option<f32>,
     translate: Option<[f32; 3]>,
     scale: Option<f32>,
-    rotate_y_deg: Option<f32>,
+    rotate: Option<[f32; 3]>,
+    matrix: Option<[[f32; 4]; 4]>,
     material: String,
 }
 
@@ -176,7 +177,8 @@ struct RawMesh {
     half_size: Option<f32>,
     translate: Option<[f32; 3]>,
     scale: Option<f32>,
-    rotate_y_deg: Option<f32>,
+    rotate: Option<[f32; 3]>,
+    matrix: Option<[[f32; 4]; 4]>,
     material: String,
 }
 
@@ -376,13 +378,30 @@ fn one_line(message: &str) -> String {
     message.trim().replace('\n', "; ")
 }
 
-fn transform(translate: Option<[f32; 3]>, scale: Option<f32>, rotate: Option<f32>) -> Transform {
-    let d = Transform::default();
-    Transform {
-        translate: translate.unwrap_or(d.translate),
-        scale: scale.unwrap_or(d.scale),
-        rotate_y_deg: rotate.unwrap_or(d.rotate_y_deg),
-    }
+/// The transform of a `[[groom]]` or `[[mesh]]` entry: `matrix`, or `translate`, `scale`
+/// and `rotate`, not both.
+fn transform(
+    translate: Option<[f32; 3]>,
+    scale: Option<f32>,
+    rotate: Option<[f32; 3]>,
+    matrix: Option<[[f32; 4]; 4]>,
+) -> Checked<Transform> {
+    let Some(matrix) = matrix else {
+        return Ok(Transform::Trs {
+            translate: translate.unwrap_or([0.0; 3]),
+            rotate_deg: rotate.unwrap_or([0.0; 3]),
+            scale: scale.unwrap_or(1.0),
+        });
+    };
+    reject(
+        "a `matrix` transform",
+        &[
+            ("translate", translate.is_some()),
+            ("scale", scale.is_some()),
+            ("rotate", rotate.is_some()),
+        ],
+    )?;
+    Ok(Transform::Matrix(matrix))
 }
 
 /// Sets fields of `$target` from a `[groom.params]` table whose keys are the field names,
@@ -554,10 +573,10 @@ impl RawGroom {
             }
         };
         let mut groom = GroomDesc::new(source, &self.material);
-        groom.basis = self.basis.map_or(groom.basis, CurveBasis::from);
+        groom.basis = self.basis.map(CurveBasis::from);
         groom.shape = self.shape.map_or(groom.shape, GroomShape::from);
         groom.radius_scale = self.radius_scale.unwrap_or(groom.radius_scale);
-        groom.transform = transform(self.translate, self.scale, self.rotate_y_deg);
+        groom.transform = transform(self.translate, self.scale, self.rotate, self.matrix)?;
         Ok(groom)
     }
 }
@@ -601,7 +620,7 @@ impl RawMesh {
         };
         Ok(MeshDesc {
             source,
-            transform: transform(self.translate, self.scale, self.rotate_y_deg),
+            transform: transform(self.translate, self.scale, self.rotate, self.matrix)?,
             material: self.material,
         })
     }

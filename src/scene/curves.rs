@@ -723,6 +723,22 @@ fn power_basis(basis: CurveBasis) -> [[f32; 4]; 4] {
     }
 }
 
+/// Control points (x, y, z, radius) moved by `place`, radii multiplied by `radius_scale`:
+/// a groom's control points where its scene entry puts them.
+pub(crate) fn placed(
+    points: &[[f32; 4]],
+    place: impl Fn([f32; 3]) -> [f32; 3],
+    radius_scale: f32,
+) -> Vec<[f32; 4]> {
+    points
+        .iter()
+        .map(|&[x, y, z, r]| {
+            let [x, y, z] = place([x, y, z]);
+            [x, y, z, r * radius_scale]
+        })
+        .collect()
+}
+
 /// Embree indexes control points with u32.
 fn check_vertex_count(n: usize) -> Result<()> {
     if n > u32::MAX as usize {

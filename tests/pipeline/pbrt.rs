@@ -7,7 +7,9 @@ use std::sync::Arc;
 
 use hairtrace::Error;
 use hairtrace::bsdf::sigma_a_from_melanin;
-use hairtrace::description::{EnvironmentSource, GroomSource, LightDesc, MaterialDesc, MeshSource};
+use hairtrace::description::{
+    EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshSource,
+};
 use hairtrace::embree::{CurveBasis, Device};
 use hairtrace::formats::pbrt::PbrtScene;
 use hairtrace::render::{Aovs, NO_STRAND, NoProgress};
@@ -30,7 +32,7 @@ fn scene(body: &str) -> hairtrace::Result<PbrtScene> {
 
 fn control_points(s: &PbrtScene, groom: usize) -> (&[[f32; 4]], &[u32]) {
     match &s.description.grooms[groom].source {
-        GroomSource::ControlPoints { points, counts } => (points, counts),
+        GroomSource::ControlPoints { points, counts, .. } => (points, counts),
         other => panic!("expected control points, got {other:?}"),
     }
 }
@@ -56,6 +58,11 @@ fn bspline(c: &[[f32; 4]], t: f32) -> [f32; 4] {
     std::array::from_fn(|k| (0..4).map(|i| w[i] * c[i][k]).sum())
 }
 
+/// The basis a pbrt groom's control points are laid out for.
+fn basis(g: &GroomDesc) -> CurveBasis {
+    g.strand_curves().unwrap().basis()
+}
+
 #[test]
 fn the_fixture_reads_into_pbrts_numbers() {
     let s = fixture();
@@ -66,7 +73,7 @@ fn the_fixture_reads_into_pbrts_numbers() {
     // camera mirrored through x = 0; widths 0.03 to 0.006 linear over 2 segments.
     let g = &d.grooms[0];
     assert_eq!(
-        (g.material.as_str(), g.basis, g.shape),
+        (g.material.as_str(), basis(g), g.shape),
         ("brown", CurveBasis::Bezier, GroomShape::Round)
     );
     let (points, counts) = control_points(&s, 0);
@@ -91,7 +98,7 @@ fn the_fixture_reads_into_pbrts_numbers() {
     // Scale 2 2 2: points and widths doubled; the anonymous material of both.
     let (points, counts) = control_points(&s, 1);
     assert_eq!(
-        (d.grooms[1].basis, d.grooms[1].shape),
+        (basis(&d.grooms[1]), d.grooms[1].shape),
         (CurveBasis::Bezier, GroomShape::Flat)
     );
     assert_eq!(counts, [4]);
@@ -106,7 +113,7 @@ fn the_fixture_reads_into_pbrts_numbers() {
         assert!((r - (0.02 + (0.01 - 0.02) * t)).abs() < 1e-6, "t {t}: {r}");
     }
     let (points, _) = control_points(&s, 2);
-    assert_eq!(d.grooms[2].basis, CurveBasis::BSpline);
+    assert_eq!(basis(&d.grooms[2]), CurveBasis::BSpline);
     assert!(close(&points[4], &[1.0, 1.6, 0.0, 0.01], 1e-6));
     assert_eq!(d.grooms[1].material, d.grooms[2].material);
 
@@ -631,7 +638,7 @@ fn a_steeply_tapered_bspline_keeps_its_curve_and_widths() {
         flat.join(" ")
     );
     let s = scene(&body).unwrap();
-    assert_eq!(s.description.grooms[0].basis, CurveBasis::Bezier);
+    assert_eq!(basis(&s.description.grooms[0]), CurveBasis::Bezier);
     let (points, _) = control_points(&s, 0);
     let original: Vec<[f32; 4]> = p.iter().map(|q| [-q[0], q[1], q[2], 0.0]).collect();
     for t in [0.0, 0.3, 0.7, 1.0] {

@@ -3,7 +3,7 @@
 
 use std::sync::{Arc, Mutex};
 
-use hairtrace::description::{GroomSource, SceneDescription, demo};
+use hairtrace::description::{GroomSource, SceneDescription, Transform, demo};
 use hairtrace::embree::{Device, is_cancelled};
 use hairtrace::scene::{Stage, StageProgress};
 
@@ -103,7 +103,11 @@ fn stages_come_in_order_and_finish() {
 fn two_grooms_keep_each_stage_monotone() {
     let mut desc = scalp(500);
     let mut second = desc.grooms[0].clone();
-    second.transform.translate = [0.0, 1.0, 0.0];
+    second.transform = Transform::Trs {
+        translate: [0.0, 1.0, 0.0],
+        rotate_deg: [0.0; 3],
+        scale: 1.0,
+    };
     desc.grooms.push(second);
     let recorder = Recorder::new(|_, _| false);
     desc.build_with(device(), &recorder).unwrap();

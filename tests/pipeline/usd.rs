@@ -9,6 +9,7 @@ use std::sync::Arc;
 use hairtrace::Error;
 use hairtrace::description::{SceneDescription, quick_look};
 use hairtrace::embree::{CurveShape, Device};
+use hairtrace::formats::units::{StageUnits, UpAxis};
 use hairtrace::formats::usd::{UsdGrooms, read_usd_file};
 use hairtrace::render::NO_STRAND;
 use hairtrace::scene::HairColor;
@@ -32,9 +33,13 @@ fn close(a: f64, b: f64, what: &str) {
 }
 
 fn check_against_usd_core(name: &str, grooms: &UsdGrooms, want: &Value) {
-    assert_eq!(grooms.up_axis, want["upAxis"].as_str().unwrap(), "{name}");
+    assert_eq!(
+        grooms.units.up_axis.name(),
+        want["upAxis"].as_str().unwrap(),
+        "{name}"
+    );
     close(
-        grooms.meters_per_unit,
+        grooms.units.meters_per_unit,
         want["metersPerUnit"].as_f64().unwrap(),
         name,
     );
@@ -146,6 +151,123 @@ fn curves_prim(body: &str) -> String {
     format!("{HEADER}def BasisCurves \"c\"\n{{\n{body}\n}}\n")
 }
 
+/// A Z-up stage in centimetres, as Blender's and Maya's exporters write them, renders
+/// upright with the automatic camera: a vertical strand along the stage's +z and a
+/// horizontal one across its top come out vertical and on top in the image, and the groom
+/// is read in metres.
+#[test]
+fn a_z_up_stage_renders_upright_in_metres() {
+    let text = format!(
+        "{HEADER}(\n    upAxis = \"Z\"\n    metersPerUnit = 0.01\n)\ndef Xform \"Groom\"\n{{\n\
+         def BasisCurves \"hair\"\n{{\nuniform token type = \"linear\"\n\
+         int[] curveVertexCounts = [2, 2]\n\
+         point3f[] points = [(0, 0, 0), (0, 0, 20), (-10, 0, 20), (10, 0, 20)]\n\
+         float[] widths = [0.4] (interpolation = \"constant\")\n}}\n}}\n"
+    );
+    let dir = std::env::temp_dir().join(format!("hairtrace-zup-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("z_up.usda");
+    std::fs::write(&path, text).unwrap();
+    let grooms = read_usd_file(&path).unwrap();
+    assert_eq!(grooms.units, StageUnits::new(UpAxis::Z, 0.01).unwrap());
+
+    let mut desc = quick_look(&path).unwrap();
+    let placed = desc.grooms[0].placed_strands().unwrap();
+    // The stage's +z is +y, in metres; its +y is -z.
+    let [x, y, z] = placed[0].strands.points[1];
+    assert!(
+        x == 0.0 && (y - 0.2).abs() < 1e-7 && z == 0.0,
+        "{:?}",
+        [x, y, z]
+    );
+    assert!((placed[0].strands.radii[0] - 0.002).abs() < 1e-9);
+    (desc.render.width, desc.render.height, desc.render.spp) = (48, 48, 1);
+    let built = desc.build(Arc::new(Device::new(Some(1)).unwrap())).unwrap();
+    let aovs = Aovs {
+        strand_id: true,
+        ..Aovs::default()
+    };
+    let ids = built
+        .render(aovs, &NoProgress)
+        .unwrap()
+        .film
+        .strand_id()
+        .unwrap()
+        .to_vec();
+    // Rows (top first) and columns of each strand's pixels.
+    let extent = |strand: f32| {
+        let (rows, cols): (Vec<usize>, Vec<usize>) = (ids.iter().enumerate())
+            .filter(|&(_, &s)| s == strand)
+            .map(|(i, _)| (i / 48, i % 48))
+            .unzip();
+        let span = |v: &[usize]| v.iter().max().unwrap() - v.iter().min().unwrap();
+        let mean = rows.iter().sum::<usize>() as f32 / rows.len() as f32;
+        (span(&rows), span(&cols), mean)
+    };
+    let (vertical, horizontal) = (extent(0.0), extent(1.0));
+    assert!(
+        vertical.0 > 3 * vertical.1,
+        "the vertical strand is tall: {vertical:?}"
+    );
+    assert!(
+        horizontal.1 > 3 * horizontal.0,
+        "the top strand is wide: {horizontal:?}"
+    );
+    assert!(
+        horizontal.2 < vertical.2,
+        "the top strand is above: {horizontal:?} {vertical:?}"
+    );
+}
+
+/// The faults real exporters make are refused with a message that names the file, the prim
+/// and the attribute at fault (here inside an Xform, as DCCs write them).
+#[test]
+fn real_file_faults_name_the_prim_and_the_attribute() {
+    let prim = |kind: &str, basis: &str, wrap: &str, counts: &str, points: usize, widths: usize| {
+        let points: Vec<String> = (0..points)
+            .map(|i| format!("({i}, {}, 0)", i * i))
+            .collect();
+        let widths: Vec<&str> = vec!["0.01"; widths];
+        format!(
+            "{HEADER}(\n    upAxis = \"Z\"\n    metersPerUnit = 1\n)\ndef Xform \"Hair\"\n{{\n\
+             def BasisCurves \"strands\"\n{{\nuniform token type = \"{kind}\"\n\
+             uniform token basis = \"{basis}\"\nuniform token wrap = \"{wrap}\"\n\
+             int[] curveVertexCounts = {counts}\npoint3f[] points = [{}]\n\
+             float[] widths = [{}] (interpolation = \"vertex\")\n}}\n}}\n",
+            points.join(", "),
+            widths.join(", ")
+        )
+    };
+    for (name, text, want) in [
+        (
+            "counts_do_not_sum",
+            prim("cubic", "catmullRom", "pinned", "[4, 4]", 7, 7),
+            "curveVertexCounts add up to 8 points but points has 7",
+        ),
+        (
+            "widths_length",
+            prim("cubic", "catmullRom", "pinned", "[4, 3]", 7, 6),
+            "widths has 6 values for Vertex interpolation: 7 expected",
+        ),
+        (
+            "cubic_too_few",
+            prim("cubic", "bspline", "nonperiodic", "[4, 3]", 7, 7),
+            "curveVertexCounts[1] = 3: cubic bspline nonperiodic curves have at least 4 points",
+        ),
+        (
+            "periodic_too_short",
+            prim("cubic", "catmullRom", "periodic", "[5, 2]", 7, 7),
+            "curveVertexCounts[1] = 2: cubic catmullRom periodic curves have at least 3 points",
+        ),
+    ] {
+        let m = refused(text, &format!("{name}.usda"));
+        assert!(
+            m.contains(&format!("{name}.usda: /Hair/strands: {want}")),
+            "{name}: {m}"
+        );
+    }
+}
+
 #[test]
 fn bad_files_are_refused_with_a_message() {
     let ok = "int[] curveVertexCounts = [4]\npoint3f[] points = [(0,0,0),(0,1,0),(0,2,0),(0,3,0)]\nfloat[] widths = [0.1] (interpolation = \"constant\")\nuniform token type = \"linear\"";
@@ -195,7 +317,7 @@ fn bad_files_are_refused_with_a_message() {
         (
             "widths_len",
             curves_prim(&ok.replace("[0.1] (interpolation = \"constant\")", "[0.1, 0.2]")),
-            "2 widths for Vertex",
+            "widths has 2 values for Vertex",
         ),
         // usd-core counts a pinned curve's varying values as its points - 2: 2 for 4.
         (
@@ -210,7 +332,7 @@ fn bad_files_are_refused_with_a_message() {
                     "[0.1, 0.2, 0.3, 0.4] (interpolation = \"varying\")",
                 ),
             ),
-            "4 widths for Varying interpolation: 2 expected",
+            "widths has 4 values for Varying interpolation: 2 expected",
         ),
         (
             "pinned_varying_two_points",
@@ -266,7 +388,7 @@ fn bad_files_are_refused_with_a_message() {
                 "[4]",
                 "[4]\nuniform token basis = \"bezier\"\nuniform token wrap = \"periodic\"",
             )),
-            "not a whole number",
+            "curveVertexCounts[0] = 4: cubic bezier periodic curves have a multiple of 3 points",
         ),
         (
             "basis",

@@ -111,7 +111,7 @@ fn scalp(
 ) -> Result<SceneDescription> {
     let mut desc = SceneDescription::from_file(&scalp_path(&ctx.scenes))?;
     for g in &mut desc.grooms {
-        (g.basis, g.shape) = (basis, shape);
+        (g.basis, g.shape) = (Some(basis), shape);
         if let GroomSource::Scalp(s) = &mut g.source {
             s.strands = strands;
         }

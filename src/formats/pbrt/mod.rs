@@ -80,12 +80,17 @@ impl PbrtScene {
         let d = &self.description;
         let mut s = String::new();
         for (i, g) in d.grooms.iter().enumerate() {
-            let GroomSource::ControlPoints { points, counts } = &g.source else {
+            let GroomSource::ControlPoints {
+                points,
+                counts,
+                basis,
+            } = &g.source
+            else {
                 continue;
             };
             let segments: usize = counts
                 .iter()
-                .filter_map(|&n| g.basis.segments_for(n as usize))
+                .filter_map(|&n| basis.segments_for(n as usize))
                 .sum();
             let (lo, hi) = points.iter().fold(
                 ([f32::INFINITY; 4], [f32::NEG_INFINITY; 4]),
@@ -102,7 +107,7 @@ impl PbrtScene {
                  {segments} segments",
                 g.material,
                 g.shape,
-                g.basis,
+                basis,
                 counts.len(),
                 points.len()
             );

@@ -96,13 +96,14 @@ impl Grooms {
             let source = GroomSource::ControlPoints {
                 points: Vec::new(),
                 counts: Vec::new(),
+                basis,
             };
             let mut groom = GroomDesc::new(source, material);
-            (groom.basis, groom.shape) = (basis, shape.into());
+            groom.shape = shape.into();
             self.list.push(groom);
             self.list.len() - 1
         });
-        let GroomSource::ControlPoints { points, counts } = &mut self.list[i].source else {
+        let GroomSource::ControlPoints { points, counts, .. } = &mut self.list[i].source else {
             unreachable!("pbrt grooms hold control points");
         };
         counts.push(u32::try_from(control.len()).map_err(|_| p.fail("too many control points"))?);

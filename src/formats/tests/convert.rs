@@ -5,10 +5,14 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::description::{GroomDesc, GroomSource};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::formats::convert::{ConvertOptions, ConvertSource, basis_named, convert};
-use crate::formats::hair::{Thickness, read_hair_file, write_hair_file};
-use crate::formats::usd::{UsdCurves, read_usd_file};
+use crate::formats::hair::{
+    HEADER_BYTES, Thickness, read_hair_file, read_hair_tag, write_hair_file,
+};
+use crate::formats::units::{StageUnits, UpAxis};
+use crate::formats::usd::{Layout, UsdCurves, Wrap, read_usd_file};
 use crate::scene::Strands;
 use crate::scene::curves::Curves;
 
@@ -22,9 +26,10 @@ fn tmp(name: &str) -> PathBuf {
     dir.join(name)
 }
 
+/// Options with `basis`, or none for "".
 fn opts(basis: &str) -> ConvertOptions {
     ConvertOptions {
-        basis: basis_named(basis).unwrap(),
+        basis: (!basis.is_empty()).then(|| basis_named(basis).unwrap()),
         ..ConvertOptions::default()
     }
 }
@@ -83,8 +88,9 @@ fn extremes() -> Strands {
     }
 }
 
-/// .hair -> .usda -> .hair gives the same file, byte for byte, for every basis: counts,
-/// points, radii and colours survive to the bit.
+/// .hair -> .usda -> .hair gives the same strands to the bit for every basis (counts,
+/// points, radii and colours), and a .hair file that convert wrote, which says its curve
+/// and units, comes back byte for byte with no basis given.
 #[test]
 fn hair_to_usd_to_hair_is_exact() {
     for (name, strands) in [
@@ -98,21 +104,134 @@ fn hair_to_usd_to_hair_is_exact() {
             let usd = tmp(&format!("g{name}_{basis}.usda"));
             let back = tmp(&format!("g{name}_{basis}.hair"));
             assert!(run(&hair, &usd, basis).unwrap().is_empty());
-            assert!(run(&usd, &back, basis).unwrap().is_empty());
+            assert!(run(&usd, &back, "").unwrap().is_empty());
             let got = read_hair_file(&back, Thickness::Diameter).unwrap();
+            // Equal as numbers: a negative zero comes back as 0 (openusd prints integral
+            // floats as integers, and the reader's transform adds +0).
+            assert_eq!(got, strands, "{basis} {name}");
             if name == "extremes" {
-                // Equal as numbers: a negative zero comes back as 0 (openusd prints
-                // integral floats as integers, and the reader's transform adds +0).
-                assert_eq!(got, strands, "{basis}");
                 assert_eq!(got.points[1][1].to_bits(), 0);
             } else {
-                assert_eq!(
-                    std::fs::read(&back).unwrap(),
-                    std::fs::read(&hair).unwrap(),
-                    "{basis} {name}"
-                );
+                let bytes = |p: &Path| std::fs::read(p).unwrap()[HEADER_BYTES..].to_vec();
+                assert_eq!(bytes(&back), bytes(&hair), "{basis} {name}");
             }
+            let tag = read_hair_tag(&back).unwrap().unwrap();
+            let drawn = Layout::of_polylines(basis_named(basis).unwrap());
+            assert_eq!((tag.layout, tag.units), (drawn, StageUnits::WORLD));
+            // The tagged file goes round again to the same bytes, with no basis given.
+            let (usd2, back2) = (
+                tmp(&format!("g{name}_{basis}_2.usda")),
+                tmp(&format!("g{name}_{basis}_2.hair")),
+            );
+            run(&back, &usd2, "").unwrap();
+            run(&usd2, &back2, "").unwrap();
+            assert_eq!(
+                std::fs::read(&back2).unwrap(),
+                std::fs::read(&back).unwrap()
+            );
         }
+    }
+    // An untagged .hair file has no curve of its own to convert.
+    let hair = tmp("gplain.hair");
+    let m = run(&hair, &tmp("nobasis.usda"), "")
+        .unwrap_err()
+        .to_string();
+    assert!(
+        m.contains("does not say which curve") && m.contains("gplain.hair"),
+        "{m}"
+    );
+}
+
+/// Every cubic basis and wrap USD has, in a Z-up stage in centimetres, goes to .hair and back
+/// to the same stage: the same layout, points, widths and colours to the bit, and the same
+/// up axis and unit.
+#[test]
+fn usd_of_every_cubic_basis_and_wrap_round_trips_through_hair() {
+    for (basis, counts, wrap) in [
+        ("bspline", "[4, 6]", "nonperiodic"),
+        ("bspline", "[3, 5]", "pinned"),
+        ("bspline", "[3, 7]", "periodic"),
+        ("catmullRom", "[4, 6]", "nonperiodic"),
+        ("catmullRom", "[3, 7]", "pinned"),
+        ("catmullRom", "[3, 7]", "periodic"),
+        ("bezier", "[4, 7]", "nonperiodic"),
+        ("bezier", "[4, 7]", "pinned"),
+        ("bezier", "[3, 6]", "periodic"),
+    ] {
+        let n: usize = counts
+            .trim_matches(['[', ']'])
+            .split(", ")
+            .map(|c| c.parse::<usize>().unwrap())
+            .sum();
+        let points: Vec<String> = (0..n)
+            .map(|i| {
+                format!(
+                    "({}, {}, {})",
+                    0.1 * i as f32 + 1.0 / 3.0,
+                    (i * i) as f32 / 7.0,
+                    1.5 - i as f32
+                )
+            })
+            .collect();
+        let widths: Vec<String> = (0..n)
+            .map(|i| format!("{}", 0.02 - 0.001 * i as f32))
+            .collect();
+        let colors: Vec<String> = (0..n)
+            .map(|i| format!("({}, 0.5, 0.25)", i as f32 / n as f32))
+            .collect();
+        let src = tmp(&format!("rt_{basis}_{wrap}.usda"));
+        std::fs::write(
+            &src,
+            format!(
+                "#usda 1.0\n(\n    metersPerUnit = 0.01\n    upAxis = \"Z\"\n)\n\
+                 def BasisCurves \"c\"\n{{\n\
+                 uniform token type = \"cubic\"\nuniform token basis = \"{basis}\"\n\
+                 uniform token wrap = \"{wrap}\"\nint[] curveVertexCounts = {counts}\n\
+                 point3f[] points = [{}]\nfloat[] widths = [{}] (interpolation = \"vertex\")\n\
+                 color3f[] primvars:displayColor = [{}] (interpolation = \"vertex\")\n}}\n",
+                points.join(", "),
+                widths.join(", "),
+                colors.join(", ")
+            ),
+        )
+        .unwrap();
+        let (hair, usda) = (
+            tmp(&format!("rt_{basis}_{wrap}.hair")),
+            tmp(&format!("rt_{basis}_{wrap}_back.usda")),
+        );
+        assert!(run(&src, &hair, "").unwrap().is_empty());
+        assert!(run(&hair, &usda, "").unwrap().is_empty());
+        let (a, b) = (read_usd_file(&src).unwrap(), read_usd_file(&usda).unwrap());
+        assert_eq!(a.units, b.units, "{basis} {wrap}");
+        assert_eq!(a.units.up_axis, UpAxis::Z);
+        assert_eq!(a.curves[0].layout, b.curves[0].layout, "{basis} {wrap}");
+        let bits = |c: &UsdCurves| {
+            (
+                c.control
+                    .iter()
+                    .flatten()
+                    .map(|v| v.to_bits())
+                    .collect::<Vec<_>>(),
+                c.authored_counts.clone(),
+                c.point_colors.clone(),
+            )
+        };
+        assert_eq!(bits(&a.curves[0]), bits(&b.curves[0]), "{basis} {wrap}");
+        // And the .hair file renders as the stage does: the same control points in the world.
+        let desc = |path: &Path| {
+            GroomDesc::new(
+                GroomSource::File {
+                    path: path.to_path_buf(),
+                    thickness: Thickness::Diameter,
+                },
+                "",
+            )
+        };
+        let from_hair = desc(&hair).placed_strands().unwrap();
+        let from_usd = desc(&src).placed_strands().unwrap();
+        assert_eq!(from_hair[0].strands, from_usd[0].strands, "{basis} {wrap}");
+        let layouts = [from_hair[0].curves.layout(), from_usd[0].curves.layout()];
+        assert_eq!(layouts[0], layouts[1], "{basis} {wrap}");
     }
 }
 
@@ -132,7 +251,7 @@ fn written_usda_reads_back_as_the_curves_of_the_hair_file() {
         let usda = tmp(&format!("drawn_{basis}.usda"));
         run(&hair, &usda, basis).unwrap();
         let stage = read_usd_file(&usda).unwrap();
-        assert_eq!((stage.up_axis.as_str(), stage.meters_per_unit), ("Y", 0.01));
+        assert_eq!(stage.units, StageUnits::WORLD);
         let [c] = stage.curves.as_slice() else {
             panic!("one prim expected")
         };
@@ -178,12 +297,13 @@ fn usd_to_hair_to_usd_keeps_the_curves() {
         let (a, b) = (read_usd_file(&src).unwrap(), read_usd_file(&usda).unwrap());
         same(&a.curves[0], &b.curves[0], case);
     }
-    // A Z-up stage keeps its points as authored, and a note says so.
+    // A Z-up stage keeps its points as authored, and the .hair file says Z-up.
     let z_up = tmp("z_up.usda");
     let text = std::fs::read_to_string(fixtures().join("case0.usda")).unwrap();
     std::fs::write(&z_up, text.replace("upAxis = \"Y\"", "upAxis = \"Z\"")).unwrap();
-    let notes = run(&z_up, &tmp("z_up.hair"), "linear").unwrap();
-    assert!(notes.iter().any(|n| n.contains("Z-up")), "{notes:?}");
+    assert!(run(&z_up, &tmp("z_up.hair"), "linear").unwrap().is_empty());
+    let tag = read_hair_tag(&tmp("z_up.hair")).unwrap().unwrap();
+    assert_eq!(tag.units, StageUnits::new(UpAxis::Z, 0.01).unwrap());
     // The linear prim of a nested, scaled and turned stage, in world space; the stage's
     // other prims have no colours, so none are written, and a note says so.
     let hair = tmp("all_bases_linear.hair");
@@ -224,16 +344,25 @@ fn usd_to_hair_to_usd_keeps_the_curves() {
     same(a, &read_usd_file(&usda).unwrap().curves[0], "coloured");
 }
 
-/// Cubic curves that a .hair file read with the chosen basis cannot hold are refused, with
-/// the way out named; with the linear basis they are sampled onto the curve.
+/// Cubic curves go to .hair as they are; a basis other than their own is refused, with the
+/// ways out named; with the linear basis they are sampled onto the curve.
 #[test]
 fn cubic_curves_are_sampled_for_linear_or_refused() {
     // case4: nonperiodic B-spline, curves of 4 and 6 points (1 and 3 segments).
     let src = fixtures().join("case4.usda");
     let hair = tmp("case4.hair");
-    for basis in ["bspline", "catmull_rom", "bezier"] {
+    for basis in ["catmull_rom", "bezier"] {
         let m = run(&src, &hair, basis).unwrap_err().to_string();
         assert!(m.contains("--basis linear") && m.contains("/hair"), "{m}");
+        assert!(m.contains("leave --basis out"), "{m}");
+    }
+    for basis in ["bspline", ""] {
+        assert!(run(&src, &hair, basis).unwrap().is_empty());
+        let tag = read_hair_tag(&hair).unwrap().unwrap();
+        assert_eq!(
+            (tag.layout.basis, tag.layout.wrap),
+            (CurveBasis::BSpline, Wrap::Nonperiodic)
+        );
     }
     let notes = run(&src, &hair, "linear").unwrap();
     assert!(notes.iter().any(|n| n.contains("sampled")), "{notes:?}");
@@ -281,7 +410,7 @@ fn cubic_curves_are_sampled_for_linear_or_refused() {
 }
 
 /// A scene file's grooms go out one prim each, in world space and with their own basis; a
-/// .hair file takes them only when they share the basis it will be read with.
+/// .hair file takes them only when they share one layout.
 #[test]
 fn scene_grooms_convert_with_their_bases() {
     let scene = tmp("two.toml");
@@ -310,6 +439,10 @@ fn scene_grooms_convert_with_their_bases() {
         .unwrap_err()
         .to_string();
     assert!(m.contains("groom1") && m.contains("--basis linear"), "{m}");
+    assert!(
+        m.contains("linear bezier nonperiodic") && m.contains("cubic bspline pinned"),
+        "{m}"
+    );
 }
 
 /// Bad paths and unknown extensions are refused before anything is written.
@@ -362,13 +495,13 @@ fn converted_usda_is_the_file_usd_core_validated() {
         std::fs::read(&out).unwrap() == std::fs::read(&want).unwrap(),
         "the converter's output changed: check it with check_converted.py, then bless it"
     );
-    // usd-core's crate file of that stage comes back as the same .hair file.
+    // usd-core's crate file of that stage comes back as the same strands, saying their curve
+    // and units.
     let back = tmp("converted_back.hair");
-    run(
-        &fixtures().join("converted_by_usd_core.usdc"),
-        &back,
-        "bspline",
-    )
-    .unwrap();
-    assert_eq!(std::fs::read(&back).unwrap(), std::fs::read(&hair).unwrap());
+    run(&fixtures().join("converted_by_usd_core.usdc"), &back, "").unwrap();
+    let bytes = |p: &Path| std::fs::read(p).unwrap()[HEADER_BYTES..].to_vec();
+    assert_eq!(bytes(&back), bytes(&hair));
+    let tag = read_hair_tag(&back).unwrap().unwrap();
+    assert_eq!(tag.layout, Layout::of_polylines(CurveBasis::BSpline));
+    assert_eq!(tag.units, StageUnits::WORLD);
 }

@@ -22,6 +22,7 @@
 
 use crate::embree::CurveBasis;
 use crate::error::{Result, invalid_arg};
+use crate::scene::Strands;
 
 /// UsdGeomBasisCurves' `wrap`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -60,6 +61,104 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The layout of the curve hairtrace draws through polylines read with `basis`
+    /// (`Curves::from_strands`): nonperiodic linear, and pinned B-spline or Catmull-Rom, whose
+    /// phantom end points are the ones hairtrace adds; Bezier strands are the Catmull-Rom
+    /// curve in Bezier form.
+    pub fn of_polylines(basis: CurveBasis) -> Layout {
+        match basis {
+            CurveBasis::Linear => Layout {
+                basis,
+                wrap: Wrap::Nonperiodic,
+            },
+            CurveBasis::BSpline => Layout {
+                basis,
+                wrap: Wrap::Pinned,
+            },
+            CurveBasis::CatmullRom | CurveBasis::Bezier => Layout {
+                basis: CurveBasis::CatmullRom,
+                wrap: Wrap::Pinned,
+            },
+        }
+    }
+
+    /// The tokens UsdGeom spells `type`, `basis` and `wrap` with.
+    pub fn tokens(self) -> (&'static str, &'static str, &'static str) {
+        let (kind, basis) = match self.basis {
+            CurveBasis::Linear => ("linear", "bezier"),
+            CurveBasis::Bezier => ("cubic", "bezier"),
+            CurveBasis::BSpline => ("cubic", "bspline"),
+            CurveBasis::CatmullRom => ("cubic", "catmullRom"),
+        };
+        let wrap = match self.wrap {
+            Wrap::Nonperiodic => "nonperiodic",
+            Wrap::Pinned => "pinned",
+            Wrap::Periodic => "periodic",
+        };
+        (kind, basis, wrap)
+    }
+
+    /// The layout UsdGeom spells with these `type`, `basis` and `wrap` tokens.
+    pub fn named(kind: &str, basis: &str, wrap: &str) -> Result<Layout> {
+        Ok(Layout {
+            basis: basis_of(kind, basis)?,
+            wrap: wrap_of(wrap)?,
+        })
+    }
+
+    /// Control points before the first authored one in Embree's layout of a curve (the
+    /// pinned wrap's phantom point): the authored points of a curve are
+    /// `control[lead..lead + n]`.
+    pub fn lead(self) -> usize {
+        usize::from(self.effective_wrap() == Wrap::Pinned)
+    }
+
+    /// Embree's control points (x, y, z, radius) of strands whose points are the authored
+    /// points of curves of this layout, how many each curve has, and the strands' colours at
+    /// every segment end. Errors name a curve whose point count makes no whole segment.
+    #[allow(clippy::type_complexity)]
+    pub fn control_points(
+        self,
+        strands: &Strands,
+    ) -> Result<(Vec<[f32; 4]>, Vec<u32>, Option<Vec<[f32; 3]>>)> {
+        let mut control = Vec::new();
+        let mut counts = Vec::with_capacity(strands.counts.len());
+        let mut colors = strands.colors.as_ref().map(|_| Vec::new());
+        let mut curve = Vec::new();
+        for (i, (start, &n)) in strands.offsets().zip(&strands.counts).enumerate() {
+            let n = n as usize;
+            let segments = self.segments(n).ok_or_else(|| {
+                let (kind, basis, wrap) = self.tokens();
+                invalid_arg!(
+                    "strand {i} has {n} points: {kind} {basis} {wrap} curves have {} points",
+                    self.count_rule()
+                )
+            })?;
+            let points = start..start + n;
+            let xyzr: Vec<[f32; 4]> = (strands.points[points.clone()].iter())
+                .zip(&strands.radii[points.clone()])
+                .map(|(p, &r)| [p[0], p[1], p[2], r])
+                .collect();
+            curve.clear();
+            // A phantom end's radius is reflected like its position, and kept only if > 0.
+            self.extend(&xyzr, &mut curve, |p, end| {
+                if p[3] > 0.0 {
+                    p
+                } else {
+                    [p[0], p[1], p[2], end[3]]
+                }
+            });
+            control.extend_from_slice(&curve);
+            counts.push(curve.len() as u32);
+            if let (Some(c), Some(out)) = (&strands.colors, &mut colors) {
+                let mut ext = Vec::new();
+                self.extend(&c[points], &mut ext, |c, _| c.map(|x| x.max(0.0)));
+                self.segment_ends(&ext, segments, out);
+            }
+        }
+        Ok((control, counts, colors))
+    }
+
     /// The wrap that changes anything for this basis (pinned means something for B-spline
     /// and Catmull-Rom only).
     fn effective_wrap(self) -> Wrap {
@@ -82,6 +181,17 @@ impl Layout {
             (_, Wrap::Nonperiodic) => (n >= 4).then(|| n - 3),
         };
         s.filter(|&s| s > 0)
+    }
+
+    /// The point counts [`Layout::segments`] takes, as a message says them.
+    pub fn count_rule(self) -> &'static str {
+        match (self.basis, self.effective_wrap()) {
+            (CurveBasis::Linear, _) | (_, Wrap::Pinned) => "at least 2",
+            (CurveBasis::Bezier, Wrap::Periodic) => "a multiple of 3",
+            (CurveBasis::Bezier, _) => "3k + 1, at least 4",
+            (_, Wrap::Periodic) => "at least 3",
+            (_, Wrap::Nonperiodic) => "at least 4",
+        }
     }
 
     /// Values a `varying` primvar holds for a curve of `segments` segments (usd-core's
@@ -211,7 +321,7 @@ impl Layout {
 }
 
 /// The Embree basis of a USD `type` and `basis`.
-pub fn basis_of(kind: &str, basis: &str) -> Result<CurveBasis> {
+fn basis_of(kind: &str, basis: &str) -> Result<CurveBasis> {
     Ok(match (kind, basis) {
         ("linear", _) => CurveBasis::Linear,
         ("cubic", "bezier") => CurveBasis::Bezier,
@@ -231,7 +341,7 @@ pub fn basis_of(kind: &str, basis: &str) -> Result<CurveBasis> {
 }
 
 /// The `wrap` token.
-pub fn wrap_of(name: &str) -> Result<Wrap> {
+fn wrap_of(name: &str) -> Result<Wrap> {
     Ok(match name {
         "nonperiodic" => Wrap::Nonperiodic,
         "pinned" => Wrap::Pinned,

@@ -1,7 +1,8 @@
 //! USD grooms: every `BasisCurves` prim of a composed stage (.usda, .usdc or .usdz, read by
 //! the pure-Rust `openusd` crate), each as its own curve geometry in world space, laid out
-//! for Embree (see [`Layout`] for the basis and wrap conversions). See docs/formats.md for
-//! what is read, the primvar names and what is refused.
+//! for Embree (see [`Layout`] for the basis and wrap conversions), turned and scaled from the
+//! stage's `upAxis` and `metersPerUnit` into hairtrace's +y up metres ([`StageUnits`]). See
+//! docs/formats.md for what is read, the primvar names and what is refused.
 
 mod crate_check;
 mod layout;
@@ -14,13 +15,15 @@ use std::path::Path;
 
 use openusd::usd::{PrimPredicate, Stage};
 
+use super::units::{StageUnits, UpAxis};
 use crate::embree::{CurveBasis, CurveShape};
 use crate::error::{Error, Result, invalid_arg};
-use crate::scene::curves::Curves;
+use crate::scene::Strands;
+use crate::scene::curves::{Curves, placed};
 use crate::scene::framing::Framing;
 
 pub use layout::{Interpolation, Layout, Wrap};
-pub use write::{CurvesToWrite, ROOT_PRIM, StageUnits, write_usd_file};
+pub use write::{CurvesToWrite, ROOT_PRIM, write_usd_file};
 
 /// Bytes a USD file may have: the reader keeps the whole stage in memory.
 const MAX_FILE_BYTES: u64 = 1 << 32;
@@ -28,11 +31,9 @@ const MAX_FILE_BYTES: u64 = 1 << 32;
 /// A stage's grooms and what the reader made of the rest.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UsdGrooms {
-    /// The stage's `upAxis` ("Y" when not authored). Reported, not applied: points are used
-    /// as authored (see docs/formats.md).
-    pub up_axis: String,
-    /// The stage's `metersPerUnit` (0.01 when not authored). Reported, not applied.
-    pub meters_per_unit: f64,
+    /// The stage's `upAxis` and `metersPerUnit` (USD's fallbacks, Y and 0.01, where not
+    /// authored): every prim's curves are turned and scaled by them into the world.
+    pub units: StageUnits,
     pub curves: Vec<UsdCurves>,
     /// Paths and types of the prims that are not BasisCurves (nor plain Xforms or Scopes).
     pub ignored: Vec<String>,
@@ -42,17 +43,21 @@ pub struct UsdGrooms {
 #[derive(Debug, Clone, PartialEq)]
 pub struct UsdCurves {
     pub path: String,
+    /// The stage's units: `control` and `bounds` are in them, [`UsdCurves::curves`] and
+    /// [`UsdCurves::frame`] bring them into the world.
+    pub units: StageUnits,
     pub layout: Layout,
     /// `curveVertexCounts` as authored.
     pub authored_counts: Vec<u32>,
     /// Segments of all curves.
     pub segments: usize,
-    /// Bounds of the authored points in world space.
+    /// Bounds of the authored points under the prim's transform, in the stage's units.
     pub bounds: ([f32; 3], [f32; 3]),
-    /// Smallest and largest world-space radius the widths give (widths / 2 times the
-    /// transform's scale).
+    /// Smallest and largest radius the widths give (widths / 2 times the transform's
+    /// scale), in the stage's units.
     pub radius_range: (f32, f32),
-    /// Control points (x, y, z, radius) for Embree, curve after curve.
+    /// Control points (x, y, z, radius) for Embree, curve after curve, under the prim's
+    /// transform and in the stage's units.
     pub control: Vec<[f32; 4]>,
     /// Control points of each curve in `control`.
     pub control_counts: Vec<u32>,
@@ -66,17 +71,22 @@ pub struct UsdCurves {
 }
 
 impl UsdCurves {
-    /// The Embree curves of this prim, radii multiplied by `radius_scale` and every point
-    /// mapped by `point` (a scene's placement of the groom). Colours and melanin go with
-    /// the strands as authored: the material converts them at each hit.
+    /// The Embree curves of this prim in the world, radii multiplied by `radius_scale` and
+    /// every point mapped by `point` (a scene's placement of the groom). Colours and melanin
+    /// go with the strands as authored: the material converts them at each hit.
     pub fn curves(
         &self,
         shape: CurveShape,
         radius_scale: f32,
         point: impl Fn([f32; 3]) -> [f32; 3],
     ) -> Result<Curves> {
+        let units = self.units;
         let curves = Curves::from_control_points(
-            crate::description::placed(&self.control, point, radius_scale),
+            placed(
+                &self.control,
+                |p| point(units.to_world(p)),
+                radius_scale * units.scale(),
+            ),
             &self.control_counts,
             self.colors.clone(),
             self.layout.basis,
@@ -94,20 +104,49 @@ impl UsdCurves {
         self.layout.basis
     }
 
-    /// Adds the prim to `framing` as a scene frames it: the corners of its authored bounds,
-    /// mapped by `point`, each widened by its largest radius times `radius_scale`.
+    /// The prim's authored points and radii, curve after curve, under its transform and in
+    /// the stage's units: the control points without the ones the wrap adds. Colours are
+    /// the authored ones where they were given per point (else none).
+    pub fn authored(&self) -> Strands {
+        let lead = self.layout.lead();
+        let mut s = Strands {
+            colors: self.point_colors.clone(),
+            ..Strands::default()
+        };
+        let mut start = 0;
+        for (&m, &n) in self.control_counts.iter().zip(&self.authored_counts) {
+            for p in &self.control[start + lead..start + lead + n as usize] {
+                s.points.push([p[0], p[1], p[2]]);
+                s.radii.push(p[3]);
+            }
+            s.counts.push(n);
+            start += m as usize;
+        }
+        s
+    }
+
+    /// Adds the prim to `framing` as a scene frames it: the corners of its bounds in the
+    /// world, mapped by `point`, each widened by its largest radius times `radius_scale`.
     pub fn frame(
         &self,
         framing: &mut Framing,
         radius_scale: f32,
         point: impl Fn([f32; 3]) -> [f32; 3],
     ) {
-        let (lo, hi) = self.bounds;
-        let r = self.radius_range.1 * radius_scale;
-        for corner in 0..8 {
-            let p = std::array::from_fn(|k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] });
+        let r = self.radius_range.1 * radius_scale * self.units.scale();
+        for p in self.world_corners() {
             framing.add_hair_point(point(p).into(), r);
         }
+    }
+
+    /// The corners of the prim's bounds in the world (turned and scaled from the stage's
+    /// units).
+    fn world_corners(&self) -> impl Iterator<Item = [f32; 3]> + '_ {
+        let (lo, hi) = self.bounds;
+        (0..8).map(move |corner| {
+            let p = std::array::from_fn(|k| if corner >> k & 1 == 1 { hi[k] } else { lo[k] });
+            self.units.to_world(p)
+        })
     }
 }
 
@@ -156,13 +195,7 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
 
 /// The grooms of a composed stage. `file_bytes` bounds what any count may ask for.
 fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
-    let meta = |key: &str| stage.stage_metadata(key).ok().flatten();
-    let up_axis = meta("upAxis")
-        .and_then(|v| v.try_as_token().map(|t| t.as_str().to_string()))
-        .unwrap_or_else(|| "Y".to_string());
-    let meters_per_unit = meta("metersPerUnit")
-        .and_then(|v| v.try_as_double())
-        .unwrap_or(0.01);
+    let units = stage_units(stage)?;
     let mut paths = Vec::new();
     stage
         .traverse(PrimPredicate::DEFAULT, |p| paths.push(p.clone()))
@@ -178,18 +211,37 @@ fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
             .unwrap_or_default();
         match kind.as_str() {
             "BasisCurves" => curves.push(
-                prim::read_basis_curves(stage, p, file_bytes).map_err(|e| e.context(p.as_str()))?,
+                prim::read_basis_curves(stage, p, file_bytes, units)
+                    .map_err(|e| e.context(p.as_str()))?,
             ),
             "" | "Xform" | "Scope" => {}
             other => ignored.push(format!("{} ({other})", p.as_str())),
         }
     }
     Ok(UsdGrooms {
-        up_axis,
-        meters_per_unit,
+        units,
         curves,
         ignored,
     })
+}
+
+/// The stage's `upAxis` and `metersPerUnit`, USD's fallback for each one not authored.
+fn stage_units(stage: &Stage) -> Result<StageUnits> {
+    let meta = |key: &str| stage.stage_metadata(key).ok().flatten();
+    let fallback = StageUnits::USD_FALLBACK;
+    let up_axis = match meta("upAxis") {
+        None => fallback.up_axis,
+        Some(v) => match v.clone().try_as_token() {
+            Some(t) => UpAxis::named(t.as_str())?,
+            None => return Err(invalid_arg!("upAxis is not a token: {v:?}")),
+        },
+    };
+    let meters_per_unit = match meta("metersPerUnit") {
+        None => fallback.meters_per_unit,
+        Some(v) => (v.clone().try_as_double())
+            .ok_or_else(|| invalid_arg!("metersPerUnit is not a number: {v:?}"))?,
+    };
+    StageUnits::new(up_axis, meters_per_unit)
 }
 
 /// Whether `path` names a USD file by its extension (.usd, .usda, .usdc, .usdz).
@@ -203,13 +255,17 @@ pub fn is_usd_path(path: &Path) -> bool {
 /// and radius range; then the stage's units and the prims that were ignored.
 pub fn info_report(grooms: &UsdGrooms) -> String {
     let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "stage:    upAxis {}, metersPerUnit {} (reported, not applied)",
-        grooms.up_axis, grooms.meters_per_unit
-    );
+    let _ = writeln!(s, "stage:    {}", grooms.units.describe());
     for c in &grooms.curves {
-        let (lo, hi) = c.bounds;
+        let (lo, hi) = c.world_corners().fold(
+            ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+            |(lo, hi), p| {
+                (
+                    std::array::from_fn(|k| lo[k].min(p[k])),
+                    std::array::from_fn(|k| hi[k].max(p[k])),
+                )
+            },
+        );
         let _ = writeln!(
             s,
             "prim {} ({:?}, {:?})",
@@ -224,10 +280,12 @@ pub fn info_report(grooms: &UsdGrooms) -> String {
             "  bounds:   min ({}, {}, {}), max ({}, {}, {})",
             lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]
         );
+        let scale = c.units.scale();
         let _ = writeln!(
             s,
             "  radius:   min {}, max {}",
-            c.radius_range.0, c.radius_range.1
+            c.radius_range.0 * scale,
+            c.radius_range.1 * scale
         );
         let _ = writeln!(
             s,

@@ -7,13 +7,10 @@ use openusd::sdf::{self, Value};
 use openusd::usd::{Attribute, Stage, TimeCode};
 
 use super::UsdCurves;
-use super::layout::{Interpolation, Layout, basis_of, wrap_of};
+use super::layout::{Interpolation, Layout};
 use crate::error::{Result, invalid_arg};
+use crate::formats::units::StageUnits;
 use crate::validate;
-
-/// Relative difference between the scales of the three axes above which a transform is
-/// refused: radii can follow a uniform scale only.
-const UNIFORM_SCALE_TOLERANCE: f64 = 1e-4;
 
 /// The attribute's default value, or its earliest time sample when only samples are
 /// authored (the reader renders one frame: the first).
@@ -119,28 +116,11 @@ fn world_transform(stage: &Stage, path: &sdf::Path, curves: &BasisCurves) -> Res
     Ok(m)
 }
 
-/// The uniform scale of a transform's linear part, or an error when it scales the axes
-/// differently (round fibres cannot follow).
+/// The uniform scale of a transform's linear part (its rows are the images of the axes),
+/// or an error when it scales the axes differently (round fibres cannot follow).
 fn uniform_scale(m: &Matrix4d) -> Result<f64> {
     let row = |i: usize| [m.0[4 * i], m.0[4 * i + 1], m.0[4 * i + 2]];
-    let len = |r: [f64; 3]| (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
-    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    let (a, b, c) = (row(0), row(1), row(2));
-    let s = [len(a), len(b), len(c)];
-    let mean = (s[0] + s[1] + s[2]) / 3.0;
-    let tol = UNIFORM_SCALE_TOLERANCE * mean;
-    let skew = [dot(a, b), dot(b, c), dot(a, c)].map(f64::abs);
-    if !(mean.is_finite() && mean > 0.0)
-        || s.iter().any(|x| (x - mean).abs() > tol)
-        || skew.iter().any(|&d| d > tol * mean)
-    {
-        return Err(invalid_arg!(
-            "the world transform scales the axes by {:?} (or shears them): radii can follow a \
-             uniform scale only",
-            s
-        ));
-    }
-    Ok(mean)
+    validate::uniform_scale("the world transform", [row(0), row(1), row(2)])
 }
 
 fn transform_point(m: &Matrix4d, p: [f32; 3]) -> [f32; 3] {
@@ -198,6 +178,7 @@ pub(super) fn read_basis_curves(
     stage: &Stage,
     path: &sdf::Path,
     file_bytes: u64,
+    units: StageUnits,
 ) -> Result<UsdCurves> {
     let curves = BasisCurves::get(stage, path.clone())
         .map_err(|e| invalid_arg!("{e:#}"))?
@@ -206,10 +187,7 @@ pub(super) fn read_basis_curves(
     let attr = |name: &str| prim.attribute(name);
     let kind = token(&attr("type"), "type", "cubic")?;
     let basis = token(&attr("basis"), "basis", "bezier")?;
-    let layout = Layout {
-        basis: basis_of(&kind, &basis)?,
-        wrap: wrap_of(&token(&attr("wrap"), "wrap", "nonperiodic")?)?,
-    };
+    let layout = Layout::named(&kind, &basis, &token(&attr("wrap"), "wrap", "nonperiodic")?)?;
     let points = vec3s(&attr("points"), "points")?.ok_or_else(|| invalid_arg!("no points"))?;
     let raw_counts = match value(&attr("curveVertexCounts"))? {
         Some(Value::IntVec(v)) => v,
@@ -228,10 +206,10 @@ pub(super) fn read_basis_curves(
         let n = usize::try_from(c)
             .map_err(|_| invalid_arg!("curveVertexCounts[{i}] = {c}: negative"))?;
         let s = layout.segments(n).ok_or_else(|| {
+            let (kind, basis, wrap) = layout.tokens();
             invalid_arg!(
-                "curve {i} has {n} points, which is not a whole number of {:?} {:?} segments",
-                layout.basis,
-                layout.wrap
+                "curveVertexCounts[{i}] = {n}: {kind} {basis} {wrap} curves have {} points",
+                layout.count_rule()
             )
         })?;
         counts.push(n);
@@ -240,7 +218,7 @@ pub(super) fn read_basis_curves(
     let total: u64 = counts.iter().map(|&n| n as u64).sum();
     if total != points.len() as u64 {
         return Err(invalid_arg!(
-            "curveVertexCounts add up to {total} points but {} points are given",
+            "curveVertexCounts add up to {total} points but points has {}",
             points.len()
         ));
     }
@@ -253,7 +231,7 @@ pub(super) fn read_basis_curves(
     let want = expected_len(widths_interp, layout, &counts, &segs)?;
     if widths.len() != want {
         return Err(invalid_arg!(
-            "{} widths for {widths_interp:?} interpolation: {want} expected",
+            "widths has {} values for {widths_interp:?} interpolation: {want} expected",
             widths.len()
         ));
     }
@@ -393,6 +371,7 @@ pub(super) fn read_basis_curves(
     }
     Ok(UsdCurves {
         path: path.as_str().to_string(),
+        units,
         layout,
         authored_counts: counts.iter().map(|&n| n as u32).collect(),
         segments: segs.iter().sum(),

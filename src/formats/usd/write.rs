@@ -19,9 +19,9 @@ use openusd::sdf::{self, Value, Variability};
 use openusd::tf::Token;
 use openusd::usd::{Prim, Stage};
 
-use super::layout::{Layout, Wrap};
-use crate::embree::CurveBasis;
+use super::layout::Layout;
 use crate::error::{Result, invalid_arg};
+use crate::formats::units::StageUnits;
 
 /// The root Xform every written prim sits under (and the stage's default prim).
 pub const ROOT_PRIM: &str = "Groom";
@@ -40,13 +40,6 @@ pub struct CurvesToWrite {
     pub colors: Option<Vec<[f32; 3]>>,
 }
 
-/// The stage's units and orientation, authored as its `upAxis` and `metersPerUnit`.
-#[derive(Debug, Clone, PartialEq)]
-pub struct StageUnits {
-    pub up_axis: String,
-    pub meters_per_unit: f64,
-}
-
 /// Writes `prims` to `path` (format by extension) under `/Groom`, with `units` as stage
 /// metadata. Errors name the path.
 pub fn write_usd_file(path: &Path, prims: &[CurvesToWrite], units: &StageUnits) -> Result<()> {
@@ -61,22 +54,6 @@ pub fn write_usd_file(path: &Path, prims: &[CurvesToWrite], units: &StageUnits) 
         .map_err(|e| at(format!("cannot write the USD file: {e:#}")))
 }
 
-/// The tokens UsdGeom spells `type`, `basis` and `wrap` with.
-fn tokens(layout: Layout) -> (&'static str, &'static str, &'static str) {
-    let (kind, basis) = match layout.basis {
-        CurveBasis::Linear => ("linear", "bezier"),
-        CurveBasis::Bezier => ("cubic", "bezier"),
-        CurveBasis::BSpline => ("cubic", "bspline"),
-        CurveBasis::CatmullRom => ("cubic", "catmullRom"),
-    };
-    let wrap = match layout.wrap {
-        Wrap::Nonperiodic => "nonperiodic",
-        Wrap::Pinned => "pinned",
-        Wrap::Periodic => "periodic",
-    };
-    (kind, basis, wrap)
-}
-
 /// An error of the USD library, its causes included.
 fn failed(e: impl std::fmt::Display) -> crate::Error {
     invalid_arg!("{e:#}")
@@ -89,7 +66,7 @@ fn author(prims: &[CurvesToWrite], units: &StageUnits) -> Result<Stage> {
     stage
         .batch_edit(&[&id], |layers| {
             let mut root = layers[0].pseudo_root_mut()?;
-            root.set("upAxis", Value::Token(Token::from(units.up_axis.as_str())));
+            root.set("upAxis", Value::Token(Token::from(units.up_axis.name())));
             root.set("metersPerUnit", Value::Double(units.meters_per_unit));
             Ok(())
         })
@@ -115,7 +92,7 @@ fn author(prims: &[CurvesToWrite], units: &StageUnits) -> Result<Stage> {
                 None => Ok(a),
             }
         };
-        let (kind, basis, wrap) = tokens(p.layout);
+        let (kind, basis, wrap) = p.layout.tokens();
         for (name, token) in [("type", kind), ("basis", basis), ("wrap", wrap)] {
             attr(name, "token", Value::Token(Token::new(token)), None)?
                 .set_variability(Variability::Uniform)

@@ -2,9 +2,13 @@
 """hairtrace against Blender Cycles on the bench scenes, on this machine, in one run.
 
     bench/peer [--quick] [--scenes fur_ball,scalp] [--repeats 3] [--threads 2] [--time-to-rmse]
+    bench/peer --scenes 'real_*_close_*'       # names or shell patterns, comma-separated
+    bench/peer --exclude 'real_*'              # the procedural scenes alone
 
 (bench/peer sets up the virtual environment, builds hairtrace and the ray-counting shim,
-then runs this file.) For each scene of bench/scenes/:
+then runs this file.) Scenes that read real grooms (`target/real-grooms/STYLE/...`) get
+them made first by bench/real_grooms.py when they are missing. For each scene of
+bench/scenes/:
 
 1. `hairtrace export` writes the scene for Cycles (bench/cycles.py reads it).
 2. A reference: each renderer renders it at `REFERENCE_FACTOR` x the scene's spp with a
@@ -31,6 +35,7 @@ exactly.
 """
 
 import argparse
+import fnmatch
 import json
 import math
 import os
@@ -45,6 +50,9 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 HAIRTRACE = os.path.join(ROOT, "target", "release", "hairtrace")
 CYCLES = os.path.join(ROOT, "bench", "cycles.py")
 SCENES = os.path.join(ROOT, "bench", "scenes")
+# Grooms made by Blender's hair node assets (bench/real_grooms.py), on demand, never committed.
+REAL_GROOMS = os.path.join(ROOT, "target", "real-grooms")
+REAL_GROOMS_MAKER = os.path.join(ROOT, "bench", "real_grooms.py")
 REFERENCE_SEED = 1_000_003
 REFERENCE_FACTOR = 16
 # Blender's default noise threshold for Cycles' adaptive sampling.
@@ -287,9 +295,55 @@ def table(results):
     return "\n".join(lines)
 
 
+def select_scenes(patterns, exclude):
+    """The scene names of bench/scenes/ that the comma-separated names or shell patterns
+    choose (all when none), in their order, less those `exclude`'s patterns match."""
+    names = sorted(f[:-5] for f in os.listdir(SCENES) if f.endswith(".toml"))
+    chosen = []
+    for pattern in (patterns.split(",") if patterns else ["*"]):
+        matched = [n for n in names if fnmatch.fnmatchcase(n, pattern.strip())]
+        if not matched:
+            sys.exit(f"bench: --scenes {pattern!r} matches no scene of bench/scenes/ "
+                     f"({', '.join(names)})")
+        chosen += [n for n in matched if n not in chosen]
+    for pattern in (exclude.split(",") if exclude else []):
+        chosen = [n for n in chosen if not fnmatch.fnmatchcase(n, pattern.strip())]
+    if not chosen:
+        sys.exit("bench: --exclude leaves no scene")
+    return chosen
+
+
+def make_real_grooms(names, log):
+    """Makes the real grooms (bench/real_grooms.py) that the scenes read and that are
+    missing: a scene's groom or mesh file under target/real-grooms/STYLE/ names its style."""
+    missing = set()
+    for name in names:
+        with open(os.path.join(SCENES, name + ".toml"), "rb") as f:
+            scene = tomllib.load(f)
+        for entry in scene.get("groom", []) + scene.get("mesh", []):
+            if "file" not in entry:
+                continue
+            path = os.path.normpath(os.path.join(SCENES, entry["file"]))
+            inside = os.path.relpath(path, REAL_GROOMS)
+            if not inside.startswith(os.pardir) and not os.path.exists(path):
+                missing.add(inside.split(os.sep)[0])
+    if missing:
+        styles = ",".join(sorted(missing))
+        log(f"real grooms {styles}: making them with bench/real_grooms.py (a minute or two each)")
+        t = time.time()
+        out = run([sys.executable, REAL_GROOMS_MAKER, "--out", REAL_GROOMS, "--styles", styles])
+        # Its summary, without Blender's own messages.
+        log("\n".join(line for line in out.splitlines()
+                      if line.split(":")[0] in missing or line.startswith("  /")))
+        log(f"  {time.time() - t:.0f} s wall")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--scenes", help="comma-separated names from bench/scenes/ (default: all)")
+    parser.add_argument("--scenes", help="comma-separated names from bench/scenes/, or shell "
+                                         "patterns of them such as 'real_*' (default: all)")
+    parser.add_argument("--exclude", help="comma-separated shell patterns of scenes to leave "
+                                          "out, such as 'real_*_hd_*'")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--threads", type=int, default=os.cpu_count())
     parser.add_argument("--quick", action="store_true", help="a quarter of each scene's spp")
@@ -302,11 +356,12 @@ def main():
     parser.add_argument("--allocation", choices=["uniform", "noise"],
                         help="also render hairtrace with this allocation")
     args = parser.parse_args()
-    names = (args.scenes.split(",") if args.scenes else
-             sorted(f[:-5] for f in os.listdir(SCENES) if f.endswith(".toml")))
+    names = select_scenes(args.scenes, args.exclude)
 
     def log(message):
         print(message, file=sys.stderr, flush=True)
+
+    make_real_grooms(names, log)
 
     results = []
     for name in names:

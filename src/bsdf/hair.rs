@@ -210,7 +210,7 @@ impl HairBsdf {
             let hv = f32x8::new(std::array::from_fn(|k| h[lane(k)]));
             let wov = [0, 1, 2].map(|c| gather(wo, c));
             let wiv = [0, 1, 2].map(|c| gather(wi, c));
-            let o = self.outgoing(hv, wov);
+            let o = self.outgoing_lanes(hv, wov);
             let (fv, pv) = self.eval_lobes(&o, wiv);
             let fa = fv.map(f32x8::to_array);
             let pa = pv.to_array();
@@ -220,6 +220,16 @@ impl HairBsdf {
             }
         }
         Ok(())
+    }
+
+    /// [`Self::outgoing`] in eight lanes, for [`Self::eval_batch`] and
+    /// [`HairPoint::eval_across`]: one copy, out of line. Inlined into both, the stage's
+    /// array maps and closures have two callers in one codegen unit, and LLVM leaves them
+    /// out of line, each call with its own index checks and copies through memory; in a
+    /// single copy each has one caller and is inlined. Same operations, same bits.
+    #[inline(never)]
+    fn outgoing_lanes(&self, h: f32x8, wo: [f32x8; 3]) -> Outgoing<f32x8> {
+        self.outgoing(h, wo)
     }
 
     /// The (h, wo) stage: tilted outgoing angles, refraction inside the fiber, Fresnel
@@ -403,7 +413,7 @@ impl HairBsdf {
             if x > 1.0 { x - 2.0 } else { x }
         }));
         let wo = [at.o.sin_to, at.o.azimuth.0, at.o.azimuth.1];
-        let o = self.outgoing(offsets, wo.map(f32x8::splat));
+        let o = self.outgoing_lanes(offsets, wo.map(f32x8::splat));
         let wi = wi.to_array();
         let mp = self.mp_packed_at(&at.o, wi).to_array().map(f32x8::splat);
         let (f, pdf) = self.sum_lobes(&o, mp, wi.map(f32x8::splat));

@@ -136,11 +136,21 @@ fn not_unit(v: Vec3, name: &str) -> Failure {
     .into()
 }
 
+/// Checks h in [-1, 1]: the compare inline, as [`check_dir`]'s, in the batch's loop over
+/// its elements too; the message out of line.
+#[inline(always)]
 pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
-    if !(-1.0..=1.0).contains(&h) {
-        return Err(invalid_arg!("h = {h}: must be in [-1, 1]").into());
+    if (-1.0..=1.0).contains(&h) {
+        Ok(h)
+    } else {
+        Err(not_in_range(h))
     }
-    Ok(h)
+}
+
+#[cold]
+#[inline(never)]
+fn not_in_range(h: f32) -> Failure {
+    invalid_arg!("h = {h}: must be in [-1, 1]").into()
 }
 
 /// Checks three uniform numbers in [0, 1): inline compares on the sample calls' hot path,

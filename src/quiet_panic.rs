@@ -11,32 +11,35 @@ use std::cell::Cell;
 use std::sync::Once;
 
 thread_local! {
-    static QUIET: Cell<bool> = const { Cell::new(false) };
+    /// How many quiet calls this thread is inside.
+    static DEPTH: Cell<u32> = const { Cell::new(0) };
 }
 
-/// Keeps this thread's panics quiet while it lives, then restores the thread's previous
-/// state (also when unwinding), so that quiet calls may nest. A guard rather than a
-/// closure, so that the code it covers is compiled as if it were not there.
+/// Keeps this thread's panics quiet while it lives (also when unwinding); quiet calls may
+/// nest. A count rather than a saved flag: entering and leaving are an increment and a
+/// decrement, with nothing kept across the call. A guard rather than a closure, so that
+/// the code it covers is compiled as if it were not there.
 #[must_use]
-pub(crate) struct Quiet(bool);
+pub(crate) struct Quiet(());
 
 impl Quiet {
     pub(crate) fn enter() -> Quiet {
         install();
-        Quiet(QUIET.replace(true))
+        DEPTH.set(DEPTH.get() + 1);
+        Quiet(())
     }
 }
 
 impl Drop for Quiet {
     fn drop(&mut self) {
-        QUIET.set(self.0);
+        DEPTH.set(DEPTH.get() - 1);
     }
 }
 
 /// Whether this thread runs a quiet call: the threads that call starts inherit it with
 /// [`inherit`].
 pub(crate) fn is_quiet() -> bool {
-    QUIET.get()
+    DEPTH.get() > 0
 }
 
 /// Runs `f` quietly when `quiet` (a worker of a quiet call), else as it is.
@@ -55,7 +58,7 @@ fn install() {
     HOOK.call_once(|| {
         let previous = std::panic::take_hook();
         std::panic::set_hook(Box::new(move |info| {
-            if !QUIET.try_with(Cell::get).unwrap_or(false) {
+            if !DEPTH.try_with(|d| d.get() > 0).unwrap_or(false) {
                 previous(info);
             }
         }));

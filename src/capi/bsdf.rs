@@ -81,18 +81,26 @@ pub(super) fn read_params(ptr: *const HtHairParams) -> Result<HairParams, Failur
 }
 
 /// Runs `f` with the BSDF for `params`, prepared once per parameter set and thread.
+///
+/// `try_with`, not `with`: `with` is not `#[inline]`, so its copy for this closure is a
+/// single one that the partitioning into codegen units may place away from the entry point,
+/// which then calls it out of line and reaches the thread-local through a function pointer.
+/// `try_with` is `#[inline]`: a copy in the entry point's own unit, inlined. It fails where
+/// `with` would panic, and so panics the same way.
 fn with_bsdf<R>(params: HairParams, f: impl FnOnce(&HairBsdf) -> R) -> Result<R, Failure> {
-    PREPARED.with(|cell| {
-        let mut slot = cell.borrow_mut();
-        // Compare bit patterns so that a NaN parameter is never taken as "unchanged".
-        let same = slot
-            .as_ref()
-            .is_some_and(|b| bits(b.params()) == bits(&params));
-        if !same {
-            *slot = Some(HairBsdf::new(&params)?);
-        }
-        Ok(f(slot.as_ref().expect("prepared above")))
-    })
+    PREPARED
+        .try_with(|cell| {
+            let mut slot = cell.borrow_mut();
+            // Compare bit patterns so that a NaN parameter is never taken as "unchanged".
+            let same = slot
+                .as_ref()
+                .is_some_and(|b| bits(b.params()) == bits(&params));
+            if !same {
+                *slot = Some(HairBsdf::new(&params)?);
+            }
+            Ok(f(slot.as_ref().expect("prepared above")))
+        })
+        .expect("cannot access a Thread Local Storage value during or after destruction")
 }
 
 fn bits(p: &HairParams) -> [u32; 7] {

@@ -1230,7 +1230,9 @@ enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
 /**
  * Adds the strands of a Cem Yuksel `.hair` file (read during the call) as polylines for
  * `basis`, shaded by the hair material `material_id`; writes the geometry id. The file's
- * thickness is a diameter unless `thickness_is_radius`.
+ * thickness is a diameter unless `thickness_is_radius`. A file that `hairtrace convert`
+ * wrote says its up axis and unit in its header, and is turned and scaled into +y up
+ * metres as a scene file reads it (docs/formats.md).
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `path` or `geom_id` NULL); `HT_ERR_IO` (the file
  * is missing or unreadable); `HT_ERR_INVALID_ARG` (an empty or non-UTF-8 path, a

@@ -19,20 +19,8 @@ use rayon::prelude::*;
 use super::order::{centroid, median_split};
 use super::{Device, sys};
 use crate::error::invalid_arg;
+pub use crate::math::CurveBasis;
 use crate::{Error, Result, threads};
-
-/// How the control points of a curve segment are interpolated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum CurveBasis {
-    /// Straight segments between consecutive points (cones in round mode).
-    Linear,
-    /// Cubic Bezier: segments of 4 points, consecutive segments share their end point.
-    Bezier,
-    /// Uniform cubic B-spline: each segment reads 4 consecutive points, overlapping by 3.
-    BSpline,
-    /// Catmull-Rom: each segment reads 4 consecutive points and runs from the 2nd to the 3rd.
-    CatmullRom,
-}
 
 /// The surface Embree builds around a curve.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -41,43 +29,6 @@ pub enum CurveShape {
     Round,
     /// A ribbon that always faces the ray: faster, approximate when seen up close.
     Flat,
-}
-
-impl CurveBasis {
-    pub const ALL: [CurveBasis; 4] = [
-        CurveBasis::Linear,
-        CurveBasis::Bezier,
-        CurveBasis::BSpline,
-        CurveBasis::CatmullRom,
-    ];
-
-    /// Control points one segment reads, starting at its index.
-    pub(crate) fn points_per_segment(self) -> usize {
-        match self {
-            CurveBasis::Linear => 2,
-            _ => 4,
-        }
-    }
-
-    /// Index distance between consecutive segments of one strand.
-    pub(crate) fn segment_stride(self) -> usize {
-        match self {
-            CurveBasis::Bezier => 3,
-            _ => 1,
-        }
-    }
-
-    /// Number of segments a strand of `points` control points has, or `None` when that
-    /// count is not a valid strand in this basis.
-    pub fn segments_for(self, points: usize) -> Option<usize> {
-        let order = self.points_per_segment();
-        if points < order {
-            return None;
-        }
-        let spare = points - order;
-        let stride = self.segment_stride();
-        (spare % stride == 0).then_some(spare / stride + 1)
-    }
 }
 
 impl CurveShape {
@@ -438,29 +389,16 @@ impl Parts {
 /// segments), within its largest Bezier radius of that hull, round or flat; a margin of
 /// 1e-5 of the coordinates covers Embree's rounding.
 fn hull_bounds(basis: CurveBasis, points: &[[f32; 4]], firsts: &[u32]) -> Bounds {
+    let span = basis.points_per_segment();
     let (mut lo, mut hi) = (Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY));
     let mut radius = 0.0f32;
     for (k, &first) in firsts.iter().enumerate() {
         if let Some(&ahead) = firsts.get(k + PREFETCH_AHEAD) {
             prefetch(&points[ahead as usize..]);
         }
-        let p = |i: usize| Vec4::from_array(points[first as usize + i]);
-        let hull = match basis {
-            CurveBasis::Linear => [p(0), p(1), p(1), p(1)],
-            CurveBasis::Bezier => [p(0), p(1), p(2), p(3)],
-            CurveBasis::BSpline => [
-                (p(0) + 4.0 * p(1) + p(2)) / 6.0,
-                (2.0 * p(1) + p(2)) / 3.0,
-                (p(1) + 2.0 * p(2)) / 3.0,
-                (p(1) + 4.0 * p(2) + p(3)) / 6.0,
-            ],
-            CurveBasis::CatmullRom => [
-                p(1),
-                p(1) + (p(2) - p(0)) / 6.0,
-                p(2) - (p(3) - p(1)) / 6.0,
-                p(2),
-            ],
-        };
+        // A linear segment reads two points: the others stand in for what it does not read.
+        let p = |i: usize| Vec4::from_array(points[first as usize + i.min(span - 1)]);
+        let hull = basis.bezier_form::<Vec4, f32>([p(0), p(1), p(2), p(3)]);
         for h in hull {
             lo = lo.min(h);
             hi = hi.max(h);
@@ -887,16 +825,6 @@ pub(crate) mod tests {
         .unwrap()
         .in_parts(&PartsCache::default())
         .unwrap()
-    }
-
-    #[test]
-    fn segments_per_basis() {
-        assert_eq!(CurveBasis::Linear.segments_for(5), Some(4));
-        assert_eq!(CurveBasis::Linear.segments_for(1), None);
-        assert_eq!(CurveBasis::BSpline.segments_for(6), Some(3));
-        assert_eq!(CurveBasis::CatmullRom.segments_for(3), None);
-        assert_eq!(CurveBasis::Bezier.segments_for(7), Some(2));
-        assert_eq!(CurveBasis::Bezier.segments_for(6), None);
     }
 
     #[test]

@@ -388,27 +388,6 @@ fn usd_groom(c: &UsdCurves, opts: &ConvertOptions, notes: &mut Vec<String>) -> R
     Ok(named(s, StrandCurves::Polylines(CurveBasis::Linear)))
 }
 
-/// The weights of a cubic segment's four control points at parameter t.
-fn cubic_weights(basis: CurveBasis, t: f64) -> [f64; 4] {
-    let (t2, t3, u) = (t * t, t * t * t, 1.0 - t);
-    match basis {
-        CurveBasis::Bezier => [u * u * u, 3.0 * t * u * u, 3.0 * t2 * u, t3],
-        CurveBasis::BSpline => [
-            u * u * u / 6.0,
-            (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
-            (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
-            t3 / 6.0,
-        ],
-        CurveBasis::CatmullRom => [
-            0.5 * (-t3 + 2.0 * t2 - t),
-            0.5 * (3.0 * t3 - 5.0 * t2 + 2.0),
-            0.5 * (-3.0 * t3 + 4.0 * t2 + t),
-            0.5 * (t3 - t2),
-        ],
-        CurveBasis::Linear => [u, t, 0.0, 0.0],
-    }
-}
-
 /// Appends one cubic curve of Embree control points `ctl` to `out` as a polyline through
 /// the curve at `steps` steps per segment; colours (given at segment ends) are blended
 /// linearly, as the renderer blends them. A radius the basis takes to <= 0 (a
@@ -428,7 +407,7 @@ fn sample_curve(
         let last = seg + 1 == segments;
         for k in 0..steps + usize::from(last) {
             let t = k as f64 / steps as f64;
-            let w = cubic_weights(basis, t);
+            let w = basis.weights(t);
             let v: [f32; 4] = std::array::from_fn(|c| {
                 (0..4).map(|j| w[j] * f64::from(cp[j][c])).sum::<f64>() as f32
             });

@@ -2,11 +2,13 @@
 //! implementation run on scalars and on SIMD vectors, and the special functions.
 
 pub mod bessel;
+pub mod curve_basis;
 pub(crate) mod fast;
 pub(crate) mod frame;
 pub(crate) mod lanes;
 pub(crate) mod sampling;
 
+pub use curve_basis::CurveBasis;
 pub use frame::Frame;
 pub use lanes::Lanes;
 

@@ -282,16 +282,12 @@ impl Curves {
                 CurveBasis::Bezier => {
                     out[0] = ext(1);
                     for (i, o) in (1..n).zip(out[1..].chunks_exact_mut(3)) {
-                        let (pm, p0, p1, p2) = (ext(i - 1), ext(i), ext(i + 1), ext(i + 2));
-                        let mut b1: [f32; 4] =
-                            std::array::from_fn(|c| p0[c] + (p1[c] - pm[c]) / 6.0);
-                        let mut b2: [f32; 4] =
-                            std::array::from_fn(|c| p1[c] - (p2[c] - p0[c]) / 6.0);
+                        let cr = [ext(i - 1), ext(i), ext(i + 1), ext(i + 2)].map(Vec4::from);
+                        let [_, b1, b2, end] = CurveBasis::CatmullRom.bezier_form::<Vec4, f32>(cr);
                         // Bernstein weights are positive: radii >= 0 at the control points
                         // keep the interpolated radius >= 0, as Embree requires.
-                        b1[3] = b1[3].max(0.0);
-                        b2[3] = b2[3].max(0.0);
-                        o.copy_from_slice(&[b1, b2, p1]);
+                        let [b1, b2] = [b1, b2].map(|b| b.with_w(b.w.max(0.0)).to_array());
+                        o.copy_from_slice(&[b1, b2, end.to_array()]);
                     }
                 }
             }
@@ -663,18 +659,19 @@ impl TrueCurves {
 }
 
 /// One curve segment as the cubic c0 + c1 u + c2 u^2 + c3 u^3 in (x, y, z, radius), for
-/// every basis from one table of coefficients ([`power_basis`]): what the level of detail
-/// samples and its hits take their tangents from. (Embree evaluates the same curves.)
+/// every basis from one table of coefficients ([`CurveBasis::power_matrix`]): what the
+/// level of detail samples and its hits take their tangents from. (Embree evaluates the
+/// same curves.)
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct SegmentCurve([Vec4; 4]);
 
 impl SegmentCurve {
     /// The segment of `basis` read from `points` (as many as one segment reads).
     pub(crate) fn new(basis: CurveBasis, points: &[[f32; 4]]) -> Self {
-        let m = power_basis(basis);
+        let m = basis.power_matrix();
         SegmentCurve(std::array::from_fn(|k| {
             (points.iter().zip(m[k]))
-                .map(|(p, w)| w * Vec4::from_array(*p))
+                .map(|(p, w)| w as f32 * Vec4::from_array(*p))
                 .sum()
         }))
     }
@@ -689,37 +686,6 @@ impl SegmentCurve {
     pub(crate) fn derivative(&self, u: f32) -> Vec4 {
         let [_, c1, c2, c3] = self.0;
         c1 + u * (2.0 * c2 + 3.0 * u * c3)
-    }
-}
-
-/// Row k holds the weights of the control points in the coefficient of u^k of a segment.
-fn power_basis(basis: CurveBasis) -> [[f32; 4]; 4] {
-    const SIXTH: f32 = 1.0 / 6.0;
-    match basis {
-        CurveBasis::Linear => [
-            [1.0, 0.0, 0.0, 0.0],
-            [-1.0, 1.0, 0.0, 0.0],
-            [0.0; 4],
-            [0.0; 4],
-        ],
-        CurveBasis::Bezier => [
-            [1.0, 0.0, 0.0, 0.0],
-            [-3.0, 3.0, 0.0, 0.0],
-            [3.0, -6.0, 3.0, 0.0],
-            [-1.0, 3.0, -3.0, 1.0],
-        ],
-        CurveBasis::BSpline => [
-            [SIXTH, 4.0 * SIXTH, SIXTH, 0.0],
-            [-0.5, 0.0, 0.5, 0.0],
-            [0.5, -1.0, 0.5, 0.0],
-            [-SIXTH, 0.5, -0.5, SIXTH],
-        ],
-        CurveBasis::CatmullRom => [
-            [0.0, 1.0, 0.0, 0.0],
-            [-0.5, 0.0, 0.5, 0.0],
-            [1.0, -2.5, 2.0, -0.5],
-            [-0.5, 1.5, -1.5, 0.5],
-        ],
     }
 }
 

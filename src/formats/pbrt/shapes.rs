@@ -171,13 +171,12 @@ fn layout(
 /// A cubic uniform B-spline as the same curve in cubic Bezier segments.
 fn bspline_to_bezier(points: &[[f64; 3]]) -> Vec<[f64; 3]> {
     let p: Vec<DVec3> = points.iter().map(|q| DVec3::from_array(*q)).collect();
-    let mut out = vec![(p[0] + 4.0 * p[1] + p[2]) / 6.0];
+    let mut out = Vec::with_capacity(3 * p.len());
     for w in p.windows(4) {
-        out.extend([
-            (2.0 * w[1] + w[2]) / 3.0,
-            (w[1] + 2.0 * w[2]) / 3.0,
-            (w[1] + 4.0 * w[2] + w[3]) / 6.0,
-        ]);
+        let bezier = CurveBasis::BSpline.bezier_form::<DVec3, f64>([w[0], w[1], w[2], w[3]]);
+        // Consecutive segments share their end point.
+        let first = if out.is_empty() { 0 } else { 1 };
+        out.extend_from_slice(&bezier[first..]);
     }
     out.iter().map(DVec3::to_array).collect()
 }

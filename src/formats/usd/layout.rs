@@ -20,6 +20,8 @@
 //! widths change linearly), colours are taken as they are, since the renderer interpolates
 //! colours between segment ends.
 
+use glam::Vec3;
+
 use crate::embree::CurveBasis;
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
@@ -307,14 +309,15 @@ impl Layout {
     /// values are `c`: the basis evaluated at the segment's start, and at the last one's end.
     pub fn segment_ends(self, c: &[[f32; 3]], segments: usize, out: &mut Vec<[f32; 3]>) {
         let stride = self.basis.segment_stride();
+        // The segment's start is its Bezier form's first point; the last segment end is the
+        // start of one more segment, whose points past the curve are never weighed.
         let at = |first: usize| -> [f32; 3] {
-            match self.basis {
-                CurveBasis::Linear | CurveBasis::Bezier => c[first],
-                CurveBasis::CatmullRom => c[first + 1],
-                CurveBasis::BSpline => std::array::from_fn(|k| {
-                    ((c[first][k] + 4.0 * c[first + 1][k] + c[first + 2][k]) / 6.0).clamp(0.0, 1.0)
-                }),
-            }
+            let p = |i: usize| Vec3::from(c[(first + i).min(c.len() - 1)]);
+            let [start, ..] = self
+                .basis
+                .bezier_form::<Vec3, f32>([p(0), p(1), p(2), p(3)]);
+            // A B-spline's weighted sum of colours >= 0 may round below 0.
+            start.max(Vec3::ZERO).to_array()
         };
         out.extend((0..=segments).map(|s| at(s * stride)));
     }

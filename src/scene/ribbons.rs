@@ -2,7 +2,9 @@
 //! flat ribbons facing the ray, the others as round tubes.
 //!
 //! A ribbon facing the ray covers, seen from the ray's origin, what the tube covers, so it
-//! blocks the same light and is hit across the same h. It differs in the depth of the hit
+//! blocks the same light, and is hit evenly across its width as the tube is (a cubic
+//! ribbon's h is the offset across the flat quad struck: `tracer::hair_hit`). It differs in
+//! the depth of the hit
 //! (by up to a radius) and at end caps and joints, differences that a strand thinner than a
 //! pixel hides inside the pixel. A flat linear curve costs Embree 1.5-1.8x less per ray than
 //! a round one. On the bench scenes the ribbons' images differ from the tubes' by under a

@@ -392,10 +392,21 @@ fn hair_hit(
             strands.absorption(&at, u),
         ),
     };
-    // One formula for every shape: on flat cubic curves it beats Embree's v (the offset
-    // across the tessellated ribbon) by two orders of magnitude on bent fibers
-    // (src/scene/tests/curves_geometry.rs prints both).
     let (frame, h) = hair_frame(tangent, ray.dir, ray.org, axis, c.radius);
+    // Embree tessellates a cubic ribbon into a few flat quads per segment, which stray from
+    // the true curve by up to about a radius where a thin fibre bends: the offset from the
+    // true curve then piles hits up at |h| = 1, where Fresnel reflects everything, and the
+    // hair shades too bright. The offset across the quad struck (-v) is spread over what
+    // the ribbon covers as h is over a tube's width; the axis moves with it, to the quad's
+    // centreline, so that a ray's way through the fibre agrees (docs/measurements.md,
+    // "Curve shapes"). The frame still follows the true curve.
+    let (h, axis) = match flat_cubic {
+        true => {
+            let h = (-hit.v).clamp(-1.0, 1.0);
+            (h, p - frame.y * (h * c.radius))
+        }
+        false => (h, axis),
+    };
     let ng = match geom.shape() {
         CurveShape::Round => hit.ng.try_normalize().unwrap_or(frame.z),
         // Embree reports the tangent as Ng of flat curves; the ribbon faces the ray.

@@ -224,6 +224,9 @@ fn measure(points: &[[f32; 3]], basis: CurveBasis, shape: CurveShape, straight: 
                             (org - axis).dot(y) / f64::from(RADIUS)
                         };
                         st.max_h_err = st.max_h_err.max((f64::from(hit.h) - h_true).abs());
+                        if shape == CurveShape::Flat && basis != CurveBasis::Linear {
+                            assert_eq!(hit.h, (-hit.v).clamp(-1.0, 1.0));
+                        }
                         // Embree's v, the alternative for flat curves, with either sign.
                         let v = f64::from(hit.v);
                         st.max_h_err_minus_v = st.max_h_err_minus_v.max((-v - h_true).abs());
@@ -301,15 +304,71 @@ fn h_tangent_and_frame_for_every_basis_and_shape() {
                 if st.max_tangent_err > 1e-4 {
                     failures.push(format!("{tag}: tangent error {:.2e}", st.max_tangent_err));
                 }
-                // The formula of docs/conventions.md on every shape (flat cubic hits are
-                // first projected onto the axis).
-                if st.max_h_err > 1e-3 {
+                // The formula of docs/conventions.md on tubes and linear ribbons; a cubic
+                // ribbon's h is the offset across the quad it struck (-v, bounded above).
+                let flat_cubic = shape == CurveShape::Flat && basis != CurveBasis::Linear;
+                if st.max_h_err > 1e-3 && !flat_cubic {
                     failures.push(format!("{tag}: h error {:.2e}", st.max_h_err));
                 }
             }
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// A fibre thin against its bend, as on real grooms (a Catmull-Rom curl whose ribbon's quads
+/// stray a few radii from the true curve): rays spread evenly across the ribbon find h
+/// spread evenly over [-1, 1] on every shape, as across a tube's width, not piled up at
+/// the edges where Fresnel reflects everything (as h taken from the true curve did).
+#[test]
+fn a_thin_bent_fibre_is_hit_across_its_whole_width_evenly() {
+    let radius = 4e-5f32;
+    let curl: Vec<[f32; 3]> = (0..24)
+        .map(|k| {
+            let t = 0.9 * k as f32;
+            [0.02 * t.cos(), 0.02 * t.sin(), 0.004 * t]
+        })
+        .collect();
+    for shape in CurveShape::ALL {
+        let s = Strands {
+            radii: vec![radius; curl.len()],
+            ..strands(&curl)
+        };
+        let curves = Curves::from_strands(&s, CurveBasis::CatmullRom, shape).unwrap();
+        let mut b = TracerBuilder::new(device(), SceneOptions::default()).unwrap();
+        b.add_curves(curves).unwrap();
+        let tracer = b.build().unwrap();
+        // Parallel rays down -y through a fine grid over the curl's footprint.
+        let (mut hs, n) = (Vec::new(), 600);
+        for i in 0..n {
+            for j in 0..n {
+                let x = -0.022 + 0.044 * (i as f32 + 0.5) / n as f32;
+                let z = -0.002 + 0.092 * (j as f32 + 0.5) / n as f32;
+                let ray = Ray::new(Vec3::new(x, 1.0, z), Vec3::NEG_Y);
+                if let Some(hit) = hair(tracer.intersect(&ray)) {
+                    hs.push(hit.h);
+                }
+            }
+        }
+        let edge = hs.iter().filter(|h| h.abs() > 0.95).count() as f32 / hs.len() as f32;
+        let mean_abs = hs.iter().map(|h| h.abs()).sum::<f32>() / hs.len() as f32;
+        println!(
+            "{shape:?}: {} hits, {:.1}% at |h| > 0.95, mean |h| {mean_abs:.3}",
+            hs.len(),
+            100.0 * edge
+        );
+        assert!(hs.len() > 1000, "{shape:?}: {} hits", hs.len());
+        // Even over [-1, 1]: 5% beyond 0.95, a mean |h| of 0.5.
+        assert!(
+            edge < 0.08,
+            "{shape:?}: {:.1}% of hits at |h| > 0.95",
+            100.0 * edge
+        );
+        assert!(
+            (mean_abs - 0.5).abs() < 0.04,
+            "{shape:?}: mean |h| {mean_abs}"
+        );
+    }
 }
 
 /// Bound of |-v - h_true| on flat cubic curves: measured 2.0e-2 on the helix (the ribbon is
@@ -496,9 +555,13 @@ fn r_lobe_peak_is_the_true_mirror_direction() {
                 report.push(format!(
                     "{name:<9} {basis:<11?} {shape:<6?} R peak - mirror: {max_err:.2e} rad"
                 ));
-                // Measured 2.3e-4 rad (the BSDF's f32 approximations; h errs by < 1e-5);
-                // a flipped frame would miss by 4 asin|h|, 0.4 rad or more here.
-                if max_err > 1e-3 {
+                // Measured 2.3e-4 rad on tubes and linear ribbons (the BSDF's f32
+                // approximations; h errs by < 1e-5); a cubic ribbon's h is its quad's, within
+                // FLAT_V_BOUND of the tube's. A flipped frame would miss by 4 asin|h|, 0.4 rad
+                // or more.
+                let flat_cubic = shape == CurveShape::Flat && basis != CurveBasis::Linear;
+                let bound = if flat_cubic { 0.15 } else { 1e-3 };
+                if max_err > bound {
                     failures.push(format!("{name} {basis:?} {shape:?}: {max_err:.3e} rad"));
                 }
             }

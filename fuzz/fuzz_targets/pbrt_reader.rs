@@ -17,12 +17,21 @@ libfuzzer_sys::fuzz_target!(|data: &[u8]| {
     match PbrtScene::from_text(text, dir, "fuzz.pbrt") {
         Ok(scene) => {
             for g in &scene.description.grooms {
-                let GroomSource::ControlPoints { points, counts } = &g.source else {
+                let GroomSource::ControlPoints {
+                    points,
+                    counts,
+                    basis,
+                } = &g.source
+                else {
                     panic!("pbrt grooms hold control points");
                 };
                 let total: usize = counts.iter().map(|&c| c as usize).sum();
                 assert_eq!(total, points.len());
-                assert!(counts.iter().all(|&c| g.basis.segments_for(c as usize).is_some()));
+                assert!(
+                    counts
+                        .iter()
+                        .all(|&c| basis.segments_for(c as usize).is_some())
+                );
                 assert!(points.iter().all(|p| p[3] >= 0.0));
             }
             assert!(scene.warnings.iter().all(|w| w.starts_with("fuzz.pbrt:")));

@@ -6,8 +6,8 @@
 use std::sync::Once;
 
 use hairtrace::Error;
-use hairtrace::formats::usd::read_usd_file;
 use hairtrace::embree::CurveShape;
+use hairtrace::formats::usd::read_usd_file;
 
 static HOOK: Once = Once::new();
 

@@ -30,7 +30,7 @@ use crate::scene::shapes;
 use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
 use crate::validate::{self, positive};
 
-use crate::formats::hair::{read_hair_file, read_hair_tag};
+use crate::formats::hair::{HairTag, read_hair_file, read_hair_tag};
 use crate::formats::mesh::read_mesh_file;
 use crate::formats::units::StageUnits;
 use crate::formats::usd::{Layout, Wrap, is_usd_path, read_usd_file};
@@ -286,12 +286,23 @@ impl GroomDesc {
     /// A `.hair` file that says nothing, with no basis given, is refused: its points could
     /// be any curve's.
     pub fn strand_curves(&self) -> Result<StrandCurves> {
+        let tag = match &self.source {
+            GroomSource::File { path, .. } if self.basis.is_none() && !is_usd_path(path) => {
+                read_hair_tag(path)?
+            }
+            _ => None,
+        };
+        self.curves_with_tag(tag)
+    }
+
+    /// [`GroomDesc::strand_curves`], with the tag of a `.hair` source read already.
+    fn curves_with_tag(&self, tag: Option<HairTag>) -> Result<StrandCurves> {
         if let Some(basis) = self.basis {
             return Ok(StrandCurves::Polylines(basis));
         }
         match &self.source {
             GroomSource::File { path, .. } if !is_usd_path(path) => {
-                let tag = read_hair_tag(path)?.ok_or_else(|| {
+                let tag = tag.ok_or_else(|| {
                     invalid_arg!(
                         "{}: a .hair file does not say which curve its points draw: give its \
                          basis (linear, bezier, bspline or catmull_rom)",
@@ -390,12 +401,12 @@ impl GroomDesc {
     /// groom, one per BasisCurves prim of a USD stage (its points under its own transform,
     /// in the stage's units).
     pub fn authored_strands(&self) -> Result<Vec<GroomStrands>> {
-        let one = |strands, units| -> Result<Vec<GroomStrands>> {
+        let one = |strands, tag: Option<HairTag>| -> Result<Vec<GroomStrands>> {
             Ok(vec![GroomStrands {
                 prim: None,
                 strands,
-                curves: self.strand_curves()?,
-                units,
+                curves: self.curves_with_tag(tag)?,
+                units: tag.map_or(StageUnits::WORLD, |t| t.units),
             }])
         };
         match &self.source {
@@ -411,11 +422,11 @@ impl GroomDesc {
                     .collect())
             }
             GroomSource::File { path, thickness } => {
-                let units = read_hair_tag(path)?.map_or(StageUnits::WORLD, |t| t.units);
-                one(read_hair_file(path, *thickness)?, units)
+                let tag = read_hair_tag(path)?;
+                one(read_hair_file(path, *thickness)?, tag)
             }
-            GroomSource::FurBall(f) => one(f.build()?, StageUnits::WORLD),
-            GroomSource::Scalp(s) => one(s.build()?, StageUnits::WORLD),
+            GroomSource::FurBall(f) => one(f.build()?, None),
+            GroomSource::Scalp(s) => one(s.build()?, None),
             GroomSource::ControlPoints { .. } => Err(invalid_arg!(
                 "a groom of control points (from a pbrt file) has no polyline strands"
             )),

@@ -63,9 +63,10 @@ pub fn demo(name: &str) -> Result<SceneDescription> {
     })
 }
 
-/// A quick look at a groom file: the default brown hair ([`HairMaterial::default`]),
-/// B-spline round curves, the default lights and an automatic camera. Fails early, before
-/// any scene is built, when the file cannot be read.
+/// A quick look at a groom file: the default brown hair ([`HairMaterial::default`]), the
+/// file's own curves (a `.hair` file that does not say its basis needs one set on the
+/// groom before the build), the default lights and an automatic camera. Fails early,
+/// before any scene is built, when the file cannot be read.
 pub fn quick_look(hair_file: &Path) -> Result<SceneDescription> {
     std::fs::metadata(hair_file).map_err(|e| Error::io(hair_file, e))?;
     let file = GroomSource::File {

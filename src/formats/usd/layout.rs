@@ -126,7 +126,7 @@ impl Layout {
         let mut control = Vec::new();
         let mut counts = Vec::with_capacity(strands.counts.len());
         let mut colors = strands.colors.as_ref().map(|_| Vec::new());
-        let mut curve = Vec::new();
+        let (mut curve, mut ext) = (Vec::new(), Vec::new());
         for (i, (start, &n)) in strands.offsets().zip(&strands.counts).enumerate() {
             let n = n as usize;
             let segments = self.segments(n).ok_or_else(|| {
@@ -153,7 +153,7 @@ impl Layout {
             control.extend_from_slice(&curve);
             counts.push(curve.len() as u32);
             if let (Some(c), Some(out)) = (&strands.colors, &mut colors) {
-                let mut ext = Vec::new();
+                ext.clear();
                 self.extend(&c[points], &mut ext, |c, _| c.map(|x| x.max(0.0)));
                 self.segment_ends(&ext, segments, out);
             }

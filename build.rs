@@ -195,6 +195,8 @@ fn link_embree(embree: &Embree) {
     println!("cargo:rustc-check-cfg=cfg(embree3)");
     println!("cargo:rustc-check-cfg=cfg(embree4)");
     println!("cargo:rustc-cfg=embree{}", embree.major);
+    // For the packages that call Embree themselves (benches/groom.rs's direct baseline).
+    println!("cargo::metadata=major={}", embree.major);
     println!("cargo:rustc-env=HT_EMBREE_VERSION={}", embree.version);
     // What a C program linking the static archive needs for Embree (tests/c_abi links
     // the examples with it): the library this build found, not a guess.
@@ -212,7 +214,7 @@ fn link_embree(embree: &Embree) {
         // A folder the loader does not search (scripts/embree4's): recorded as an rpath so
         // that the binaries, tests and shared library run without LD_LIBRARY_PATH.
         println!("cargo:rustc-link-arg=-Wl,-rpath,{}", dir.display());
-        // The same for the packages that link this library (the command line).
+        // The same for the packages that link this library (the command line, the benches).
         println!("cargo::metadata=rpath={}", dir.display());
     }
     println!("cargo:rustc-link-lib=dylib=embree{}", embree.major);

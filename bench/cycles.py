@@ -16,7 +16,8 @@ BSDF-sampled rays find it; --sample-uniform-env changes that).
 - OUT.exr is linear RGB, row 0 at the top, like hairtrace's EXR.
 - STATS.json: sync_seconds and render_seconds, Cycles' own split (its render time leaves
   out scene sync, BVH build and kernel loading), read from the cycles.<layer>.*_time
-  stamps Blender writes into the EXR header (0.01 s resolution); samples (camera
+  stamps Blender writes into the EXR header (0.01 s resolution); wait_seconds, the whole
+  wait from reading the scene into Blender to the written image; samples (camera
   samples); closest_rays / shadow_rays from the bench/count_rays.c shim when
   HT_RAY_COUNT_FILE is set, else null.
 
@@ -459,17 +460,21 @@ def render(args):
     """One render in this process; returns the timing part of the stats."""
     import bpy
 
-    scene = build_scene(args.scene, args)
     start = time.perf_counter()
+    scene = build_scene(args.scene, args)
+    loaded = time.perf_counter()
     bpy.ops.render.render(write_still=True)
-    wall = time.perf_counter() - start
+    wall = time.perf_counter() - loaded
     stamps = exr_string_attributes(args.output)
     found = {}
     for key, value in stamps.items():
         m = re.fullmatch(r"cycles\.(.+)\.(render_time|synchronization_time|total_time)", key)
         if m:
             found[m.group(2)] = seconds(value)
-    stats = {"wall_seconds": wall, "blender": bpy.app.version_string,
+    # The whole wait: the scene read into Blender (grooms, meshes, lights), synced, built,
+    # rendered and written; Python's and bpy's own start-up are left out.
+    stats = {"wall_seconds": wall, "wait_seconds": loaded - start + wall,
+             "blender": bpy.app.version_string,
              "uniform_env_light_sampled": args.sample_uniform_env}
     if "render_time" in found and "synchronization_time" in found:
         # Cycles' Progress: render time excludes scene update, BVH build and kernel

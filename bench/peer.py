@@ -17,9 +17,11 @@ bench/scenes/:
    neither renderer is measured against its own bias; the distance between the two
    (converged difference) is reported against the noise the two references carry.
 3. Timed renders at the scene's spp, hairtrace and Cycles interleaved, `--repeats` times
-   with different seeds: path-tracing seconds (scene build or sync excluded), camera
-   samples per second, rays per camera sample, RMSE against the reference, efficiency
-   1 / (RMSE^2 x seconds). Medians are reported. Cycles renders twice, with its adaptive
+   with different seeds: path-tracing seconds (scene build or sync excluded), the whole
+   wait (hairtrace: its process, start to written image; Cycles: the scene read into
+   Blender, synced, built, rendered and written), camera samples per second, rays per
+   camera sample, RMSE against the reference, efficiency 1 / (RMSE^2 x seconds) on each
+   of the two times. Medians are reported. Cycles renders twice, with its adaptive
    sampling off and on at Blender's default threshold (`CYCLES_ADAPTIVE`, the spp then
    its most samples); hairtrace is compared with the better of the two on each scene, and
    the table says which. hairtrace renders with the scene's own settings (its
@@ -94,12 +96,14 @@ class Scene:
         extra = ["--allocation", allocation] if allocation else []
         if noise_target:
             extra += ["--noise-target", repr(noise_target)]
+        start = time.perf_counter()
         run([HAIRTRACE, "render", self.path, "--spp", str(spp), "--seed", str(seed),
              "--threads", str(self.threads), "--max-depth", str(self.max_depth),
              "--filter", "box", "-o", out, "--stats", stats] + extra)
+        wait = time.perf_counter() - start
         with open(stats) as f:
             s = json.load(f)
-        return {"seconds": s["seconds"], "samples": s["samples"], "rays": s["rays"],
+        return {"seconds": s["seconds"], "wait": wait, "samples": s["samples"], "rays": s["rays"],
                 "spp": s["spp"], "noise": s["noise"]}
 
     def cycles(self, spp, seed, out, adaptive=0.0):
@@ -117,7 +121,8 @@ class Scene:
         rays = None
         if s.get("closest_rays") is not None:
             rays = s["closest_rays"] + (s.get("shadow_rays") or 0)
-        return {"seconds": s["render_seconds"], "samples": s["samples"], "rays": rays}
+        return {"seconds": s["render_seconds"], "wait": s["wait_seconds"],
+                "samples": s["samples"], "rays": rays}
 
 
 class Reference:
@@ -155,10 +160,12 @@ def measure(scene, ref, repeats, allocation, log):
             r = render(scene.spp, seed, out)
             r["rmse"], r["mean"] = ref.rmse(out)
             runs[name].append(r)
-            log(f"  {name} seed {seed}: {r['seconds']:.3f} s, RMSE {r['rmse']:.5f}")
+            log(f"  {name} seed {seed}: {r['seconds']:.3f} s ({r['wait']:.3f} s whole wait), "
+                f"RMSE {r['rmse']:.5f}")
     rows = {}
     for name, rs in runs.items():
         seconds = statistics.median(r["seconds"] for r in rs)
+        wait = statistics.median(r["wait"] for r in rs)
         rmse = statistics.median(r["rmse"] for r in rs)
         rays = [r["rays"] / r["samples"] for r in rs if r["rays"] is not None]
         rows[name] = {
@@ -167,6 +174,8 @@ def measure(scene, ref, repeats, allocation, log):
             "rays_per_sample": statistics.median(rays) if rays else None,
             "rmse": rmse,
             "efficiency": 1.0 / (rmse * rmse * seconds),
+            "wait_seconds": wait,
+            "wait_efficiency": 1.0 / (rmse * rmse * wait),
             "runs": rs,
         }
     # Each reference carries the noise of a timed render divided by REFERENCE_FACTOR in
@@ -174,6 +183,7 @@ def measure(scene, ref, repeats, allocation, log):
     expected = math.sqrt(sum(rows[n]["rmse"] ** 2 for n in ("hairtrace", "Cycles"))
                          / REFERENCE_FACTOR)
     best = max(("Cycles", "Cycles adaptive"), key=lambda n: rows[n]["efficiency"])
+    best_wait = max(("Cycles", "Cycles adaptive"), key=lambda n: rows[n]["wait_efficiency"])
     converged = {
         "rmse_between_references": math.sqrt(ref.mse_ab),
         "expected_from_noise": expected,
@@ -183,7 +193,7 @@ def measure(scene, ref, repeats, allocation, log):
     return {"scene": scene.name, "spp": scene.spp, "reference_spp": ref.spp,
             "size": [scene.width, scene.height], "max_depth": scene.max_depth,
             "threads": scene.threads, "renderers": rows, "converged": converged,
-            "best_cycles": best}
+            "best_cycles": best, "best_cycles_wait": best_wait}
 
 
 def time_to_rmse(scene, ref, fixed, repeats, log):
@@ -269,12 +279,14 @@ def rmse_table(results):
 def table(results):
     lines = [
         "| scene | renderer | path tracing s | camera samples/s | rays/sample | RMSE "
-        "| efficiency 1/(RMSE²·s) | vs Cycles' better |",
-        "|---|---|---|---|---|---|---|---|",
+        "| efficiency 1/(RMSE²·s) | vs Cycles' better | whole wait s | vs Cycles' better, "
+        "whole wait |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for res in results:
         # Against Cycles' better setting on this scene, adaptive sampling off or on.
         cycles = res["renderers"][res["best_cycles"]]["efficiency"]
+        cycles_wait = res["renderers"][res["best_cycles_wait"]]["wait_efficiency"]
         w, h = res["size"]
         label = f"{res['scene']} ({w}x{h}, {res['spp']} spp)"
         for name, r in res["renderers"].items():
@@ -282,7 +294,8 @@ def table(results):
             lines.append(
                 f"| {label} | {name} | {r['seconds']:.2f} | {r['samples_per_second'] / 1e6:.3f} M "
                 f"| {rays} | {r['rmse']:.5f} | {r['efficiency']:.0f} "
-                f"| {r['efficiency'] / cycles:.2f}x |")
+                f"| {r['efficiency'] / cycles:.2f}x | {r['wait_seconds']:.2f} "
+                f"| {r['wait_efficiency'] / cycles_wait:.2f}x |")
     lines.append("")
     lines.append("| scene | converged difference (RMSE between references) | expected from their noise "
                  "| mean hairtrace | mean Cycles |")

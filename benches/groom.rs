@@ -5,9 +5,9 @@
 //! starts them past the fiber they leave, hairtrace uses its exclusion filter instead). Also the 8-wide packet call
 //! on primary rays, to see whether packets pay. Prints a markdown table.
 //!
-//! `cargo bench --bench groom --features bench-internals` (all sizes; the feature opens the tracer
-//! and the raw Embree bindings for the direct baseline) or add `-- 100000` (sizes up
-//! to the given strand count).
+//! `cargo bench -p hairtrace-benches --bench groom` (all sizes; the package turns on the
+//! library's `bench-internals`, which opens the tracer and the raw Embree bindings for the
+//! direct baseline) or add `-- 100000` (sizes up to the given strand count).
 
 use std::hint::black_box;
 use std::sync::Arc;

@@ -6,7 +6,7 @@
 //! it, so a rebuild is left with Embree's top-level scene (docs/large-grooms.md, "A C
 //! scene builds again without sorting or cutting").
 //!
-//! `cargo bench --bench rebuild [-- STRANDS]`
+//! `cargo bench -p hairtrace-benches --bench rebuild [-- STRANDS]`
 
 use std::ptr::{null, null_mut};
 use std::time::Instant;

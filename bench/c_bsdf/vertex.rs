@@ -1,7 +1,7 @@
 //! The Rust vertex that bench/c_bsdf compares the C calls with: `HairBsdf::at` + `eval` +
 //! `sample` on the inputs bench.c draws (its generator, its order of draws, its two
 //! materials, alternating), timed with its protocol: 41 interleaved rounds over 4096 inputs,
-//! medians of ns per vertex. Run by bench/c_bsdf/run (`cargo bench --bench c_vertex`).
+//! medians of ns per vertex. Run by bench/c_bsdf/run (`cargo bench -p hairtrace-benches --bench c_vertex`).
 
 use glam::Vec3;
 use hairtrace::bsdf::sigma_a_from_melanin;

@@ -1,0 +1,1 @@
+//! Empty: the package holds only its benchmarks (see Cargo.toml).

@@ -8,9 +8,11 @@ mod crate_check;
 mod layout;
 mod prim;
 mod resolver;
+mod text_arrays;
 mod write;
 
 use std::fmt::Write as _;
+use std::io::Read as _;
 use std::path::Path;
 
 use openusd::usd::{PrimPredicate, Stage};
@@ -168,16 +170,19 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
     // indexes some tables of a corrupt .usdc without checking them, and panics: the panic
     // is caught here and becomes this file's error (the stage is dropped with it).
     let read = std::panic::catch_unwind(|| {
-        let stage = Stage::builder()
-            .resolver(resolver::CheckingResolver::default())
-            .open(name)
-            .map_err(|e| invalid_arg!("not a readable USD stage: {e:#}"))?;
-        let grooms = read_stage(&stage, meta.len())?;
-        // Composition is lazy: its errors (cycles, missing layers) are known once every
-        // prim has been visited.
-        match stage.composition_errors().first() {
-            Some(e) => Err(invalid_arg!("composition failed: {e}")),
-            None => Ok(grooms),
+        // A text stage goes through the fast path for its arrays first; whatever that
+        // cannot read cleanly is read again as openusd reads it, so that errors and panics
+        // are openusd's own.
+        let fast = is_text_layer(path)
+            .then(|| std::panic::catch_unwind(|| read_lifting(name, meta.len())).ok())
+            .flatten()
+            .flatten();
+        match fast {
+            Some(grooms) => Ok(grooms),
+            None => read_stage(
+                &open(name, resolver::CheckingResolver::default())?,
+                meta.len(),
+            ),
         }
     });
     match read {
@@ -193,7 +198,40 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
     }
 }
 
+/// Whether the file starts as a text layer does.
+fn is_text_layer(path: &Path) -> bool {
+    let mut head = [0; 5];
+    let read = std::fs::File::open(path).and_then(|mut f| f.read_exact(&mut head));
+    read.is_ok() && &head == b"#usda"
+}
+
+fn open(name: &str, resolver: resolver::CheckingResolver) -> Result<Stage> {
+    Stage::builder()
+        .resolver(resolver)
+        .open(name)
+        .map_err(|e| invalid_arg!("not a readable USD stage: {e:#}"))
+}
+
+/// The grooms with the numeric arrays of text layers lifted out before openusd parses
+/// them and put back after (see `text_arrays`); `None` when anything went otherwise.
+fn read_lifting(name: &str, file_bytes: u64) -> Option<UsdGrooms> {
+    let lifted = resolver::Lifted::default();
+    let stage = open(name, resolver::CheckingResolver::lifting(lifted.clone())).ok()?;
+    // Layers load as composition reaches them: a traversal reaches every one the
+    // reader's own traversal will.
+    stage.traverse(PrimPredicate::DEFAULT, |_| {}).ok()?;
+    let layers = std::mem::take(&mut *resolver::lock(&lifted));
+    for (id, arrays) in &layers {
+        text_arrays::restore(&mut *stage.layer_mut(id)?, arrays)?;
+    }
+    let grooms = read_stage(&stage, file_bytes).ok()?;
+    // A text layer opened after the arrays were put back would hold placeholders.
+    resolver::lock(&lifted).is_empty().then_some(grooms)
+}
+
 /// The grooms of a composed stage. `file_bytes` bounds what any count may ask for.
+/// Composition is lazy: its errors (cycles, missing layers) are known once every prim has
+/// been visited.
 fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
     let units = stage_units(stage)?;
     let mut paths = Vec::new();
@@ -218,11 +256,14 @@ fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
             other => ignored.push(format!("{} ({other})", p.as_str())),
         }
     }
-    Ok(UsdGrooms {
-        units,
-        curves,
-        ignored,
-    })
+    match stage.composition_errors().first() {
+        Some(e) => Err(invalid_arg!("composition failed: {e}")),
+        None => Ok(UsdGrooms {
+            units,
+            curves,
+            ignored,
+        }),
+    }
 }
 
 /// The stage's `upAxis` and `metersPerUnit`, USD's fallback for each one not authored.

@@ -6,34 +6,55 @@
 //! parsing its first layer from memory, so the package is checked whole: every entry
 //! must be stored uncompressed (as the USDZ format requires; a compressed entry could
 //! inflate without bound) and every crate entry must pass.
+//!
+//! A resolver made [`CheckingResolver::lifting`] also hands openusd each text layer with
+//! its numeric arrays cut out (see `text_arrays`), keeping them for the reader to put back.
 
+use std::collections::HashMap;
 use std::io::{self, Read};
+use std::sync::{Arc, Mutex};
 use std::time::SystemTime;
 
 use openusd::ar::{self, Asset, AssetInfo, DefaultResolver, ResolvedPath, Resolver};
 
 use super::crate_check::{MAGIC, Refusal, check_crate};
+use super::text_arrays::{self, TextArrays};
+
+/// The arrays cut out of each text layer, by resolved path.
+pub(super) type Lifted = Arc<Mutex<HashMap<String, TextArrays>>>;
 
 /// openusd's [`DefaultResolver`] with each asset checked before it is handed on.
 #[derive(Default)]
 pub(super) struct CheckingResolver {
     inner: DefaultResolver,
+    lifted: Option<Lifted>,
 }
 
 impl CheckingResolver {
+    /// A resolver that cuts the numeric arrays out of text layers into `lifted`.
+    pub(super) fn lifting(lifted: Lifted) -> Self {
+        Self {
+            inner: DefaultResolver::default(),
+            lifted: Some(lifted),
+        }
+    }
+
     /// The bytes of `resolved`, refused if they are more than the reader's
     /// `MAX_FILE_BYTES` or fail [`check_layer`].
     fn checked(&self, resolved: &ResolvedPath) -> io::Result<Vec<u8>> {
         let refused = |why: String| io::Error::new(io::ErrorKind::InvalidData, why);
         let name = resolved.to_string();
-        if let Some((package, _)) = ar::split_package_relative_path_outer(&name) {
+        let packaged = ar::split_package_relative_path_outer(&name);
+        if let Some((package, _)) = &packaged {
             // The default resolver reads a packaged layer straight from the package on
             // disk: the package is checked whole first.
             self.checked(&ResolvedPath::new(package))?;
         }
         let asset = self.inner.open_asset(resolved)?;
         let limit = super::MAX_FILE_BYTES;
-        let mut bytes = Vec::new();
+        // Sized once: a large text layer would otherwise be copied as the buffer grows.
+        let size = asset.size().map_or(0, |n| n.min(limit));
+        let mut bytes = Vec::with_capacity(usize::try_from(size).unwrap_or(0));
         asset.take(limit + 1).read_to_end(&mut bytes)?;
         if bytes.len() as u64 > limit {
             return Err(refused(format!(
@@ -41,7 +62,18 @@ impl CheckingResolver {
             )));
         }
         check_layer(&bytes).map_err(|why| refused(format!("{name}: {why}")))?;
-        Ok(bytes)
+        match &self.lifted {
+            Some(lifted) if packaged.is_none() && bytes.starts_with(b"#usda") => {
+                match text_arrays::lift(bytes) {
+                    Ok((text, arrays)) => {
+                        lock(lifted).insert(name, arrays);
+                        Ok(text)
+                    }
+                    Err(bytes) => Ok(bytes),
+                }
+            }
+            _ => Ok(bytes),
+        }
     }
 }
 
@@ -81,6 +113,14 @@ impl Resolver for CheckingResolver {
     fn identity(&self) -> String {
         self.inner.identity()
     }
+}
+
+/// The lifted arrays, whether or not a thread panicked holding them (a panic abandons the
+/// read that lifted them).
+pub(super) fn lock(lifted: &Lifted) -> std::sync::MutexGuard<'_, HashMap<String, TextArrays>> {
+    lifted
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Packages inside packages are checked to this depth: each level holds a copy of what it

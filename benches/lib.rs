@@ -1,1 +1,0 @@
-//! Empty: the package holds only its benchmarks (see Cargo.toml).

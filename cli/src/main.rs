@@ -68,6 +68,10 @@ enum Command {
     /// Compare an image with a reference of the same size: RMSE, largest difference and
     /// both means over the RGB channels (one JSON line with --json).
     Compare(CompareArgs),
+    /// Whether renders converge to references: each side two or more seeds of one frame;
+    /// the means of square pixel blocks against the noise the seeds show (z-scores), and
+    /// the frame's mean difference. Exits with 3 when the difference is beyond noise.
+    Bias(BiasArgs),
     /// Measure speed against error (BSDF variants, render knobs on the bench scenes, scaling
     /// with strand count, Blender Cycles if installed, a gallery) and write REPORT.md with
     /// its PNG plots.
@@ -191,6 +195,22 @@ struct ExportArgs {
 struct CompareArgs {
     image: PathBuf,
     reference: PathBuf,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    json: bool,
+}
+
+#[derive(Args)]
+struct BiasArgs {
+    /// Renders of the way under test, one per seed.
+    #[arg(long, num_args = 2.., required = true)]
+    images: Vec<PathBuf>,
+    /// Renders of the reference way, one per seed (seeds none of `--images` used).
+    #[arg(long, num_args = 2.., required = true)]
+    references: Vec<PathBuf>,
+    /// Side of a block in pixels.
+    #[arg(long, default_value_t = 8)]
+    block: usize,
     /// Print one JSON object instead of text.
     #[arg(long)]
     json: bool,
@@ -862,6 +882,55 @@ fn compare(args: &CompareArgs) -> hairtrace::Result<()> {
     Ok(())
 }
 
+/// `Ok(true)` when the images are within noise of the references.
+fn bias(args: &BiasArgs) -> hairtrace::Result<bool> {
+    let read = |paths: &[PathBuf]| {
+        paths
+            .iter()
+            .map(|p| image::read_image(p))
+            .collect::<hairtrace::Result<Vec<_>>>()
+    };
+    let b = image::block_bias(&read(&args.images)?, &read(&args.references)?, args.block)?;
+    if args.json {
+        let json = serde_json::json!({
+            "block": b.block,
+            "blocks": b.blocks,
+            "z_mean": b.z_mean,
+            "z_rms": b.z_rms,
+            "z_max": b.z_max,
+            "worst_block": [b.worst.0, b.worst.1],
+            "over_two": b.over_two,
+            "noise_calibration": b.noise_calibration,
+            "mean_difference": b.mean_difference,
+            "mean_difference_sigma": b.mean_difference_sigma,
+            "within_noise": b.within_noise(),
+        });
+        println!("{json}");
+    } else {
+        println!(
+            "{} blocks of {}x{}: z mean {:+.3}, rms {:.3}, max {:.2} (the block at {}, {}), \
+             {:.1}% over 2 (noise alone: 4.6%); frame mean {:+.3}% +- {:.3}%; {}",
+            b.blocks,
+            b.block,
+            b.block,
+            b.z_mean,
+            b.z_rms,
+            b.z_max,
+            b.worst.0,
+            b.worst.1,
+            100.0 * b.over_two,
+            100.0 * b.mean_difference,
+            100.0 * b.mean_difference_sigma,
+            if b.within_noise() {
+                "within noise"
+            } else {
+                "BEYOND NOISE"
+            }
+        );
+    }
+    Ok(b.within_noise())
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -891,6 +960,10 @@ fn main() -> ExitCode {
         Command::Lobes(a) => lobes(a),
         Command::Info(a) => info(a),
         Command::Compare(a) => compare(a),
+        Command::Bias(a) => match bias(a) {
+            Ok(false) => return ExitCode::from(3),
+            other => other.map(|_| ()),
+        },
         Command::Export(a) => export(a),
         Command::Report(a) => report::run(&report::ReportOptions {
             quick: a.quick,

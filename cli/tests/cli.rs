@@ -379,6 +379,60 @@ fn variants_render_from_one_build_as_their_own_commands_would() {
     assert_one_line_error(&hairtrace(&args), "must be an .exr");
 }
 
+/// `bias` finds a change of the image that seeds cannot explain, and nothing where only
+/// the seeds differ; a side of one seed has no noise to measure and is refused.
+#[test]
+fn bias_tells_a_change_from_noise() {
+    let render = |seed: &str, depth: &str| {
+        let out = tmp(&format!("cli_bias_{seed}_{depth}.exr"));
+        let o = hairtrace(&[
+            "render",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--spp",
+            "4",
+            "--seed",
+            seed,
+            "--max-depth",
+            depth,
+            "-o",
+            &out,
+        ]);
+        assert!(o.status.success(), "{o:?}");
+        out
+    };
+    let (a1, a2) = (render("1", "64"), render("2", "64"));
+    let (b1, b2) = (render("3", "64"), render("4", "64"));
+    let (c1, c2) = (render("5", "1"), render("6", "1"));
+    let o = hairtrace(&[
+        "bias",
+        "--images",
+        &a1,
+        &a2,
+        "--references",
+        &b1,
+        &b2,
+        "--json",
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let b: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert_eq!(
+        (b["within_noise"].as_bool(), b["block"].as_u64()),
+        (Some(true), Some(8)),
+        "{b}"
+    );
+    // Direct light alone is darker than every bounce: beyond noise, exit status 3.
+    let o = hairtrace(&["bias", "--images", &c1, &c2, "--references", &b1, &b2]);
+    assert_eq!(o.status.code(), Some(3), "{o:?}");
+    assert!(stdout(&o).contains("BEYOND NOISE"), "{}", stdout(&o));
+    assert_one_line_error(
+        &hairtrace(&["bias", "--images", &a1, "--references", &b1, &b2]),
+        "--images",
+    );
+}
+
 /// What the peer benchmark drives: a box-filtered render with its figures in JSON,
 /// `compare` against another seed, `export` for Cycles.
 #[test]

@@ -4,7 +4,7 @@
 use std::path::Path;
 use std::process::Command;
 
-const SECTIONS: [&str; 5] = ["BSDF", "Render", "Gallery", "Scale", "Peers"];
+const SECTIONS: [&str; 6] = ["BSDF", "Render", "Gallery", "Scale", "Real grooms", "Peers"];
 
 /// Every link target `](file)` in a Markdown text.
 fn links(text: &str) -> Vec<&str> {

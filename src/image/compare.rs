@@ -21,35 +21,11 @@ pub struct Comparison {
 /// three are RGB; alpha and AOVs are ignored). Sums in f64, so that a 4k frame's RMSE does
 /// not depend on summation order.
 pub fn compare(image: &Image, reference: &Image) -> Result<Comparison> {
-    if (image.width, image.height) != (reference.width, reference.height) {
-        return Err(invalid_arg!(
-            "images differ in size: {}x{} against a {}x{} reference",
-            image.width,
-            image.height,
-            reference.width,
-            reference.height
-        ));
-    }
-    if image.channels < 3 || reference.channels < 3 {
-        return Err(invalid_arg!(
-            "RGB images needed: {} and {} channels",
-            image.channels,
-            reference.channels
-        ));
-    }
-    let rgb = |img: &Image| {
-        img.pixels
-            .chunks_exact(img.channels)
-            .flat_map(|p| p[..3].iter().map(|&v| f64::from(v)))
-            .collect::<Vec<_>>()
-    };
-    let (a, b) = (rgb(image), rgb(reference));
-    if let Some(v) = a.iter().chain(&b).find(|v| !v.is_finite()) {
-        return Err(invalid_arg!("images must be finite: found {v}"));
-    }
+    let values = rgb_values(&[image, reference])?;
+    let (a, b) = (&values[0], &values[1]);
     let n = a.len().max(1) as f64;
     let (mut sq, mut max_abs) = (0.0, 0.0f64);
-    for (x, y) in a.iter().zip(&b) {
+    for (x, y) in a.iter().zip(b) {
         let d = x - y;
         sq += d * d;
         max_abs = max_abs.max(d.abs());
@@ -60,6 +36,46 @@ pub fn compare(image: &Image, reference: &Image) -> Result<Comparison> {
         mean: a.iter().sum::<f64>() / n,
         reference_mean: b.iter().sum::<f64>() / n,
     })
+}
+
+/// The RGB values of renders of one frame, in f64, pixel by pixel: the images must have
+/// the same size, at least three channels each (alpha and AOVs are ignored) and finite
+/// values.
+pub(super) fn rgb_values(images: &[&Image]) -> Result<Vec<Vec<f64>>> {
+    let first = images
+        .first()
+        .ok_or_else(|| invalid_arg!("no images to compare"))?;
+    for img in images {
+        if (img.width, img.height) != (first.width, first.height) {
+            return Err(invalid_arg!(
+                "images differ in size: {}x{} against {}x{}",
+                img.width,
+                img.height,
+                first.width,
+                first.height
+            ));
+        }
+        if img.channels < 3 {
+            return Err(invalid_arg!(
+                "RGB images needed: one has {} channels",
+                img.channels
+            ));
+        }
+    }
+    images
+        .iter()
+        .map(|img| {
+            let rgb: Vec<f64> = img
+                .pixels
+                .chunks_exact(img.channels)
+                .flat_map(|p| p[..3].iter().map(|&v| f64::from(v)))
+                .collect();
+            match rgb.iter().find(|v| !v.is_finite()) {
+                Some(v) => Err(invalid_arg!("images must be finite: found {v}")),
+                None => Ok(rgb),
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -16,7 +16,9 @@ use std::path::Path;
 use crate::error::invalid_arg;
 use crate::{Error, Result};
 
+mod blocks;
 mod compare;
+pub use blocks::{BlockBias, block_bias};
 pub use compare::{Comparison, compare};
 
 /// How samples are stored in the file.

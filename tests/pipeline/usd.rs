@@ -284,6 +284,32 @@ fn real_file_faults_name_the_prim_and_the_attribute() {
     }
 }
 
+/// A tuple with another count of numbers than its type's is refused, naming the prim and
+/// the attribute, wherever it is in the array (openusd alone would read it and fill the
+/// missing numbers).
+#[test]
+fn tuples_of_the_wrong_size_are_refused() {
+    let points = |list: &str| {
+        curves_prim(&format!(
+            "uniform token type = \"linear\"\nint[] curveVertexCounts = [2]\n\
+             point3f[] points = [{list}]\nfloat[] widths = [0.1] (interpolation = \"constant\")"
+        ))
+    };
+    for (name, list, element) in [
+        ("short_first", "(0, 0), (1, 1, 1)", 0),
+        ("short_last", "(0, 0, 0), (1, 1)", 1),
+        ("long", "(0, 0, 0), (1, 1, 1, 1)", 1),
+    ] {
+        let m = refused(points(list), &format!("{name}.usda"));
+        assert!(
+            m.contains(&format!(
+                "/c.points: element {element} is a tuple of another size"
+            )),
+            "{name}: {m}"
+        );
+    }
+}
+
 #[test]
 fn bad_files_are_refused_with_a_message() {
     let ok = "int[] curveVertexCounts = [4]\npoint3f[] points = [(0,0,0),(0,1,0),(0,2,0),(0,3,0)]\nfloat[] widths = [0.1] (interpolation = \"constant\")\nuniform token type = \"linear\"";

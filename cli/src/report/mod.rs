@@ -10,6 +10,7 @@ mod machine;
 mod markdown;
 mod peers;
 mod plots;
+mod real_bias;
 mod render;
 mod scale;
 mod scale_cycles;
@@ -69,7 +70,7 @@ struct Section {
     steps: fn(&Context) -> u64,
 }
 
-const SECTIONS: [Section; 5] = [
+const SECTIONS: [Section; 6] = [
     Section {
         title: "BSDF: time against accuracy",
         run: bsdf::section,
@@ -89,6 +90,11 @@ const SECTIONS: [Section; 5] = [
         title: "Scale: strand count, build time, memory, rays per second",
         run: scale::section,
         steps: scale::steps,
+    },
+    Section {
+        title: "Real grooms: the defaults against round curves",
+        run: real_bias::section,
+        steps: real_bias::steps,
     },
     Section {
         title: "Peers: Blender Cycles",

@@ -172,11 +172,16 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
     let read = std::panic::catch_unwind(|| {
         // A text stage goes through the fast path for its arrays first; whatever that
         // cannot read cleanly is read again as openusd reads it, so that errors and panics
-        // are openusd's own.
-        let fast = is_text_layer(path)
-            .then(|| std::panic::catch_unwind(|| read_lifting(name, meta.len())).ok())
-            .flatten()
-            .flatten();
+        // are openusd's own (and the fast path's panic, quiet, is not printed twice).
+        let fast = if is_text_layer(path) {
+            std::panic::catch_unwind(|| {
+                let _quiet = crate::quiet_panic::Quiet::enter();
+                read_lifting(name, meta.len())
+            })
+            .unwrap_or(Ok(None))?
+        } else {
+            None
+        };
         match fast {
             Some(grooms) => Ok(grooms),
             None => read_stage(
@@ -213,20 +218,30 @@ fn open(name: &str, resolver: resolver::CheckingResolver) -> Result<Stage> {
 }
 
 /// The grooms with the numeric arrays of text layers lifted out before openusd parses
-/// them and put back after (see `text_arrays`); `None` when anything went otherwise.
-fn read_lifting(name: &str, file_bytes: u64) -> Option<UsdGrooms> {
+/// them and put back after (see `text_arrays`); `None` when anything went otherwise, an
+/// error for a malformed tuple, which openusd would read without a word.
+fn read_lifting(name: &str, file_bytes: u64) -> Result<Option<UsdGrooms>> {
     let lifted = resolver::Lifted::default();
-    let stage = open(name, resolver::CheckingResolver::lifting(lifted.clone())).ok()?;
+    let Ok(stage) = open(name, resolver::CheckingResolver::lifting(lifted.clone())) else {
+        return Ok(None);
+    };
     // Layers load as composition reaches them: a traversal reaches every one the
     // reader's own traversal will.
-    stage.traverse(PrimPredicate::DEFAULT, |_| {}).ok()?;
+    if stage.traverse(PrimPredicate::DEFAULT, |_| {}).is_err() {
+        return Ok(None);
+    }
     let layers = std::mem::take(&mut *resolver::lock(&lifted));
     for (id, arrays) in &layers {
-        text_arrays::restore(&mut *stage.layer_mut(id)?, arrays)?;
+        let Some(mut layer) = stage.layer_mut(id) else {
+            return Ok(None);
+        };
+        if text_arrays::restore(&mut layer, arrays)?.is_none() {
+            return Ok(None);
+        }
     }
-    let grooms = read_stage(&stage, file_bytes).ok()?;
+    let grooms = read_stage(&stage, file_bytes).ok();
     // A text layer opened after the arrays were put back would hold placeholders.
-    resolver::lock(&lifted).is_empty().then_some(grooms)
+    Ok(grooms.filter(|_| resolver::lock(&lifted).is_empty()))
 }
 
 /// The grooms of a composed stage. `file_bytes` bounds what any count may ask for.

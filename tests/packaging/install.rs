@@ -157,8 +157,9 @@ fn cpp_hosts_build_against_the_installed_prefix() {
 }
 
 /// What `c_examples/furnace.cpp` printed: through hairtrace.hpp the white furnace gives 1
-/// within 0.5%, every vertex has the bits of the same vertex made with the C calls, and
-/// a bad parameter is an exception with the library's message.
+/// within 0.5%, every vertex made with the noexcept status forms has the bits of the same
+/// vertex made with the value forms and with the C calls, an unfilled point gives a status
+/// and the message, and a bad parameter is an exception with the library's message.
 fn check_furnace(out: &str) {
     let value = |key: &str| -> Vec<f64> {
         let line = out.lines().find_map(|l| l.strip_prefix(key));
@@ -171,6 +172,10 @@ fn check_furnace(out: &str) {
     assert!((furnace - 1.0).abs() < 5e-3, "furnace {furnace}:\n{out}");
     let mismatches = value("mismatches ");
     assert!(mismatches[0] == 0.0 && mismatches[1] > 19_000.0, "{out}");
+    assert!(
+        out.contains("unfilled invalid argument: point was not filled"),
+        "{out}"
+    );
     assert!(out.contains("error invalid argument: "), "{out}");
     assert!(out.contains("beta_m = 2"), "{out}");
 }

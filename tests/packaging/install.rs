@@ -215,3 +215,31 @@ fn assert_macros_prefixed(include: &Path) {
         include.display()
     );
 }
+
+/// `scripts/install --help` prints the help (its options, what a prefix gets, how a host
+/// that only shades and one that renders link) and succeeds; without a prefix it is a usage
+/// error that points to the help.
+#[test]
+fn install_prints_its_help() {
+    let script = root().join("scripts/install");
+    let out = Command::new(&script).arg("--help").output().unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let help = String::from_utf8(out.stdout).unwrap();
+    for words in [
+        "--prefix DIR",
+        "--bsdf-only",
+        "--no-build",
+        "COMPONENTS bsdf",
+        "hairtrace::bsdf",
+        "pkg-config --cflags --libs hairtrace-bsdf",
+        "libhairtrace.so.ABI",
+    ] {
+        assert!(help.contains(words), "no {words:?} in:\n{help}");
+    }
+    let bare = Command::new(&script).output().unwrap();
+    assert_eq!(bare.status.code(), Some(2), "{bare:?}");
+    assert!(
+        String::from_utf8_lossy(&bare.stderr).contains("--help"),
+        "{bare:?}"
+    );
+}

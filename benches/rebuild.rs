@@ -1,7 +1,7 @@
 //! A C host's scene built and built again: a fur ball of copied xyzr points (10^6 strands
 //! x 16 linear round segments unless `-- STRANDS` says otherwise), then a triangle added
 //! before each of a few more builds (added geometry makes the next build start over).
-//! Prints each `ht_scene_build`'s seconds and the rebuilds' median. The first build
+//! Prints each `ht_scene_build_with`'s seconds and the rebuilds' median. The first build
 //! orders the strands, cuts the groom into parts and bounds them; the scene keeps all of
 //! it, so a rebuild is left with Embree's top-level scene (docs/large-grooms.md, "A C
 //! scene builds again without sorting or cutting").
@@ -18,8 +18,9 @@ use hairtrace::capi::geometry::{
 };
 use hairtrace::capi::lights::ht_scene_add_environment;
 use hairtrace::capi::materials::{ht_scene_add_diffuse_material, ht_scene_add_hair_material};
-use hairtrace::capi::render::{ht_render_settings_default, ht_scene_build};
+use hairtrace::capi::render::ht_scene_build_with;
 use hairtrace::capi::scene::{ht_device_free, ht_device_new, ht_scene_free, ht_scene_new};
+use hairtrace::capi::settings::{ht_settings_free, ht_settings_new, ht_settings_set};
 use hairtrace::scene::FurBall;
 
 const REBUILDS: usize = 5;
@@ -54,17 +55,16 @@ fn main() {
         basis: HT_CURVE_LINEAR,
         shape: HT_CURVE_ROUND,
     };
-    let settings = hairtrace::capi::render::HtRenderSettings {
-        width: 64,
-        height: 64,
-        threads: 2,
-        ..ht_render_settings_default()
-    };
     // SAFETY: live handles and locals; the scene copies the points it is given.
     unsafe {
         let (mut device, mut scene) = (null_mut(), null_mut());
         ok(ht_device_new(2, &mut device));
         ok(ht_scene_new(device, &mut scene));
+        let mut settings = null_mut();
+        ok(ht_settings_new(&mut settings));
+        for (key, value) in [(c"width", c"64"), (c"height", c"64"), (c"threads", c"2")] {
+            ok(ht_settings_set(settings, key.as_ptr(), value.as_ptr()));
+        }
         let (mut hair, mut floor) = (0, 0);
         ok(ht_scene_add_hair_material(
             scene,
@@ -80,7 +80,7 @@ fn main() {
         ok(ht_scene_add_environment(scene, [0.5f32; 3].as_ptr()));
         let build = || {
             let t0 = Instant::now();
-            ok(ht_scene_build(scene, &settings, None, null_mut()));
+            ok(ht_scene_build_with(scene, settings, None, null_mut()));
             t0.elapsed().as_secs_f64()
         };
         println!("{strands} strands x 16 linear round segments, copied, 2 threads");
@@ -105,6 +105,7 @@ fn main() {
         println!("rebuilds: {rebuilds:.2?} s");
         rebuilds.sort_by(f64::total_cmp);
         println!("median rebuild: {:.2} s", rebuilds[REBUILDS / 2]);
+        ok(ht_settings_free(settings));
         ok(ht_scene_free(scene));
         ok(ht_device_free(device));
     }

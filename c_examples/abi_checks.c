@@ -237,47 +237,45 @@ int main(void) {
     ROW(ht_scene_set_thin_lens(scene, 2e18f, 1.0f), BAD, "aperture_radius");
     ROW(ht_scene_set_thin_lens(scene, 0.0f, -1.0f), BAD, "focus_distance = -1");
 
-    /* Rendering: a 2 x 2 image. Nothing above was added but the lights. */
-    HtRenderSettings s = ht_render_settings_default();
-    s.width = 2;
-    s.height = 2;
-    s.spp = 1;
-    s.threads = 1;
+    /* Rendering: a 2 x 2 image, settings by name. Nothing above was added but the lights. */
+    HtSettings *s = NULL;
+    ROW(ht_settings_new(NULL), NUL, "out is NULL");
+    ROW(ht_settings_new(&s), HT_OK, "");
+    ROW(ht_settings_set(s, "width", "2"), HT_OK, "");
+    ROW(ht_settings_set(s, "height", "2"), HT_OK, "");
+    ROW(ht_settings_set(s, "spp", "1"), HT_OK, "");
+    ROW(ht_settings_set(s, "threads", "1"), HT_OK, "");
+    ROW(ht_settings_set(NULL, "spp", "1"), NUL, "settings is NULL");
+    ROW(ht_settings_set(s, NULL, "1"), NUL, "key is NULL");
+    ROW(ht_settings_set(s, "spp", "0"), BAD, "spp = 0: must be >= 1");
+    ROW(ht_settings_set(s, "sp", "4"), BAD, "sp: not a render setting");
+    ROW(ht_settings_set(s, "filter_radius", "nan"), BAD, "filter_radius = nan");
     Aligned out;
     float *rgb = out.f, *odd_rgb = (float *)(void *)((char *)out.f + 2);
-    ROW(ht_render(NULL, &s, rgb, 12), NUL, "scene is NULL");
-    ROW(ht_render(scene, NULL, rgb, 12), NUL, "settings is NULL");
-    ROW(ht_render(scene, &s, NULL, 12), NUL, "rgb is NULL");
-    unsigned char settings_bytes[2 * sizeof(HtRenderSettings)];
-    memcpy(settings_bytes + 1, &s, sizeof s);
-    ROW(ht_render(scene, (const HtRenderSettings *)(const void *)(settings_bytes + 1), rgb, 12),
-        BAD, "settings = ");
-    ROW(ht_render(scene, &s, rgb, (size_t)-1), BAD, "rgb_len = ");
-    ROW(ht_render(scene, &s, odd_rgb, 12), BAD, "not aligned to 4 bytes");
-    ROW(ht_render_aovs(scene, &s, rgb, 12, NULL, rgb, NULL, 4), BAD, "rgb and depth overlap");
-    ROW(ht_render_aovs(scene, &s, rgb, 12, rgb + 16, NULL, rgb + 20, 4), BAD,
+    ROW(ht_render_with(NULL, s, NULL, NULL, rgb, 12, NULL, NULL, NULL, 4), NUL, "scene is NULL");
+    ROW(ht_render_with(scene, NULL, NULL, NULL, rgb, 12, NULL, NULL, NULL, 4), NUL,
+        "settings is NULL");
+    ROW(ht_render_with(scene, s, NULL, NULL, NULL, 12, NULL, NULL, NULL, 4), NUL, "rgb is NULL");
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, (size_t)-1, NULL, NULL, NULL, 4), BAD,
+        "rgb_len = ");
+    ROW(ht_render_with(scene, s, NULL, NULL, odd_rgb, 12, NULL, NULL, NULL, 4), BAD,
+        "not aligned to 4 bytes");
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, 12, NULL, rgb, NULL, 4), BAD,
+        "rgb and depth overlap");
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, 12, rgb + 16, NULL, rgb + 20, 4), BAD,
         "albedo and strand_id overlap");
-    ROW(ht_render_aovs(scene, &s, rgb, 12, NULL, NULL, NULL, SIZE_MAX), BAD, "pixel_count");
-    ROW(ht_scene_build(NULL, &s, NULL, NULL), NUL, "scene is NULL");
-    ROW(ht_scene_build(scene, NULL, NULL, NULL), NUL, "settings is NULL");
-    ROW(ht_scene_build(scene, (const HtRenderSettings *)(const void *)(settings_bytes + 1), NULL,
-                       NULL),
-        BAD, "settings = ");
-    s.spp = 0;
-    ROW(ht_scene_build(scene, &s, NULL, NULL), BAD, "spp = 0");
-    ROW(ht_render(scene, &s, rgb, 12), BAD, "spp = 0");
-    s.spp = 1;
-    s.filter = 5;
-    ROW(ht_render(scene, &s, rgb, 12), BAD, "filter = 5");
-    s.filter = HT_FILTER_TENT;
-    s.filter_radius = nan;
-    ROW(ht_render(scene, &s, rgb, 12), BAD, "filter_radius = NaN");
-    s.filter_radius = 1.0f;
-    s.width = 0;
-    ROW(ht_render(scene, &s, rgb, 0), BAD, "width = 0");
-    s.width = 2;
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, 12, NULL, NULL, NULL, SIZE_MAX), BAD,
+        "pixel_count");
+    ROW(ht_scene_build_with(NULL, s, NULL, NULL), NUL, "scene is NULL");
+    ROW(ht_scene_build_with(scene, NULL, NULL, NULL), NUL, "settings is NULL");
+    /* Rules between settings are checked where the settings are used. */
+    ROW(ht_settings_set(s, "crop", "0,0,3,2"), HT_OK, "");
+    ROW(ht_scene_build_with(scene, s, NULL, NULL), BAD, "crop = 0,0,3,2");
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, 18, NULL, NULL, NULL, 6), BAD, "crop = 0,0,3,2");
+    ROW(ht_settings_set(s, "crop", "none"), HT_OK, "");
     /* No geometry and no camera: nothing to frame. */
-    ROW(ht_render(scene, &s, rgb, 12), BAD, "no geometry to frame");
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, 12, NULL, NULL, NULL, 4), BAD,
+        "no geometry to frame");
 
     /* Images. */
     const float px[12] = {0};
@@ -304,10 +302,12 @@ int main(void) {
     /* After all of that, a valid strand renders, and a callback can cancel it. */
     ROW(ht_scene_add_curves(scene, &c, hair, &id), HT_OK, "");
     ROW(ht_scene_set_camera(scene, eye, origin, up, 20.0f), HT_OK, "");
-    ROW(ht_render(scene, &s, rgb, 12), HT_OK, "");
-    s.progress = cancel_at_once;
-    s.spp = 4000000000u;
-    ROW(ht_render(scene, &s, rgb, 12), HT_ERR_CANCELLED, "cancelled");
+    ROW(ht_render_with(scene, s, NULL, NULL, rgb, 12, NULL, NULL, NULL, 4), HT_OK, "");
+    ROW(ht_settings_set(s, "spp", "4000000000"), HT_OK, "");
+    ROW(ht_render_with(scene, s, cancel_at_once, NULL, rgb, 12, NULL, NULL, NULL, 4),
+        HT_ERR_CANCELLED, "cancelled");
+    ROW(ht_settings_free(s), HT_OK, "");
+    ROW(ht_settings_free(NULL), HT_OK, "");
 
     ROW(ht_shutdown(), BAD, "still in use");
     ht_scene_free(scene);

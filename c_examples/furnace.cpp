@@ -1,10 +1,12 @@
 /* The hair BSDF from C++ through hairtrace.hpp: a white furnace over random hits, each
- * shaded as a path vertex is (the frame of the hit, a point, a sampled direction and its
- * weight, the pdf of light from that direction, and the BSDF toward it across the fibre),
- * next to the same vertex made with the C calls a host used before the combined ones (the
- * frame conversions, ht_hair_point_init, _sample and _pdf, the weight computed by the
- * host). With no absorption the mean weight is 1; the two paths must agree bit for bit.
- * Prints "furnace MEAN", "mismatches M of N" and "error STATUS: MESSAGE". */
+ * shaded as a renderer's worker thread shades a path vertex, with the noexcept status
+ * forms and a default-constructed vertex (a point from the hit, frame included, a sampled
+ * direction with f |cos|, its weight and pdf, the pdf of light from that direction, and
+ * the BSDF toward it across the fibre). Each vertex is made again with the throwing value
+ * forms, with the frame and the point in two steps, and with the C calls; all must agree
+ * bit for bit. With no absorption the mean weight is 1.
+ * Prints "furnace MEAN", "mismatches M of N", "unfilled STATUS: MESSAGE" and
+ * "error STATUS: MESSAGE". */
 #include "hairtrace.hpp"
 
 #include <cmath>
@@ -19,6 +21,14 @@ struct HostVec {
     float x, y, z;
 };
 
+/* What a host's path vertex holds: default-constructed, filled by the status forms. */
+struct Vertex {
+    hairtrace::Point point;
+    hairtrace::Sample sample{};
+    hairtrace::Eval light{};
+    hairtrace::Across across{};
+};
+
 uint32_t state = 12345u;
 float uniform() {
     state = state * 1664525u + 1013904223u;
@@ -31,44 +41,44 @@ HostVec random_unit() {
     return HostVec{r * std::cos(phi), r * std::sin(phi), z};
 }
 
-bool same_bits(const float *a, const float *b, size_t n) {
-    return std::memcmp(a, b, n * sizeof(float)) == 0;
+template <class T> bool same_bits(const T &a, const T &b) {
+    return std::memcmp(&a, &b, sizeof(T)) == 0;
 }
 
-/* The C path: the vertex as the ABI-6 calls make it. Returns false if a call fails. */
-bool c_vertex(const HtHairPrepared *prepared, const float tangent[3], const float org[3],
-              const float dir[3], const float u[3], float wi[3], float weight[3], float *pdf,
-              float *light_pdf) {
-    const float axis[3] = {0.0f, 0.0f, 0.0f}, wo[3] = {-dir[0], -dir[1], -dir[2]};
-    HtHairFrame frame;
-    float wo_local[3], wi_local[3], f[3];
+bool same(const hairtrace::Sample &a, const hairtrace::Sample &b) {
+    return same_bits(a.wi, b.wi) && same_bits(a.f_cos, b.f_cos) &&
+           same_bits(a.weight, b.weight) && same_bits(a.pdf, b.pdf);
+}
+
+bool same(const hairtrace::Eval &a, const hairtrace::Eval &b) {
+    return same_bits(a.f_cos, b.f_cos) && same_bits(a.pdf, b.pdf);
+}
+
+/* The worker's vertex: status forms only, no exception can leave it. */
+HtStatus shade(const hairtrace::Material &material, const HostVec &tangent, const float org[3],
+               const HostVec &dir, const hairtrace::Vec3 &u, Vertex &v) noexcept {
+    HtStatus s = v.point.set_at_hit(material, tangent, org, dir, HostVec{0.0f, 0.0f, 0.0f}, 1.0f);
+    if (s == HT_OK) s = v.point.sample_world(u, v.sample);
+    if (s == HT_OK && v.sample) s = v.point.eval_world(v.sample.wi, v.light);
+    if (s == HT_OK && v.sample) s = v.point.eval_across_world(v.sample.wi, v.across);
+    return s;
+}
+
+/* The same vertex with the C calls. */
+bool c_agrees(const HtHairPrepared *prepared, const HostVec &tangent, const float org[3],
+              const HostVec &dir, const hairtrace::Vec3 &u, const Vertex &v) {
+    const float t[3] = {tangent.x, tangent.y, tangent.z}, d[3] = {dir.x, dir.y, dir.z};
+    const float axis[3] = {0.0f, 0.0f, 0.0f};
     HtHairPoint point;
-    if (ht_hair_frame(tangent, org, dir, axis, 1.0f, &frame) != HT_OK ||
-        ht_hair_frame_to_local(&frame, wo, wo_local) != HT_OK ||
-        ht_hair_point_init(prepared, frame.h, wo_local, &point) != HT_OK ||
-        ht_hair_point_sample(&point, u, wi_local, f, pdf) != HT_OK) {
+    hairtrace::Sample s;
+    hairtrace::Eval e{};
+    if (ht_hair_point_at_hit(prepared, t, org, d, axis, 1.0f, &point) != HT_OK ||
+        ht_hair_point_sample_world(&point, u.data(), s.wi.data(), s.f_cos.data(), s.weight.data(),
+                                   &s.pdf) != HT_OK ||
+        (s && ht_hair_point_eval_world(&point, s.wi.data(), e.f_cos.data(), &e.pdf) != HT_OK)) {
         return false;
     }
-    float w[3] = {0.0f, 0.0f, 0.0f}, d[3] = {0.0f, 0.0f, 0.0f};
-    bool finite = true;
-    for (int c = 0; c < 3; ++c) {
-        w[c] = *pdf > 0.0f ? f[c] * std::fabs(wi_local[2]) / *pdf : 0.0f;
-        finite = finite && std::isfinite(w[c]);
-    }
-    if (*pdf > 0.0f && finite) {
-        if (ht_hair_frame_to_world(&frame, wi_local, d) != HT_OK) return false;
-    } else {
-        w[0] = w[1] = w[2] = 0.0f;
-        *pdf = 0.0f;
-    }
-    std::memcpy(wi, d, sizeof d);
-    std::memcpy(weight, w, sizeof w);
-    /* The pdf of light arriving from the sampled direction (for MIS), given in world
-     * space as a light gives it. */
-    *light_pdf = 0.0f;
-    float back[3];
-    return *pdf == 0.0f || (ht_hair_frame_to_local(&frame, d, back) == HT_OK &&
-                            ht_hair_point_pdf(&point, back, light_pdf) == HT_OK);
+    return same(s, v.sample) && same(e, v.light);
 }
 
 } // namespace
@@ -100,48 +110,41 @@ int main() {
             const hairtrace::Vec3 u = {uniform(), uniform(), uniform()};
             ++shaded;
 
+            Vertex v;
+            hairtrace::check(shade(material, tangent, org, dir, u, v));
+            if (v.sample) sum += v.sample.weight[1];
+            /* The value forms, and the frame then the point, give the same bits. */
+            const auto point = hairtrace::Point::at_hit(material, tangent, org, dir,
+                                                        HostVec{0.0f, 0.0f, 0.0f}, 1.0f);
             const auto frame =
                 hairtrace::Frame::at_hit(tangent, org, dir, HostVec{0.0f, 0.0f, 0.0f}, 1.0f);
-            const auto point =
-                hairtrace::Point::world(material, frame, HostVec{-dir.x, -dir.y, -dir.z});
-            const hairtrace::Sample s = point.sample_world(u);
-            float light_pdf = 0.0f;
-            bool across_agrees = true;
-            if (s) {
-                const hairtrace::Eval e = point.eval_world(hairtrace::as<HostVec>(s.wi));
-                light_pdf = e.pdf;
-                sum += s.weight[1];
-                /* Across the fibre: the world lanes are the local point's lanes through the
-                 * frame, and lane 0, the point's own offset, is the plain evaluation. */
-                const hairtrace::Across world = point.eval_across_world(hairtrace::as<HostVec>(s.wi));
-                const hairtrace::Point local(material, frame.h(),
-                                             frame.to_local(HostVec{-dir.x, -dir.y, -dir.z}));
-                const hairtrace::Across lanes = local.eval_across(frame.to_local(s.wi));
-                for (size_t k = 0; k < HT_ACROSS; ++k) {
-                    across_agrees = across_agrees &&
-                                    same_bits(world[k].f_cos.data(), lanes[k].f_cos.data(), 3) &&
-                                    same_bits(&world[k].pdf, &lanes[k].pdf, 1);
-                }
-                across_agrees = across_agrees && same_bits(world[0].f_cos.data(), e.f_cos.data(), 3) &&
-                                same_bits(&world[0].pdf, &e.pdf, 1);
+            /* wo = -ray_dir normalised, as the point at the hit takes it. */
+            const float r = 1.0f / std::sqrt(dir.x * dir.x + dir.y * dir.y + dir.z * dir.z);
+            const auto framed =
+                hairtrace::Point::world(material, frame, HostVec{-dir.x * r, -dir.y * r, -dir.z * r});
+            bool agrees = same(point.sample_world(u), v.sample) &&
+                          same(framed.sample_world(u), v.sample) &&
+                          c_agrees(prepared, tangent, org, dir, u, v);
+            if (v.sample) {
+                const hairtrace::Across lanes = point.eval_across_world(hairtrace::as<HostVec>(v.sample.wi));
+                agrees = agrees && same(point.eval_world(v.sample.wi), v.light) &&
+                         same(framed.eval_world(v.sample.wi), v.light) && same(v.across[0], v.light);
+                for (size_t k = 0; k < HT_ACROSS; ++k) agrees = agrees && same(lanes[k], v.across[k]);
             }
-
-            const float t[3] = {tangent.x, tangent.y, tangent.z}, d[3] = {dir.x, dir.y, dir.z};
-            float c_wi[3], c_weight[3], c_pdf, c_light_pdf;
-            if (!c_vertex(prepared, t, org, d, u.data(), c_wi, c_weight, &c_pdf, &c_light_pdf)) {
-                hairtrace::check(HT_ERR_INVALID_ARG);
-            }
-            if (!same_bits(s.wi.data(), c_wi, 3) || !same_bits(s.weight.data(), c_weight, 3) ||
-                !same_bits(&s.pdf, &c_pdf, 1) || !same_bits(&light_pdf, &c_light_pdf, 1) ||
-                !across_agrees) {
-                ++mismatches;
-            }
+            mismatches += !agrees;
         }
         ht_hair_prepared_free(prepared);
         std::printf("furnace %.6f\n", sum / shaded);
         std::printf("mismatches %d of %d\n", mismatches, shaded);
 
-        /* A broken contract is an exception with the library's message. */
+        /* A status form on a vertex that was never filled: a status and the message, no
+         * throw. */
+        const Vertex unfilled;
+        hairtrace::Eval e{};
+        const HtStatus s = unfilled.point.eval_world(HostVec{0.0f, 0.0f, 1.0f}, e);
+        std::printf("unfilled %s: %s\n", ht_status_str(static_cast<int32_t>(s)), ht_last_error());
+
+        /* A broken contract in a value form is an exception with the library's message. */
         HtHairParams rough = white;
         rough.beta_m = 2.0f;
         try {

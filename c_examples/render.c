@@ -171,14 +171,20 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     if (check(ht_scene_set_camera(scene, eye, target, up, 35.0f), "camera")) return 1;
 
     Progress progress = {0, 0, 0};
-    HtRenderSettings settings = ht_render_settings_default();
-    settings.width = WIDTH;
-    settings.height = HEIGHT;
-    settings.spp = 4;
-    settings.seed = 1;
-    settings.progress = count_progress;
-    settings.progress_user = &progress;
-    if (check(ht_render(scene, &settings, b->rgb, WIDTH * HEIGHT * 3), "ht_render")) return 1;
+    HtSettings *settings = NULL;
+    if (check(ht_settings_new(&settings), "settings")) return 1;
+    char size[2][16];
+    snprintf(size[0], sizeof size[0], "%d", WIDTH);
+    snprintf(size[1], sizeof size[1], "%d", HEIGHT);
+    if (check(ht_settings_set(settings, "width", size[0]), "width") ||
+        check(ht_settings_set(settings, "height", size[1]), "height") ||
+        check(ht_settings_set(settings, "spp", "4"), "spp") ||
+        check(ht_settings_set(settings, "seed", "1"), "seed"))
+        return 1;
+    if (check(ht_render_with(scene, settings, count_progress, &progress, b->rgb,
+                             WIDTH * HEIGHT * 3, NULL, NULL, NULL, WIDTH * HEIGHT),
+              "ht_render_with"))
+        return 1;
 
     double sum = 0.0;
     for (int i = 0; i < WIDTH * HEIGHT * 3; i++) sum += b->rgb[i];
@@ -190,14 +196,13 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     /* A crop renders exactly the full frame's pixels there, so a farm can split a frame;
      * this one also asks for the depth AOV (the other AOVs are not wanted: NULL). */
     float crop[CROP_W * CROP_H * 3], depth[CROP_W * CROP_H];
-    settings.crop_x0 = CROP_X0;
-    settings.crop_y0 = CROP_Y0;
-    settings.crop_x1 = CROP_X0 + CROP_W;
-    settings.crop_y1 = CROP_Y0 + CROP_H;
-    settings.progress = NULL;
-    if (check(ht_render_aovs(scene, &settings, crop, CROP_W * CROP_H * 3, NULL, depth, NULL,
-                             CROP_W * CROP_H),
-              "ht_render_aovs"))
+    char window[64];
+    snprintf(window, sizeof window, "%d,%d,%d,%d", CROP_X0, CROP_Y0, CROP_X0 + CROP_W,
+             CROP_Y0 + CROP_H);
+    if (check(ht_settings_set(settings, "crop", window), "crop")) return 1;
+    if (check(ht_render_with(scene, settings, NULL, NULL, crop, CROP_W * CROP_H * 3, NULL, depth,
+                             NULL, CROP_W * CROP_H),
+              "ht_render_with"))
         return 1;
     int same = 1, hits = 0;
     for (int y = 0; y < CROP_H; y++) {
@@ -214,7 +219,11 @@ static int render_fur(HtScene *scene, const Buffers *b, const char *out) {
     if (check(ht_scene_set_hair_material(scene, hair_id, &hair, &variation), "set hair"))
         return 1;
     float darker[CROP_W * CROP_H * 3];
-    if (check(ht_render(scene, &settings, darker, CROP_W * CROP_H * 3), "ht_render")) return 1;
+    if (check(ht_render_with(scene, settings, NULL, NULL, darker, CROP_W * CROP_H * 3, NULL, NULL,
+                             NULL, CROP_W * CROP_H),
+              "ht_render_with"))
+        return 1;
+    if (check(ht_settings_free(settings), "free settings")) return 1;
     double before = 0.0, after = 0.0;
     for (int i = 0; i < CROP_W * CROP_H * 3; i++) {
         before += crop[i];

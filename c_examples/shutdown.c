@@ -49,22 +49,22 @@ static int render_once(HtDevice **device, HtScene **scene) {
     c.colors = NULL;
     c.basis = HT_CURVE_LINEAR;
     c.shape = HT_CURVE_ROUND;
-    HtRenderSettings s = ht_render_settings_default();
-    s.width = 4;
-    s.height = 4;
-    s.spp = 2;
-    s.threads = 2;
+    HtSettings *s = NULL;
     float rgb[48];
-    if (ht_device_new(2, device) != HT_OK || ht_scene_new(*device, scene) != HT_OK ||
+    if (ht_settings_new(&s) != HT_OK || ht_settings_set(s, "width", "4") != HT_OK ||
+        ht_settings_set(s, "height", "4") != HT_OK || ht_settings_set(s, "spp", "2") != HT_OK ||
+        ht_settings_set(s, "threads", "2") != HT_OK || ht_device_new(2, device) != HT_OK ||
+        ht_scene_new(*device, scene) != HT_OK ||
         ht_scene_add_hair_material(*scene, &params, &hair) != HT_OK ||
         ht_scene_add_curves(*scene, &c, hair, &geom) != HT_OK ||
         ht_scene_add_environment(*scene, sky) != HT_OK ||
         ht_scene_set_camera(*scene, eye, target, up, 30.0f) != HT_OK ||
-        ht_render(*scene, &s, rgb, 48) != HT_OK) {
+        ht_render_with(*scene, s, NULL, NULL, rgb, 48, NULL, NULL, NULL, 16) != HT_OK) {
         printf("render failed: %s\n", ht_last_error());
+        ht_settings_free(s);
         return 1;
     }
-    return 0;
+    return ht_settings_free(s) != HT_OK;
 }
 
 int main(void) {

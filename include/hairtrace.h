@@ -30,7 +30,7 @@
  * Version of the C ABI; bumped on any incompatible change of a signature or struct. The
  * shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
  */
-#define HT_ABI_VERSION 6
+#define HT_ABI_VERSION 7
 
 /**
  * The major part of the library version, which `ht_version()` returns as a string. The
@@ -271,86 +271,10 @@ enum HtStatus ht_hair_sigma_a_preset(const char *name, float *sigma_a);
 enum HtStatus ht_hair_sigma_a_from_color(const float *color, float beta_n, float *sigma_a);
 
 /**
- * Evaluates the BSDF for one (h, wo, wi): writes `f[3]` (linear RGB, per steradian,
- * pbrt's convention: includes the 1/|wi.z| factor, so `f * |wi.z|` is the scattered
- * fraction per unit solid angle) and `*pdf` (the density of `ht_hair_sample` at wi, per
- * unit solid angle).
- *
- * - `params`: see `HtHairParams`; a value out of range: `HT_ERR_INVALID_ARG` naming it.
- * - `h`: offset across the fibre in [-1, 1] (NaN refused); `wo`, `wi`: 3 floats each,
- *   unit vectors (|length - 1| <= 1e-3) in the local frame, both pointing away from the
- *   fibre. `HtHairFrame` says how to build the frame and h: a wrong frame or a flipped
- *   h is *not* detectable here and gives HT_OK with mirrored lobes.
- * - Pointers: none may be NULL (`HT_ERR_NULL_ARG`, checked before any value); all 4-byte
- *   aligned; `f` and `pdf` must not overlap each other or an input (`HT_ERR_INVALID_ARG`).
- *   Outputs are untouched on error. Nothing is kept after the call.
- *
- * Any thread, concurrently. Each thread keeps the last parameter set it saw with its
- * prepared constants; calls alternating between materials prepare them every time:
- * use `ht_hair_prepare` and `HtHairPoint` for that.
- *
- * # Safety
- * Each pointer is NULL or points to its type (3 floats for `wo`, `wi`, `f`), outputs
- * writable.
- */
-enum HtStatus ht_hair_eval(const struct HtHairParams *params,
-                           float h,
-                           const float *wo,
-                           const float *wi,
-                           float *f,
-                           float *pdf);
-
-/**
- * Samples an incident direction for wo at h from three uniform numbers `u[3]` in [0, 1):
- * writes `wi[3]` (unit, local frame, pointing away), `f[3]` and `*pdf` exactly as
- * `ht_hair_eval` gives them at that wi. `f * |wi.z| / pdf` is the path weight. pdf = 0
- * (with wi and f zero) means no direction could be sampled; the status is still HT_OK.
- *
- * Ranges of `params`, `h`, `wo` as in `ht_hair_eval`; `u[i]` outside [0, 1) or NaN:
- * `HT_ERR_INVALID_ARG`. Pointers: none NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte
- * aligned; the outputs `wi`, `f`, `pdf` must not overlap each other or an input
- * (`HT_ERR_INVALID_ARG`). Outputs are untouched on error. Any thread, as `ht_hair_eval`.
- *
- * # Safety
- * Each pointer is NULL or points to its type (3 floats for `wo`, `u`, `wi`, `f`),
- * outputs writable.
- */
-enum HtStatus ht_hair_sample(const struct HtHairParams *params,
-                             float h,
-                             const float *wo,
-                             const float *u,
-                             float *wi,
-                             float *f,
-                             float *pdf);
-
-/**
- * `n` evaluations at once (eight per SIMD step), each bit-identical to `ht_hair_eval`:
- * reads `h[n]`, `wo[3n]`, `wi[3n]`, writes `f[3n]`, `pdf[n]`, tightly packed.
- *
- * - `params` is checked (NULL, ranges) even when `n` = 0.
- * - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked before any
- *   value); 4-byte aligned; `3n` floats must fit in memory (a huge or "negative" `n`:
- *   `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other or an input
- *   (`HT_ERR_INVALID_ARG`).
- * - Every element is checked (ranges as in `ht_hair_eval`) before anything is written;
- *   the message names the first bad element (`element 7: ...`).
- *
- * Any thread, as `ht_hair_eval`.
- *
- * # Safety
- * Each array is NULL or holds the number of floats given above (outputs writable).
- */
-enum HtStatus ht_hair_eval_batch(const struct HtHairParams *params,
-                                 size_t n,
-                                 const float *h,
-                                 const float *wo,
-                                 const float *wi,
-                                 float *f,
-                                 float *pdf);
-
-/**
  * Builds the frame and h of a hit (the convention at `HtHairFrame`) from world-space
  * inputs and writes them to `*frame`; the frame is computed in double precision.
+ * `ht_hair_point_at_hit` builds the same frame and the point there in one call; this one
+ * is for a host that wants the frame itself (its axes, or h to check its own against).
  *
  * - `tangent`: the curve's tangent at the hit (any non-zero length, root to tip);
  *   `ray_org`, `ray_dir`: the ray that hit (any non-zero length); `axis`: the axis point
@@ -375,41 +299,6 @@ enum HtStatus ht_hair_frame(const float *tangent,
                             float radius,
                             struct HtHairFrame *frame);
 
-/**
- * Writes the world direction `w[3]` in the local frame to `out[3]`: (dot(w, x), dot(w, y),
- * dot(w, z)). Lengths are kept (give unit vectors to get the BSDF's unit wo and wi);
- * directions keep their sense (wo must point toward the viewer, i.e. -ray_dir).
- *
- * - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
- *   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
- * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
- *   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
- *   untouched on error.
- *
- * Any thread.
- *
- * # Safety
- * `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
- */
-enum HtStatus ht_hair_frame_to_local(const struct HtHairFrame *frame, const float *w, float *out);
-
-/**
- * Writes the local direction `w[3]` (e.g. a sampled wi) in world space to `out[3]`:
- * w.x x + w.y y + w.z z. Lengths and senses are kept.
- *
- * - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
- *   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
- * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
- *   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
- *   untouched on error.
- *
- * Any thread.
- *
- * # Safety
- * `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
- */
-enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const float *w, float *out);
-
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus
@@ -419,8 +308,8 @@ enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const floa
  * ==================================================================================== */
 
 /**
- * Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
- * grow without changing the ABI.
+ * Bytes of an `HtHairPoint`: the point and its frame fill most of them, the rest leaves
+ * room for the model to grow without changing the ABI.
  */
 #define HT_HAIR_POINT_SIZE 384
 
@@ -430,7 +319,7 @@ enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const floa
 #define HT_HAIR_POINT_ALIGN 16
 
 /**
- * Offsets across the fibre that `ht_hair_point_eval_across` evaluates: one lane each.
+ * Offsets across the fibre that `ht_hair_point_eval_across_world` evaluates: one lane each.
  */
 #define HT_ACROSS 8
 
@@ -442,8 +331,9 @@ enum HtStatus ht_hair_frame_to_world(const struct HtHairFrame *frame, const floa
 typedef struct HtHairPrepared HtHairPrepared;
 
 /**
- * Storage for the BSDF at one shading point (a prepared BSDF at a fixed h and wo), filled
- * by `ht_hair_point_init` and then evaluated and sampled any number of times.
+ * Storage for the BSDF at one shading point (a prepared BSDF at a hit's frame, h and wo),
+ * filled by `ht_hair_point_at_hit` (or `ht_hair_point_init_world`) and then evaluated and
+ * sampled any number of times.
  *
  * - The host allocates it (stack, arrays, its own vertex structs): `HT_HAIR_POINT_SIZE`
  *   bytes aligned to `HT_HAIR_POINT_ALIGN` (16); this type has both, so declaring an
@@ -452,9 +342,8 @@ typedef struct HtHairPrepared HtHairPrepared;
  * - The bytes are opaque. They hold plain numbers and no pointer: a filled point is
  *   self-contained, may be copied with `memcpy` or assignment, stays valid after its
  *   `HtHairPrepared` is freed, and needs no release.
- * - A point that `ht_hair_point_init` did not fill (zeroed, or overwritten) is refused
- *   with `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised
- *   storage.
+ * - A point that no init filled (zeroed, or overwritten) is refused with
+ *   `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised storage.
  * - Reading it from several threads at once is safe; filling it while another thread
  *   reads it is a data race (the host's to avoid).
  */
@@ -527,38 +416,43 @@ enum HtStatus ht_hair_prepare(const struct HtHairParams *params, struct HtHairPr
 enum HtStatus ht_hair_prepared_free(struct HtHairPrepared *prepared);
 
 /**
- * Fills `*point` with the BSDF of `prepared` at offset `h` and outgoing direction `wo`:
- * the work that depends on (h, wo) (Fresnel, absorption, refraction) is done here once,
- * and shared by every eval, pdf and sample at that point.
+ * A renderer's hair hit to a ready point, in one call: the hit's frame and h (exactly as
+ * `ht_hair_frame` builds them, and kept in the point) and the point of `prepared` there,
+ * seen from wo = -normalize(ray_dir). Equal, bit for bit, to `ht_hair_frame` followed by
+ * `ht_hair_point_init_world(prepared, &frame, wo, point)`.
  *
- * - `h` in [-1, 1], `wo[3]` a unit vector (|length - 1| <= 1e-3) in the local frame
- *   pointing away from the fibre (see `HtHairFrame`); else `HT_ERR_INVALID_ARG`.
- * - `prepared`, `wo`, `point`: not NULL (`HT_ERR_NULL_ARG`, checked first); `wo` 4-byte
- *   and `point` 16-byte aligned; `wo` must not lie inside `*point`. On error `*point` is
- *   untouched.
+ * - `tangent`, `ray_org`, `ray_dir`, `axis`, `radius`: as `ht_hair_frame` takes them, and
+ *   refused as it refuses them (`HT_ERR_INVALID_ARG`: not finite, a zero tangent or ray
+ *   direction, a radius not finite and > 0, a ray that passes the axis more than
+ *   `1 + HT_HAIR_FRAME_H_TOLERANCE` radii away).
+ * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); the floats 4-byte and `point`
+ *   16-byte aligned; no input may lie inside `*point` (`HT_ERR_INVALID_ARG`). On error
+ *   `*point` is untouched.
  *
  * Any thread; `prepared` may be shared, `point` must not be read meanwhile.
  *
  * # Safety
- * `prepared` is NULL or a live handle; `wo` NULL or 3 floats; `point` NULL or writable
- * storage of `HT_HAIR_POINT_SIZE` bytes.
+ * `prepared` is NULL or a live handle; each float pointer NULL or 3 floats; `point` NULL
+ * or writable storage of `HT_HAIR_POINT_SIZE` bytes.
  */
-enum HtStatus ht_hair_point_init(const struct HtHairPrepared *prepared,
-                                 float h,
-                                 const float *wo,
-                                 struct HtHairPoint *point);
+enum HtStatus ht_hair_point_at_hit(const struct HtHairPrepared *prepared,
+                                   const float *tangent,
+                                   const float *ray_org,
+                                   const float *ray_dir,
+                                   const float *axis,
+                                   float radius,
+                                   struct HtHairPoint *point);
 
 /**
- * `ht_hair_point_init` from a hit's frame: h is `frame->h`, and `wo[3]` is in *world*
- * space (toward the viewer, -ray_dir normalised at a camera hit). The point keeps the
- * frame's axes, so that `ht_hair_point_eval_world` and `ht_hair_point_sample_world` take
- * and give world directions; the local calls work on it as well. Equal, bit for bit, to
- * `ht_hair_point_init(prepared, frame->h, wo_local, point)` with `wo_local` from
- * `ht_hair_frame_to_local(frame, wo, wo_local)`.
+ * The point of `prepared` at a hit's frame: h is `frame->h`, and `wo[3]` is in world
+ * space (toward the viewer, -ray_dir normalised at the hit that made the frame). The
+ * point keeps the frame's axes, so that the other point calls take and give world
+ * directions. For a host that builds its own frame (or its own h), or works in the local
+ * frame: pass the axes (1,0,0), (0,1,0), (0,0,1) and every direction is its local form.
  *
  * - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
  *   or left-handed, or `h` outside [-1, 1]: `HT_ERR_INVALID_ARG`. Checked here once: the
- *   world-space calls trust it.
+ *   other point calls trust it.
  * - `wo`: a world direction whose local form is a unit vector (|length - 1| <= 1e-3);
  *   else `HT_ERR_INVALID_ARG`.
  * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `frame` and `wo` 4-byte and
@@ -577,185 +471,18 @@ enum HtStatus ht_hair_point_init_world(const struct HtHairPrepared *prepared,
                                        struct HtHairPoint *point);
 
 /**
- * f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward
- * `wi[3]` at a filled point: the same bits as `ht_hair_eval` with the point's parameters,
- * h and wo.
+ * f |cos| and the pdf toward the world `wi[3]` at a filled point, for a light's
+ * contribution and its MIS weight: writes `f_cos[3]` = f * |cos| (f the BSDF, RGB per
+ * steradian, times the cosine to the fibre's normal plane: the fraction scattered per
+ * unit solid angle) and `*pdf`, the density of `ht_hair_point_sample_world` at wi (per
+ * unit solid angle). wi is taken to the point's frame (with no second check of the frame:
+ * init made it) and must be a unit vector there (|length - 1| <= 1e-3).
  *
- * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame, pointing away;
- *   else `HT_ERR_INVALID_ARG`.
- * - `point`, `wi`, `f`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
- *   filled by `ht_hair_point_init` and 16-byte aligned, the floats 4-byte aligned
- *   (`HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi` or the point
- *   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f` NULL or 3 floats,
- * `pdf` NULL or 1 float; outputs writable.
- */
-enum HtStatus ht_hair_point_eval(const struct HtHairPoint *point,
-                                 const float *wi,
-                                 float *f,
-                                 float *pdf);
-
-/**
- * f * |wi.z| and the pdf toward `wi[3]` (the point's local frame) at `HT_ACROSS` offsets
- * across the fibre: the point's h and its shifts by 2k / `HT_ACROSS`, wrapped into
- * [-1, 1]. Writes lane k's f |cos| to `f_cos[3k..3k+3]` and its pdf to `pdf[k]`; lane 0
- * is the point's own h.
- *
- * What it is for: a strand under a pixel wide shows the camera its whole width, so the
- * image holds the BSDF averaged across the fibre. Next-event estimation that weighs a
- * light by the mean over the lanes of `f_cos[k]` times the lane's own MIS weight (from
- * `pdf[k]`), while BSDF sampling still draws from the point, renders the same image in
- * expectation with less noise: hairtrace's own renderer does so and measures 1.5x-2.5x
- * less variance under small lights (docs/c-abi.md). At a camera ray's hit on a strand
- * wider than its pixel, use `ht_hair_point_eval_cos`: the image resolves the fibre there.
- *
- * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
- *   `HT_ERR_INVALID_ARG`.
+ * - `wi` not a unit vector: `HT_ERR_INVALID_ARG`.
  * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
- *   filled by an init and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf`
- *   must not overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs
- *   untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
- * NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
- */
-enum HtStatus ht_hair_point_eval_across(const struct HtHairPoint *point,
-                                        const float *wi,
-                                        float *f_cos,
-                                        float *pdf);
-
-/**
- * `ht_hair_point_eval_across` with `wi[3]` in *world* space, at a point filled by
- * `ht_hair_point_init_world`: wi is taken to the point's frame, as
- * `ht_hair_point_eval_world` takes it, and must be a unit vector there (|length - 1| <=
- * 1e-3). The same bits as `ht_hair_frame_to_local` followed by `ht_hair_point_eval_across`.
- *
- * - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
- * - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
- *   `HT_ERR_INVALID_ARG`.
- * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
- *   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
- *   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
- * NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
- */
-enum HtStatus ht_hair_point_eval_across_world(const struct HtHairPoint *point,
-                                              const float *wi,
-                                              float *f_cos,
-                                              float *pdf);
-
-/**
- * The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
- * `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
- *
- * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
- *   `HT_ERR_INVALID_ARG`.
- * - `point`, `wi`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled by
- *   an init and 16-byte aligned, the floats 4-byte aligned; `pdf` must not overlap `wi`
- *   or the point (`HT_ERR_INVALID_ARG`). `*pdf` untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `pdf`
- * NULL or 1 writable float.
- */
-enum HtStatus ht_hair_point_pdf(const struct HtHairPoint *point, const float *wi, float *pdf);
-
-/**
- * Samples an incident direction at a filled point from `u[3]` in [0, 1): writes `wi[3]`
- * (unit, local frame), `f[3]` and `*pdf`, the same bits as `ht_hair_sample` with the
- * point's parameters, h and wo. pdf = 0 (wi, f zero) means no direction; still HT_OK.
- *
- * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
- * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled and 16-byte
- *   aligned, floats 4-byte aligned; `wi`, `f`, `pdf` must not overlap each other, `u` or
- *   the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `f` NULL or 3
- * floats, `pdf` NULL or 1 float; outputs writable.
- */
-enum HtStatus ht_hair_point_sample(const struct HtHairPoint *point,
-                                   const float *u,
-                                   float *wi,
-                                   float *f,
-                                   float *pdf);
-
-/**
- * One call for what a path vertex wants of a light direction: writes `f_cos[3]` =
- * f * |wi.z| (the `f` of `ht_hair_point_eval` times the cosine, in that order: the
- * fraction scattered per unit solid angle) and `*pdf`, the same pdf as
- * `ht_hair_point_eval`.
- *
- * - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
- *   `HT_ERR_INVALID_ARG`.
- * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
- *   filled by an init and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf`
- *   must not overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs
- *   untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
- * floats, `pdf` NULL or 1 float; outputs writable.
- */
-enum HtStatus ht_hair_point_eval_cos(const struct HtHairPoint *point,
-                                     const float *wi,
-                                     float *f_cos,
-                                     float *pdf);
-
-/**
- * One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
- * `ht_hair_point_sample`), `weight[3]` = f * |wi.z| / pdf (the path throughput factor,
- * from that call's f and pdf in that order) and `*pdf`. pdf = 0 (wi, weight zero) means
- * no direction, also when the weight would not be finite; still HT_OK.
- *
- * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
- * - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
- *   `point` filled by an init and 16-byte aligned, the floats 4-byte aligned; `wi`,
- *   `weight` and `pdf` must not overlap each other, `u` or the point
- *   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
- *
- * Any thread, concurrently on the same point.
- *
- * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
- * floats, `pdf` NULL or 1 float; outputs writable.
- */
-enum HtStatus ht_hair_point_sample_cos(const struct HtHairPoint *point,
-                                       const float *u,
-                                       float *wi,
-                                       float *weight,
-                                       float *pdf);
-
-/**
- * `ht_hair_point_eval_cos` with `wi[3]` in *world* space, at a point filled by
- * `ht_hair_point_init_world`: wi is taken to the point's frame (as
- * `ht_hair_frame_to_local` does, but with no check of the frame: init made it) and must be
- * a unit vector there (|length - 1| <= 1e-3). The same bits as `ht_hair_frame_to_local`
- * followed by `ht_hair_point_eval_cos`.
- *
- * - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
- * - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
- *   `HT_ERR_INVALID_ARG`.
- * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
- *   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
- *   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *   filled and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf` must not
+ *   overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
+ *   error.
  *
  * Any thread, concurrently on the same point.
  *
@@ -769,83 +496,69 @@ enum HtStatus ht_hair_point_eval_world(const struct HtHairPoint *point,
                                        float *pdf);
 
 /**
- * `ht_hair_point_sample_cos` giving `wi[3]` in *world* space, at a point filled by
- * `ht_hair_point_init_world`: the local sample taken to world space with the point's
- * frame, the same bits as `ht_hair_point_sample_cos` followed by `ht_hair_frame_to_world`
- * (weight and pdf are unchanged). pdf = 0 (wi, weight zero) means no direction.
+ * f |cos| and the pdf toward the world `wi[3]` at `HT_ACROSS` offsets across the fibre:
+ * the point's h and its shifts by 2k / `HT_ACROSS`, wrapped into [-1, 1]. Writes lane k's
+ * f |cos| to `f_cos[3k..3k+3]` and its pdf to `pdf[k]`; lane 0 is the point's own h, the
+ * values of `ht_hair_point_eval_world`. wi is taken to the point's frame, as
+ * `ht_hair_point_eval_world` takes it.
  *
- * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
- * - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+ * What it is for: a strand under a pixel wide shows the camera its whole width, so the
+ * image holds the BSDF averaged across the fibre. Next-event estimation that weighs a
+ * light by the mean over the lanes of `f_cos[k]` times the lane's own MIS weight (from
+ * `pdf[k]`), while BSDF sampling still draws from the point, renders the same image in
+ * expectation with less noise: hairtrace's own renderer does so and measures 1.5x-2.5x
+ * less variance under small lights (docs/c-abi.md). At a camera ray's hit on a strand
+ * wider than its pixel, use `ht_hair_point_eval_world`: the image resolves the fibre there.
+ *
+ * - `wi` not a unit vector in the point's frame (|length - 1| <= 1e-3):
  *   `HT_ERR_INVALID_ARG`.
- * - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
- *   `point` 16-byte and the floats 4-byte aligned; `wi`, `weight` and `pdf` must not
- *   overlap each other, `u` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
+ * - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+ *   filled and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf` must not
+ *   overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
  *   error.
  *
  * Any thread, concurrently on the same point.
  *
  * # Safety
- * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
- * floats, `pdf` NULL or 1 float; outputs writable.
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
+ * NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
+ */
+enum HtStatus ht_hair_point_eval_across_world(const struct HtHairPoint *point,
+                                              const float *wi,
+                                              float *f_cos,
+                                              float *pdf);
+
+/**
+ * A sampled direction and what a path vertex wants of it, from `u[3]` in [0, 1): writes
+ * `wi[3]` (unit, world space), `f_cos[3]` = f * |cos| (as `ht_hair_point_eval_world`
+ * gives it toward wi: for a host that weighs strategies itself, with MIS or otherwise),
+ * `weight[3]` = f_cos / pdf (the path throughput factor, from the same f_cos and pdf) and
+ * `*pdf` (per unit solid angle). pdf = 0 (wi, f_cos, weight zero) means no direction, also
+ * when the weight would not be finite; still HT_OK.
+ *
+ * - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+ * - `point`, `u`, `wi`, `f_cos`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked
+ *   first); `point` filled and 16-byte aligned, the floats 4-byte aligned; no output may
+ *   overlap another, `u` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+ *
+ * Any thread, concurrently on the same point.
+ *
+ * # Safety
+ * `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `f_cos`, `weight`
+ * NULL or 3 floats, `pdf` NULL or 1 float; outputs writable.
  */
 enum HtStatus ht_hair_point_sample_world(const struct HtHairPoint *point,
                                          const float *u,
                                          float *wi,
+                                         float *f_cos,
                                          float *weight,
                                          float *pdf);
-
-/**
- * `ht_hair_point_eval` over `n` points at once: `points[n]` (each filled, possibly from
- * different prepared BSDFs), `wi[3n]` in, `f[3n]` and `pdf[n]` out, tightly packed; each
- * result bit-identical to `ht_hair_point_eval`.
- *
- * - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
- *   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
- *   "negative" `n`: `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi`
- *   or `points` (`HT_ERR_INVALID_ARG`).
- * - Every point and every `wi` is checked before anything is written; the message names
- *   the first bad element (`element 7: ...`).
- *
- * Any thread, concurrently on the same points.
- *
- * # Safety
- * Each array is NULL or holds the number of elements given above (outputs writable).
- */
-enum HtStatus ht_hair_points_eval(const struct HtHairPoint *points,
-                                  size_t n,
-                                  const float *wi,
-                                  float *f,
-                                  float *pdf);
-
-/**
- * `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
- * `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
- * `ht_hair_point_sample`. `pdf[i]` = 0 (`wi`, `f` zero) means no direction for point i.
- *
- * - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
- *   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
- *   "negative" `n`: `HT_ERR_INVALID_ARG`); `wi`, `f` and `pdf` must not overlap each
- *   other, `u` or `points` (`HT_ERR_INVALID_ARG`).
- * - Every point must be filled and every `u` in [0, 1) (`HT_ERR_INVALID_ARG`), all
- *   checked before anything is written; the message names the first bad element.
- *
- * Any thread, concurrently on the same points.
- *
- * # Safety
- * Each array is NULL or holds the number of elements given above (outputs writable).
- */
-enum HtStatus ht_hair_points_sample(const struct HtHairPoint *points,
-                                    size_t n,
-                                    const float *u,
-                                    float *wi,
-                                    float *f,
-                                    float *pdf);
 
 #if defined(HT_RENDER)
 
 /**
- * `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
- * material varies them (`ht_scene_add_hair_material_varied`): the parameters of
+ * `ht_hair_point_init_world` for one strand of a groom whose parameters vary as a scene's
+ * hair material varies them (`ht_scene_add_hair_material_varied`): the parameters of
  * `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
  * (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
  * `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
@@ -854,25 +567,25 @@ enum HtStatus ht_hair_points_sample(const struct HtHairPoint *points,
  *
  * - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
  *   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
- *   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
- *   Else `HT_ERR_INVALID_ARG`.
- * - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
- *   as `ht_hair_point_init`. On error `*point` is untouched.
+ *   the variation's ranges as at `HtHairVariation`; `frame`, `wo` as
+ *   `ht_hair_point_init_world`. Else `HT_ERR_INVALID_ARG`.
+ * - Pointers: `prepared`, `variation`, `frame`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`);
+ *   others as `ht_hair_point_init_world`. On error `*point` is untouched.
  * - Cost: an init plus the preparation of the varied parameters (about one evaluation).
  *
  * Any thread; `prepared` and `variation` may be shared, `point` must not be read
  * meanwhile. Not in the BSDF-only library.
  *
  * # Safety
- * As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
- * floats.
+ * As `ht_hair_point_init_world`; `variation` NULL or an `HtHairVariation`; `color` NULL
+ * or 3 floats.
  */
 enum HtStatus ht_hair_point_init_strand(const struct HtHairPrepared *prepared,
                                         const struct HtHairVariation *variation,
                                         uint32_t strand,
                                         float s,
                                         const float *color,
-                                        float h,
+                                        const struct HtHairFrame *frame,
                                         const float *wo,
                                         struct HtHairPoint *point);
 
@@ -900,7 +613,7 @@ typedef struct HtDevice HtDevice;
  * be used concurrently).
  *
  * Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
- * later additions. Its first build (`ht_scene_build` or the first render) puts the
+ * later additions. Its first build (`ht_scene_build_with` or the first render) puts the
  * scene's curves in spatial order and shares their control points with Embree's
  * buffers, so a built scene holds one copy of them plus the BVH (an `auto` groom's
  * level-of-detail ribbons and round/flat shares are copies of their own), and a rebuild
@@ -1402,7 +1115,7 @@ struct HtHairVariation ht_hair_variation_default(void);
 
 /**
  * Adds a hair material with the same parameters on every strand (ranges as for
- * `ht_hair_eval`); writes its id (0, 1, ... in the order materials are added) to
+ * `ht_hair_prepare`); writes its id (0, 1, ... in the order materials are added) to
  * `material_id`.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
@@ -1488,7 +1201,7 @@ enum HtStatus ht_scene_set_diffuse_material(struct HtScene *scene,
 /**
  * Joins the worker threads the library started, once every device and scene has been
  * freed: TBB's workers, which Embree used to build scenes and which otherwise run until
- * the process exits. Render threads need no call: each `ht_render` joins its own before
+ * the process exits. Render threads need no call: each `ht_render_with` joins its own before
  * it returns. After `HT_OK` no thread started by hairtrace is running, and the library
  * may still be used again (a new device starts new workers).
  *
@@ -1607,9 +1320,11 @@ const char *ht_settings_key(size_t index);
 #if defined(HT_RENDER)
 
 /**
- * A pixel filter: one of the `HT_FILTER_*` constants.
+ * Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never
+ * decreasing from call to call. Return false to cancel the build. Called from Embree's
+ * worker threads, never two calls at once; it must return normally (as `HtProgressFn`).
  */
-typedef uint32_t HtPixelFilter;
+typedef bool (*HtBuildProgressFn)(double fraction, void *user);
 
 /**
  * Told how far a render has got: `done` of `total` pixels, counted over the render's
@@ -1620,134 +1335,19 @@ typedef uint32_t HtPixelFilter;
  * round and, while pixels take long (many samples), also every 20 ms or so of work with an
  * unchanged `done`, so that it can cancel any render promptly. Return false to cancel: no
  * new sample starts, the round of unfinished tiles is dropped (their pixels keep the
- * rounds they finished), and `ht_render` returns `HT_ERR_CANCELLED`.
+ * rounds they finished), and `ht_render_with` returns `HT_ERR_CANCELLED`.
  *
  * Called from the render's worker threads (not necessarily the one that called
- * `ht_render`), but never two calls at once, so `user` needs no locking against itself.
+ * `ht_render_with`), but never two calls at once, so `user` needs no locking against itself.
  * Inside it, `ht_progress_noise()` tells the render's estimated noise so far. The
  * callback must return normally: a C++ exception or a longjmp out of it is undefined
  * behaviour (catch inside and return false instead).
  */
 typedef bool (*HtProgressFn)(uint64_t done, uint64_t total, void *user);
 
-/**
- * Deprecated (ABI 6, the last to have it): use `HtSettings` with `ht_settings_set`,
- * `ht_scene_build_with` and `ht_render_with`, whose settings are named and never change
- * the ABI's layout (settings added since, such as `isa`, are only there).
- *
- * What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
- * the fields you need.
- */
-typedef struct HtRenderSettings {
-    /**
-     * Image size in pixels, each in [1, 32768].
-     */
-    uint32_t width;
-    uint32_t height;
-    /**
-     * Samples per pixel, >= 1.
-     */
-    uint32_t spp;
-    /**
-     * The image depends only on the scene, these settings and this seed: never on the
-     * thread count.
-     */
-    uint64_t seed;
-    /**
-     * Render threads; 0: one per hardware thread.
-     */
-    uint32_t threads;
-    /**
-     * Longest path in scattering events, >= 1. Light hair needs many: the default (256)
-     * keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
-     */
-    uint32_t max_depth;
-    /**
-     * Crop window: render only the pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
-     * full width x height frame (x0 < x1 <= width, y0 < y1 <= height); all four 0 renders
-     * the full frame. The output buffers then hold the window's pixels alone, rows from
-     * its top. A crop renders exactly the values the full frame has at those pixels (the
-     * camera still sees the full frame, and every sample depends only on the seed and its
-     * full-frame pixel), so a render farm can split a frame into windows and reassemble
-     * them bit for bit.
-     */
-    uint32_t crop_x0;
-    uint32_t crop_y0;
-    uint32_t crop_x1;
-    uint32_t crop_y1;
-    /**
-     * Pixel filter: `HT_FILTER_TENT` (the default: thin strands alias under a box) or
-     * `HT_FILTER_BOX` (one pixel, for comparisons with renderers that use it).
-     */
-    HtPixelFilter filter;
-    /**
-     * The tent's half-width in pixels, in (0, 8]; ignored by the box. Default 1.
-     */
-    float filter_radius;
-    /**
-     * May be NULL: no progress reports, no cancellation.
-     */
-    HtProgressFn progress;
-    /**
-     * Passed to `progress` as it is.
-     */
-    void *progress_user;
-    /**
-     * Past this many scattering events a hair BSDF is one merged lobe: the same energy
-     * (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
-     * per event and far less noisy on light hair, but biased (light hair comes out
-     * brighter), so off by default. 0 (the default): the exact model at every event.
-     * Otherwise in [1, max_depth]; max_depth changes nothing. docs/measurements.md, "Speed against
-     * error", has what it costs and buys. (ABI 5.)
-     */
-    uint32_t deep_bounce_depth;
-    /**
-     * Hair lobes whose attenuation (largest channel) is below this fraction of the total
-     * are dropped from evaluation and sampling (the strongest lobe is always kept); in
-     * [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
-     * measured, saves no time: off by default (docs/measurements.md, "Speed against error"). (ABI 5.)
-     */
-    float lobe_cull;
-    /**
-     * Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
-     * (largest channel, in the image's units) is below this value traces its shadow ray
-     * with probability contribution / threshold and is reweighted by the inverse. Unbiased;
-     * finite and >= 0, 0 traces every shadow ray. Default 0.03, chosen on the bench
-     * scenes (docs/measurements.md, "Render efficiency"). (ABI 6.)
-     */
-    float light_threshold;
-} HtRenderSettings;
-
-/**
- * Told how far the build of a scene's BVH has got: `fraction` in [0, 1], never
- * decreasing from call to call. Return false to cancel the build. Called from Embree's
- * worker threads, never two calls at once; it must return normally (as `HtProgressFn`).
- */
-typedef bool (*HtBuildProgressFn)(double fraction, void *user);
-
-/**
- * A separable tent of half-width `filter_radius` pixels.
- */
-#define HT_FILTER_TENT 0
-
-/**
- * The one-pixel box.
- */
-#define HT_FILTER_BOX 1
-
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
-
-/**
- * Deprecated with `HtRenderSettings`: use `ht_settings_new`.
- *
- * 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
- * crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
- * deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03. Cannot fail; any
- * thread.
- */
-struct HtRenderSettings ht_render_settings_default(void);
 
 /**
  * The estimated noise of the render whose progress callback calls this (the RMSE of its
@@ -1759,30 +1359,10 @@ struct HtRenderSettings ht_render_settings_default(void);
 float ht_progress_noise(void);
 
 /**
- * Deprecated with `HtRenderSettings`: use `ht_scene_build_with`.
- *
- * Builds now what `ht_render` with `settings` would build first: the Embree scene (and,
- * for `HT_CURVE_AUTO` curves, their shapes for this camera and image height), telling
- * `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom takes tens
- * of seconds here; a render with the same view then starts at once. Only the size of
- * `settings` (width, height) matters; its render callback is not called.
- *
- * Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
- * out of range, a scene with no light, or no camera and no geometry to frame);
- * `HT_ERR_EMBREE` (the build failed); `HT_ERR_CANCELLED` (`progress` returned false: the
- * scene is left unbuilt, and the next build or render starts over).
- *
- * # Safety
- * `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
- * `settings` is NULL or readable.
- */
-enum HtStatus ht_scene_build(struct HtScene *scene,
-                             const struct HtRenderSettings *settings,
-                             HtBuildProgressFn progress,
-                             void *user);
-
-/**
- * As `ht_scene_build` (deprecated), with settings by name.
+ * Builds now what `ht_render_with` with `settings` would build first: the Embree scene
+ * (and, for `HT_CURVE_AUTO` curves, their shapes for this camera and image height),
+ * telling `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom
+ * takes tens of seconds here; a render with the same view then starts at once.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
  * out of range, a scene with no light, or no camera and no geometry to frame);
@@ -1802,36 +1382,20 @@ enum HtStatus ht_scene_build_with(struct HtScene *scene,
                                   void *user);
 
 /**
- * Deprecated with `HtRenderSettings`: use `ht_render_with`.
- *
- * Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
- * `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
- * owned by the host. `ht_render_aovs` without AOVs.
+ * Renders `scene` with `settings` into `rgb`: linear float RGB, interleaved, rows from the
+ * top, `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a
+ * crop) owned by the host, telling `progress` (may be NULL) with `user`.
  *
  * The first render builds the Embree scene (its time is part of the call, silent:
- * `ht_scene_build` reports it); later ones reuse it until geometry is added, or until
- * a view needs other shapes for `HT_CURVE_AUTO` curves. Blocks until the image is done,
- * on worker threads of its own that are joined before it returns. On `HT_ERR_CANCELLED`,
- * `rgb` holds the pixels finished before the callback said stop and 0 elsewhere; on other
- * errors it is left untouched.
+ * `ht_scene_build_with` reports it); later ones reuse it until geometry is added, or until
+ * a view needs other shapes for `HT_CURVE_AUTO` curves. On `HT_ERR_CANCELLED`, `rgb` holds
+ * the pixels finished before the callback said stop and 0 elsewhere; on other errors
+ * every buffer is left untouched.
  *
- * Statuses: as `ht_render_aovs`.
- *
- * # Safety
- * As `ht_render_aovs`.
- */
-enum HtStatus ht_render(struct HtScene *scene,
-                        const struct HtRenderSettings *settings,
-                        float *rgb,
-                        size_t rgb_len);
-
-/**
- * Deprecated with `HtRenderSettings`: use `ht_render_with`.
- *
- * As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
- * and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
- * `pixel_count` is the crop window's pixel count (width * height without a crop), and
- * each buffer holds that many pixels, rows from the top, in memory of its own:
+ * It also writes the AOVs (arbitrary output variables, for compositing and denoising)
+ * whose buffers are not NULL; NULL means not wanted, and costs nothing. `pixel_count` is
+ * the crop window's pixel count (width * height without a crop), and each buffer holds
+ * that many pixels, rows from the top, in memory of its own:
  *
  * - `albedo`: 3 floats per pixel, the mean reflectance colour (hair colour, diffuse
  *   albedo, linear RGB in [0, 1]) of the surfaces the pixel's camera rays hit first;
@@ -1844,32 +1408,7 @@ enum HtStatus ht_render(struct HtScene *scene,
  *   no id.
  *
  * On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the passes each pixel finished and the
- * values of "nothing hit" elsewhere; on other errors every buffer is left untouched.
- *
- * Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
- * (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer
- * misaligned, any two buffers (or a buffer and `*settings`) overlapping, a scene with no
- * light, or no camera and no geometry to frame); `HT_ERR_EMBREE` (the scene build
- * failed); `HT_ERR_CANCELLED` (the progress callback returned false).
- *
- * # Safety
- * `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
- * `settings` is NULL or readable; each non-NULL buffer holds the floats its length says,
- * writable, and nothing else reads or writes it during the call.
- */
-enum HtStatus ht_render_aovs(struct HtScene *scene,
-                             const struct HtRenderSettings *settings,
-                             float *rgb,
-                             size_t rgb_len,
-                             float *albedo,
-                             float *depth,
-                             float *strand_id,
-                             size_t pixel_count);
-
-/**
- * As `ht_render_aovs` (deprecated), with settings by name and the progress callback
- * (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
- * may be NULL (not wanted).
+ * values of "nothing hit" elsewhere.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
  * (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer

@@ -6,16 +6,19 @@
  *   calls this layer does not wrap.
  * - The host's own vectors go in and out as they are: anything with `x, y, z` members or
  *   an `operator[]` (glm, Eigen, a `float[3]`, a std::array), converted to float.
- * - Errors are exceptions (`hairtrace::Error`, with the status and `ht_last_error()`'s
- *   message). Every status the library returns is a broken contract (a bad argument, a file
- *   that cannot be read), never a per-sample outcome: "no direction" is a sample with
- *   pdf 0, not an error. So a throw happens once in a failing run and costs nothing on the
- *   paths a host takes per sample, and a C++17 host has no std::expected. A host built
- *   without exceptions uses hairtrace.h directly.
+ * - Two forms of every per-vertex call. The value form throws `hairtrace::Error` (the
+ *   status and `ht_last_error()`'s message): for set-up and for hosts that catch per
+ *   frame. The status form is `noexcept`, writes its result to an out-parameter and
+ *   returns the `HtStatus` (`HT_OK`, or read `ht_last_error()` on this thread): for a
+ *   renderer's worker threads, where an escaped exception would end the render and a
+ *   try/catch around every vertex is not wanted. "No direction" is a sample with pdf 0,
+ *   not an error, in both forms.
  *
- * The hot path is three calls per path vertex: `Point::world` (or the local constructor),
- * `eval_world` (f |cos| and pdf toward a light), `sample_world` (a direction, its weight
- * f |cos| / pdf and pdf). They give the bits of the C calls they wrap.
+ * The hot path is three calls per path vertex: `Point::set_at_hit` (a hit to a point with
+ * its frame), `eval_world` (f |cos| and pdf toward a light), `sample_world` (a direction,
+ * f |cos|, the weight f |cos| / pdf and the pdf). `Point` and `Frame` are
+ * default-constructible, so a host's vertex struct holds them. They give the bits of the C
+ * calls they wrap.
  */
 #ifndef HT_HAIRTRACE_HPP
 #define HT_HAIRTRACE_HPP
@@ -86,9 +89,11 @@ struct Eval {
 /** `Eval` at each of the `HT_ACROSS` offsets across the fibre, the point's own first. */
 using Across = std::array<Eval, HT_ACROSS>;
 
-/** A sampled direction, its weight f |cos| / pdf and its pdf; pdf 0: no direction. */
+/** A sampled direction, f |cos| toward it, its weight f |cos| / pdf and its pdf; pdf 0: no
+ * direction. */
 struct Sample {
     Vec3 wi;
+    Vec3 f_cos;
     Vec3 weight;
     float pdf;
     explicit operator bool() const noexcept { return pdf > 0.0f; }
@@ -121,46 +126,43 @@ inline Vec3 sigma_a_preset(const char *name) {
 
 /**
  * The shading frame and h of a hair hit (`HtHairFrame`, `ht_hair_frame`): the convention
- * every call assumes, built from the hit instead of by hand.
+ * every call assumes, built from the hit instead of by hand. Default-constructed, it is no
+ * frame (zero axes): a point refuses it until it is set.
  */
 class Frame {
 public:
+    Frame() noexcept : frame_() {}
+    /** A frame the host built itself; checked where it is used. */
+    explicit Frame(const HtHairFrame &frame) noexcept : frame_(frame) {}
+
     /** From the curve's tangent, the ray, the axis point at the hit and the radius there. */
     template <class T, class O, class D, class A>
     static Frame at_hit(const T &tangent, const O &ray_org, const D &ray_dir, const A &axis,
                         float radius) {
-        const Vec3 t = vec3(tangent), o = vec3(ray_org), d = vec3(ray_dir), a = vec3(axis);
         Frame f;
-        check(ht_hair_frame(t.data(), o.data(), d.data(), a.data(), radius, &f.frame_));
+        check(f.set_at_hit(tangent, ray_org, ray_dir, axis, radius));
         return f;
     }
-    /** A frame the host built itself; checked where it is used. */
-    explicit Frame(const HtHairFrame &frame) : frame_(frame) {}
+    /** `at_hit` into this frame, with a status instead of a throw (unchanged on error). */
+    template <class T, class O, class D, class A>
+    HtStatus set_at_hit(const T &tangent, const O &ray_org, const D &ray_dir, const A &axis,
+                        float radius) noexcept {
+        const Vec3 t = vec3(tangent), o = vec3(ray_org), d = vec3(ray_dir), a = vec3(axis);
+        return ht_hair_frame(t.data(), o.data(), d.data(), a.data(), radius, &frame_);
+    }
 
     /** The offset across the fibre, in radii. */
     float h() const noexcept { return frame_.h; }
-    /** A world direction in the local frame (`ht_hair_frame_to_local`). */
-    template <class V> Vec3 to_local(const V &w) const { return convert(ht_hair_frame_to_local, w); }
-    /** A local direction in world space (`ht_hair_frame_to_world`). */
-    template <class V> Vec3 to_world(const V &w) const { return convert(ht_hair_frame_to_world, w); }
     const HtHairFrame &c() const noexcept { return frame_; }
 
 private:
-    Frame() : frame_() {}
-    template <class V>
-    Vec3 convert(HtStatus (*call)(const HtHairFrame *, const float *, float *), const V &w) const {
-        const Vec3 in = vec3(w);
-        Vec3 out;
-        check(call(&frame_, in.data(), out.data()));
-        return out;
-    }
     HtHairFrame frame_;
 };
 
 /**
  * A hair material: the BSDF prepared for one parameter set (`ht_hair_prepare`). Copies share
  * the one immutable handle, which any number of threads may use at once; the last copy
- * releases it.
+ * releases it. Made once per material, at set-up: it throws.
  */
 class Material {
 public:
@@ -177,90 +179,108 @@ private:
 
 /**
  * The BSDF at one path vertex (`HtHairPoint`): plain bytes in the host's memory, filled once
- * and then evaluated and sampled any number of times, by any number of threads. Copyable,
- * no release, independent of the `Material` it came from.
+ * and then evaluated and sampled any number of times, by any number of threads, in world
+ * space. Copyable, no release, independent of the `Material` it came from.
+ * Default-constructed it is unfilled (zero bytes): every call on it returns
+ * `HT_ERR_INVALID_ARG` (or throws, in the value form) until a `set_*` fills it.
  */
 class Point {
 public:
-    /** At offset `h` with `wo` in the local frame (`ht_hair_point_init`). */
-    template <class V> Point(const Material &material, float h, const V &wo) {
-        const Vec3 w = vec3(wo);
-        check(ht_hair_point_init(material.get(), h, w.data(), &point_));
-    }
-    /** At a hit's frame, `wo` in world space (`ht_hair_point_init_world`): the world calls. */
-    template <class V> static Point world(const Material &material, const Frame &frame, const V &wo) {
-        const Vec3 w = vec3(wo);
+    Point() noexcept : point_() {}
+
+    /** A renderer's hit to a point, frame included (`ht_hair_point_at_hit`): the curve's
+     * tangent, the ray, the axis point at the hit and the radius there; wo is -ray_dir. */
+    template <class T, class O, class D, class A>
+    static Point at_hit(const Material &material, const T &tangent, const O &ray_org,
+                        const D &ray_dir, const A &axis, float radius) {
         Point p;
-        check(ht_hair_point_init_world(material.get(), &frame.c(), w.data(), &p.point_));
+        check(p.set_at_hit(material, tangent, ray_org, ray_dir, axis, radius));
         return p;
+    }
+    /** `at_hit` into this point, with a status instead of a throw (unchanged on error). */
+    template <class T, class O, class D, class A>
+    HtStatus set_at_hit(const Material &material, const T &tangent, const O &ray_org,
+                        const D &ray_dir, const A &axis, float radius) noexcept {
+        const Vec3 t = vec3(tangent), o = vec3(ray_org), d = vec3(ray_dir), a = vec3(axis);
+        return ht_hair_point_at_hit(material.get(), t.data(), o.data(), d.data(), a.data(),
+                                    radius, &point_);
+    }
+    /** At a frame, `wo` in world space (`ht_hair_point_init_world`). */
+    template <class V> static Point world(const Material &material, const Frame &frame, const V &wo) {
+        Point p;
+        check(p.set_world(material, frame, wo));
+        return p;
+    }
+    /** `world` into this point, with a status instead of a throw (unchanged on error). */
+    template <class V>
+    HtStatus set_world(const Material &material, const Frame &frame, const V &wo) noexcept {
+        const Vec3 w = vec3(wo);
+        return ht_hair_point_init_world(material.get(), &frame.c(), w.data(), &point_);
     }
 
 #if defined(HT_RENDER)
     /** At strand `strand`, position `s`, of a groom varied as `variation` says, with the
-     * strand's colour `color` (NULL: none): `ht_hair_point_init_strand`. */
+     * strand's colour `color` (NULL: none), at a frame with `wo` in world space:
+     * `ht_hair_point_init_strand`. */
     template <class V>
     static Point strand(const Material &material, const HtHairVariation &variation,
-                        uint32_t strand, float s, const float *color, float h, const V &wo) {
+                        uint32_t strand, float s, const float *color, const Frame &frame,
+                        const V &wo) {
         const Vec3 w = vec3(wo);
         Point p;
-        check(ht_hair_point_init_strand(material.get(), &variation, strand, s, color, h, w.data(),
-                                        &p.point_));
+        check(ht_hair_point_init_strand(material.get(), &variation, strand, s, color, &frame.c(),
+                                        w.data(), &p.point_));
         return p;
     }
 #endif
 
-    /** f |cos| and pdf toward the local `wi` (`ht_hair_point_eval_cos`). */
-    template <class V> Eval eval(const V &wi) const { return eval_with(ht_hair_point_eval_cos, wi); }
-    /** A local direction from `u` in [0, 1)^3 (`ht_hair_point_sample_cos`). */
-    Sample sample(const Vec3 &u) const { return sample_with(ht_hair_point_sample_cos, u); }
     /** f |cos| and pdf toward the world `wi` (`ht_hair_point_eval_world`). */
     template <class V> Eval eval_world(const V &wi) const {
-        return eval_with(ht_hair_point_eval_world, wi);
+        Eval e;
+        check(eval_world(wi, e));
+        return e;
+    }
+    /** `eval_world` into `out`, with a status instead of a throw. */
+    template <class V> HtStatus eval_world(const V &wi, Eval &out) const noexcept {
+        const Vec3 w = vec3(wi);
+        return ht_hair_point_eval_world(&point_, w.data(), out.f_cos.data(), &out.pdf);
     }
     /** A world direction from `u` in [0, 1)^3 (`ht_hair_point_sample_world`). */
-    Sample sample_world(const Vec3 &u) const { return sample_with(ht_hair_point_sample_world, u); }
-    /** f |cos| and pdf toward the local `wi` at `HT_ACROSS` offsets across the fibre, the
-     * point's own first (`ht_hair_point_eval_across`): next-event estimation weighs a light
-     * by the lanes' mean, each lane with its own MIS weight (docs/c-abi.md). */
-    template <class V> Across eval_across(const V &wi) const {
-        return across_with(ht_hair_point_eval_across, wi);
+    Sample sample_world(const Vec3 &u) const {
+        Sample s;
+        check(sample_world(u, s));
+        return s;
     }
-    /** The same toward the world `wi` (`ht_hair_point_eval_across_world`). */
+    /** `sample_world` into `out`, with a status instead of a throw. */
+    HtStatus sample_world(const Vec3 &u, Sample &out) const noexcept {
+        return ht_hair_point_sample_world(&point_, u.data(), out.wi.data(), out.f_cos.data(),
+                                          out.weight.data(), &out.pdf);
+    }
+    /** f |cos| and pdf toward the world `wi` at `HT_ACROSS` offsets across the fibre, the
+     * point's own first (`ht_hair_point_eval_across_world`): next-event estimation weighs a
+     * light by the lanes' mean, each lane with its own MIS weight (docs/c-abi.md). */
     template <class V> Across eval_across_world(const V &wi) const {
-        return across_with(ht_hair_point_eval_across_world, wi);
+        Across lanes;
+        check(eval_across_world(wi, lanes));
+        return lanes;
+    }
+    /** `eval_across_world` into `out`, with a status instead of a throw. */
+    template <class V> HtStatus eval_across_world(const V &wi, Across &out) const noexcept {
+        const Vec3 w = vec3(wi);
+        std::array<float, 3 * HT_ACROSS> f_cos;
+        std::array<float, HT_ACROSS> pdf;
+        const HtStatus status = ht_hair_point_eval_across_world(&point_, w.data(), f_cos.data(),
+                                                                pdf.data());
+        if (status == HT_OK) {
+            for (std::size_t k = 0; k < HT_ACROSS; ++k) {
+                out[k] = Eval{{f_cos[3 * k], f_cos[3 * k + 1], f_cos[3 * k + 2]}, pdf[k]};
+            }
+        }
+        return status;
     }
     const HtHairPoint &c() const noexcept { return point_; }
 
 private:
-    Point() {}
-    template <class V>
-    Eval eval_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *),
-                   const V &wi) const {
-        const Vec3 w = vec3(wi);
-        Eval e;
-        check(call(&point_, w.data(), e.f_cos.data(), &e.pdf));
-        return e;
-    }
-    template <class V>
-    Across across_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *),
-                       const V &wi) const {
-        const Vec3 w = vec3(wi);
-        std::array<float, 3 * HT_ACROSS> f_cos;
-        std::array<float, HT_ACROSS> pdf;
-        check(call(&point_, w.data(), f_cos.data(), pdf.data()));
-        Across lanes;
-        for (std::size_t k = 0; k < HT_ACROSS; ++k) {
-            lanes[k] = Eval{{f_cos[3 * k], f_cos[3 * k + 1], f_cos[3 * k + 2]}, pdf[k]};
-        }
-        return lanes;
-    }
-    Sample sample_with(HtStatus (*call)(const HtHairPoint *, const float *, float *, float *,
-                                        float *),
-                       const Vec3 &u) const {
-        Sample s;
-        check(call(&point_, u.data(), s.wi.data(), s.weight.data(), &s.pdf));
-        return s;
-    }
     HtHairPoint point_;
 };
 

@@ -1,10 +1,14 @@
-//! The Rust vertex that bench/c_bsdf compares the C calls with: `HairBsdf::at` + `eval` +
-//! `sample` on the inputs bench.c draws (its generator, its order of draws, its two
-//! materials, alternating), timed with its protocol: 41 interleaved rounds over 4096 inputs,
-//! medians of ns per vertex. Run by bench/c_bsdf/run (`cargo bench -p hairtrace-benches --bench c_vertex`).
+//! The Rust vertex that bench/c_bsdf compares the C and C++ calls with, on the inputs
+//! bench.c and hits.h draw (their generator, their order of draws, their two materials,
+//! alternating), timed with their protocol: 41 interleaved rounds over 4096 inputs, medians
+//! of ns per vertex. From a hit, as vertex.cpp: the frame and h (`hair_frame_offset`, the
+//! renderer's and the C ABI's), `HairBsdf::at`, f |cos| and pdf toward the light, and a
+//! sample with its weight turned to world space; and in the local frame, `at` + `eval` +
+//! `sample`. Run by bench/c_bsdf/run (`cargo bench -p hairtrace-benches --bench c_vertex`).
 
 use glam::Vec3;
 use hairtrace::bsdf::sigma_a_from_melanin;
+use hairtrace::math::hair_frame_offset;
 use hairtrace::{HairBsdf, HairParams};
 use std::hint::black_box;
 use std::time::Instant;
@@ -12,7 +16,7 @@ use std::time::Instant;
 const N: usize = 4096;
 const ROUNDS: usize = 41;
 
-/// bench.c's xorshift64*: 24 bits in [0, 1).
+/// hits.h's xorshift64*: 24 bits in [0, 1).
 struct Rng(u64);
 
 impl Rng {
@@ -30,6 +34,46 @@ impl Rng {
         let r = (1.0 - z * z).max(0.0).sqrt();
         [z, r * phi.cos(), r * phi.sin()]
     }
+
+    /// hits.h's `bench_hit`, operation for operation: tangent, ray, axis point, radius,
+    /// light and u.
+    fn hit(&mut self) -> Hit {
+        let (t, d, light) = (self.unit(), self.unit(), self.unit());
+        let u = [self.uniform(), self.uniform(), self.uniform()];
+        let mut h = 2.0 * self.uniform() - 1.0;
+        let y = [
+            t[1] * d[2] - t[2] * d[1],
+            t[2] * d[0] - t[0] * d[2],
+            t[0] * d[1] - t[1] * d[0],
+        ];
+        let n = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]).sqrt();
+        if n < 1e-3 {
+            h = 0.0;
+        }
+        let (radius, axis) = (0.03f32, [0.5f32, -0.25, 1.0]);
+        let s = if n < 1e-3 { 0.0 } else { h * radius / n };
+        let org: [f32; 3] = std::array::from_fn(|c| axis[c] + y[c] * s - 4.0 * d[c]);
+        Hit {
+            tangent: t.into(),
+            org: org.into(),
+            dir: d.into(),
+            axis: axis.into(),
+            radius,
+            light: light.into(),
+            u,
+        }
+    }
+}
+
+/// A renderer's hit and what its vertex needs (hits.h's `BenchHit`).
+struct Hit {
+    tangent: Vec3,
+    org: Vec3,
+    dir: Vec3,
+    axis: Vec3,
+    radius: f32,
+    light: Vec3,
+    u: [f32; 3],
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -54,6 +98,23 @@ fn main() {
             (h, wo.into(), wi.into(), u)
         })
         .collect();
+    let mut hit_rng = Rng(0x51ed_2701_f3a5_c7b9);
+    let hits: Vec<Hit> = (0..N).map(|_| hit_rng.hit()).collect();
+    let from_hit = || {
+        for (i, k) in hits.iter().enumerate() {
+            let (frame, offset) = hair_frame_offset(k.tangent, k.dir, k.org, k.axis, k.radius);
+            let h = offset.clamp(-1.0, 1.0) as f32;
+            let point = bsdfs[i & 1].at(h, frame.to_local(-k.dir.normalize()));
+            let wi = frame.to_local(k.light);
+            let e = point.eval(wi);
+            black_box((e.f * wi.z.abs(), e.pdf));
+            let s = point.sample(k.u).map(|s| {
+                let f_cos = s.f * s.wi.z.abs();
+                (frame.to_world(s.wi), f_cos, f_cos / s.pdf, s.pdf)
+            });
+            black_box(s);
+        }
+    };
     let vertex = || {
         for (i, &(h, wo, wi, u)) in inputs.iter().enumerate() {
             let point = bsdfs[i & 1].at(h, wo);
@@ -79,7 +140,11 @@ fn main() {
             black_box(p.sample(u));
         }
     };
-    let methods: [(&str, &dyn Fn()); 4] = [
+    let methods: [(&str, &dyn Fn()); 5] = [
+        (
+            "Rust vertex from a hit (frame, at, eval, sample)",
+            &from_hit,
+        ),
         ("Rust vertex (at + eval + sample)", &vertex),
         ("Rust HairBsdf::at", &at),
         ("Rust HairPoint::eval", &eval),
@@ -94,6 +159,6 @@ fn main() {
         }
     }
     for ((name, _), ns) in methods.iter().zip(ns) {
-        println!("{name:<44} {:8.1}", median(ns));
+        println!("{name:<48} {:8.1}", median(ns));
     }
 }

@@ -11,11 +11,13 @@ use super::render::*;
 use super::render_tests::{bits, fur_scene, light, render_c, settings};
 use super::scene::*;
 use super::scene_tests::{Handles, curves_desc, fails, last_error, sized, small_fur};
+use super::settings::HtSettings;
 use super::settings_tests::Named;
 use crate::description::{
     GroomDesc, GroomSource, LightDesc, MaterialDesc, MeshDesc, MeshSource, SceneDescription,
 };
 use crate::embree::{CurveBasis, Device};
+use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, NoProgress};
 use crate::scene::material::HairMaterial;
 use crate::scene::{FurBall, GroomShape};
@@ -260,7 +262,8 @@ fn a_host_without_a_camera_builds_once() {
         );
         light(&h, false);
         let s = settings(24);
-        let status = unsafe { ht_scene_build(h.scene, &s, None, null_mut()) };
+        let handle = HtSettings { settings: s };
+        let status = unsafe { ht_scene_build_with(h.scene, &handle, None, null_mut()) };
         assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
         assert_eq!(builds(&h), 1, "shape {shape}");
         assert_eq!(render_c(&h, &s).0, HtStatus::HT_OK);
@@ -367,13 +370,13 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
             HtStatus::HT_OK
         );
     }
-    let s = HtRenderSettings {
+    let s = RenderSettings {
         width: 40,
         height: 30,
         spp: 4,
         seed: 3,
-        threads: 2,
-        ..ht_render_settings_default()
+        threads: Some(2),
+        ..RenderSettings::default()
     };
     let (status, rgb) = render_c(&h, &s);
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());

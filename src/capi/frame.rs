@@ -51,17 +51,10 @@ pub struct HtHairFrame {
     pub h: f32,
 }
 
-/// A finite `float[3]` (NULL and alignment already checked).
-fn finite(s: &[f32], name: &str) -> Result<Vec3, Failure> {
-    let v = vec3(s);
-    if !v.is_finite() {
-        return Err(invalid_arg!("{name} = {v}: must be finite").into());
-    }
-    Ok(v)
-}
-
 /// Builds the frame and h of a hit (the convention at `HtHairFrame`) from world-space
 /// inputs and writes them to `*frame`; the frame is computed in double precision.
+/// `ht_hair_point_at_hit` builds the same frame and the point there in one call; this one
+/// is for a host that wants the frame itself (its axes, or h to check its own against).
 ///
 /// - `tangent`: the curve's tangent at the hit (any non-zero length, root to tip);
 ///   `ray_org`, `ray_dir`: the ray that hit (any non-zero length); `axis`: the axis point
@@ -103,47 +96,75 @@ pub unsafe extern "C" fn ht_hair_frame(
         ];
         let mut v = [Vec3::ZERO; 4];
         for (v, &(p, name)) in v.iter_mut().zip(&inputs) {
-            *v = finite(host_slice(p, 3, name)?, name)?;
+            *v = vec3(host_slice(p, 3, name)?);
         }
         host_slice(frame.cast_const(), 1, "frame")?;
         let spans = inputs.map(|(p, name)| Span::of(name, p, 3));
         check_disjoint(&[Span::of("frame", frame, 1)], &spans)?;
         let [tangent, org, dir, axis] = v;
-        for (v, name) in [(tangent, "tangent"), (dir, "ray_dir")] {
-            if v.length_squared() == 0.0 {
-                return Err(invalid_arg!("{name} is zero: it must give a direction").into());
-            }
-        }
-        if !(radius.is_finite() && radius > 0.0) {
-            return Err(invalid_arg!("radius = {radius}: must be finite and > 0").into());
-        }
-        let (axes, offset) = hair_frame_offset(tangent, dir, org, axis, radius);
-        let limit = 1.0 + f64::from(HT_HAIR_FRAME_H_TOLERANCE);
-        if offset.is_nan() || offset.abs() > limit {
-            return Err(invalid_arg!(
-                "the ray passes the axis {offset} radii away (radius = {radius}): not a hit \
-                 on this fibre (is the radius a diameter, or axis the wrong point?)"
-            )
-            .into());
-        }
+        let (axes, h) = hit_frame(tangent, org, dir, axis, radius)?;
         host_slice_mut(frame, 1, "frame")?[0] = HtHairFrame {
             x: axes.x.to_array(),
             y: axes.y.to_array(),
             z: axes.z.to_array(),
-            h: offset.clamp(-1.0, 1.0) as f32,
+            h,
         };
         Ok(())
     })
 }
 
-/// The frame's axes, checked: finite, unit and orthogonal to 1e-3, right-handed; and its h,
-/// unchecked.
-pub(super) fn read_frame(ptr: *const HtHairFrame) -> Result<(Frame, f32), Failure> {
-    let f = host_slice(ptr, 1, "frame")?[0];
-    Ok((checked_axes(&f)?, f.h))
+/// The frame and h (clamped to +-1) of a hit, its values checked as `ht_hair_frame`
+/// documents: finite, a non-zero tangent and ray direction, a radius finite and > 0, and a
+/// ray within `1 + HT_HAIR_FRAME_H_TOLERANCE` radii of the axis.
+#[inline(always)]
+pub(super) fn hit_frame(
+    tangent: Vec3,
+    org: Vec3,
+    dir: Vec3,
+    axis: Vec3,
+    radius: f32,
+) -> Result<(Frame, f32), Failure> {
+    let usable = tangent.is_finite()
+        && org.is_finite()
+        && dir.is_finite()
+        && axis.is_finite()
+        && tangent.length_squared() > 0.0
+        && dir.length_squared() > 0.0
+        && radius.is_finite()
+        && radius > 0.0;
+    if !usable {
+        return Err(not_a_hit([tangent, org, dir, axis], radius));
+    }
+    let (axes, offset) = hair_frame_offset(tangent, dir, org, axis, radius);
+    let limit = 1.0 + f64::from(HT_HAIR_FRAME_H_TOLERANCE);
+    if offset.is_nan() || offset.abs() > limit {
+        return Err(invalid_arg!(
+            "the ray passes the axis {offset} radii away (radius = {radius}): not a hit \
+             on this fibre (is the radius a diameter, or axis the wrong point?)"
+        )
+        .into());
+    }
+    Ok((axes, offset.clamp(-1.0, 1.0) as f32))
 }
 
-/// The axes of a frame the host passed, checked as [`read_frame`] says.
+/// The message for the first of a hit's values that [`hit_frame`] refuses.
+#[cold]
+#[inline(never)]
+fn not_a_hit(v: [Vec3; 4], radius: f32) -> Failure {
+    let names = ["tangent", "ray_org", "ray_dir", "axis"];
+    if let Some(k) = v.iter().position(|v| !v.is_finite()) {
+        return invalid_arg!("{} = {}: must be finite", names[k], v[k]).into();
+    }
+    for (v, name) in [(v[0], "tangent"), (v[2], "ray_dir")] {
+        if v.length_squared() == 0.0 {
+            return invalid_arg!("{name} is zero: it must give a direction").into();
+        }
+    }
+    invalid_arg!("radius = {radius}: must be finite and > 0").into()
+}
+
+/// The axes of a frame the host passed, checked: finite, unit and orthogonal to 1e-3,
+/// right-handed.
 #[inline(always)]
 pub(super) fn checked_axes(f: &HtHairFrame) -> Result<Frame, Failure> {
     let [x, y, z] = [f.x, f.y, f.z].map(Vec3::from_array);
@@ -163,75 +184,6 @@ fn not_a_frame(x: Vec3, y: Vec3, z: Vec3) -> Failure {
          with ht_hair_frame)"
     )
     .into()
-}
-
-/// Shared body of the two conversions.
-fn convert(
-    frame: *const HtHairFrame,
-    w: *const f32,
-    out: *mut f32,
-    map: fn(&Frame, Vec3) -> Vec3,
-) -> Result<(), Failure> {
-    require(&[
-        (frame.cast(), "frame"),
-        (w.cast(), "w"),
-        (out.cast_const().cast(), "out"),
-    ])?;
-    let w_s = host_slice(w, 3, "w")?;
-    host_slice(out.cast_const(), 3, "out")?;
-    check_disjoint(
-        &[Span::of("out", out, 3)],
-        &[Span::of("w", w, 3), Span::of("frame", frame, 1)],
-    )?;
-    let (frame, _) = read_frame(frame)?;
-    let w = finite(w_s, "w")?;
-    host_slice_mut(out, 3, "out")?.copy_from_slice(&map(&frame, w).to_array());
-    Ok(())
-}
-
-/// Writes the world direction `w[3]` in the local frame to `out[3]`: (dot(w, x), dot(w, y),
-/// dot(w, z)). Lengths are kept (give unit vectors to get the BSDF's unit wo and wi);
-/// directions keep their sense (wo must point toward the viewer, i.e. -ray_dir).
-///
-/// - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
-///   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
-/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
-///   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
-///   untouched on error.
-///
-/// Any thread.
-///
-/// # Safety
-/// `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_frame_to_local(
-    frame: *const HtHairFrame,
-    w: *const f32,
-    out: *mut f32,
-) -> HtStatus {
-    boundary(|| convert(frame, w, out, Frame::to_local))
-}
-
-/// Writes the local direction `w[3]` (e.g. a sampled wi) in world space to `out[3]`:
-/// w.x x + w.y y + w.z z. Lengths and senses are kept.
-///
-/// - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
-///   or left-handed: `HT_ERR_INVALID_ARG`. `w` finite.
-/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first), 4-byte aligned; `out` must not
-///   overlap `w` or `frame` (no in-place conversion): `HT_ERR_INVALID_ARG`. `out` is
-///   untouched on error.
-///
-/// Any thread.
-///
-/// # Safety
-/// `frame` is NULL or an `HtHairFrame`; `w`, `out` NULL or 3 floats, `out` writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_frame_to_world(
-    frame: *const HtHairFrame,
-    w: *const f32,
-    out: *mut f32,
-) -> HtStatus {
-    boundary(|| convert(frame, w, out, Frame::to_world))
 }
 
 // The tests compare the helper with the renderer's own frames and Embree's hits.
@@ -289,19 +241,10 @@ mod tests {
             (f.x, f.y, f.z, f.h),
             (want.x.to_array(), want.y.to_array(), want.z.to_array(), h)
         );
-        // Round trip through the local frame; wo = -d has y = 0 and z > 0 there.
-        let wo = (-d).normalize();
-        let (mut local, mut back) = ([0.0f32; 3], [0.0f32; 3]);
-        assert_eq!(
-            unsafe { ht_hair_frame_to_local(&f, wo.as_ref().as_ptr(), local.as_mut_ptr()) },
-            HtStatus::HT_OK
-        );
-        assert!(local[1].abs() < 1e-6 && local[2] > 0.0, "{local:?}");
-        assert_eq!(
-            unsafe { ht_hair_frame_to_world(&f, local.as_ptr(), back.as_mut_ptr()) },
-            HtStatus::HT_OK
-        );
-        assert!((Vec3::from_array(back) - wo).length() < 1e-6);
+        // wo = -d has y = 0 and z > 0 in the frame.
+        let axes = checked_axes(&f).ok().expect("a frame");
+        let local = axes.to_local((-d).normalize());
+        assert!(local.y.abs() < 1e-6 && local.z > 0.0, "{local:?}");
     }
 
     #[test]
@@ -328,15 +271,20 @@ mod tests {
         assert_eq!(s, HtStatus::HT_OK);
         let [x, y, z] = [f.x, f.y, f.z].map(Vec3::from_array);
         assert!(x.dot(y).abs() < 1e-6 && (x.cross(y) - z).length() < 1e-6 && f.h == 0.0);
-        // A mirrored (left-handed) frame is refused by the conversions.
+        // A mirrored (left-handed) frame is refused where a host's frame is read.
         let mirrored = HtHairFrame {
             z: (-z).to_array(),
             ..f
         };
-        let mut out = [0.0f32; 3];
-        let s = unsafe { ht_hair_frame_to_local(&mirrored, f.x.as_ptr(), out.as_mut_ptr()) };
+        let Err(Failure(status, message)) = checked_axes(&mirrored) else {
+            panic!("a mirrored frame was accepted")
+        };
+        assert_eq!(status, HtStatus::HT_ERR_INVALID_ARG);
+        assert!(message.contains("right-handed"), "{message}");
+        // A non-finite input is named.
+        let (s, _) = frame(Vec3::X, Vec3::NAN, -Vec3::Z, Vec3::ZERO, 1.0);
         assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-        assert!(last_error().contains("right-handed"), "{}", last_error());
+        assert!(last_error().contains("ray_org = [NaN"), "{}", last_error());
     }
 
     /// Real hits from Embree, near the silhouette and on a bent tube, for every basis and

@@ -45,7 +45,7 @@ pub extern "C" fn ht_hair_variation_default() -> HtHairVariation {
 }
 
 /// Adds a hair material with the same parameters on every strand (ranges as for
-/// `ht_hair_eval`); writes its id (0, 1, ... in the order materials are added) to
+/// `ht_hair_prepare`); writes its id (0, 1, ... in the order materials are added) to
 /// `material_id`.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);

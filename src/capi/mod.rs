@@ -51,7 +51,7 @@ use std::path::PathBuf;
 
 /// Version of the C ABI; bumped on any incompatible change of a signature or struct. The
 /// shared library's soname carries it: `libhairtrace.so.<HT_ABI_VERSION>`.
-pub const HT_ABI_VERSION: u32 = 6;
+pub const HT_ABI_VERSION: u32 = 7;
 
 /// The major part of the library version, which `ht_version()` returns as a string. The
 /// three parts are Cargo's version: a compile-time check keeps them equal.

@@ -1,28 +1,27 @@
 //! The prepared hair BSDF for hosts: a handle holding the per-material constants, and a
 //! per-vertex point in storage the host owns, so that a path vertex costs no allocation
-//! and no re-preparation (docs/c-abi.md).
+//! and no re-preparation (docs/c-abi.md, section 12).
 //!
-//! The point is an `OwnedPoint` (its own copy of the BSDF plus the (h, wo) work) written
-//! into the host's `HtHairPoint` bytes behind a tag; it runs the Rust `HairPoint` code, so
-//! it gives the same bits. A point filled from a frame keeps the frame's axes too, so that
-//! its world-space calls convert directions without the host's calls or a second check of
-//! the frame: what init established is not checked again per direction.
+//! The point is an `OwnedPoint` (its own copy of the BSDF plus the (h, wo) work) and the
+//! world axes of its hit's frame, written into the host's `HtHairPoint` bytes behind a tag;
+//! it runs the Rust `HairPoint` code, so it gives the same bits. Every call takes and gives
+//! world directions: the frame is checked once, when the point is filled, and what init
+//! established is not checked again per direction.
 
 use super::bsdf::{
-    Arg, check_args, check_dir, check_h, check_u, read_params, read3, require, sample_parts,
-    write_eval, write_sample, write1, write3,
+    Arg, check_args, check_dir, check_h, check_u, read_params, read3, require, write1, write3,
 };
-use super::frame::{HtHairFrame, checked_axes};
+use super::frame::{HtHairFrame, checked_axes, hit_frame};
 use super::{
     Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
 };
-use crate::bsdf::{BsdfEval, BsdfSample, HairBsdf, OwnedPoint};
+use crate::bsdf::{HairBsdf, OwnedPoint};
 use crate::error::invalid_arg;
 use crate::math::Frame;
 use glam::Vec3;
 
-/// Bytes of an `HtHairPoint`: 320 are used today, the rest leaves room for the model to
-/// grow without changing the ABI.
+/// Bytes of an `HtHairPoint`: the point and its frame fill most of them, the rest leaves
+/// room for the model to grow without changing the ABI.
 pub const HT_HAIR_POINT_SIZE: usize = 384;
 /// Alignment of an `HtHairPoint` in bytes.
 pub const HT_HAIR_POINT_ALIGN: usize = 16;
@@ -34,8 +33,9 @@ pub struct HtHairPrepared {
     bsdf: HairBsdf,
 }
 
-/// Storage for the BSDF at one shading point (a prepared BSDF at a fixed h and wo), filled
-/// by `ht_hair_point_init` and then evaluated and sampled any number of times.
+/// Storage for the BSDF at one shading point (a prepared BSDF at a hit's frame, h and wo),
+/// filled by `ht_hair_point_at_hit` (or `ht_hair_point_init_world`) and then evaluated and
+/// sampled any number of times.
 ///
 /// - The host allocates it (stack, arrays, its own vertex structs): `HT_HAIR_POINT_SIZE`
 ///   bytes aligned to `HT_HAIR_POINT_ALIGN` (16); this type has both, so declaring an
@@ -44,9 +44,8 @@ pub struct HtHairPrepared {
 /// - The bytes are opaque. They hold plain numbers and no pointer: a filled point is
 ///   self-contained, may be copied with `memcpy` or assignment, stays valid after its
 ///   `HtHairPrepared` is freed, and needs no release.
-/// - A point that `ht_hair_point_init` did not fill (zeroed, or overwritten) is refused
-///   with `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised
-///   storage.
+/// - A point that no init filled (zeroed, or overwritten) is refused with
+///   `HT_ERR_INVALID_ARG` when its tag does not match; never pass uninitialised storage.
 /// - Reading it from several threads at once is safe; filling it while another thread
 ///   reads it is a data race (the host's to avoid).
 #[repr(C, align(16))]
@@ -54,57 +53,25 @@ pub struct HtHairPoint {
     pub opaque: [u8; HT_HAIR_POINT_SIZE],
 }
 
-/// What the host's `HtHairPoint` bytes hold.
+/// What the host's `HtHairPoint` bytes hold: the point and the world axes of its frame.
 #[repr(C)]
 struct Stored {
-    /// [`TAG`] or [`TAG_FRAMED`] once filled: catches points that were never filled.
+    /// [`TAG`] once filled: catches points that were never filled.
     tag: u64,
     point: OwnedPoint,
-}
-
-/// What a point filled by `ht_hair_point_init_world` ([`TAG_FRAMED`]) holds: the point and
-/// the world axes of its frame, for the world-space calls.
-#[repr(C)]
-struct Framed {
-    stored: Stored,
     frame: Frame,
 }
 
-/// "htpoint" and a layout version: a point filled in the local frame.
-const TAG: u64 = 0x6874_706f_696e_7401;
-/// The tag of a point filled from a frame, whose world-space calls may convert.
-const TAG_FRAMED: u64 = 0x6874_706f_696e_7402;
+/// "htpoint" and a layout version (3: every point holds its frame, ABI 7).
+const TAG: u64 = 0x6874_706f_696e_7403;
 
-// The host's storage must hold a `Framed` (and so a `Stored`) at its alignment: checked at
-// compile time.
+// The host's storage must hold a `Stored` at its alignment: checked at compile time.
 const _: () = assert!(
-    size_of::<Framed>() <= HT_HAIR_POINT_SIZE
-        && align_of::<Framed>() <= HT_HAIR_POINT_ALIGN
+    size_of::<Stored>() <= HT_HAIR_POINT_SIZE
+        && align_of::<Stored>() <= HT_HAIR_POINT_ALIGN
         && size_of::<HtHairPoint>() == HT_HAIR_POINT_SIZE
         && align_of::<HtHairPoint>() == HT_HAIR_POINT_ALIGN
 );
-
-/// The filled point behind the host's storage (NULL, misaligned or unfilled: an error).
-fn read_point<'a>(point: *const HtHairPoint, name: &str) -> Result<&'a Stored, Failure> {
-    host_slice(point, 1, name)?;
-    if !filled(point) {
-        return Err(invalid_arg!(
-            "{name} was not filled by ht_hair_point_init (or was overwritten)"
-        )
-        .into());
-    }
-    // SAFETY: non-NULL, aligned and filled (checked); `HtHairPoint` holds a `Stored`.
-    Ok(unsafe { &*point.cast::<Stored>() })
-}
-
-/// The tag of a non-NULL, aligned point.
-#[inline(always)]
-fn filled(point: *const HtHairPoint) -> bool {
-    // SAFETY: the caller checked `point`; `HtHairPoint` is at least as large and as aligned
-    // as `Stored` (asserted above), and `Stored` is plain numbers, valid for any bytes.
-    let tag = unsafe { (*point.cast::<Stored>()).tag };
-    tag == TAG || tag == TAG_FRAMED
-}
 
 /// The point of a per-point call, with the call's pointers checked: the common case (all
 /// non-NULL and aligned, outputs clear of the inputs and the point, the point filled)
@@ -116,34 +83,23 @@ fn checked_point<'a>(
     outputs: &[Arg],
 ) -> Result<&'a Stored, Failure> {
     check_args((point, "point"), inputs, outputs)?;
-    if filled(point) {
-        // SAFETY: non-NULL, aligned (checked above) and filled.
-        return Ok(unsafe { &*point.cast::<Stored>() });
+    // SAFETY: non-NULL and aligned (checked above); `HtHairPoint` is at least as large and
+    // as aligned as `Stored` (asserted above), whose tag is a plain number valid for any
+    // bytes, and a filled point holds a whole `Stored`.
+    let stored = unsafe { &*point.cast::<Stored>() };
+    if stored.tag == TAG {
+        Ok(stored)
+    } else {
+        Err(unfilled())
     }
-    read_point(point, "point")
-}
-
-/// [`checked_point`] for the world-space calls: the point must hold a frame.
-#[inline(always)]
-fn checked_framed<'a>(
-    point: *const HtHairPoint,
-    inputs: &[Arg],
-    outputs: &[Arg],
-) -> Result<&'a Framed, Failure> {
-    if checked_point(point, inputs, outputs)?.tag != TAG_FRAMED {
-        return Err(unframed());
-    }
-    // SAFETY: aligned (checked) and filled by `ht_hair_point_init_world`, which wrote a
-    // `Framed` there (asserted to fit above).
-    Ok(unsafe { &*point.cast::<Framed>() })
 }
 
 #[cold]
 #[inline(never)]
-fn unframed() -> Failure {
+fn unfilled() -> Failure {
     invalid_arg!(
-        "point was filled by ht_hair_point_init, without a frame: the world-space calls need \
-         a point from ht_hair_point_init_world"
+        "point was not filled by ht_hair_point_at_hit or ht_hair_point_init_world (or was \
+         overwritten)"
     )
     .into()
 }
@@ -194,46 +150,14 @@ pub unsafe extern "C" fn ht_hair_prepared_free(prepared: *mut HtHairPrepared) ->
     })
 }
 
-/// Fills `*point` with the BSDF of `prepared` at offset `h` and outgoing direction `wo`:
-/// the work that depends on (h, wo) (Fresnel, absorption, refraction) is done here once,
-/// and shared by every eval, pdf and sample at that point.
-///
-/// - `h` in [-1, 1], `wo[3]` a unit vector (|length - 1| <= 1e-3) in the local frame
-///   pointing away from the fibre (see `HtHairFrame`); else `HT_ERR_INVALID_ARG`.
-/// - `prepared`, `wo`, `point`: not NULL (`HT_ERR_NULL_ARG`, checked first); `wo` 4-byte
-///   and `point` 16-byte aligned; `wo` must not lie inside `*point`. On error `*point` is
-///   untouched.
-///
-/// Any thread; `prepared` may be shared, `point` must not be read meanwhile.
-///
-/// # Safety
-/// `prepared` is NULL or a live handle; `wo` NULL or 3 floats; `point` NULL or writable
-/// storage of `HT_HAIR_POINT_SIZE` bytes.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_init(
-    prepared: *const HtHairPrepared,
-    h: f32,
-    wo: *const f32,
-    point: *mut HtHairPoint,
-) -> HtStatus {
-    boundary(|| {
-        check_init(prepared, wo, None, point)?;
-        let h = check_h(h)?;
-        let wo = check_dir(read3(wo), "wo")?;
-        // SAFETY: non-NULL, aligned and clear of `wo` (checked); a live handle (the
-        // caller's promise).
-        unsafe { fill(point, &(*prepared).bsdf, h, wo, TAG) };
-        Ok(())
-    })
-}
-
 /// The pointers of a point init, checked inline in the common case, else in the documented
-/// order with messages: every NULL first, then alignment, then `wo` or `frame` inside the
-/// point.
+/// order with messages: every NULL first, then alignment, then an input inside the point.
+/// `inputs` are the float arrays it reads (3 floats each); `frame` the frame it reads, if
+/// any.
 #[inline(always)]
 fn check_init(
     prepared: *const HtHairPrepared,
-    wo: *const f32,
+    inputs: &[(*const f32, &'static str)],
     frame: Option<*const HtHairFrame>,
     point: *mut HtHairPoint,
 ) -> Result<(), Failure> {
@@ -242,9 +166,9 @@ fn check_init(
     let fast = !prepared.is_null()
         && !point.is_null()
         && point.is_aligned()
-        && !wo.is_null()
-        && wo.is_aligned()
-        && apart(wo as usize, 3 * size_of::<f32>())
+        && inputs.iter().all(|&(p, _)| {
+            !p.is_null() && p.is_aligned() && apart(p as usize, 3 * size_of::<f32>())
+        })
         && frame.is_none_or(|f| {
             !f.is_null() && f.is_aligned() && apart(f as usize, size_of::<HtHairFrame>())
         });
@@ -253,45 +177,96 @@ fn check_init(
     }
     let mut all = vec![(prepared.cast(), "prepared")];
     all.extend(frame.map(|f| (f.cast(), "frame")));
-    all.extend([(wo.cast(), "wo"), (point.cast_const().cast(), "point")]);
+    all.extend(inputs.iter().map(|&(p, name)| (p.cast(), name)));
+    all.push((point.cast_const().cast(), "point"));
     require(&all)?;
-    host_slice(wo, 3, "wo")?;
     host_slice(point.cast_const(), 1, "point")?;
-    let mut inputs = vec![Span::of("wo", wo, 3)];
+    let mut spans = Vec::with_capacity(inputs.len() + 1);
+    for &(p, name) in inputs {
+        host_slice(p, 3, name)?;
+        spans.push(Span::of(name, p, 3));
+    }
     if let Some(f) = frame {
         host_slice(f, 1, "frame")?;
-        inputs.push(Span::of("frame", f, 1));
+        spans.push(Span::of("frame", f, 1));
     }
-    check_disjoint(&[Span::of("point", point, 1)], &inputs)
+    check_disjoint(&[Span::of("point", point, 1)], &spans)
 }
 
-/// Writes the point of `bsdf` at (h, wo), tagged `tag`, into the host's storage in place:
+/// Writes the point of `bsdf` at (h, wo) and `frame` into the host's storage in place:
 /// built on the stack and copied, the same point cost init a third more (docs/c-abi.md,
-/// "What a vertex costs").
+/// "Cost").
 ///
 /// # Safety
 /// `point` is non-NULL, aligned, writable and not read by anyone meanwhile.
 #[inline(always)]
-unsafe fn fill(point: *mut HtHairPoint, bsdf: &HairBsdf, h: f32, wo: Vec3, tag: u64) {
+unsafe fn fill(point: *mut HtHairPoint, bsdf: &HairBsdf, frame: Frame, h: f32, wo: Vec3) {
     let stored = point.cast::<Stored>();
     // SAFETY: the caller's promise; `HtHairPoint` holds a `Stored` (asserted above), whose
     // fields are plain numbers valid once written.
     unsafe {
-        (&raw mut (*stored).tag).write(tag);
+        (&raw mut (*stored).tag).write(TAG);
+        (&raw mut (*stored).frame).write(frame);
         OwnedPoint::fill(&mut *(&raw mut (*stored).point).cast(), bsdf, h, wo);
     }
 }
 
-/// `ht_hair_point_init` from a hit's frame: h is `frame->h`, and `wo[3]` is in *world*
-/// space (toward the viewer, -ray_dir normalised at a camera hit). The point keeps the
-/// frame's axes, so that `ht_hair_point_eval_world` and `ht_hair_point_sample_world` take
-/// and give world directions; the local calls work on it as well. Equal, bit for bit, to
-/// `ht_hair_point_init(prepared, frame->h, wo_local, point)` with `wo_local` from
-/// `ht_hair_frame_to_local(frame, wo, wo_local)`.
+/// A renderer's hair hit to a ready point, in one call: the hit's frame and h (exactly as
+/// `ht_hair_frame` builds them, and kept in the point) and the point of `prepared` there,
+/// seen from wo = -normalize(ray_dir). Equal, bit for bit, to `ht_hair_frame` followed by
+/// `ht_hair_point_init_world(prepared, &frame, wo, point)`.
+///
+/// - `tangent`, `ray_org`, `ray_dir`, `axis`, `radius`: as `ht_hair_frame` takes them, and
+///   refused as it refuses them (`HT_ERR_INVALID_ARG`: not finite, a zero tangent or ray
+///   direction, a radius not finite and > 0, a ray that passes the axis more than
+///   `1 + HT_HAIR_FRAME_H_TOLERANCE` radii away).
+/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); the floats 4-byte and `point`
+///   16-byte aligned; no input may lie inside `*point` (`HT_ERR_INVALID_ARG`). On error
+///   `*point` is untouched.
+///
+/// Any thread; `prepared` may be shared, `point` must not be read meanwhile.
+///
+/// # Safety
+/// `prepared` is NULL or a live handle; each float pointer NULL or 3 floats; `point` NULL
+/// or writable storage of `HT_HAIR_POINT_SIZE` bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_at_hit(
+    prepared: *const HtHairPrepared,
+    tangent: *const f32,
+    ray_org: *const f32,
+    ray_dir: *const f32,
+    axis: *const f32,
+    radius: f32,
+    point: *mut HtHairPoint,
+) -> HtStatus {
+    boundary(|| {
+        let inputs = [
+            (tangent, "tangent"),
+            (ray_org, "ray_org"),
+            (ray_dir, "ray_dir"),
+            (axis, "axis"),
+        ];
+        check_init(prepared, &inputs, None, point)?;
+        let [tangent, org, dir, axis] = inputs.map(|(p, _)| read3(p));
+        let (axes, h) = hit_frame(tangent, org, dir, axis, radius)?;
+        // The frame's z faces the viewer and y is across the ray: wo has y = 0 there.
+        let wo = check_dir(axes.to_local(-dir.normalize()), "wo")?;
+        // SAFETY: non-NULL, aligned and clear of the inputs (checked); a live handle (the
+        // caller's promise).
+        unsafe { fill(point, &(*prepared).bsdf, axes, h, wo) };
+        Ok(())
+    })
+}
+
+/// The point of `prepared` at a hit's frame: h is `frame->h`, and `wo[3]` is in world
+/// space (toward the viewer, -ray_dir normalised at the hit that made the frame). The
+/// point keeps the frame's axes, so that the other point calls take and give world
+/// directions. For a host that builds its own frame (or its own h), or works in the local
+/// frame: pass the axes (1,0,0), (0,1,0), (0,0,1) and every direction is its local form.
 ///
 /// - `frame`: as `ht_hair_frame` writes it; axes not finite, unit and orthogonal to 1e-3,
 ///   or left-handed, or `h` outside [-1, 1]: `HT_ERR_INVALID_ARG`. Checked here once: the
-///   world-space calls trust it.
+///   other point calls trust it.
 /// - `wo`: a world direction whose local form is a unit vector (|length - 1| <= 1e-3);
 ///   else `HT_ERR_INVALID_ARG`.
 /// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `frame` and `wo` 4-byte and
@@ -311,24 +286,27 @@ pub unsafe extern "C" fn ht_hair_point_init_world(
     point: *mut HtHairPoint,
 ) -> HtStatus {
     boundary(|| {
-        check_init(prepared, wo, Some(frame), point)?;
-        // SAFETY: non-NULL and aligned (checked above), an `HtHairFrame` (the caller's
-        // promise).
-        let frame = unsafe { frame.read() };
-        let (axes, h) = (checked_axes(&frame)?, frame.h);
-        let h = check_h(h)?;
-        let wo = check_dir(axes.to_local(read3(wo)), "wo")?;
-        // SAFETY: as in `ht_hair_point_init`; the storage holds a `Framed` (asserted above).
-        unsafe {
-            fill(point, &(*prepared).bsdf, h, wo, TAG_FRAMED);
-            (&raw mut (*point.cast::<Framed>()).frame).write(axes);
-        }
+        check_init(prepared, &[(wo, "wo")], Some(frame), point)?;
+        let (axes, h, wo) = framed(frame, wo)?;
+        // SAFETY: as in `ht_hair_point_at_hit`.
+        unsafe { fill(point, &(*prepared).bsdf, axes, h, wo) };
         Ok(())
     })
 }
 
-/// `ht_hair_point_init` for one strand of a groom whose parameters vary as a scene's hair
-/// material varies them (`ht_scene_add_hair_material_varied`): the parameters of
+/// The checked axes and h of a frame `check_init` has passed, and the world `wo` in them.
+#[inline(always)]
+fn framed(frame: *const HtHairFrame, wo: *const f32) -> Result<(Frame, f32, Vec3), Failure> {
+    // SAFETY: non-NULL and aligned (checked by `check_init`), an `HtHairFrame` (the
+    // caller's promise).
+    let frame = unsafe { frame.read() };
+    let axes = checked_axes(&frame)?;
+    let h = check_h(frame.h)?;
+    Ok((axes, h, check_dir(axes.to_local(read3(wo)), "wo")?))
+}
+
+/// `ht_hair_point_init_world` for one strand of a groom whose parameters vary as a scene's
+/// hair material varies them (`ht_scene_add_hair_material_varied`): the parameters of
 /// `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
 /// (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
 /// `variation->use_vertex_colors` is 1 (NULL: none). No handle per parameter set and no
@@ -337,18 +315,18 @@ pub unsafe extern "C" fn ht_hair_point_init_world(
 ///
 /// - `strand`: the strand's index as the scene numbers strands (0, 1, ... in the order the
 ///   host adds them); `s` in [0, 1]; `color` each channel in [0, 1] (0 is taken as 1e-4);
-///   the variation's ranges as at `HtHairVariation`; `h`, `wo` as `ht_hair_point_init`.
-///   Else `HT_ERR_INVALID_ARG`.
-/// - Pointers: `prepared`, `variation`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`); others
-///   as `ht_hair_point_init`. On error `*point` is untouched.
+///   the variation's ranges as at `HtHairVariation`; `frame`, `wo` as
+///   `ht_hair_point_init_world`. Else `HT_ERR_INVALID_ARG`.
+/// - Pointers: `prepared`, `variation`, `frame`, `wo`, `point` not NULL (`HT_ERR_NULL_ARG`);
+///   others as `ht_hair_point_init_world`. On error `*point` is untouched.
 /// - Cost: an init plus the preparation of the varied parameters (about one evaluation).
 ///
 /// Any thread; `prepared` and `variation` may be shared, `point` must not be read
 /// meanwhile. Not in the BSDF-only library.
 ///
 /// # Safety
-/// As `ht_hair_point_init`; `variation` NULL or an `HtHairVariation`; `color` NULL or 3
-/// floats.
+/// As `ht_hair_point_init_world`; `variation` NULL or an `HtHairVariation`; `color` NULL
+/// or 3 floats.
 #[cfg(feature = "render")]
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
@@ -358,17 +336,16 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
     strand: u32,
     s: f32,
     color: *const f32,
-    h: f32,
+    frame: *const HtHairFrame,
     wo: *const f32,
     point: *mut HtHairPoint,
 ) -> HtStatus {
     use crate::scene::material::HairColor;
     boundary(|| {
         require(&[(variation.cast(), "variation")])?;
-        check_init(prepared, wo, None, point)?;
+        check_init(prepared, &[(wo, "wo")], Some(frame), point)?;
         let v = super::read_host(variation, "variation")?;
-        let h = check_h(h)?;
-        let wo = check_dir(read3(wo), "wo")?;
+        let (axes, h, wo) = framed(frame, wo)?;
         if !(0.0..=1.0).contains(&s) {
             return Err(invalid_arg!("s = {s}: must be in [0, 1]").into());
         }
@@ -386,279 +363,24 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
         let material = super::materials::varied_material(base, &v)?;
         material.check_variation()?;
         let bsdf = HairBsdf::new(&material.varied(base, strand, s, groom))?;
-        // SAFETY: non-NULL, aligned and clear of `wo` (checked).
-        unsafe { fill(point, &bsdf, h, wo, TAG) };
+        // SAFETY: non-NULL, aligned and clear of the inputs (checked).
+        unsafe { fill(point, &bsdf, axes, h, wo) };
         Ok(())
     })
 }
 
-/// f (RGB, includes 1/|wi.z| as `ht_hair_eval`) and pdf (per unit solid angle) toward
-/// `wi[3]` at a filled point: the same bits as `ht_hair_eval` with the point's parameters,
-/// h and wo.
+/// f |cos| and the pdf toward the world `wi[3]` at a filled point, for a light's
+/// contribution and its MIS weight: writes `f_cos[3]` = f * |cos| (f the BSDF, RGB per
+/// steradian, times the cosine to the fibre's normal plane: the fraction scattered per
+/// unit solid angle) and `*pdf`, the density of `ht_hair_point_sample_world` at wi (per
+/// unit solid angle). wi is taken to the point's frame (with no second check of the frame:
+/// init made it) and must be a unit vector there (|length - 1| <= 1e-3).
 ///
-/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame, pointing away;
-///   else `HT_ERR_INVALID_ARG`.
-/// - `point`, `wi`, `f`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
-///   filled by `ht_hair_point_init` and 16-byte aligned, the floats 4-byte aligned
-///   (`HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi` or the point
-///   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f` NULL or 3 floats,
-/// `pdf` NULL or 1 float; outputs writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_eval(
-    point: *const HtHairPoint,
-    wi: *const f32,
-    f: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        let p = checked_point(point, &[(wi, "wi", 3)], &[(f, "f", 3), (pdf, "pdf", 1)])?;
-        write_eval(p.point.eval(check_dir(read3(wi), "wi")?), f, pdf);
-        Ok(())
-    })
-}
-
-/// Offsets across the fibre that `ht_hair_point_eval_across` evaluates: one lane each.
-pub const HT_ACROSS: usize = 8;
-const _: () = assert!(HT_ACROSS == crate::bsdf::ACROSS);
-
-/// f * |wi.z| and the pdf toward `wi[3]` (the point's local frame) at `HT_ACROSS` offsets
-/// across the fibre: the point's h and its shifts by 2k / `HT_ACROSS`, wrapped into
-/// [-1, 1]. Writes lane k's f |cos| to `f_cos[3k..3k+3]` and its pdf to `pdf[k]`; lane 0
-/// is the point's own h.
-///
-/// What it is for: a strand under a pixel wide shows the camera its whole width, so the
-/// image holds the BSDF averaged across the fibre. Next-event estimation that weighs a
-/// light by the mean over the lanes of `f_cos[k]` times the lane's own MIS weight (from
-/// `pdf[k]`), while BSDF sampling still draws from the point, renders the same image in
-/// expectation with less noise: hairtrace's own renderer does so and measures 1.5x-2.5x
-/// less variance under small lights (docs/c-abi.md). At a camera ray's hit on a strand
-/// wider than its pixel, use `ht_hair_point_eval_cos`: the image resolves the fibre there.
-///
-/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
-///   `HT_ERR_INVALID_ARG`.
+/// - `wi` not a unit vector: `HT_ERR_INVALID_ARG`.
 /// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
-///   filled by an init and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf`
-///   must not overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs
-///   untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
-/// NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_eval_across(
-    point: *const HtHairPoint,
-    wi: *const f32,
-    f_cos: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        point_and_wi(point, wi, (f_cos, pdf, HT_ACROSS), false)
-            .map(|(p, wi)| write_across(p, wi, f_cos, pdf))
-    })
-}
-
-/// `ht_hair_point_eval_across` with `wi[3]` in *world* space, at a point filled by
-/// `ht_hair_point_init_world`: wi is taken to the point's frame, as
-/// `ht_hair_point_eval_world` takes it, and must be a unit vector there (|length - 1| <=
-/// 1e-3). The same bits as `ht_hair_frame_to_local` followed by `ht_hair_point_eval_across`.
-///
-/// - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
-/// - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
-///   `HT_ERR_INVALID_ARG`.
-/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
-///   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
-///   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
-/// NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_eval_across_world(
-    point: *const HtHairPoint,
-    wi: *const f32,
-    f_cos: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        point_and_wi(point, wi, (f_cos, pdf, HT_ACROSS), true)
-            .map(|(p, wi)| write_across(p, wi, f_cos, pdf))
-    })
-}
-
-/// Writes lane k's f |cos| toward the local `wi` to `f_cos[3k..3k+3]` and its pdf to
-/// `pdf[k]`, for the `HT_ACROSS` offsets across the fibre (checked outputs).
-fn write_across(p: &Stored, wi: Vec3, f_cos: *mut f32, pdf: *mut f32) {
-    let a = p.point.eval_across(wi);
-    let cos = wi.z.abs();
-    for k in 0..HT_ACROSS {
-        // SAFETY: `f_cos` holds 3 * HT_ACROSS floats and `pdf` HT_ACROSS (checked).
-        unsafe {
-            write3(f_cos.add(3 * k), (a.f[k] * cos).to_array());
-            write1(pdf.add(k), a.pdf[k]);
-        }
-    }
-}
-
-/// The pdf alone (per unit solid angle) toward `wi[3]` at a filled point: the `pdf` that
-/// `ht_hair_point_eval` writes, for hosts that need only the density (MIS weights).
-///
-/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
-///   `HT_ERR_INVALID_ARG`.
-/// - `point`, `wi`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled by
-///   an init and 16-byte aligned, the floats 4-byte aligned; `pdf` must not overlap `wi`
-///   or the point (`HT_ERR_INVALID_ARG`). `*pdf` untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `pdf`
-/// NULL or 1 writable float.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_pdf(
-    point: *const HtHairPoint,
-    wi: *const f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        let p = checked_point(point, &[(wi, "wi", 3)], &[(pdf, "pdf", 1)])?;
-        write1(pdf, p.point.eval(check_dir(read3(wi), "wi")?).pdf);
-        Ok(())
-    })
-}
-
-/// Samples an incident direction at a filled point from `u[3]` in [0, 1): writes `wi[3]`
-/// (unit, local frame), `f[3]` and `*pdf`, the same bits as `ht_hair_sample` with the
-/// point's parameters, h and wo. pdf = 0 (wi, f zero) means no direction; still HT_OK.
-///
-/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
-/// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `point` filled and 16-byte
-///   aligned, floats 4-byte aligned; `wi`, `f`, `pdf` must not overlap each other, `u` or
-///   the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `f` NULL or 3
-/// floats, `pdf` NULL or 1 float; outputs writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_sample(
-    point: *const HtHairPoint,
-    u: *const f32,
-    wi: *mut f32,
-    f: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        let outputs = [
-            (wi.cast_const(), "wi", 3),
-            (f.cast_const(), "f", 3),
-            (pdf.cast_const(), "pdf", 1),
-        ];
-        let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
-        let s = p.point.sample(check_u(read3(u).to_array(), "u")?);
-        write_sample(s, wi, f, pdf);
-        Ok(())
-    })
-}
-
-/// f |cos| and pdf of an evaluation at the local `wi`: `f * |wi.z|`, the scattered fraction
-/// per unit solid angle, as a host multiplies it.
-#[inline(always)]
-fn times_cos(e: BsdfEval, wi: Vec3) -> BsdfEval {
-    BsdfEval {
-        f: e.f * wi.z.abs(),
-        pdf: e.pdf,
-    }
-}
-
-/// A sample's wi, weight f |wi.z| / pdf and pdf, or zeros when there is none or the weight
-/// is not finite (a pdf that underflowed).
-#[inline(always)]
-fn weighted(s: Option<BsdfSample>) -> Option<BsdfSample> {
-    s.map(|s| BsdfSample {
-        f: s.f * s.wi.z.abs() / s.pdf,
-        ..s
-    })
-    .filter(|s| s.f.is_finite())
-}
-
-/// One call for what a path vertex wants of a light direction: writes `f_cos[3]` =
-/// f * |wi.z| (the `f` of `ht_hair_point_eval` times the cosine, in that order: the
-/// fraction scattered per unit solid angle) and `*pdf`, the same pdf as
-/// `ht_hair_point_eval`.
-///
-/// - `wi`: unit vector (|length - 1| <= 1e-3) in the point's local frame; else
-///   `HT_ERR_INVALID_ARG`.
-/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
-///   filled by an init and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf`
-///   must not overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs
-///   untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
-/// floats, `pdf` NULL or 1 float; outputs writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_eval_cos(
-    point: *const HtHairPoint,
-    wi: *const f32,
-    f_cos: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        point_and_wi(point, wi, (f_cos, pdf, 1), false).map(|(p, wi)| write_cos(p, wi, f_cos, pdf))
-    })
-}
-
-/// One call for what a path vertex wants of a sampled direction: writes `wi[3]` (as
-/// `ht_hair_point_sample`), `weight[3]` = f * |wi.z| / pdf (the path throughput factor,
-/// from that call's f and pdf in that order) and `*pdf`. pdf = 0 (wi, weight zero) means
-/// no direction, also when the weight would not be finite; still HT_OK.
-///
-/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
-/// - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
-///   `point` filled by an init and 16-byte aligned, the floats 4-byte aligned; `wi`,
-///   `weight` and `pdf` must not overlap each other, `u` or the point
-///   (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
-///
-/// Any thread, concurrently on the same point.
-///
-/// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
-/// floats, `pdf` NULL or 1 float; outputs writable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_point_sample_cos(
-    point: *const HtHairPoint,
-    u: *const f32,
-    wi: *mut f32,
-    weight: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| sample_cos(point, u, wi, weight, pdf, false))
-}
-
-/// `ht_hair_point_eval_cos` with `wi[3]` in *world* space, at a point filled by
-/// `ht_hair_point_init_world`: wi is taken to the point's frame (as
-/// `ht_hair_frame_to_local` does, but with no check of the frame: init made it) and must be
-/// a unit vector there (|length - 1| <= 1e-3). The same bits as `ht_hair_frame_to_local`
-/// followed by `ht_hair_point_eval_cos`.
-///
-/// - `wi` not a unit vector in the point's frame: `HT_ERR_INVALID_ARG`.
-/// - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
-///   `HT_ERR_INVALID_ARG`.
-/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
-///   16-byte and the floats 4-byte aligned; `f_cos` and `pdf` must not overlap each other,
-///   `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///   filled and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf` must not
+///   overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
+///   error.
 ///
 /// Any thread, concurrently on the same point.
 ///
@@ -673,257 +395,143 @@ pub unsafe extern "C" fn ht_hair_point_eval_world(
     pdf: *mut f32,
 ) -> HtStatus {
     boundary(|| {
-        point_and_wi(point, wi, (f_cos, pdf, 1), true).map(|(p, wi)| write_cos(p, wi, f_cos, pdf))
+        let (p, wi) = point_and_wi(point, wi, (f_cos, pdf, 1))?;
+        let e = p.point.eval(wi);
+        write3(f_cos, (e.f * wi.z.abs()).to_array());
+        write1(pdf, e.pdf);
+        Ok(())
     })
 }
 
-/// `ht_hair_point_sample_cos` giving `wi[3]` in *world* space, at a point filled by
-/// `ht_hair_point_init_world`: the local sample taken to world space with the point's
-/// frame, the same bits as `ht_hair_point_sample_cos` followed by `ht_hair_frame_to_world`
-/// (weight and pdf are unchanged). pdf = 0 (wi, weight zero) means no direction.
+/// Offsets across the fibre that `ht_hair_point_eval_across_world` evaluates: one lane each.
+pub const HT_ACROSS: usize = 8;
+const _: () = assert!(HT_ACROSS == crate::bsdf::ACROSS);
+
+/// f |cos| and the pdf toward the world `wi[3]` at `HT_ACROSS` offsets across the fibre:
+/// the point's h and its shifts by 2k / `HT_ACROSS`, wrapped into [-1, 1]. Writes lane k's
+/// f |cos| to `f_cos[3k..3k+3]` and its pdf to `pdf[k]`; lane 0 is the point's own h, the
+/// values of `ht_hair_point_eval_world`. wi is taken to the point's frame, as
+/// `ht_hair_point_eval_world` takes it.
 ///
-/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
-/// - A point filled by `ht_hair_point_init` or `ht_hair_point_init_strand` (no frame):
+/// What it is for: a strand under a pixel wide shows the camera its whole width, so the
+/// image holds the BSDF averaged across the fibre. Next-event estimation that weighs a
+/// light by the mean over the lanes of `f_cos[k]` times the lane's own MIS weight (from
+/// `pdf[k]`), while BSDF sampling still draws from the point, renders the same image in
+/// expectation with less noise: hairtrace's own renderer does so and measures 1.5x-2.5x
+/// less variance under small lights (docs/c-abi.md). At a camera ray's hit on a strand
+/// wider than its pixel, use `ht_hair_point_eval_world`: the image resolves the fibre there.
+///
+/// - `wi` not a unit vector in the point's frame (|length - 1| <= 1e-3):
 ///   `HT_ERR_INVALID_ARG`.
-/// - `point`, `u`, `wi`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first);
-///   `point` 16-byte and the floats 4-byte aligned; `wi`, `weight` and `pdf` must not
-///   overlap each other, `u` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
+/// - `point`, `wi`, `f_cos`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked first); `point`
+///   filled and 16-byte aligned, the floats 4-byte aligned; `f_cos` and `pdf` must not
+///   overlap each other, `wi` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on
 ///   error.
 ///
 /// Any thread, concurrently on the same point.
 ///
 /// # Safety
-/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `weight` NULL or 3
-/// floats, `pdf` NULL or 1 float; outputs writable.
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `wi` NULL or 3 floats; `f_cos`
+/// NULL or `3 * HT_ACROSS` writable floats, `pdf` NULL or `HT_ACROSS` writable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_hair_point_eval_across_world(
+    point: *const HtHairPoint,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+) -> HtStatus {
+    boundary(|| {
+        let (p, wi) = point_and_wi(point, wi, (f_cos, pdf, HT_ACROSS))?;
+        let a = p.point.eval_across(wi);
+        let cos = wi.z.abs();
+        for k in 0..HT_ACROSS {
+            // SAFETY: `f_cos` holds 3 * HT_ACROSS floats and `pdf` HT_ACROSS (checked).
+            unsafe {
+                write3(f_cos.add(3 * k), (a.f[k] * cos).to_array());
+                write1(pdf.add(k), a.pdf[k]);
+            }
+        }
+        Ok(())
+    })
+}
+
+/// A sampled direction and what a path vertex wants of it, from `u[3]` in [0, 1): writes
+/// `wi[3]` (unit, world space), `f_cos[3]` = f * |cos| (as `ht_hair_point_eval_world`
+/// gives it toward wi: for a host that weighs strategies itself, with MIS or otherwise),
+/// `weight[3]` = f_cos / pdf (the path throughput factor, from the same f_cos and pdf) and
+/// `*pdf` (per unit solid angle). pdf = 0 (wi, f_cos, weight zero) means no direction, also
+/// when the weight would not be finite; still HT_OK.
+///
+/// - `u[i]` outside [0, 1) or NaN: `HT_ERR_INVALID_ARG`.
+/// - `point`, `u`, `wi`, `f_cos`, `weight`, `pdf`: not NULL (`HT_ERR_NULL_ARG`, checked
+///   first); `point` filled and 16-byte aligned, the floats 4-byte aligned; no output may
+///   overlap another, `u` or the point (`HT_ERR_INVALID_ARG`). Outputs untouched on error.
+///
+/// Any thread, concurrently on the same point.
+///
+/// # Safety
+/// `point` is NULL or `HT_HAIR_POINT_SIZE` readable bytes; `u`, `wi`, `f_cos`, `weight`
+/// NULL or 3 floats, `pdf` NULL or 1 float; outputs writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_point_sample_world(
     point: *const HtHairPoint,
     u: *const f32,
     wi: *mut f32,
+    f_cos: *mut f32,
     weight: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| sample_cos(point, u, wi, weight, pdf, true))
-}
-
-/// Writes f |cos| and the pdf toward the local `wi` (checked outputs).
-#[inline(always)]
-fn write_cos(p: &Stored, wi: Vec3, f_cos: *mut f32, pdf: *mut f32) {
-    write_eval(times_cos(p.point.eval(wi), wi), f_cos, pdf);
+    boundary(|| {
+        let outputs = [
+            (wi.cast_const(), "wi", 3),
+            (f_cos.cast_const(), "f_cos", 3),
+            (weight.cast_const(), "weight", 3),
+            (pdf.cast_const(), "pdf", 1),
+        ];
+        let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
+        let s = p.point.sample(check_u(read3(u).to_array(), "u")?);
+        // The weight from f_cos in that order; none when it is not finite (a pdf that
+        // underflowed).
+        let s = s
+            .map(|s| (s, s.f * s.wi.z.abs()))
+            .filter(|(s, fc)| (*fc / s.pdf).is_finite());
+        let zero = ([0.0; 3], [0.0; 3], [0.0; 3], 0.0);
+        let (d, fc, w, density) = s.map_or(zero, |(s, fc)| {
+            let d = p.frame.to_world(s.wi).to_array();
+            (d, fc.to_array(), (fc / s.pdf).to_array(), s.pdf)
+        });
+        write3(wi, d);
+        write3(f_cos, fc);
+        write3(weight, w);
+        write1(pdf, density);
+        Ok(())
+    })
 }
 
 /// The checked point of an evaluation into `lanes` values of `f_cos` (3 floats each) and
-/// `pdf`, and `wi[3]` in its local frame: read as given, or, with `world`, in world space
-/// and taken to the frame of a point that holds one.
+/// `pdf`, and the world `wi[3]` in the point's frame.
 #[inline(always)]
 fn point_and_wi<'a>(
     point: *const HtHairPoint,
     wi: *const f32,
     (f_cos, pdf, lanes): (*mut f32, *mut f32, usize),
-    world: bool,
 ) -> Result<(&'a Stored, Vec3), Failure> {
-    let inputs = [(wi, "wi", 3)];
     let outputs = [
         (f_cos.cast_const(), "f_cos", 3 * lanes),
         (pdf.cast_const(), "pdf", lanes),
     ];
-    if world {
-        let p = checked_framed(point, &inputs, &outputs)?;
-        let local = p.frame.to_local(read3(wi));
-        Ok((&p.stored, check_dir(local, "wi (in the point's frame)")?))
-    } else {
-        let p = checked_point(point, &inputs, &outputs)?;
-        Ok((p, check_dir(read3(wi), "wi")?))
-    }
-}
-
-/// The body of `ht_hair_point_sample_cos` and, with `world`, `ht_hair_point_sample_world`
-/// (`wi` given in world space with the point's frame).
-#[inline(always)]
-fn sample_cos(
-    point: *const HtHairPoint,
-    u: *const f32,
-    wi: *mut f32,
-    weight: *mut f32,
-    pdf: *mut f32,
-    world: bool,
-) -> Result<(), Failure> {
-    let inputs = [(u, "u", 3)];
-    let outputs = [
-        (wi.cast_const(), "wi", 3),
-        (weight.cast_const(), "weight", 3),
-        (pdf.cast_const(), "pdf", 1),
-    ];
-    let (p, frame) = if world {
-        let p = checked_framed(point, &inputs, &outputs)?;
-        (&p.stored, Some(&p.frame))
-    } else {
-        (checked_point(point, &inputs, &outputs)?, None)
-    };
-    let s = weighted(p.point.sample(check_u(read3(u).to_array(), "u")?));
-    let s = s.map(|s| BsdfSample {
-        wi: frame.map_or(s.wi, |f| f.to_world(s.wi)),
-        ..s
-    });
-    write_sample(s, wi, weight, pdf);
-    Ok(())
-}
-
-/// The pointers of a batch over points, checked as one: `points[n]`, an input of `3n`
-/// floats, and the outputs (`3n` floats each, then `pdf[n]`).
-struct Batch<'a> {
-    points: &'a [HtHairPoint],
-    input: &'a [[f32; 3]],
-    name: &'static str,
-}
-
-impl Batch<'_> {
-    /// NULL checks of everything (when n > 0), then sizes, alignment and overlap.
-    fn check(
-        points: *const HtHairPoint,
-        n: usize,
-        input: (*const f32, &'static str),
-        outputs: &[(*mut f32, &str)],
-        pdf: *mut f32,
-    ) -> Result<Self, Failure> {
-        if n > 0 {
-            let mut all = vec![(points.cast(), "points"), (input.0.cast(), input.1)];
-            all.extend(
-                outputs
-                    .iter()
-                    .map(|&(p, name)| (p.cast_const().cast(), name)),
-            );
-            all.push((pdf.cast_const().cast(), "pdf"));
-            require(&all)?;
-        }
-        let points = host_slice(points, n, "points")?;
-        let input_s = host_slice(input.0.cast::<[f32; 3]>(), n, input.1)?;
-        let mut spans = Vec::with_capacity(outputs.len() + 1);
-        for &(p, name) in outputs {
-            host_slice(p.cast_const().cast::<[f32; 3]>(), n, name)?;
-            spans.push(Span::of(name, p.cast_const().cast::<[f32; 3]>(), n));
-        }
-        host_slice(pdf.cast_const(), n, "pdf")?;
-        spans.push(Span::of("pdf", pdf, n));
-        check_disjoint(
-            &spans,
-            &[
-                Span::of("points", points.as_ptr(), n),
-                Span::of(input.1, input_s.as_ptr(), n),
-            ],
-        )?;
-        Ok(Batch {
-            points,
-            input: input_s,
-            name: input.1,
-        })
-    }
-
-    /// Checks that every point is filled and every input valid (`check`) before anything
-    /// is written; the message names the first bad element. Then runs `each` on every
-    /// element: its point, its input and its index.
-    fn run<T>(
-        &self,
-        check: impl Fn([f32; 3], &str) -> Result<T, Failure>,
-        mut each: impl FnMut(usize, &OwnedPoint, T),
-    ) -> Result<(), Failure> {
-        let (points, input) = (self.points, self.input);
-        for i in 0..points.len() {
-            if !filled(&points[i]) {
-                read_point(&points[i], "point")
-                    .map_err(|Failure(s, m)| Failure(s, format!("element {i}: {m}")))?;
-            }
-            if let Err(Failure(s, m)) = check(input[i], self.name) {
-                return Err(Failure(s, format!("element {i}: {m}")));
-            }
-        }
-        for (i, (point, &x)) in points.iter().zip(input).enumerate() {
-            // SAFETY: aligned (the slice's type) and filled (checked above).
-            let p = unsafe { &(*std::ptr::from_ref(point).cast::<Stored>()).point };
-            each(i, p, check(x, self.name)?);
-        }
-        Ok(())
-    }
-}
-
-/// `ht_hair_point_eval` over `n` points at once: `points[n]` (each filled, possibly from
-/// different prepared BSDFs), `wi[3n]` in, `f[3n]` and `pdf[n]` out, tightly packed; each
-/// result bit-identical to `ht_hair_point_eval`.
-///
-/// - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
-///   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
-///   "negative" `n`: `HT_ERR_INVALID_ARG`); `f` and `pdf` must not overlap each other, `wi`
-///   or `points` (`HT_ERR_INVALID_ARG`).
-/// - Every point and every `wi` is checked before anything is written; the message names
-///   the first bad element (`element 7: ...`).
-///
-/// Any thread, concurrently on the same points.
-///
-/// # Safety
-/// Each array is NULL or holds the number of elements given above (outputs writable).
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_points_eval(
-    points: *const HtHairPoint,
-    n: usize,
-    wi: *const f32,
-    f: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        let batch = Batch::check(points, n, (wi, "wi"), &[(f, "f")], pdf)?;
-        let f = host_slice_mut(f.cast::<[f32; 3]>(), n, "f")?;
-        let pdf = host_slice_mut(pdf, n, "pdf")?;
-        batch.run(
-            |w, name| check_dir(Vec3::from_array(w), name),
-            |i, p, wi| {
-                let e = p.eval(wi);
-                (f[i], pdf[i]) = (e.f.to_array(), e.pdf);
-            },
-        )
-    })
-}
-
-/// `ht_hair_point_sample` over `n` points at once: `points[n]`, `u[3n]` in, `wi[3n]`,
-/// `f[3n]` and `pdf[n]` out, tightly packed; each result bit-identical to
-/// `ht_hair_point_sample`. `pdf[i]` = 0 (`wi`, `f` zero) means no direction for point i.
-///
-/// - Arrays: NULL allowed only when `n` = 0 (else `HT_ERR_NULL_ARG`, checked first);
-///   `points` 16-byte and the floats 4-byte aligned; sizes must fit in memory (a huge or
-///   "negative" `n`: `HT_ERR_INVALID_ARG`); `wi`, `f` and `pdf` must not overlap each
-///   other, `u` or `points` (`HT_ERR_INVALID_ARG`).
-/// - Every point must be filled and every `u` in [0, 1) (`HT_ERR_INVALID_ARG`), all
-///   checked before anything is written; the message names the first bad element.
-///
-/// Any thread, concurrently on the same points.
-///
-/// # Safety
-/// Each array is NULL or holds the number of elements given above (outputs writable).
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_hair_points_sample(
-    points: *const HtHairPoint,
-    n: usize,
-    u: *const f32,
-    wi: *mut f32,
-    f: *mut f32,
-    pdf: *mut f32,
-) -> HtStatus {
-    boundary(|| {
-        let batch = Batch::check(points, n, (u, "u"), &[(wi, "wi"), (f, "f")], pdf)?;
-        let wi = host_slice_mut(wi.cast::<[f32; 3]>(), n, "wi")?;
-        let f = host_slice_mut(f.cast::<[f32; 3]>(), n, "f")?;
-        let pdf = host_slice_mut(pdf, n, "pdf")?;
-        batch.run(check_u, |i, p, u| {
-            (wi[i], f[i], pdf[i]) = sample_parts(p.sample(u));
-        })
-    })
+    let p = checked_point(point, &[(wi, "wi", 3)], &outputs)?;
+    let local = p.frame.to_local(read3(wi));
+    Ok((p, check_dir(local, "wi (in the point's frame)")?))
 }
 
 #[cfg(test)]
 mod tests {
     use super::super::bsdf::last_error;
+    use super::super::frame::ht_hair_frame;
     use super::*;
     use crate::bsdf::HairParams;
-    use std::ptr::null_mut;
+    use std::ptr::{null, null_mut};
 
     fn point() -> HtHairPoint {
         HtHairPoint {
@@ -937,6 +545,51 @@ mod tests {
         handle
     }
 
+    /// The frame whose world directions are the local ones, at offset `h`.
+    fn local(h: f32) -> HtHairFrame {
+        HtHairFrame {
+            x: [1.0, 0.0, 0.0],
+            y: [0.0, 1.0, 0.0],
+            z: [0.0, 0.0, 1.0],
+            h,
+        }
+    }
+
+    /// `ht_hair_point_eval_world`: f |cos| and pdf.
+    fn eval(p: &HtHairPoint, wi: [f32; 3]) -> (HtStatus, [f32; 3], f32) {
+        let (mut f_cos, mut pdf) = ([0.0f32; 3], 0.0f32);
+        let s = unsafe { ht_hair_point_eval_world(p, wi.as_ptr(), f_cos.as_mut_ptr(), &mut pdf) };
+        (s, f_cos, pdf)
+    }
+
+    /// `ht_hair_point_sample_world`: status, wi, f |cos|, weight, pdf.
+    fn sample(p: &HtHairPoint, u: [f32; 3]) -> (HtStatus, [[f32; 3]; 3], f32) {
+        let (mut out, mut pdf) = ([[0.0f32; 3]; 3], 0.0f32);
+        let [wi, f_cos, weight] = &mut out;
+        let s = unsafe {
+            ht_hair_point_sample_world(
+                p,
+                u.as_ptr(),
+                wi.as_mut_ptr(),
+                f_cos.as_mut_ptr(),
+                weight.as_mut_ptr(),
+                &mut pdf,
+            )
+        };
+        (s, out, pdf)
+    }
+
+    /// `ht_hair_point_eval_across_world`, as bits.
+    fn across(p: &HtHairPoint, wi: [f32; 3]) -> ([u32; 3 * HT_ACROSS], [u32; HT_ACROSS]) {
+        let (mut f, mut pdf) = ([0.0f32; 3 * HT_ACROSS], [0.0f32; HT_ACROSS]);
+        let s = unsafe {
+            ht_hair_point_eval_across_world(p, wi.as_ptr(), f.as_mut_ptr(), pdf.as_mut_ptr())
+        };
+        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+        (f.map(f32::to_bits), pdf.map(f32::to_bits))
+    }
+
+    /// In the local frame every call is the Rust point's, times |wi.z| where it says f |cos|.
     #[test]
     fn points_give_the_rust_bits_and_outlive_their_handle() {
         let params = HtHairParams {
@@ -947,7 +600,8 @@ mod tests {
         let handle = prepare(&params);
         let (h, wo) = (0.4f32, Vec3::new(0.6, 0.0, 0.8));
         let mut pt = point();
-        let s = unsafe { ht_hair_point_init(handle, h, wo.as_ref().as_ptr(), &mut pt) };
+        let s =
+            unsafe { ht_hair_point_init_world(handle, &local(h), wo.as_ref().as_ptr(), &mut pt) };
         assert_eq!(s, HtStatus::HT_OK);
         assert_eq!(unsafe { ht_hair_prepared_free(handle) }, HtStatus::HT_OK);
         // A byte copy is as good as the original, after the handle is gone.
@@ -956,150 +610,104 @@ mod tests {
         for k in 0..64 {
             let a = 0.1 * k as f32;
             let wi = Vec3::new(a.sin() * 0.5, a.cos() * 0.7, 0.5).normalize();
-            let (mut f, mut pdf, mut pdf_only) = ([0.0f32; 3], 0.0f32, 0.0f32);
-            let s = unsafe {
-                ht_hair_point_eval(&copy, wi.as_ref().as_ptr(), f.as_mut_ptr(), &mut pdf)
-            };
-            assert_eq!(s, HtStatus::HT_OK);
             let want = rust.eval(wi);
-            assert_eq!((f, pdf), (want.f.to_array(), want.pdf));
-            let s = unsafe { ht_hair_point_pdf(&copy, wi.as_ref().as_ptr(), &mut pdf_only) };
+            let cos = wi.z.abs();
             assert_eq!(
-                (s, pdf_only.to_bits()),
-                (HtStatus::HT_OK, want.pdf.to_bits())
+                eval(&copy, wi.to_array()),
+                (HtStatus::HT_OK, (want.f * cos).to_array(), want.pdf)
             );
             // Across the fibre: each lane's f |cos| and pdf, as the Rust point's lanes.
-            let (mut f_cos, mut pdf_lanes) = ([0.0f32; 3 * HT_ACROSS], [0.0f32; HT_ACROSS]);
-            let s = unsafe {
-                ht_hair_point_eval_across(
-                    &copy,
-                    wi.as_ref().as_ptr(),
-                    f_cos.as_mut_ptr(),
-                    pdf_lanes.as_mut_ptr(),
-                )
-            };
-            assert_eq!(s, HtStatus::HT_OK);
+            let (f_cos, pdf) = across(&copy, wi.to_array());
             let lanes = rust.eval_across(wi).unwrap();
             for k in 0..HT_ACROSS {
-                let want = (lanes.f[k] * wi.z.abs()).to_array();
+                let want = (lanes.f[k] * cos).to_array().map(f32::to_bits);
                 assert_eq!(f_cos[3 * k..3 * k + 3], want, "lane {k}");
-                assert_eq!(pdf_lanes[k].to_bits(), lanes.pdf[k].to_bits(), "lane {k}");
+                assert_eq!(pdf[k], lanes.pdf[k].to_bits(), "lane {k}");
             }
             let u = [k as f32 / 64.0, 0.37, 0.81];
-            let (mut wi_s, mut f_s, mut pdf_s) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
-            let s = unsafe {
-                ht_hair_point_sample(
-                    &pt,
-                    u.as_ptr(),
-                    wi_s.as_mut_ptr(),
-                    f_s.as_mut_ptr(),
-                    &mut pdf_s,
-                )
-            };
-            assert_eq!(s, HtStatus::HT_OK);
             let want = rust.sample(u).unwrap();
+            let f_cos = want.f * want.wi.z.abs();
+            let (s, [wi_s, f_cos_s, weight], pdf) = sample(&pt, u);
+            assert_eq!(s, HtStatus::HT_OK);
             assert_eq!(
-                (wi_s, f_s, pdf_s),
-                (want.wi.to_array(), want.f.to_array(), want.pdf)
+                (wi_s, f_cos_s, weight, pdf),
+                (
+                    want.wi.to_array(),
+                    f_cos.to_array(),
+                    (f_cos / want.pdf).to_array(),
+                    want.pdf
+                )
             );
         }
     }
 
-    /// The world-space calls are the host's conversions around the local calls, bit for bit.
+    /// A hit to a point in one call is `ht_hair_frame` then `ht_hair_point_init_world`, and
+    /// the world calls are the Rust point's behind the frame's conversions, bit for bit.
     #[test]
-    fn world_calls_equal_the_conversions_around_the_local_calls() {
-        use super::super::frame::{ht_hair_frame, ht_hair_frame_to_local, ht_hair_frame_to_world};
-        let handle = prepare(&HairParams::default().into());
+    fn a_hit_gives_the_framed_point_of_the_rust_calls() {
+        let params: HtHairParams = HairParams::default().into();
+        let (handle, bsdf) = (prepare(&params), HairBsdf::new(&params.into()).unwrap());
         for k in 0..200 {
             let a = 0.37 * k as f32;
-            let tangent = Vec3::new(a.cos(), a.sin(), 0.3 * (2.0 * a).sin()).normalize();
-            let dir = Vec3::new((1.7 * a).sin(), -0.4, (0.9 * a).cos()).normalize();
-            let across = tangent.cross(dir).normalize();
-            let h = (0.61 * k as f32).sin() * 0.95;
-            let org = across * h - dir * 4.0;
-            let mut frame = HtHairFrame {
-                x: [0.0; 3],
-                y: [0.0; 3],
-                z: [0.0; 3],
-                h: 0.0,
-            };
-            let arr = |v: &Vec3| v.to_array();
-            let s = unsafe {
-                ht_hair_frame(
-                    arr(&tangent).as_ptr(),
-                    arr(&org).as_ptr(),
-                    arr(&dir).as_ptr(),
-                    [0.0f32; 3].as_ptr(),
-                    1.0,
-                    &mut frame,
-                )
-            };
-            assert_eq!(s, HtStatus::HT_OK);
-            let wo = arr(&-dir);
-            let (mut world, mut local) = (point(), point());
-            let mut wo_local = [0.0f32; 3];
+            let tangent = Vec3::new(a.cos(), a.sin(), 0.3 * (2.0 * a).sin()) * 2.0;
+            let dir = Vec3::new((1.7 * a).sin(), -0.4, (0.9 * a).cos()) * 0.5;
+            let across_ray = tangent.cross(dir).normalize();
+            let (radius, axis) = (0.03, Vec3::new(1.0, -2.0, 0.5));
+            let org = axis + across_ray * (0.61 * k as f32).sin() * 0.95 * radius - dir * 8.0;
+            let hit = [tangent, org, dir, axis].map(|v| v.to_array());
+            let [t, o, d, x] = hit.each_ref().map(|v| v.as_ptr());
+            let (mut at_hit, mut framed) = (point(), point());
+            let mut frame = local(0.0);
             unsafe {
+                let s = ht_hair_point_at_hit(handle, t, o, d, x, radius, &mut at_hit);
+                assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
                 assert_eq!(
-                    ht_hair_point_init_world(handle, &frame, wo.as_ptr(), &mut world),
+                    ht_hair_frame(t, o, d, x, radius, &mut frame),
                     HtStatus::HT_OK
                 );
-                ht_hair_frame_to_local(&frame, wo.as_ptr(), wo_local.as_mut_ptr());
-                ht_hair_point_init(handle, frame.h, wo_local.as_ptr(), &mut local);
+                let wo = (-dir.normalize()).to_array();
+                let s = ht_hair_point_init_world(handle, &frame, wo.as_ptr(), &mut framed);
+                assert_eq!(s, HtStatus::HT_OK);
             }
+            let axes = checked_axes(&frame).ok().expect("a frame");
+            let rust = bsdf.at(frame.h, axes.to_local(-dir.normalize()));
             // Light from a direction of the world, and a sample.
-            let wi = arr(&Vec3::new(0.3, (1.3 * a).cos(), (1.3 * a).sin()).normalize());
+            let wi = Vec3::new(0.3, (1.3 * a).cos(), (1.3 * a).sin()).normalize();
             let u = [(0.13 * k as f32).fract(), 0.42, (0.71 * k as f32).fract()];
-            let (mut f_w, mut pdf_w, mut f_l, mut pdf_l) =
-                ([0.0f32; 3], 0.0f32, [0.0f32; 3], 0.0f32);
-            let mut wi_local = [0.0f32; 3];
-            let (mut d_w, mut wt_w, mut p_w) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
-            let (mut d_l, mut wt_l, mut p_l, mut d_back) =
-                ([0.0f32; 3], [0.0f32; 3], 0.0f32, [0.0f32; 3]);
-            unsafe {
-                assert_eq!(
-                    ht_hair_point_eval_world(&world, wi.as_ptr(), f_w.as_mut_ptr(), &mut pdf_w),
-                    HtStatus::HT_OK
-                );
-                ht_hair_frame_to_local(&frame, wi.as_ptr(), wi_local.as_mut_ptr());
-                ht_hair_point_eval_cos(&local, wi_local.as_ptr(), f_l.as_mut_ptr(), &mut pdf_l);
-                let s = ht_hair_point_sample_world(
-                    &world,
-                    u.as_ptr(),
-                    d_w.as_mut_ptr(),
-                    wt_w.as_mut_ptr(),
-                    &mut p_w,
-                );
-                assert_eq!(s, HtStatus::HT_OK);
-                ht_hair_point_sample_cos(
-                    &local,
-                    u.as_ptr(),
-                    d_l.as_mut_ptr(),
-                    wt_l.as_mut_ptr(),
-                    &mut p_l,
-                );
-                ht_hair_frame_to_world(&frame, d_l.as_ptr(), d_back.as_mut_ptr());
-            }
-            assert_eq!((f_w, pdf_w), (f_l, pdf_l), "eval at {k}");
-            assert_eq!((d_w, wt_w, p_w), (d_back, wt_l, p_l), "sample at {k}");
+            let (status, f_cos, pdf) = eval(&at_hit, wi.to_array());
+            assert_eq!(status, HtStatus::HT_OK);
+            assert_eq!(
+                eval(&framed, wi.to_array()),
+                (status, f_cos, pdf),
+                "eval at {k}"
+            );
+            let l = axes.to_local(wi);
+            let want = rust.eval(l);
+            assert_eq!((f_cos, pdf), ((want.f * l.z.abs()).to_array(), want.pdf));
+            let (status, [d_s, fc_s, w_s], p_s) = sample(&at_hit, u);
+            assert_eq!(status, HtStatus::HT_OK);
+            assert_eq!(
+                sample(&framed, u),
+                (status, [d_s, fc_s, w_s], p_s),
+                "sample at {k}"
+            );
+            let want = rust.sample(u).unwrap();
+            let fc = want.f * want.wi.z.abs();
+            assert_eq!(
+                (d_s, fc_s, w_s, p_s),
+                (
+                    axes.to_world(want.wi).to_array(),
+                    fc.to_array(),
+                    (fc / want.pdf).to_array(),
+                    want.pdf
+                ),
+                "sample at {k}"
+            );
             // Across the fibre, lane 0 (the point's own h) being the plain evaluation.
-            type Across = unsafe extern "C" fn(
-                *const HtHairPoint,
-                *const f32,
-                *mut f32,
-                *mut f32,
-            ) -> HtStatus;
-            let lanes = |call: Across, p: &HtHairPoint, wi: &[f32; 3]| {
-                let (mut f, mut pdf) = ([0.0f32; 3 * HT_ACROSS], [0.0f32; HT_ACROSS]);
-                let s = unsafe { call(p, wi.as_ptr(), f.as_mut_ptr(), pdf.as_mut_ptr()) };
-                assert_eq!(s, HtStatus::HT_OK);
-                (f.map(f32::to_bits), pdf.map(f32::to_bits))
-            };
-            let across_w = lanes(ht_hair_point_eval_across_world, &world, &wi);
-            let across_l = lanes(ht_hair_point_eval_across, &local, &wi_local);
-            assert_eq!(across_w, across_l, "across at {k}");
-            assert_eq!(across_w.0[..3], f_w.map(f32::to_bits), "lane 0 at {k}");
-            assert_eq!(across_w.1[0], pdf_w.to_bits(), "lane 0 at {k}");
-            assert!(pdf_w > 0.0 && p_w > 0.0, "{k}: a lobe toward every light");
+            let (f_lanes, pdf_lanes) = across(&at_hit, wi.to_array());
+            assert_eq!(f_lanes[..3], f_cos.map(f32::to_bits), "lane 0 at {k}");
+            assert_eq!(pdf_lanes[0], pdf.to_bits(), "lane 0 at {k}");
+            assert!(pdf > 0.0 && p_s > 0.0, "{k}: a lobe toward every light");
         }
         unsafe { ht_hair_prepared_free(handle) };
     }
@@ -1125,16 +733,14 @@ mod tests {
         };
         let scene = material.prepare().unwrap();
         let mut distinct = std::collections::BTreeSet::new();
+        let wo = Vec3::new(0.3, 0.2, 0.9).normalize();
         for k in 0..120u32 {
             let (strand, s) = (k * 7 % 23, (k % 11) as f32 / 10.0);
             let color = [0.3 + 0.005 * k as f32, 0.2, 0.1];
             let groom = (k % 2 == 0).then_some(color);
-            let (h, wo) = (
-                0.9 * (0.3 * k as f32).sin(),
-                Vec3::new(0.3, 0.2, 0.9).normalize(),
-            );
+            let h = 0.9 * (0.3 * k as f32).sin();
             let mut pt = point();
-            let color_ptr = groom.as_ref().map_or(std::ptr::null(), |c| c.as_ptr());
+            let color_ptr = groom.as_ref().map_or(null(), |c| c.as_ptr());
             let st = unsafe {
                 ht_hair_point_init_strand(
                     handle,
@@ -1142,7 +748,7 @@ mod tests {
                     strand,
                     s,
                     color_ptr,
-                    h,
+                    &local(h),
                     wo.as_ref().as_ptr(),
                     &mut pt,
                 )
@@ -1152,176 +758,165 @@ mod tests {
             distinct.insert(want.params().sigma_a.map(f32::to_bits));
             let rust = want.at(h, wo);
             let wi = Vec3::new(-0.2, 0.7, 0.5).normalize();
-            let (mut f, mut pdf) = ([0.0f32; 3], 0.0f32);
-            unsafe { ht_hair_point_eval(&pt, wi.as_ref().as_ptr(), f.as_mut_ptr(), &mut pdf) };
             let e = rust.eval(wi);
-            assert_eq!((f, pdf), (e.f.to_array(), e.pdf), "strand {strand} s {s}");
+            let want_eval = (HtStatus::HT_OK, (e.f * wi.z.abs()).to_array(), e.pdf);
+            assert_eq!(eval(&pt, wi.to_array()), want_eval, "strand {strand} s {s}");
             let u = [0.61, 0.27, 0.83];
-            let (mut w, mut fs, mut ps) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
-            unsafe {
-                ht_hair_point_sample(&pt, u.as_ptr(), w.as_mut_ptr(), fs.as_mut_ptr(), &mut ps)
-            };
             let want = rust.sample(u).unwrap();
-            assert_eq!(
-                (w, fs, ps),
-                (want.wi.to_array(), want.f.to_array(), want.pdf)
-            );
+            let (_, [wi_s, f_cos, _], pdf) = sample(&pt, u);
+            let fc = (want.f * want.wi.z.abs()).to_array();
+            assert_eq!((wi_s, f_cos, pdf), (want.wi.to_array(), fc, want.pdf));
         }
         assert!(
             distinct.len() > 100,
             "the parameters vary: {}",
             distinct.len()
         );
+        let init = |variation: &HtHairVariation, s: f32, pt: &mut HtHairPoint| unsafe {
+            let wo = [0.0f32, 0.0, 1.0];
+            ht_hair_point_init_strand(
+                handle,
+                variation,
+                0,
+                s,
+                null(),
+                &local(0.0),
+                wo.as_ptr(),
+                pt,
+            )
+        };
         let bad = HtHairVariation {
             roughness_variation: 2.0,
             ..variation
         };
-        let wo = [0.0f32, 0.0, 1.0];
         let mut pt = point();
-        let st = unsafe {
-            ht_hair_point_init_strand(
-                handle,
-                &bad,
-                0,
-                0.5,
-                std::ptr::null(),
-                0.0,
-                wo.as_ptr(),
-                &mut pt,
-            )
-        };
-        assert_eq!(st, HtStatus::HT_ERR_INVALID_ARG);
+        assert_eq!(init(&bad, 0.5, &mut pt), HtStatus::HT_ERR_INVALID_ARG);
         assert!(
             last_error().contains("roughness_variation = 2"),
             "{}",
             last_error()
         );
-        let st = unsafe {
-            ht_hair_point_init_strand(
-                handle,
-                &variation,
-                0,
-                1.5,
-                std::ptr::null(),
-                0.0,
-                wo.as_ptr(),
-                &mut pt,
-            )
-        };
+        let st = init(&variation, 1.5, &mut pt);
         assert!(st == HtStatus::HT_ERR_INVALID_ARG && last_error().contains("s = 1.5"));
+        assert_eq!(pt.opaque, [0; HT_HAIR_POINT_SIZE], "a refused init wrote");
         unsafe { ht_hair_prepared_free(handle) };
     }
 
     #[test]
     fn unfilled_misaligned_and_overlapping_points_are_refused() {
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
+        let fails = |status: HtStatus, want: HtStatus, words: &str| {
+            assert_eq!(status, want, "{}", last_error());
+            assert!(last_error().contains(words), "{}", last_error());
+        };
         let wi = [0.0f32, 0.0, 1.0];
-        let (mut f, mut pdf) = ([0.0f32; 3], 0.0f32);
         let zeroed = point();
-        let s = unsafe { ht_hair_point_eval(&zeroed, wi.as_ptr(), f.as_mut_ptr(), &mut pdf) };
-        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-        assert!(
-            last_error().contains("not filled by ht_hair_point_init"),
-            "{}",
-            last_error()
+        fails(
+            eval(&zeroed, wi).0,
+            INVALID,
+            "not filled by ht_hair_point_at_hit",
         );
+        fails(sample(&zeroed, [0.5; 3]).0, INVALID, "not filled");
         let handle = prepare(&HairParams::default().into());
         let mut two = [point(), point()];
         let odd = unsafe { two.as_mut_ptr().cast::<u8>().add(4) }.cast::<HtHairPoint>();
-        let s = unsafe { ht_hair_point_init(handle, 0.0, wi.as_ptr(), odd) };
-        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-        assert!(
-            last_error().contains("not aligned to 16"),
-            "{}",
-            last_error()
+        let frame = local(0.0);
+        let init = |frame: *const HtHairFrame, wo: *const f32, pt: *mut HtHairPoint| unsafe {
+            ht_hair_point_init_world(handle, frame, wo, pt)
+        };
+        fails(init(&frame, wi.as_ptr(), odd), INVALID, "not aligned to 16");
+        // wo inside the point it fills, or the frame.
+        let inside = two[0].opaque.as_ptr();
+        fails(
+            init(&frame, inside.cast(), &mut two[0]),
+            INVALID,
+            "point and wo overlap",
         );
-        // wo inside the point it fills.
-        let inside = two[0].opaque.as_ptr().cast::<f32>();
-        let s = unsafe { ht_hair_point_init(handle, 0.0, inside, &mut two[0]) };
-        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-        assert!(
-            last_error().contains("point and wo overlap"),
-            "{}",
-            last_error()
+        fails(
+            init(inside.cast(), wi.as_ptr(), &mut two[0]),
+            INVALID,
+            "point and frame overlap",
         );
-        unsafe { ht_hair_prepared_free(handle) };
-    }
-
-    #[test]
-    fn batches_match_single_calls_and_check_every_element() {
-        let handle = prepare(&HairParams::default().into());
-        let mut points = [point(), point(), point()];
-        for (k, p) in points.iter_mut().enumerate() {
-            let wo = Vec3::new(0.2 * k as f32, 0.0, 1.0).normalize();
-            unsafe { ht_hair_point_init(handle, 0.3 * k as f32, wo.as_ref().as_ptr(), p) };
-        }
-        let wi = [[0.0f32, 0.6, 0.8], [0.0, -0.6, 0.8], [1.0, 0.0, 0.0]];
-        let (mut f, mut pdf) = ([[0.0f32; 3]; 3], [0.0f32; 3]);
-        let s = unsafe {
-            ht_hair_points_eval(
-                points.as_ptr(),
-                3,
-                wi.as_ptr().cast(),
-                f.as_mut_ptr().cast(),
-                pdf.as_mut_ptr(),
-            )
+        // NULL before any value; then the frame, then wo.
+        let mut pt = point();
+        fails(init(null(), wi.as_ptr(), &mut pt), NULL, "frame is NULL");
+        let mirrored = HtHairFrame {
+            z: [0.0, 0.0, -1.0],
+            ..frame
         };
-        assert_eq!(s, HtStatus::HT_OK);
-        let u = [[0.1f32, 0.2, 0.3], [0.5, 0.5, 0.5], [0.9, 0.1, 0.7]];
-        let (mut wis, mut fs, mut pdfs) = ([[0.0f32; 3]; 3], [[0.0f32; 3]; 3], [0.0f32; 3]);
-        let s = unsafe {
-            ht_hair_points_sample(
-                points.as_ptr(),
-                3,
-                u.as_ptr().cast(),
-                wis.as_mut_ptr().cast(),
-                fs.as_mut_ptr().cast(),
-                pdfs.as_mut_ptr(),
-            )
-        };
-        assert_eq!(s, HtStatus::HT_OK);
-        for k in 0..3 {
-            let (mut f1, mut p1) = ([0.0f32; 3], 0.0f32);
-            unsafe { ht_hair_point_eval(&points[k], wi[k].as_ptr(), f1.as_mut_ptr(), &mut p1) };
-            assert_eq!((f[k], pdf[k]), (f1, p1));
-            let (mut w1, mut f1, mut p1) = ([0.0f32; 3], [0.0f32; 3], 0.0f32);
-            unsafe {
-                ht_hair_point_sample(
-                    &points[k],
-                    u[k].as_ptr(),
-                    w1.as_mut_ptr(),
-                    f1.as_mut_ptr(),
-                    &mut p1,
-                )
-            };
-            assert_eq!((wis[k], fs[k], pdfs[k]), (w1, f1, p1));
-        }
-        let bad = [[0.0f32, 0.6, 0.8], [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
-        let s = unsafe {
-            ht_hair_points_eval(
-                points.as_ptr(),
-                3,
-                bad.as_ptr().cast(),
-                f.as_mut_ptr().cast(),
-                pdf.as_mut_ptr(),
-            )
-        };
-        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-        assert!(last_error().starts_with("element 1: "), "{}", last_error());
-        let s = unsafe {
-            ht_hair_points_eval(
-                points.as_ptr(),
-                usize::MAX / 2,
-                bad.as_ptr().cast(),
-                f.as_mut_ptr().cast(),
-                pdf.as_mut_ptr(),
-            )
-        };
-        assert_eq!(s, HtStatus::HT_ERR_INVALID_ARG);
-        assert!(
-            last_error().contains("do not fit in memory"),
-            "{}",
-            last_error()
+        fails(
+            init(&mirrored, wi.as_ptr(), &mut pt),
+            INVALID,
+            "right-handed",
         );
+        fails(init(&local(1.5), wi.as_ptr(), &mut pt), INVALID, "h = 1.5");
+        fails(
+            init(&frame, [0.0f32, 0.0, 2.0].as_ptr(), &mut pt),
+            INVALID,
+            "wo = ",
+        );
+        // A hit that is not one, and NULL first whatever else is wrong.
+        let (t, o, d, x) = (
+            [1.0f32, 0.0, 0.0],
+            [0.0f32, 0.5, 4.0],
+            [0.0f32, 0.0, -1.0],
+            [0.0f32; 3],
+        );
+        let hit = |prepared, radius, pt| unsafe {
+            ht_hair_point_at_hit(
+                prepared,
+                t.as_ptr(),
+                o.as_ptr(),
+                d.as_ptr(),
+                x.as_ptr(),
+                radius,
+                pt,
+            )
+        };
+        fails(hit(null(), f32::NAN, &raw mut pt), NULL, "prepared is NULL");
+        fails(hit(handle, 0.0, &raw mut pt), INVALID, "radius = 0");
+        fails(hit(handle, 0.1, &raw mut pt), INVALID, "5 radii away");
+        let far = [0.0f32, 2e38, 4.0];
+        let s = unsafe {
+            ht_hair_point_at_hit(
+                handle,
+                t.as_ptr(),
+                far.as_ptr(),
+                d.as_ptr(),
+                x.as_ptr(),
+                1.0,
+                &mut pt,
+            )
+        };
+        fails(s, INVALID, "radii away");
+        let s = unsafe {
+            ht_hair_point_at_hit(
+                handle,
+                inside.cast(),
+                o.as_ptr(),
+                d.as_ptr(),
+                x.as_ptr(),
+                1.0,
+                &mut two[0],
+            )
+        };
+        fails(s, INVALID, "point and tangent overlap");
+        assert_eq!(pt.opaque, [0; HT_HAIR_POINT_SIZE], "a refused init wrote");
+        assert_eq!(hit(handle, 1.0, &raw mut pt), HtStatus::HT_OK);
+        // Per direction: a unit wi, u in [0, 1), outputs apart.
+        fails(
+            eval(&pt, [0.0, 0.0, 0.5]).0,
+            INVALID,
+            "wi (in the point's frame)",
+        );
+        fails(sample(&pt, [0.5, 1.0, 0.5]).0, INVALID, "u[1] = 1");
+        let mut out = [7.0f32; 8];
+        let s = unsafe {
+            let o = out.as_mut_ptr();
+            ht_hair_point_sample_world(&pt, [0.5f32; 3].as_ptr(), o, o.add(2), o.add(5), o.add(7))
+        };
+        fails(s, INVALID, "wi and f_cos overlap");
+        assert_eq!(out, [7.0; 8], "a refused call wrote");
         unsafe { ht_hair_prepared_free(handle) };
     }
 }

@@ -4,17 +4,16 @@ use super::scene::{HtScene, scene_mut};
 use super::settings::{HtSettings, read_settings};
 use super::{
     Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
-    non_null_mut, read_host, read_path,
+    non_null_mut, read_path,
 };
 use crate::error::invalid_arg;
 use crate::image::{WriteOptions, write_image};
 use crate::render::renderer::render;
-use crate::render::settings::{Filter, PathSettings, RenderSettings};
+use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
 use crate::scene::stages::{NoStages, Stage, StageProgress};
 use std::cell::Cell;
 use std::ffi::{c_char, c_void};
-use std::ptr::null_mut;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Told how far a render has got: `done` of `total` pixels, counted over the render's
@@ -25,153 +24,15 @@ use std::sync::atomic::{AtomicU32, Ordering};
 /// round and, while pixels take long (many samples), also every 20 ms or so of work with an
 /// unchanged `done`, so that it can cancel any render promptly. Return false to cancel: no
 /// new sample starts, the round of unfinished tiles is dropped (their pixels keep the
-/// rounds they finished), and `ht_render` returns `HT_ERR_CANCELLED`.
+/// rounds they finished), and `ht_render_with` returns `HT_ERR_CANCELLED`.
 ///
 /// Called from the render's worker threads (not necessarily the one that called
-/// `ht_render`), but never two calls at once, so `user` needs no locking against itself.
+/// `ht_render_with`), but never two calls at once, so `user` needs no locking against itself.
 /// Inside it, `ht_progress_noise()` tells the render's estimated noise so far. The
 /// callback must return normally: a C++ exception or a longjmp out of it is undefined
 /// behaviour (catch inside and return false instead).
 pub type HtProgressFn =
     Option<unsafe extern "C" fn(done: u64, total: u64, user: *mut c_void) -> bool>;
-
-/// A pixel filter: one of the `HT_FILTER_*` constants.
-pub type HtPixelFilter = u32;
-/// A separable tent of half-width `filter_radius` pixels.
-pub const HT_FILTER_TENT: HtPixelFilter = 0;
-/// The one-pixel box.
-pub const HT_FILTER_BOX: HtPixelFilter = 1;
-
-/// Deprecated (ABI 6, the last to have it): use `HtSettings` with `ht_settings_set`,
-/// `ht_scene_build_with` and `ht_render_with`, whose settings are named and never change
-/// the ABI's layout (settings added since, such as `isa`, are only there).
-///
-/// What `ht_render` is asked to do. Start from `ht_render_settings_default()` and change
-/// the fields you need.
-#[repr(C)]
-#[derive(Debug, Clone, Copy)]
-pub struct HtRenderSettings {
-    /// Image size in pixels, each in [1, 32768].
-    pub width: u32,
-    pub height: u32,
-    /// Samples per pixel, >= 1.
-    pub spp: u32,
-    /// The image depends only on the scene, these settings and this seed: never on the
-    /// thread count.
-    pub seed: u64,
-    /// Render threads; 0: one per hardware thread.
-    pub threads: u32,
-    /// Longest path in scattering events, >= 1. Light hair needs many: the default (256)
-    /// keeps blonde hair from darkening; Russian roulette ends most paths far earlier.
-    pub max_depth: u32,
-    /// Crop window: render only the pixels [crop_x0, crop_x1) x [crop_y0, crop_y1) of the
-    /// full width x height frame (x0 < x1 <= width, y0 < y1 <= height); all four 0 renders
-    /// the full frame. The output buffers then hold the window's pixels alone, rows from
-    /// its top. A crop renders exactly the values the full frame has at those pixels (the
-    /// camera still sees the full frame, and every sample depends only on the seed and its
-    /// full-frame pixel), so a render farm can split a frame into windows and reassemble
-    /// them bit for bit.
-    pub crop_x0: u32,
-    pub crop_y0: u32,
-    pub crop_x1: u32,
-    pub crop_y1: u32,
-    /// Pixel filter: `HT_FILTER_TENT` (the default: thin strands alias under a box) or
-    /// `HT_FILTER_BOX` (one pixel, for comparisons with renderers that use it).
-    pub filter: HtPixelFilter,
-    /// The tent's half-width in pixels, in (0, 8]; ignored by the box. Default 1.
-    pub filter_radius: f32,
-    /// May be NULL: no progress reports, no cancellation.
-    pub progress: HtProgressFn,
-    /// Passed to `progress` as it is.
-    pub progress_user: *mut c_void,
-    /// Past this many scattering events a hair BSDF is one merged lobe: the same energy
-    /// (albedo), the residual lobe's longitudinal spread, no azimuthal highlights. Cheaper
-    /// per event and far less noisy on light hair, but biased (light hair comes out
-    /// brighter), so off by default. 0 (the default): the exact model at every event.
-    /// Otherwise in [1, max_depth]; max_depth changes nothing. docs/measurements.md, "Speed against
-    /// error", has what it costs and buys. (ABI 5.)
-    pub deep_bounce_depth: u32,
-    /// Hair lobes whose attenuation (largest channel) is below this fraction of the total
-    /// are dropped from evaluation and sampling (the strongest lobe is always kept); in
-    /// [0, 1), 0 (the default) keeps every lobe. It loses the dropped lobes' energy and,
-    /// measured, saves no time: off by default (docs/measurements.md, "Speed against error"). (ABI 5.)
-    pub lobe_cull: f32,
-    /// Shadow-ray roulette: a light sample whose unoccluded contribution to the pixel
-    /// (largest channel, in the image's units) is below this value traces its shadow ray
-    /// with probability contribution / threshold and is reweighted by the inverse. Unbiased;
-    /// finite and >= 0, 0 traces every shadow ray. Default 0.03, chosen on the bench
-    /// scenes (docs/measurements.md, "Render efficiency"). (ABI 6.)
-    pub light_threshold: f32,
-}
-
-/// Deprecated with `HtRenderSettings`: use `ht_settings_new`.
-///
-/// 640 x 480, 16 samples per pixel, seed 0, every core, max_depth 256, the full frame (no
-/// crop), a tent filter of radius 1, no callback, the exact hair BSDF at every event (no
-/// deep-bounce lobe, no lobe culling), shadow-ray roulette below 0.03. Cannot fail; any
-/// thread.
-#[unsafe(no_mangle)]
-pub extern "C" fn ht_render_settings_default() -> HtRenderSettings {
-    let d = RenderSettings::default();
-    let [crop_x0, crop_y0, crop_x1, crop_y1] = d.crop.unwrap_or_default();
-    HtRenderSettings {
-        width: d.width,
-        height: d.height,
-        spp: d.spp,
-        seed: d.seed,
-        threads: 0,
-        max_depth: d.path.max_depth,
-        crop_x0,
-        crop_y0,
-        crop_x1,
-        crop_y1,
-        filter: HT_FILTER_TENT,
-        filter_radius: d.filter_radius,
-        progress: None,
-        progress_user: null_mut(),
-        deep_bounce_depth: d.path.deep_bounce_depth.unwrap_or(0),
-        lobe_cull: d.path.lobe_cull,
-        light_threshold: d.path.light_threshold,
-    }
-}
-
-impl HtRenderSettings {
-    /// The Rust settings these stand for (the filter checked, the rest not yet validated).
-    pub(super) fn to_rust(self) -> crate::Result<RenderSettings> {
-        let crop = [self.crop_x0, self.crop_y0, self.crop_x1, self.crop_y1];
-        let filter = match self.filter {
-            HT_FILTER_TENT => Filter::Tent,
-            HT_FILTER_BOX => Filter::Box,
-            other => {
-                return Err(invalid_arg!(
-                    "filter = {other}: must be HT_FILTER_TENT (0) or HT_FILTER_BOX (1)"
-                ));
-            }
-        };
-        Ok(RenderSettings {
-            width: self.width,
-            height: self.height,
-            spp: self.spp,
-            seed: self.seed,
-            threads: (self.threads > 0).then_some(self.threads as usize),
-            crop: (crop != [0; 4]).then_some(crop),
-            filter,
-            // The box ignores the radius, so a host may leave any value there.
-            filter_radius: match filter {
-                Filter::Tent => self.filter_radius,
-                Filter::Box => RenderSettings::default().filter_radius,
-            },
-            path: PathSettings {
-                max_depth: self.max_depth,
-                deep_bounce_depth: (self.deep_bounce_depth > 0).then_some(self.deep_bounce_depth),
-                lobe_cull: self.lobe_cull,
-                light_threshold: self.light_threshold,
-                ..PathSettings::default()
-            },
-            ..RenderSettings::default()
-        })
-    }
-}
 
 /// The host's callback as a [`Progress`] sink.
 struct HostProgress {
@@ -249,37 +110,10 @@ impl StageProgress for HostBuildProgress {
     }
 }
 
-/// Deprecated with `HtRenderSettings`: use `ht_scene_build_with`.
-///
-/// Builds now what `ht_render` with `settings` would build first: the Embree scene (and,
-/// for `HT_CURVE_AUTO` curves, their shapes for this camera and image height), telling
-/// `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom takes tens
-/// of seconds here; a render with the same view then starts at once. Only the size of
-/// `settings` (width, height) matters; its render callback is not called.
-///
-/// Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
-/// out of range, a scene with no light, or no camera and no geometry to frame);
-/// `HT_ERR_EMBREE` (the build failed); `HT_ERR_CANCELLED` (`progress` returned false: the
-/// scene is left unbuilt, and the next build or render starts over).
-///
-/// # Safety
-/// `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
-/// `settings` is NULL or readable.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_scene_build(
-    scene: *mut HtScene,
-    settings: *const HtRenderSettings,
-    progress: HtBuildProgressFn,
-    user: *mut c_void,
-) -> HtStatus {
-    boundary(|| {
-        let settings = read_host(settings, "settings")?.to_rust()?;
-        settings.validate()?;
-        build(scene, &settings, progress, user)
-    })
-}
-
-/// As `ht_scene_build` (deprecated), with settings by name.
+/// Builds now what `ht_render_with` with `settings` would build first: the Embree scene
+/// (and, for `HT_CURVE_AUTO` curves, their shapes for this camera and image height),
+/// telling `progress` (may be NULL) how far the BVH build has got. A 10^6-strand groom
+/// takes tens of seconds here; a render with the same view then starts at once.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene` or `settings` NULL); `HT_ERR_INVALID_ARG` (settings
 /// out of range, a scene with no light, or no camera and no geometry to frame);
@@ -321,53 +155,20 @@ fn build(
     Ok(())
 }
 
-/// Deprecated with `HtRenderSettings`: use `ht_render_with`.
-///
-/// Renders `scene` into `rgb`: linear float RGB, interleaved, rows from the top,
-/// `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a crop)
-/// owned by the host. `ht_render_aovs` without AOVs.
+/// Renders `scene` with `settings` into `rgb`: linear float RGB, interleaved, rows from the
+/// top, `rgb_len` = 3 floats per pixel of the crop window (width * height * 3 without a
+/// crop) owned by the host, telling `progress` (may be NULL) with `user`.
 ///
 /// The first render builds the Embree scene (its time is part of the call, silent:
-/// `ht_scene_build` reports it); later ones reuse it until geometry is added, or until
-/// a view needs other shapes for `HT_CURVE_AUTO` curves. Blocks until the image is done,
-/// on worker threads of its own that are joined before it returns. On `HT_ERR_CANCELLED`,
-/// `rgb` holds the pixels finished before the callback said stop and 0 elsewhere; on other
-/// errors it is left untouched.
+/// `ht_scene_build_with` reports it); later ones reuse it until geometry is added, or until
+/// a view needs other shapes for `HT_CURVE_AUTO` curves. On `HT_ERR_CANCELLED`, `rgb` holds
+/// the pixels finished before the callback said stop and 0 elsewhere; on other errors
+/// every buffer is left untouched.
 ///
-/// Statuses: as `ht_render_aovs`.
-///
-/// # Safety
-/// As `ht_render_aovs`.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn ht_render(
-    scene: *mut HtScene,
-    settings: *const HtRenderSettings,
-    rgb: *mut f32,
-    rgb_len: usize,
-) -> HtStatus {
-    // A wrong rgb_len is reported as such before the pixel count derived from it.
-    let pixel_count = rgb_len / 3;
-    // SAFETY: the caller's promises; the AOV pointers are NULL.
-    unsafe {
-        ht_render_aovs(
-            scene,
-            settings,
-            rgb,
-            rgb_len,
-            null_mut(),
-            null_mut(),
-            null_mut(),
-            pixel_count,
-        )
-    }
-}
-
-/// Deprecated with `HtRenderSettings`: use `ht_render_with`.
-///
-/// As `ht_render`, and also writes the AOVs (arbitrary output variables, for compositing
-/// and denoising) whose buffers are not NULL; NULL means not wanted, and costs nothing.
-/// `pixel_count` is the crop window's pixel count (width * height without a crop), and
-/// each buffer holds that many pixels, rows from the top, in memory of its own:
+/// It also writes the AOVs (arbitrary output variables, for compositing and denoising)
+/// whose buffers are not NULL; NULL means not wanted, and costs nothing. `pixel_count` is
+/// the crop window's pixel count (width * height without a crop), and each buffer holds
+/// that many pixels, rows from the top, in memory of its own:
 ///
 /// - `albedo`: 3 floats per pixel, the mean reflectance colour (hair colour, diffuse
 ///   albedo, linear RGB in [0, 1]) of the surfaces the pixel's camera rays hit first;
@@ -380,43 +181,7 @@ pub unsafe extern "C" fn ht_render(
 ///   no id.
 ///
 /// On `HT_ERR_CANCELLED` the AOVs, like `rgb`, hold the passes each pixel finished and the
-/// values of "nothing hit" elsewhere; on other errors every buffer is left untouched.
-///
-/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
-/// (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer
-/// misaligned, any two buffers (or a buffer and `*settings`) overlapping, a scene with no
-/// light, or no camera and no geometry to frame); `HT_ERR_EMBREE` (the scene build
-/// failed); `HT_ERR_CANCELLED` (the progress callback returned false).
-///
-/// # Safety
-/// `scene` is NULL or a live handle not in use on another thread (the whole call uses it);
-/// `settings` is NULL or readable; each non-NULL buffer holds the floats its length says,
-/// writable, and nothing else reads or writes it during the call.
-#[unsafe(no_mangle)]
-#[allow(clippy::too_many_arguments)] // the C signature: one argument per buffer
-pub unsafe extern "C" fn ht_render_aovs(
-    scene: *mut HtScene,
-    settings: *const HtRenderSettings,
-    rgb: *mut f32,
-    rgb_len: usize,
-    albedo: *mut f32,
-    depth: *mut f32,
-    strand_id: *mut f32,
-    pixel_count: usize,
-) -> HtStatus {
-    boundary(|| {
-        let s = read_host(settings, "settings")?;
-        let rust = s.to_rust()?;
-        rust.validate()?;
-        let span = Span::of("settings", settings, 1);
-        let buffers = (rgb, rgb_len, albedo, depth, strand_id, pixel_count);
-        render_into(scene, &rust, span, s.progress, s.progress_user, buffers)
-    })
-}
-
-/// As `ht_render_aovs` (deprecated), with settings by name and the progress callback
-/// (may be NULL) and its `user` pointer as arguments. `rgb` is required; each AOV buffer
-/// may be NULL (not wanted).
+/// values of "nothing hit" elsewhere.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `settings` or `rgb` NULL); `HT_ERR_INVALID_ARG`
 /// (settings out of range, `rgb_len` or `pixel_count` not what the window needs, a buffer

@@ -2,6 +2,7 @@
 
 use super::HtStatus;
 use super::render::*;
+use super::settings::HtSettings;
 use crate::capi::geometry::*;
 use crate::capi::lights::*;
 use crate::capi::scene::*;
@@ -33,15 +34,73 @@ const SUN_DIR: [f32; 3] = [1.0, 1.0, 1.0];
 const SUN: [f32; 3] = [2.0, 2.0, 1.8];
 const SUN_RADIUS_DEG: f32 = 2.0;
 
-pub(super) fn settings(size: u32) -> HtRenderSettings {
-    HtRenderSettings {
+pub(super) fn settings(size: u32) -> RenderSettings {
+    RenderSettings {
         width: size,
         height: size,
         spp: 4,
         seed: 7,
-        threads: 2,
-        ..ht_render_settings_default()
+        threads: Some(2),
+        ..RenderSettings::default()
     }
+}
+
+/// `ht_render_with` with `s` behind its handle, set directly rather than by name so that
+/// values `ht_settings_set` refuses reach the render's own checks; `aovs` are the albedo,
+/// depth and strand-id buffers (NULL: not wanted), `progress` the callback and its user.
+#[allow(clippy::too_many_arguments)]
+pub(super) unsafe fn render_raw(
+    scene: *mut HtScene,
+    s: &RenderSettings,
+    rgb: *mut f32,
+    rgb_len: usize,
+    aovs: [*mut f32; 3],
+    pixel_count: usize,
+    (progress, user): (HtProgressFn, *mut c_void),
+) -> HtStatus {
+    let handle = HtSettings { settings: *s };
+    let [albedo, depth, strand_id] = aovs;
+    unsafe {
+        ht_render_with(
+            scene,
+            &handle,
+            progress,
+            user,
+            rgb,
+            rgb_len,
+            albedo,
+            depth,
+            strand_id,
+            pixel_count,
+        )
+    }
+}
+
+/// `ht_render_with` of `s` into `rgb_len` floats of `rgb`, without AOVs or a callback.
+unsafe fn render_rgb(
+    scene: *mut HtScene,
+    s: &RenderSettings,
+    rgb: *mut f32,
+    rgb_len: usize,
+) -> HtStatus {
+    let none = [null_mut(); 3];
+    unsafe {
+        render_raw(
+            scene,
+            s,
+            rgb,
+            rgb_len,
+            none,
+            rgb_len / 3,
+            (None, null_mut()),
+        )
+    }
+}
+
+/// The pixels of `s`'s crop window (the frame without one).
+fn window_pixels(s: &RenderSettings) -> usize {
+    let [x0, y0, x1, y1] = s.window();
+    ((x1 - x0) * (y1 - y0)) as usize
 }
 
 /// The small fur ball with hair, sky and sun through the C functions.
@@ -75,31 +134,42 @@ pub(super) fn light(h: &Handles, camera: bool) {
     }
 }
 
-pub(super) fn render_c(h: &Handles, s: &HtRenderSettings) -> (HtStatus, Vec<f32>) {
-    unsafe {
-        let mut rgb = vec![-1.0f32; (s.width * s.height * 3) as usize];
-        let status = ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len());
-        (status, rgb)
-    }
+pub(super) fn render_c(h: &Handles, s: &RenderSettings) -> (HtStatus, Vec<f32>) {
+    render_reporting(h, s, (None, null_mut()))
 }
 
-/// Renders through `ht_render_aovs` with every AOV: rgb, albedo, depth, strand id.
-pub(super) fn render_aovs_c(h: &Handles, s: &HtRenderSettings) -> [Vec<f32>; 4] {
-    unsafe {
-        let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
-        let pixels = ((x1 - x0) * (y1 - y0)) as usize;
-        let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
-        let [rgb, albedo, depth, strand_id] = &mut out;
-        let status = ht_render_aovs(
+/// [`render_c`], telling `progress` with its user pointer.
+fn render_reporting(
+    h: &Handles,
+    s: &RenderSettings,
+    progress: (HtProgressFn, *mut c_void),
+) -> (HtStatus, Vec<f32>) {
+    let pixels = window_pixels(s);
+    let mut rgb = vec![-1.0f32; 3 * pixels];
+    let none = [null_mut(); 3];
+    let status = unsafe {
+        render_raw(
             h.scene,
             s,
             rgb.as_mut_ptr(),
             rgb.len(),
-            albedo.as_mut_ptr(),
-            depth.as_mut_ptr(),
-            strand_id.as_mut_ptr(),
+            none,
             pixels,
-        );
+            progress,
+        )
+    };
+    (status, rgb)
+}
+
+/// Renders through `ht_render_with` with every AOV: rgb, albedo, depth, strand id.
+pub(super) fn render_aovs_c(h: &Handles, s: &RenderSettings) -> [Vec<f32>; 4] {
+    unsafe {
+        let pixels = window_pixels(s);
+        let mut out = [3, 3, 1, 1].map(|channels| vec![-2.0f32; channels * pixels]);
+        let [rgb, albedo, depth, strand_id] = &mut out;
+        let aovs = [albedo, depth, strand_id].map(|b| b.as_mut_ptr());
+        let none = (None, null_mut());
+        let status = render_raw(h.scene, s, rgb.as_mut_ptr(), rgb.len(), aovs, pixels, none);
         assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
         out
     }
@@ -143,9 +213,9 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
     assert_eq!(bits(&rgb), bits(out.film.rgb()));
     assert!(rgb.iter().any(|v| *v > 0.0));
 
-    // The filter field reaches the renderer: a box render is the Rust box render.
-    let boxed = HtRenderSettings {
-        filter: HT_FILTER_BOX,
+    // The filter reaches the renderer: a box render is the Rust box render.
+    let boxed = RenderSettings {
+        filter: crate::render::settings::Filter::Box,
         ..settings(32)
     };
     let (status, box_rgb) = render_c(&h, &boxed);
@@ -160,11 +230,14 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
 
     // So do the fidelity knobs: each C render is the Rust render with the same path
     // settings, and a deep-bounce depth of max_depth is the exact image.
-    let exact = HtRenderSettings {
-        max_depth: 6,
+    let exact = RenderSettings {
+        path: PathSettings {
+            max_depth: 6,
+            ..PathSettings::default()
+        },
         ..settings(32)
     };
-    let c_image = |s: HtRenderSettings| {
+    let c_image = |s: RenderSettings| {
         let (status, rgb) = render_c(&h, &s);
         assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
         bits(&rgb)
@@ -177,12 +250,6 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
         (0, 0.2, default_threshold),
         (6, 0.0, 0.0),
     ] {
-        let knob = HtRenderSettings {
-            deep_bounce_depth,
-            lobe_cull,
-            light_threshold,
-            ..exact
-        };
         let path = PathSettings {
             max_depth: 6,
             deep_bounce_depth: (deep_bounce_depth > 0).then_some(deep_bounce_depth),
@@ -190,6 +257,7 @@ fn c_render_matches_the_rust_api_bit_for_bit() {
             light_threshold,
             ..PathSettings::default()
         };
+        let knob = RenderSettings { path, ..exact };
         let rust_knob = RenderSettings { path, ..rust };
         let out = render(&world, &camera, &rust_knob, Aovs::default(), &NoProgress).unwrap();
         let got = c_image(knob);
@@ -263,11 +331,8 @@ fn crops_reassemble_into_the_full_frame_bit_for_bit() {
     // Three windows that tile the frame, cutting through the renderer's 16 x 16 tiles.
     let mut assembled = full.clone().map(|buffer| vec![f32::NAN; buffer.len()]);
     for [x0, y0, x1, y1] in [[0, 0, 13, 21], [13, 0, 32, 21], [0, 21, 32, 32]] {
-        let s = HtRenderSettings {
-            crop_x0: x0,
-            crop_y0: y0,
-            crop_x1: x1,
-            crop_y1: y1,
+        let s = RenderSettings {
+            crop: Some([x0, y0, x1, y1]),
             ..full_settings
         };
         let crop = render_aovs_c(&h, &s);
@@ -315,15 +380,14 @@ fn aovs_report_the_first_hits_and_null_ones_are_skipped() {
         // Only the depth: the other buffers may be NULL, and it is the same depth.
         let mut rgb_only = vec![0.0f32; rgb.len()];
         let mut depth_only = vec![0.0f32; depth.len()];
-        let status = ht_render_aovs(
+        let status = render_raw(
             h.scene,
             &s,
             rgb_only.as_mut_ptr(),
             rgb_only.len(),
-            null_mut(),
-            depth_only.as_mut_ptr(),
-            null_mut(),
+            [null_mut(), depth_only.as_mut_ptr(), null_mut()],
             depth.len(),
+            (None, null_mut()),
         );
         assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
         assert_eq!(bits(&rgb_only), bits(&rgb));
@@ -380,19 +444,15 @@ extern "C" fn count(done: u64, total: u64, user: *mut c_void) -> bool {
 fn the_callback_reports_progress_and_cancels() {
     let h = fur_scene(true);
     let calls = AtomicU32::new(0);
-    let mut s = HtRenderSettings {
-        progress: Some(count),
-        progress_user: std::ptr::from_ref(&calls).cast_mut().cast(),
-        ..settings(64)
-    };
-    let (status, full) = render_c(&h, &s);
+    let s = settings(64);
+    let user = std::ptr::from_ref(&calls).cast_mut().cast();
+    let (status, full) = render_reporting(&h, &s, (Some(count), user));
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
     // 16 x 16 tiles: one call per tile, and more if a tile takes over 20 ms.
     assert!(calls.load(Ordering::Relaxed) >= 16);
 
     calls.store(0, Ordering::Relaxed);
-    s.progress = Some(count_then_cancel);
-    let (status, partial) = render_c(&h, &s);
+    let (status, partial) = render_reporting(&h, &s, (Some(count_then_cancel), user));
     fails(
         status,
         HtStatus::HT_ERR_CANCELLED,
@@ -483,68 +543,86 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
         let s = settings(8);
         let mut rgb = vec![0.0f32; 8 * 8 * 3];
         let (ptr, len) = (rgb.as_mut_ptr(), rgb.len());
-        fails(ht_render(null_mut(), &s, ptr, len), NULL, "scene");
-        fails(ht_render(h.scene, null(), ptr, len), NULL, "settings");
-        fails(ht_render(h.scene, &s, null_mut(), len), NULL, "rgb");
+        let none = [null_mut(); 3];
+        let no_progress = (None, null_mut());
+        let nowhere = |scene, s: *const HtSettings, rgb| {
+            ht_render_with(
+                scene,
+                s,
+                None,
+                null_mut(),
+                rgb,
+                len,
+                none[0],
+                none[1],
+                none[2],
+                64,
+            )
+        };
+        let good = HtSettings { settings: s };
+        fails(nowhere(null_mut(), &good, ptr), NULL, "scene");
+        fails(nowhere(h.scene, null(), ptr), NULL, "settings");
+        fails(nowhere(h.scene, &good, null_mut()), NULL, "rgb");
         fails(
-            ht_render(h.scene, &s, ptr, len - 1),
+            render_rgb(h.scene, &s, ptr, len - 1),
             INVALID,
             "rgb_len = 191",
         );
-        let zero = HtRenderSettings { width: 0, ..s };
-        fails(ht_render(h.scene, &zero, ptr, 0), INVALID, "width = 0");
-        let depth = HtRenderSettings { max_depth: 0, ..s };
+        let zero = RenderSettings { width: 0, ..s };
+        fails(render_rgb(h.scene, &zero, ptr, 0), INVALID, "width = 0");
+        let path = |path: PathSettings| RenderSettings { path, ..s };
+        let depth = path(PathSettings {
+            max_depth: 0,
+            ..s.path
+        });
         fails(
-            ht_render(h.scene, &depth, ptr, len),
+            render_rgb(h.scene, &depth, ptr, len),
             INVALID,
             "max_depth = 0",
         );
-        let spp = HtRenderSettings { spp: 0, ..s };
-        fails(ht_render(h.scene, &spp, ptr, len), INVALID, "spp = 0");
-        let filter = HtRenderSettings { filter: 7, ..s };
-        fails(ht_render(h.scene, &filter, ptr, len), INVALID, "filter = 7");
-        let radius = HtRenderSettings {
+        let spp = RenderSettings { spp: 0, ..s };
+        fails(render_rgb(h.scene, &spp, ptr, len), INVALID, "spp = 0");
+        let radius = RenderSettings {
             filter_radius: f32::NAN,
             ..s
         };
         fails(
-            ht_render(h.scene, &radius, ptr, len),
+            render_rgb(h.scene, &radius, ptr, len),
             INVALID,
             "filter_radius = NaN",
         );
-        let deep = HtRenderSettings {
+        let deep = path(PathSettings {
             max_depth: 4,
-            deep_bounce_depth: 5,
-            ..s
-        };
+            deep_bounce_depth: Some(5),
+            ..s.path
+        });
         fails(
-            ht_render(h.scene, &deep, ptr, len),
+            render_rgb(h.scene, &deep, ptr, len),
             INVALID,
             "deep_bounce_depth = 5: must be at most max_depth = 4",
         );
-        let cull = HtRenderSettings {
+        let cull = path(PathSettings {
             lobe_cull: 1.0,
-            ..s
-        };
+            ..s.path
+        });
         fails(
-            ht_render(h.scene, &cull, ptr, len),
+            render_rgb(h.scene, &cull, ptr, len),
             INVALID,
             "lobe_cull = 1",
         );
         for bad in [-0.5, f32::NAN, f32::INFINITY] {
-            let threshold = HtRenderSettings {
+            let threshold = path(PathSettings {
                 light_threshold: bad,
-                ..s
-            };
+                ..s.path
+            });
             fails(
-                ht_render(h.scene, &threshold, ptr, len),
+                render_rgb(h.scene, &threshold, ptr, len),
                 INVALID,
                 "light_threshold",
             );
         }
-        let aovs = |s: &HtRenderSettings, rgb_len, pixel_count| {
-            let n = null_mut();
-            ht_render_aovs(h.scene, s, ptr, rgb_len, n, n, n, pixel_count)
+        let aovs = |s: &RenderSettings, rgb_len, pixel_count| {
+            render_raw(h.scene, s, ptr, rgb_len, none, pixel_count, no_progress)
         };
         fails(
             aovs(&s, len, 63),
@@ -552,11 +630,8 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             "pixel_count = 63: must be 8 * 8 = 64",
         );
         // A 4 x 3 window: 12 pixels.
-        let crop = HtRenderSettings {
-            crop_x0: 2,
-            crop_y0: 1,
-            crop_x1: 6,
-            crop_y1: 4,
+        let crop = RenderSettings {
+            crop: Some([2, 1, 6, 4]),
             ..s
         };
         fails(
@@ -569,17 +644,16 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
             INVALID,
             "pixel_count = 64: must be 4 * 3 = 12",
         );
-        let outside = HtRenderSettings { crop_x1: 9, ..crop };
+        let outside = RenderSettings {
+            crop: Some([2, 1, 9, 4]),
+            ..s
+        };
         fails(aovs(&outside, 36, 12), INVALID, "crop = 2,1,9,4");
-        let reversed = HtRenderSettings { crop_x0: 6, ..crop };
+        let reversed = RenderSettings {
+            crop: Some([6, 1, 6, 4]),
+            ..s
+        };
         fails(aovs(&reversed, 36, 12), INVALID, "crop = 6,1,6,4");
-        // Only all four zero mean the full frame.
-        let partial = HtRenderSettings { crop_x1: 4, ..s };
-        fails(
-            ht_render(h.scene, &partial, ptr, len),
-            INVALID,
-            "crop = 0,0,4,0",
-        );
         assert!(
             rgb.iter().all(|v| *v == 0.0),
             "failed renders leave the buffer alone"
@@ -588,14 +662,14 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
         let dark = Handles::new();
         let hair = dark.hair_material();
         assert_eq!(dark.add_strands(&small_fur(), hair), HtStatus::HT_OK);
-        fails(ht_render(dark.scene, &s, ptr, len), INVALID, "no light");
+        fails(render_rgb(dark.scene, &s, ptr, len), INVALID, "no light");
         let empty = Handles::new();
         assert_eq!(
             ht_scene_add_environment(empty.scene, SKY.as_ptr()),
             HtStatus::HT_OK
         );
         fails(
-            ht_render(empty.scene, &s, ptr, len),
+            render_rgb(empty.scene, &s, ptr, len),
             INVALID,
             "ht_scene_set_camera",
         );
@@ -610,7 +684,7 @@ fn bad_settings_and_incomplete_scenes_are_reported() {
         );
         assert_eq!(set, HtStatus::HT_OK);
         assert_eq!(
-            ht_render(empty.scene, &s, ptr, len),
+            render_rgb(empty.scene, &s, ptr, len),
             HtStatus::HT_OK,
             "{}",
             last_error()
@@ -660,25 +734,6 @@ fn images_are_written_through_oiio() {
 }
 
 #[test]
-fn the_default_settings_are_the_rust_defaults() {
-    let d = ht_render_settings_default();
-    let r = RenderSettings::default();
-    assert_eq!(
-        (d.width, d.height, d.spp, d.seed),
-        (r.width, r.height, r.spp, r.seed)
-    );
-    assert_eq!((d.threads, d.max_depth), (0, r.path.max_depth));
-    let rust = d.to_rust().unwrap();
-    assert_eq!(rust.crop, None, "the full frame");
-    assert_eq!(
-        (rust.filter, rust.filter_radius),
-        (r.filter, r.filter_radius)
-    );
-    assert_eq!(rust.path, r.path, "no deep-bounce lobe, no lobe culling");
-    assert!(d.progress.is_none() && d.progress_user.is_null());
-}
-
-#[test]
 fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     let strands = small_fur();
     let points = xyzr(&strands);
@@ -710,19 +765,14 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     // 273 to 455 pixels of image height. At 32 every strand is a ribbon; at 1000 every
     // strand a tube (a 16-pixel crop keeps that render small); at 350, both.
     let small = settings(32);
-    let tall = HtRenderSettings {
+    let tall = RenderSettings {
         width: 1000,
         height: 1000,
-        crop_x0: 492,
-        crop_y0: 300,
-        crop_x1: 508,
-        crop_y1: 316,
+        crop: Some([492, 300, 508, 316]),
         ..settings(32)
     };
-    let image = |h: &Handles, s: &HtRenderSettings| {
-        let [x0, y0, x1, y1] = s.to_rust().unwrap().window();
-        let mut rgb = vec![0.0f32; ((x1 - x0) * (y1 - y0) * 3) as usize];
-        let status = unsafe { ht_render(h.scene, s, rgb.as_mut_ptr(), rgb.len()) };
+    let image = |h: &Handles, s: &RenderSettings| {
+        let (status, rgb) = render_c(h, s);
         assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
         bits(&rgb)
     };
@@ -773,7 +823,14 @@ fn scene_build_reports_its_progress_and_the_render_reuses_it() {
     };
     let mut calls: Vec<f64> = Vec::new();
     let user = (&raw mut calls).cast::<c_void>();
-    let status = unsafe { ht_scene_build(h.scene, &s, Some(record_build), user) };
+    let status = unsafe {
+        ht_scene_build_with(
+            h.scene,
+            &HtSettings { settings: s },
+            Some(record_build),
+            user,
+        )
+    };
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
     assert!(calls.windows(2).all(|w| w[0] <= w[1]), "{calls:?}");
     assert_eq!(calls.last(), Some(&1.0), "{calls:?}");
@@ -791,15 +848,24 @@ fn scene_build_reports_its_progress_and_the_render_reuses_it() {
     let h = fur_scene(true);
     let mut calls: Vec<f64> = Vec::new();
     let user = (&raw mut calls).cast::<c_void>();
-    let status = unsafe { ht_scene_build(h.scene, &s, Some(cancel_build), user) };
+    let status = unsafe {
+        ht_scene_build_with(
+            h.scene,
+            &HtSettings { settings: s },
+            Some(cancel_build),
+            user,
+        )
+    };
     assert_eq!(status, HtStatus::HT_ERR_CANCELLED, "{}", last_error());
     assert_eq!(calls.len(), 1);
     assert!(tracer_of(&h).is_none());
     assert_eq!(render_c(&h, &s).0, HtStatus::HT_OK);
     // Bad settings are refused before anything is built.
-    let bad = HtRenderSettings { spp: 0, ..s };
+    let bad = HtSettings {
+        settings: RenderSettings { spp: 0, ..s },
+    };
     assert_eq!(
-        unsafe { ht_scene_build(h.scene, &bad, None, null_mut()) },
+        unsafe { ht_scene_build_with(h.scene, &bad, None, null_mut()) },
         HtStatus::HT_ERR_INVALID_ARG
     );
     assert!(last_error().contains("spp = 0"));

@@ -37,7 +37,7 @@ pub struct HtDevice {
 /// be used concurrently).
 ///
 /// Memory: the scene keeps its own copy of every geometry, so that it can rebuild after
-/// later additions. Its first build (`ht_scene_build` or the first render) puts the
+/// later additions. Its first build (`ht_scene_build_with` or the first render) puts the
 /// scene's curves in spatial order and shares their control points with Embree's
 /// buffers, so a built scene holds one copy of them plus the BVH (an `auto` groom's
 /// level-of-detail ribbons and round/flat shares are copies of their own), and a rebuild

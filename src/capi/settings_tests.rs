@@ -6,7 +6,7 @@ use super::render_tests::{bits, fur_scene, render_aovs_c, settings};
 use super::scene::HtScene;
 use super::scene_tests::{fails, last_error};
 use super::settings::*;
-use crate::render::settings::RenderSettings;
+use crate::render::settings::{Filter, PathSettings, RenderSettings};
 use std::ffi::{CStr, CString, c_char};
 use std::ptr::{null, null_mut};
 
@@ -83,16 +83,16 @@ impl Drop for Named {
 }
 
 #[test]
-fn settings_by_name_render_what_the_struct_renders_bit_for_bit() {
+fn settings_by_name_render_what_the_rust_settings_render_bit_for_bit() {
     let h = fur_scene(true);
-    let s = HtRenderSettings {
-        filter: HT_FILTER_BOX,
-        crop_x0: 4,
-        crop_y0: 2,
-        crop_x1: 20,
-        crop_y1: 18,
-        light_threshold: 0.0,
-        max_depth: 12,
+    let s = RenderSettings {
+        filter: Filter::Box,
+        crop: Some([4, 2, 20, 18]),
+        path: PathSettings {
+            light_threshold: 0.0,
+            max_depth: 12,
+            ..PathSettings::default()
+        },
         ..settings(24)
     };
     let by_struct = render_aovs_c(&h, &s);

@@ -2,7 +2,7 @@
 //! it, or check for leaks, with no thread of ours left running.
 //!
 //! Render threads need nothing here: each render runs on a pool of its own that is joined
-//! before `ht_render` returns (`render_tiles`). The threads that outlive every handle are
+//! before `ht_render_with` returns (`render_tiles`). The threads that outlive every handle are
 //! TBB's, which Embree uses to build scenes: TBB keeps its workers after the last Embree
 //! device is released, until the process exits or someone finalizes it. TBB has no C
 //! interface, so its two exported entry points for that (oneTBB's `task_scheduler_handle`
@@ -81,7 +81,7 @@ fn join_tbb_workers() -> Result<(), Failure> {
 
 /// Joins the worker threads the library started, once every device and scene has been
 /// freed: TBB's workers, which Embree used to build scenes and which otherwise run until
-/// the process exits. Render threads need no call: each `ht_render` joins its own before
+/// the process exits. Render threads need no call: each `ht_render_with` joins its own before
 /// it returns. After `HT_OK` no thread started by hairtrace is running, and the library
 /// may still be used again (a new device starts new workers).
 ///

@@ -6,11 +6,13 @@ use super::geometry::*;
 use super::lights::*;
 use super::materials::*;
 use super::render::*;
-use super::render_tests::{bits, fur_scene, light, render_c, settings};
+use super::render_tests::{bits, fur_scene, light, render_c, render_raw, settings};
 use super::scene::*;
 use super::scene_tests::{Handles, fails, last_error, sized, small_fur, xyzr, xyzr_desc};
+use super::settings::HtSettings;
 use crate::capi::bsdf::ht_hair_params_default;
 use crate::embree::Ray;
+use crate::render::settings::RenderSettings;
 use crate::scene::NoStages;
 use glam::Vec3;
 use std::ffi::{CString, c_void};
@@ -91,7 +93,7 @@ fn shared_points_off_16_bytes_are_refused_and_copies_of_them_render() {
     }
 }
 
-/// A camera at 1e19 or an aperture of 2e18 aborted inside ht_render (Embree's ray
+/// A camera at 1e19 or an aperture of 2e18 aborted inside the render (Embree's ray
 /// validity assertion); such values, and geometry and lights as far out, are refused when
 /// they are set, and the scene renders with what it had.
 #[test]
@@ -187,33 +189,42 @@ fn a_render_of_billions_of_samples_per_pixel_cancels() {
     std::thread::spawn(move || {
         let scene = scene;
         let calls = std::sync::atomic::AtomicU32::new(0);
-        let s = HtRenderSettings {
+        let s = RenderSettings {
             spp: 4_000_000_000,
-            progress: Some(stop),
-            progress_user: std::ptr::from_ref(&calls).cast_mut().cast(),
             ..settings(4)
         };
+        let user = std::ptr::from_ref(&calls).cast_mut().cast();
         let mut rgb = vec![-1.0f32; 48];
+        let none = [null_mut(); 3];
         // SAFETY: a live scene used by this thread alone; rgb holds 48 floats.
-        let status = unsafe { ht_render(scene.0, &s, rgb.as_mut_ptr(), rgb.len()) };
+        let status = unsafe {
+            render_raw(
+                scene.0,
+                &s,
+                rgb.as_mut_ptr(),
+                48,
+                none,
+                16,
+                (Some(stop), user),
+            )
+        };
         tx.send((status, last_error(), calls.into_inner(), rgb))
             .unwrap();
     });
     let (status, message, calls, rgb) = rx
         .recv_timeout(Duration::from_secs(120))
-        .expect("ht_render did not return after the callback cancelled");
+        .expect("ht_render_with did not return after the callback cancelled");
     assert_eq!(status, HT_ERR_CANCELLED, "{message}");
     assert!(message.contains("cancelled"), "{message}");
     assert!(calls >= 1);
     // The render goes in passes of 8 spp: the first finished (and was stored) before the
     // callback's first answer, and no later one.
-    let first_pass = HtRenderSettings {
+    let first_pass = RenderSettings {
         spp: 8,
         ..settings(4)
     };
-    let mut expected = vec![-1.0f32; 48];
-    // SAFETY: the scene is no longer used by the thread, which has sent its result.
-    let status = unsafe { ht_render(h.scene, &first_pass, expected.as_mut_ptr(), 48) };
+    // The scene is no longer used by the thread, which has sent its result.
+    let (status, expected) = render_c(&h, &first_pass);
     assert_eq!(status, HT_OK);
     assert_eq!(rgb, expected, "the pixels hold the first pass alone");
 }
@@ -227,8 +238,9 @@ fn overlapping_render_buffers_are_refused() {
         let s = settings(4);
         let mut rgb = vec![-3.0f32; 48 + 16];
         let p = rgb.as_mut_ptr();
+        let none = (None, null_mut());
         let call = |albedo: *mut f32, depth: *mut f32, strand: *mut f32| {
-            ht_render_aovs(h.scene, &s, p, 48, albedo, depth, strand, 16)
+            render_raw(h.scene, &s, p, 48, [albedo, depth, strand], 16, none)
         };
         fails(
             call(null_mut(), p, null_mut()),
@@ -245,11 +257,13 @@ fn overlapping_render_buffers_are_refused() {
             INVALID,
             "depth and strand_id overlap",
         );
-        let mut settings_in = [s; 1];
-        let sp = settings_in.as_mut_ptr();
-        let status = ht_render_aovs(
+        let mut settings_in = HtSettings { settings: s };
+        let sp = &raw mut settings_in;
+        let status = ht_render_with(
             h.scene,
             sp,
+            None,
+            null_mut(),
             sp.cast(),
             3 * 16,
             null_mut(),

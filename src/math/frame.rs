@@ -37,7 +37,7 @@ impl Frame {
 ///
 /// Degenerate input never gives NaN axes: a zero tangent becomes a direction perpendicular
 /// to the ray, and a ray along the tangent gets an arbitrary y perpendicular to x.
-pub(crate) fn hair_frame_offset(
+pub fn hair_frame_offset(
     tangent: Vec3,
     dir: Vec3,
     org: Vec3,

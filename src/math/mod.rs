@@ -9,7 +9,7 @@ pub(crate) mod lanes;
 pub(crate) mod sampling;
 
 pub use curve_basis::CurveBasis;
-pub use frame::Frame;
+pub use frame::{Frame, hair_frame_offset};
 pub use lanes::Lanes;
 
 /// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,

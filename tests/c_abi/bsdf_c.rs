@@ -1,6 +1,6 @@
 //! The BSDF entry points from C: every bad argument gets its status and message
-//! (`c/bsdf_args.c`), every entry point gives the Rust API's bits on random inputs
-//! (`c/bsdf_bits.c`), and the benchmark's plain float port agrees with the model
+//! (`c/bsdf_args.c`), every per-direction entry point gives the Rust API's bits on random
+//! inputs (`c/bsdf_bits.c`), and the benchmark's plain float port agrees with the model
 //! (`bench/c_bsdf`).
 
 use crate::c_examples::build_and_run_file;
@@ -95,39 +95,26 @@ fn every_c_entry_point_gives_the_rust_bits() {
             .collect();
         let bsdf = HairBsdf::new(p).unwrap();
         let point = bsdf.at(*h, Vec3::from_array(*wo));
-        let e = point.eval(Vec3::from_array(*wi));
-        let eval = [e.f.x, e.f.y, e.f.z, e.pdf];
-        let sample = point.sample(*u).map_or([0.0; 7], |s| {
-            [s.wi.x, s.wi.y, s.wi.z, s.f.x, s.f.y, s.f.z, s.pdf]
-        });
-        // f |cos| and the path weight f |cos| / pdf, as a host computes them from eval and
-        // sample (no direction, or a weight that is not finite: zeros).
-        let cos = e.f * wi[2].abs();
-        let eval_cos = [cos.x, cos.y, cos.z, e.pdf];
-        let sample_cos = point
+        let wi = Vec3::from_array(*wi);
+        // f |cos| and pdf; a sample's wi, f |cos|, weight f |cos| / pdf and pdf (zeros
+        // without a direction or a finite weight); each lane's f |cos|, then their pdfs.
+        let e = point.eval(wi);
+        let cos = e.f * wi.z.abs();
+        let eval = [cos.x, cos.y, cos.z, e.pdf];
+        let sample = point
             .sample(*u)
-            .map(|s| (s.wi, s.f * s.wi.z.abs() / s.pdf, s.pdf))
-            .filter(|(_, w, _)| w.is_finite())
-            .map_or([0.0; 7], |(d, w, p)| [d.x, d.y, d.z, w.x, w.y, w.z, p]);
-        // point eval, point pdf, point sample, eval, sample, points eval, points sample,
-        // eval batch: each the Rust HairPoint's bits; then the combined calls.
-        let want: Vec<u32> = eval
-            .iter()
-            .chain(&[e.pdf])
-            .chain(&sample)
-            .chain(&eval)
-            .chain(&sample)
-            .chain(&eval)
-            .chain(&sample)
-            .chain(&eval)
-            .chain(&eval_cos)
-            .chain(&sample_cos)
+            .map(|s| (s.wi, s.f * s.wi.z.abs(), s.pdf))
+            .filter(|(_, fc, p)| (*fc / *p).is_finite())
+            .map_or([0.0; 10], |(d, fc, p)| {
+                let w = fc / p;
+                [d.x, d.y, d.z, fc.x, fc.y, fc.z, w.x, w.y, w.z, p]
+            });
+        let lanes = point.eval_across(wi).expect("the point's lanes");
+        let across = (lanes.f.iter().flat_map(|f| (*f * wi.z.abs()).to_array())).chain(lanes.pdf);
+        let want: Vec<u32> = (eval.into_iter().chain(sample).chain(across))
             .map(|v| v.to_bits())
             .collect();
-        assert_eq!(
-            got, want,
-            "case {i}: {p:?} h {h} wo {wo:?} wi {wi:?} u {u:?}"
-        );
+        assert_eq!(got, want, "case {i}: {p:?} h {h} wo {wo:?} wi {wi} u {u:?}");
     }
 }
 

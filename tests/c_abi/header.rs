@@ -1,6 +1,8 @@
 //! The checked-in C header must be exactly what cbindgen makes of the current sources, so
-//! that hosts compiling against `include/hairtrace.h` see the ABI the library exports.
+//! that hosts compiling against `include/hairtrace.h` see the ABI the library exports; and
+//! docs/c-abi.md lists every function it declares.
 
+use std::collections::BTreeSet;
 use std::path::Path;
 
 #[test]
@@ -40,4 +42,51 @@ fn header_matches_the_sources() {
             first_difference + 1
         );
     }
+}
+
+/// The `ht_*` names in `text` that are followed by `(`, outside comment lines.
+fn called_names(text: &str) -> BTreeSet<String> {
+    let code = text.lines().filter(|l| {
+        let l = l.trim_start();
+        !(l.starts_with('*') || l.starts_with("/*") || l.starts_with("//"))
+    });
+    let mut names = BTreeSet::new();
+    for line in code {
+        for (at, _) in line.match_indices("ht_") {
+            let rest = &line[at..];
+            let end = rest
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(rest.len());
+            let joined = line[..at].ends_with(|c: char| c.is_ascii_alphanumeric() || c == '_');
+            if !joined && rest[end..].starts_with('(') {
+                names.insert(rest[..end].to_string());
+            }
+        }
+    }
+    names
+}
+
+/// docs/c-abi.md's table of functions (section 1) names every function the header declares,
+/// and no other.
+#[test]
+fn the_function_table_lists_every_function() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let header = std::fs::read_to_string(root.join("include/hairtrace.h")).unwrap();
+    let declared = called_names(&header);
+    assert!(declared.len() > 40, "{declared:?}");
+    let doc = std::fs::read_to_string(root.join("docs/c-abi.md")).unwrap();
+    let start = doc.find("## 1. Shape of the interface").expect("section 1");
+    let end = start + doc[start..].find("\n## 2.").expect("section 2");
+    let mut listed = BTreeSet::new();
+    for row in doc[start..end].lines().filter(|l| l.starts_with('|')) {
+        for cell in row.split('`').skip(1).step_by(2) {
+            if cell.starts_with("ht_") {
+                listed.insert(cell.to_string());
+            }
+        }
+    }
+    assert_eq!(
+        listed, declared,
+        "docs/c-abi.md section 1 lists these, the header declares those"
+    );
 }

@@ -21,7 +21,7 @@ fn bsdf_only_host_loads_neither_embree_nor_openimageio() {
     let cflags = pkg_config(prefix, &["--cflags", "hairtrace"]);
     assert!(cflags.contains(&"-DHT_BSDF_ONLY".to_string()), "{cflags:?}");
     let declared = declared_functions(prefix, &["-DHT_BSDF_ONLY"]);
-    assert!(declared.contains("ht_hair_eval"), "{declared:?}");
+    assert!(declared.contains("ht_hair_point_at_hit"), "{declared:?}");
     assert!(!declared.contains("ht_device_new"), "{declared:?}");
     assert_eq!(declared, defined_functions(&lib.join("libhairtrace.a")));
     assert_eq!(declared, defined_functions(&lib.join("libhairtrace.so")));

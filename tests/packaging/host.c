@@ -1,6 +1,6 @@
 /* A host of the installed library (tests/packaging): compiled as C99 and as C++, linked
  * through pkg-config or CMake, shared or static, full or BSDF-only. It prints the versions
- * it was compiled and linked against, one BSDF evaluation, what the process costs after
+ * it was compiled and linked against, one BSDF evaluation (f |cos| and pdf), what the process costs after
  * start-up (threads, resident memory, mapped shared objects) and, with the full library,
  * that a render device can be made. */
 #include <hairtrace.h>
@@ -39,12 +39,19 @@ static void print_maps(const char *a, const char *b) {
 
 int main(void) {
     HtHairParams p = ht_hair_params_default();
+    /* The worked example of docs/conventions.md at the local frame: f |cos| and pdf. */
+    const HtHairFrame local = {{1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, 0.5f};
     const float wo[3] = {0.0f, 0.0f, 1.0f}, wi[3] = {0.0f, 0.8660254f, 0.5f};
     float f[3], pdf;
-    if (ht_hair_eval(&p, 0.5f, wo, wi, f, &pdf) != HT_OK) {
-        fprintf(stderr, "ht_hair_eval: %s\n", ht_last_error());
+    HtHairPrepared *prepared = NULL;
+    HtHairPoint point;
+    if (ht_hair_prepare(&p, &prepared) != HT_OK ||
+        ht_hair_point_init_world(prepared, &local, wo, &point) != HT_OK ||
+        ht_hair_point_eval_world(&point, wi, f, &pdf) != HT_OK) {
+        fprintf(stderr, "the BSDF: %s\n", ht_last_error());
         return 1;
     }
+    ht_hair_prepared_free(prepared);
     printf("header %d.%d.%d abi %d\n", HT_VERSION_MAJOR, HT_VERSION_MINOR, HT_VERSION_PATCH,
            HT_ABI_VERSION);
     printf("library %s abi %u\n", ht_version(), ht_abi_version());

@@ -157,8 +157,9 @@ fn cpp_hosts_build_against_the_installed_prefix() {
 }
 
 /// What `c_examples/furnace.cpp` printed: through hairtrace.hpp the white furnace gives 1
-/// within 0.5%, every vertex has the bits of the same vertex made with the C calls, and
-/// a bad parameter is an exception with the library's message.
+/// within 0.5%, every vertex made with the noexcept status forms has the bits of the same
+/// vertex made with the value forms and with the C calls, an unfilled point gives a status
+/// and the message, and a bad parameter is an exception with the library's message.
 fn check_furnace(out: &str) {
     let value = |key: &str| -> Vec<f64> {
         let line = out.lines().find_map(|l| l.strip_prefix(key));
@@ -171,6 +172,10 @@ fn check_furnace(out: &str) {
     assert!((furnace - 1.0).abs() < 5e-3, "furnace {furnace}:\n{out}");
     let mismatches = value("mismatches ");
     assert!(mismatches[0] == 0.0 && mismatches[1] > 19_000.0, "{out}");
+    assert!(
+        out.contains("unfilled invalid argument: point was not filled"),
+        "{out}"
+    );
     assert!(out.contains("error invalid argument: "), "{out}");
     assert!(out.contains("beta_m = 2"), "{out}");
 }
@@ -208,5 +213,33 @@ fn assert_macros_prefixed(include: &Path) {
         2,
         "hairtrace.h and hairtrace.hpp in {}",
         include.display()
+    );
+}
+
+/// `scripts/install --help` prints the help (its options, what a prefix gets, how a host
+/// that only shades and one that renders link) and succeeds; without a prefix it is a usage
+/// error that points to the help.
+#[test]
+fn install_prints_its_help() {
+    let script = root().join("scripts/install");
+    let out = Command::new(&script).arg("--help").output().unwrap();
+    assert!(out.status.success(), "{out:?}");
+    let help = String::from_utf8(out.stdout).unwrap();
+    for words in [
+        "--prefix DIR",
+        "--bsdf-only",
+        "--no-build",
+        "COMPONENTS bsdf",
+        "hairtrace::bsdf",
+        "pkg-config --cflags --libs hairtrace-bsdf",
+        "libhairtrace.so.ABI",
+    ] {
+        assert!(help.contains(words), "no {words:?} in:\n{help}");
+    }
+    let bare = Command::new(&script).output().unwrap();
+    assert_eq!(bare.status.code(), Some(2), "{bare:?}");
+    assert!(
+        String::from_utf8_lossy(&bare.stderr).contains("--help"),
+        "{bare:?}"
     );
 }

@@ -173,17 +173,17 @@ impl Report {
     }
 
     /// The host saw this crate's version and ABI in the header and in the library, and its
-    /// evaluation has the Rust API's bits (`%.9g` prints an f32 exactly).
+    /// evaluation (f |cos| and pdf) has the Rust API's bits (`%.9g` prints an f32 exactly).
     fn check_versions_and_eval(&self) {
         let abi = hairtrace::capi::HT_ABI_VERSION;
         let want = format!("{} abi {abi}", env!("CARGO_PKG_VERSION"));
         assert_eq!(self.header, want, "{self:?}");
         assert_eq!(self.library, want, "{self:?}");
-        let e = HairBsdf::new(&HairParams::default()).unwrap().eval(
-            0.5,
-            Vec3::Z,
-            Vec3::new(0.0, 0.866_025_4, 0.5),
-        );
-        assert_eq!(self.eval, [e.f.x, e.f.y, e.f.z, e.pdf], "{self:?}");
+        let wi = Vec3::new(0.0, 0.866_025_4, 0.5);
+        let e = HairBsdf::new(&HairParams::default())
+            .unwrap()
+            .eval(0.5, Vec3::Z, wi);
+        let f_cos = e.f * wi.z;
+        assert_eq!(self.eval, [f_cos.x, f_cos.y, f_cos.z, e.pdf], "{self:?}");
     }
 }

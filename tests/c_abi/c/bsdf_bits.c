@@ -1,10 +1,10 @@
-/* The BSDF through every C entry point, for inputs the Rust test writes to the file named
- * by argv[1], one case a line as 17 hexadecimal float bit patterns: sigma_a[3], eta,
- * beta_m, beta_n, alpha, h, wo[3], wi[3], u[3]. Prints one line a case with the bit
- * patterns of: ht_hair_point_eval (f, pdf), ht_hair_point_pdf, ht_hair_point_sample (wi,
- * f, pdf), ht_hair_eval, ht_hair_sample, ht_hair_points_eval, ht_hair_points_sample,
- * ht_hair_eval_batch (one material per case), ht_hair_point_eval_cos (f_cos, pdf) and
- * ht_hair_point_sample_cos (wi, weight, pdf), so that the test compares them with Rust. */
+/* The BSDF through every per-direction C entry point, for inputs the Rust test writes to
+ * the file named by argv[1], one case a line as 17 hexadecimal float bit patterns:
+ * sigma_a[3], eta, beta_m, beta_n, alpha, h, wo[3], wi[3], u[3]. Each point is filled at
+ * the local frame (axes x, y, z), where world directions are the local ones. Prints one
+ * line a case with the bit patterns of: ht_hair_point_eval_world (f_cos, pdf),
+ * ht_hair_point_sample_world (wi, f_cos, weight, pdf) and ht_hair_point_eval_across_world
+ * (f_cos and pdf of each lane), so that the test compares them with Rust. */
 #include "hairtrace.h"
 
 #include <stdint.h>
@@ -71,58 +71,24 @@ int main(int argc, char **argv) {
     }
     fclose(in);
 
-    /* malloc aligns to 16 on 64-bit platforms, as HtHairPoint needs. */
-    HtHairPoint *points = (HtHairPoint *)malloc(n * sizeof *points);
-    float *wi = (float *)malloc(n * 3 * sizeof(float)), *u = (float *)malloc(n * 3 * sizeof(float));
-    float *bf = (float *)malloc(n * 3 * sizeof(float)), *bp = (float *)malloc(n * sizeof(float));
-    float *sw = (float *)malloc(n * 3 * sizeof(float)), *sf = (float *)malloc(n * 3 * sizeof(float));
-    float *sp = (float *)malloc(n * sizeof(float));
-    for (size_t i = 0; i < n; ++i) {
-        HtHairPrepared *prepared;
-        ok(ht_hair_prepare(&cases[i].params, &prepared), "prepare", i);
-        ok(ht_hair_point_init(prepared, cases[i].h, cases[i].wo, &points[i]), "init", i);
-        ok(ht_hair_prepared_free(prepared), "free", i); /* the point outlives it */
-        memcpy(wi + 3 * i, cases[i].wi, sizeof cases[i].wi);
-        memcpy(u + 3 * i, cases[i].u, sizeof cases[i].u);
-    }
-    ok(ht_hair_points_eval(points, n, wi, bf, bp), "points_eval", 0);
-    ok(ht_hair_points_sample(points, n, u, sw, sf, sp), "points_sample", 0);
-
     for (size_t i = 0; i < n; ++i) {
         const Case *c = &cases[i];
-        float f[3], pdf, pdf_only, s[7], e[4], t[7], b[4], ec[4], sc[7];
-        ok(ht_hair_point_eval(&points[i], c->wi, f, &pdf), "point_eval", i);
-        ok(ht_hair_point_pdf(&points[i], c->wi, &pdf_only), "point_pdf", i);
-        ok(ht_hair_point_sample(&points[i], c->u, s, s + 3, s + 6), "point_sample", i);
-        ok(ht_hair_eval(&c->params, c->h, c->wo, c->wi, e, e + 3), "eval", i);
-        ok(ht_hair_sample(&c->params, c->h, c->wo, c->u, t, t + 3, t + 6), "sample", i);
-        ok(ht_hair_eval_batch(&c->params, 1, &c->h, c->wo, c->wi, b, b + 3), "eval_batch", i);
-        ok(ht_hair_point_eval_cos(&points[i], c->wi, ec, ec + 3), "point_eval_cos", i);
-        ok(ht_hair_point_sample_cos(&points[i], c->u, sc, sc + 3, sc + 6), "point_sample_cos", i);
-        put(f, 3);
-        put(&pdf, 1);
-        put(&pdf_only, 1);
-        put(s, 7);
+        const HtHairFrame local = {{1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, c->h};
+        HtHairPrepared *prepared;
+        HtHairPoint point;
+        float e[4], s[10], across[4 * HT_ACROSS];
+        ok(ht_hair_prepare(&c->params, &prepared), "prepare", i);
+        ok(ht_hair_point_init_world(prepared, &local, c->wo, &point), "init", i);
+        ok(ht_hair_prepared_free(prepared), "free", i); /* the point outlives it */
+        ok(ht_hair_point_eval_world(&point, c->wi, e, e + 3), "eval", i);
+        ok(ht_hair_point_sample_world(&point, c->u, s, s + 3, s + 6, s + 9), "sample", i);
+        ok(ht_hair_point_eval_across_world(&point, c->wi, across, across + 3 * HT_ACROSS),
+           "across", i);
         put(e, 4);
-        put(t, 7);
-        put(bf + 3 * i, 3);
-        put(bp + i, 1);
-        put(sw + 3 * i, 3);
-        put(sf + 3 * i, 3);
-        put(sp + i, 1);
-        put(b, 4);
-        put(ec, 4);
-        put(sc, 7);
+        put(s, 10);
+        put(across, 4 * HT_ACROSS);
         printf("\n");
     }
-    free(points);
-    free(wi);
-    free(u);
-    free(bf);
-    free(bp);
-    free(sw);
-    free(sf);
-    free(sp);
     free(cases);
     return 0;
 }

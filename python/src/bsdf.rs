@@ -31,7 +31,14 @@ pub struct PyHairBsdf {
     bsdf: HairBsdf,
 }
 
+/// f and pdf, as `eval` returns them.
 type Pair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>);
+/// wi, f and pdf, as `sample` returns them.
+type Triple<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<f32>>,
+);
 
 #[pymethods]
 impl PyHairBsdf {
@@ -139,11 +146,7 @@ impl PyHairBsdf {
         h: &Bound<'py, PyAny>,
         wo: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
-    ) -> PyResult<(
-        Bound<'py, PyArray2<f32>>,
-        Bound<'py, PyArray2<f32>>,
-        Bound<'py, PyArray1<f32>>,
-    )> {
+    ) -> PyResult<Triple<'py>> {
         let (h, wo, u) = (
             Floats::rows(h, "h", 0)?,
             Floats::rows(wo, "wo", 3)?,

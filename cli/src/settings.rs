@@ -91,9 +91,6 @@ pub struct Variant {
     pub values: SettingArgs,
 }
 
-/// The settings a build is made for: a variant that changes one needs a build of its own.
-const BUILD_SETTINGS: [&str; 5] = ["width", "height", "isa", "lod_pixels", "curve_parts"];
-
 impl Variant {
     /// `OUT:NAME=VALUE NAME=VALUE ...`: the image, then settings separated by spaces (no
     /// setting's value holds a colon, so the output is what comes before the last one).
@@ -127,14 +124,12 @@ impl Variant {
         let mut settings = *base;
         self.values.apply(&mut settings)?;
         settings.validate()?;
-        for name in BUILD_SETTINGS {
-            if settings.get(name).ok() != base.get(name).ok() {
-                return Err(hairtrace::Error::InvalidArg(format!(
-                    "--variant {}: {name} is a setting the build is made for: render it \
-                     with a command of its own",
-                    self.output.display()
-                )));
-            }
+        if let Some(name) = settings.build_change(base) {
+            return Err(hairtrace::Error::InvalidArg(format!(
+                "--variant {}: {name} is a setting the build is made for: render it with a \
+                 command of its own",
+                self.output.display()
+            )));
         }
         Ok(settings)
     }

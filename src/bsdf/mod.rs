@@ -6,6 +6,7 @@ pub(crate) mod absorption;
 pub(crate) mod azimuthal;
 pub(crate) mod diffuse;
 pub(crate) mod hair;
+pub mod inputs;
 mod limits;
 pub(crate) mod longitudinal;
 pub(crate) mod params;

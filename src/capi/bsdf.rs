@@ -9,8 +9,7 @@ use super::{
     Failure, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut, non_null,
     read_path,
 };
-use crate::bsdf::{HairParams, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
-use crate::error::invalid_arg;
+use crate::bsdf::{HairParams, inputs, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 use glam::Vec3;
 use std::ffi::c_char;
 
@@ -68,75 +67,24 @@ pub(super) fn read_params(ptr: *const HtHairParams) -> Result<HairParams, Failur
     Ok(host_slice(ptr, 1, "params")?[0].into())
 }
 
-/// Largest accepted |length - 1| of a direction.
-pub(super) const UNIT_TOLERANCE: f32 = 1e-3;
+pub(super) use crate::bsdf::inputs::{UNIT_TOLERANCE, is_unit};
 
-/// Checks that a direction is a finite unit vector (to [`UNIT_TOLERANCE`]): the model reads
-/// angles from its components.
+/// [`inputs::check_dir`] with the C ABI's failure.
 #[inline(always)]
 pub(super) fn check_dir(v: Vec3, name: &str) -> Result<Vec3, Failure> {
-    if is_unit(v) {
-        Ok(v)
-    } else {
-        Err(not_unit(v, name))
-    }
+    Ok(inputs::check_dir(v, name)?)
 }
 
-/// Whether `v` is a finite unit vector to [`UNIT_TOLERANCE`]; false for NaN.
-#[inline(always)]
-pub(super) fn is_unit(v: Vec3) -> bool {
-    // Squared length against the squared bounds: no square root on the hot path.
-    let (lo, hi) = (
-        (1.0 - UNIT_TOLERANCE).powi(2),
-        (1.0 + UNIT_TOLERANCE).powi(2),
-    );
-    let len2 = v.length_squared();
-    len2 >= lo && len2 <= hi
-}
-
-#[cold]
-#[inline(never)]
-fn not_unit(v: Vec3, name: &str) -> Failure {
-    invalid_arg!(
-        "{name} = {v}: must be a finite unit vector (length {}, tolerance {UNIT_TOLERANCE})",
-        v.length()
-    )
-    .into()
-}
-
-/// Checks h in [-1, 1]: the compare inline, as [`check_dir`]'s, in the batch's loop over
-/// its elements too; the message out of line.
+/// [`inputs::check_h`] with the C ABI's failure.
 #[inline(always)]
 pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
-    if (-1.0..=1.0).contains(&h) {
-        Ok(h)
-    } else {
-        Err(not_in_range(h))
-    }
+    Ok(inputs::check_h(h)?)
 }
 
-#[cold]
-#[inline(never)]
-fn not_in_range(h: f32) -> Failure {
-    invalid_arg!("h = {h}: must be in [-1, 1]").into()
-}
-
-/// Checks three uniform numbers in [0, 1): inline compares on the sample calls' hot path,
-/// the message out of line.
+/// [`inputs::check_u`] with the C ABI's failure.
 #[inline(always)]
 pub(super) fn check_u(u: [f32; 3], name: &str) -> Result<[f32; 3], Failure> {
-    if u.iter().all(|x| (0.0..1.0).contains(x)) {
-        Ok(u)
-    } else {
-        Err(not_uniform(u, name))
-    }
-}
-
-#[cold]
-#[inline(never)]
-fn not_uniform(u: [f32; 3], name: &str) -> Failure {
-    let bad = u.iter().position(|x| !(0.0..1.0).contains(x)).unwrap_or(0);
-    invalid_arg!("{name}[{bad}] = {}: must be in [0, 1)", u[bad]).into()
+    Ok(inputs::check_u(u, name)?)
 }
 
 /// NULL-checks every pointer of a call before anything else, so that a NULL pointer is

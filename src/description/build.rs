@@ -131,6 +131,7 @@ impl SceneDescription {
             camera,
             settings,
             stages: stages.times(),
+            framing,
             sources: built
                 .built_from
                 .into_iter()
@@ -208,8 +209,9 @@ impl SceneDescription {
 }
 
 impl MaterialDesc {
-    /// The material, every value checked.
-    pub(super) fn prepare(&self) -> Result<Material> {
+    /// The material, every value checked: a host that edits a scene checks an edit with
+    /// it before there is a build to take it.
+    pub fn prepare(&self) -> Result<Material> {
         Ok(match self {
             MaterialDesc::Hair(h) => Material::Hair(Box::new(h.prepare()?)),
             MaterialDesc::Diffuse { albedo } => {
@@ -314,7 +316,7 @@ impl GroomDesc {
                     l => StrandCurves::Authored(l),
                 })
             }
-            GroomSource::FurBall(_) | GroomSource::Scalp(_) => {
+            GroomSource::FurBall(_) | GroomSource::Scalp(_) | GroomSource::Strands(_) => {
                 Ok(StrandCurves::Polylines(CurveBasis::BSpline))
             }
             GroomSource::File { path, .. } => Err(invalid_arg!(
@@ -427,6 +429,7 @@ impl GroomDesc {
             }
             GroomSource::FurBall(f) => one(f.build()?, None),
             GroomSource::Scalp(s) => one(s.build()?, None),
+            GroomSource::Strands(s) => one(s.clone(), None),
             GroomSource::ControlPoints { .. } => Err(invalid_arg!(
                 "a groom of control points (from a pbrt file) has no polyline strands"
             )),
@@ -537,9 +540,18 @@ impl LightDesc {
 }
 
 impl CameraDesc {
+    /// Checks a camera placed by `eye` and `target` (or given one of them alone) before
+    /// there is anything to frame; an automatic camera is checked when the build frames it.
+    pub fn validate(&self) -> Result<()> {
+        match (self.eye, self.target) {
+            (None, None) => Ok(()),
+            _ => self.build(&Framing::default(), 1.0).map(|_| ()),
+        }
+    }
+
     /// The camera for an image of `aspect`, framing `framing` when no eye and target are
     /// given.
-    fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
+    pub(super) fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
         let (camera, target) = match (self.eye, self.target) {
             (Some(eye), Some(target)) => {
                 let (eye, target) = (Vec3::from_array(eye), Vec3::from_array(target));

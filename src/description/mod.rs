@@ -111,6 +111,7 @@ use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, Progress};
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
+use crate::scene::framing::Framing;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::material::HairMaterial;
 use crate::scene::mesh::Mesh;
@@ -224,6 +225,9 @@ pub enum GroomSource {
     },
     FurBall(FurBall),
     Scalp(ScalpPatch),
+    /// A host's own polylines (points, radii, counts per strand), drawn as a `.hair`
+    /// file's are: through the groom's basis, B-spline when it gives none.
+    Strands(Strands),
     /// Control points (x, y, z, radius) already laid out for `basis`, `counts[i]` of them
     /// for strand i, as a pbrt file gives them: handed to Embree as they are, with no
     /// polyline conversion (and so no `.hair` export).
@@ -345,8 +349,9 @@ pub fn has_extension(path: &std::path::Path, ext: &str) -> bool {
 
 /// What a render needs, built from a description. Materials and lights can be changed
 /// on it without a new build ([`BuiltScene::set_material`], [`BuiltScene::set_lights`]),
-/// and so can the camera and the settings, as long as the curves' view-dependent shapes
-/// still hold for them (a render checks it, and refuses a view they no longer serve).
+/// and so can the camera ([`BuiltScene::set_camera`]) and the settings, as long as the
+/// curves' view-dependent shapes still hold for them ([`BuiltScene::serves`]; a render
+/// refuses a view they no longer serve).
 pub struct BuiltScene {
     pub(crate) world: World,
     pub camera: Camera,
@@ -355,6 +360,9 @@ pub struct BuiltScene {
     pub stages: StageTimes,
     /// The name of each geometry's material, by geometry id.
     sources: Vec<String>,
+    /// What the automatic camera frames, kept so that a new `[camera]` frames what the
+    /// build's did.
+    framing: Framing,
 }
 
 impl BuiltScene {
@@ -437,6 +445,23 @@ impl BuiltScene {
             self.world.set_material(g, prepared.clone())?;
         }
         Ok(())
+    }
+
+    /// Places the camera as the `[camera]` table `camera` says, without a new build: an
+    /// automatic camera frames the built grooms as the build's did, for the built image's
+    /// aspect. A render refuses a camera the build does not serve ([`Self::serves`]).
+    pub fn set_camera(&mut self, camera: &CameraDesc) -> Result<()> {
+        let aspect = self.settings.width as f32 / self.settings.height as f32;
+        self.camera = camera.build(&self.framing, aspect)?;
+        Ok(())
+    }
+
+    /// Whether a render of the camera with `settings` can use this build: the curves'
+    /// view-dependent shapes hold for it (a view that sees them no smaller) and the
+    /// settings change none of [`BUILD_SETTINGS`](crate::render::settings::BUILD_SETTINGS).
+    pub fn serves(&self, settings: &RenderSettings) -> bool {
+        settings.build_change(&self.settings).is_none()
+            && renderer::serves(&self.world, &self.camera, settings)
     }
 
     /// Replaces the lights without a new build.

@@ -44,13 +44,38 @@ impl BlockBias {
     pub const NORMAL_OVER_TWO: f64 = 0.0455;
 
     /// Whether the blocks' scatter is what noise alone gives: the share over 2 within
-    /// three binomial deviations of the normal share, and the frame's mean difference
-    /// within three of its deviations.
+    /// three binomial deviations of the normal share, no block beyond
+    /// [`Self::largest_z_of_noise`], and the frame's mean difference within three of its
+    /// deviations. The largest |z| catches a bias confined to a few blocks (a silhouette),
+    /// which the share and the mean average away.
     pub fn within_noise(&self) -> bool {
         let p = Self::NORMAL_OVER_TWO;
         let share_sigma = (p * (1.0 - p) / self.blocks.max(1) as f64).sqrt();
         self.over_two <= p + 3.0 * share_sigma
+            && self.z_max <= Self::largest_z_of_noise(self.blocks)
             && self.mean_difference.abs() <= 3.0 * self.mean_difference_sigma
+    }
+
+    /// The |z| that noise alone exceeds in some block of `blocks` one time in a hundred
+    /// (Bonferroni: a two-sided normal tail of 0.01 / blocks), from the tail's asymptotic
+    /// series, within a few percent of the tail from |z| = 2.5 on.
+    pub fn largest_z_of_noise(blocks: usize) -> f64 {
+        let target = 0.01 / blocks.max(1) as f64;
+        let two_tails = |z: f64| {
+            let density = (-0.5 * z * z).exp() / std::f64::consts::TAU.sqrt();
+            let z2 = z * z;
+            2.0 * density / z * (1.0 - 1.0 / z2 + 3.0 / (z2 * z2))
+        };
+        let (mut lo, mut hi) = (2.0, 40.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if two_tails(mid) > target {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
     }
 }
 
@@ -295,6 +320,28 @@ mod tests {
             "in the brighter quadrant: {r:?}"
         );
         assert!(r.mean_difference > 0.0, "{r:?}");
+    }
+
+    #[test]
+    fn the_largest_z_of_noise_grows_with_the_blocks() {
+        // Two-sided normal quantiles: 1% (2.576), 1e-4 (3.891), 1e-6 (4.892).
+        for (blocks, z) in [(1, 2.576), (100, 3.891), (10_000, 4.892)] {
+            let got = BlockBias::largest_z_of_noise(blocks);
+            assert!((got / z - 1.0).abs() < 0.01, "{blocks}: {got} against {z}");
+        }
+    }
+
+    #[test]
+    fn a_bias_in_one_block_is_found() {
+        let mut rng = Pcg64::seed_from_u64(9);
+        let flat = |_: usize, _: usize| 0.5;
+        // One 8x8 block of 64 (a silhouette's worth) 20% brighter.
+        let spot = |x: usize, y: usize| if x < 8 && y < 8 { 0.6 } else { 0.5 };
+        let (a, b) = (seeds(4, &spot, false, &mut rng), seeds(4, &flat, false, &mut rng));
+        let r = block_bias(&a, &b, 8).unwrap();
+        assert!(r.over_two < 0.1 && r.z_max > 5.0, "{r:?}");
+        assert_eq!(r.worst, (0, 0));
+        assert!(!r.within_noise(), "{r:?}");
     }
 
     #[test]

@@ -133,6 +133,16 @@ pub fn film_bytes_and_uniform(
     )
 }
 
+/// Whether `world`'s curves, shaped for the view they were built for, hold for `camera`
+/// at `settings`' image height and level of detail ([`crate::scene::tracer::Tracer::serves`]).
+pub(crate) fn serves(world: &World, camera: &Camera, settings: &RenderSettings) -> bool {
+    (world.tracer).serves(&DetailView::new(
+        *camera,
+        settings.height,
+        settings.lod_pixels,
+    ))
+}
+
 /// Renders `world` through `camera`. Each sample's numbers depend only on the seed, the
 /// full-frame pixel and the sample index, so the image is the same for any thread count,
 /// tile order or crop. A world whose curves were shaped for a view (the `auto` shape)
@@ -158,11 +168,7 @@ pub fn render(
     progress: &dyn Progress,
 ) -> Result<RenderOutput> {
     settings.validate()?;
-    if !world.tracer.serves(&DetailView::new(
-        *camera,
-        settings.height,
-        settings.lod_pixels,
-    )) {
+    if !serves(world, camera, settings) {
         return Err(invalid_arg!(
             "the scene's curves were shaped for a view that saw them smaller (from farther, \
              or with fewer pixels): build the scene again for this camera and image height"

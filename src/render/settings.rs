@@ -450,6 +450,11 @@ pub enum Filter {
     Box,
 }
 
+/// The settings a build is made for (the film's shape, Embree's kernels, the curves'
+/// level of detail and parts): a render that changes one needs a build of its own. The
+/// command line's variants and the Python package decide by this list alone.
+pub const BUILD_SETTINGS: [&str; 5] = ["width", "height", "isa", "lod_pixels", "curve_parts"];
+
 /// Largest accepted image side, so that a typo cannot ask for terabytes.
 pub(crate) const MAX_SIDE: u32 = 1 << 15;
 
@@ -522,6 +527,14 @@ impl RenderSettings {
             }
         }
         Ok(())
+    }
+
+    /// The first of [`BUILD_SETTINGS`] whose value differs from `built`'s (the settings a
+    /// scene was built for): None when a render with these settings can use that build.
+    pub fn build_change(&self, built: &RenderSettings) -> Option<&'static str> {
+        BUILD_SETTINGS
+            .into_iter()
+            .find(|name| self.get(name).ok() != built.get(name).ok())
     }
 
     /// The crop window, or the full frame.

@@ -42,7 +42,9 @@ fn shrink(desc: &mut SceneDescription) {
         match &mut g.source {
             GroomSource::FurBall(f) => f.strands = 300,
             GroomSource::Scalp(s) => s.strands = 300,
-            GroomSource::File { .. } | GroomSource::ControlPoints { .. } => {}
+            GroomSource::File { .. }
+            | GroomSource::Strands(_)
+            | GroomSource::ControlPoints { .. } => {}
         }
     }
 }

@@ -1,0 +1,274 @@
+//! The hair BSDF on numpy arrays: one call evaluates or samples n inputs, every input
+//! checked first as the C ABI checks it (`hairtrace::bsdf::inputs`), the GIL released
+//! while the batch runs. The absorption conversions take arrays too.
+
+use hairtrace::bsdf::{self, inputs};
+use hairtrace::glam::Vec3;
+use hairtrace::{HairBsdf, HairParams};
+use numpy::ndarray::{Array, IxDyn};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::arrays::{Floats, same_rows, show_shape};
+use crate::errors::IntoPy;
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyHairBsdf>()?;
+    m.add_function(wrap_pyfunction!(sigma_a_from_melanin, m)?)?;
+    m.add_function(wrap_pyfunction!(sigma_a_from_color, m)?)?;
+    m.add_function(wrap_pyfunction!(sigma_a_preset, m)?)?;
+    let presets: Vec<&str> = bsdf::SIGMA_A_PRESETS.iter().map(|(n, _)| *n).collect();
+    m.add("SIGMA_A_PRESETS", presets)?;
+    Ok(())
+}
+
+/// The Chiang 2016 hair BSDF for one parameter set (docs/conventions.md: the fibre's
+/// frame, x along the fibre, h across it). Parameters left out take the default brown
+/// hair's; each is checked against its range (ValueError), never clamped.
+#[pyclass(name = "HairBsdf", module = "hairtrace", frozen)]
+pub struct PyHairBsdf {
+    bsdf: HairBsdf,
+}
+
+/// f and pdf, as `eval` returns them.
+type Pair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray1<f32>>);
+/// wi, f and pdf, as `sample` returns them.
+type Triple<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<f32>>,
+);
+
+#[pymethods]
+impl PyHairBsdf {
+    #[new]
+    #[pyo3(signature = (sigma_a=None, eta=None, beta_m=None, beta_n=None, alpha=None))]
+    fn new(
+        sigma_a: Option<[f32; 3]>,
+        eta: Option<f32>,
+        beta_m: Option<f32>,
+        beta_n: Option<f32>,
+        alpha: Option<f32>,
+    ) -> PyResult<Self> {
+        let d = HairParams::default();
+        let params = HairParams {
+            sigma_a: sigma_a.unwrap_or(d.sigma_a),
+            eta: eta.unwrap_or(d.eta),
+            beta_m: beta_m.unwrap_or(d.beta_m),
+            beta_n: beta_n.unwrap_or(d.beta_n),
+            alpha: alpha.unwrap_or(d.alpha),
+        };
+        Ok(PyHairBsdf {
+            bsdf: HairBsdf::new(&params).py()?,
+        })
+    }
+
+    #[getter]
+    fn sigma_a(&self) -> [f32; 3] {
+        self.bsdf.params().sigma_a
+    }
+    #[getter]
+    fn eta(&self) -> f32 {
+        self.bsdf.params().eta
+    }
+    #[getter]
+    fn beta_m(&self) -> f32 {
+        self.bsdf.params().beta_m
+    }
+    #[getter]
+    fn beta_n(&self) -> f32 {
+        self.bsdf.params().beta_n
+    }
+    #[getter]
+    fn alpha(&self) -> f32 {
+        self.bsdf.params().alpha
+    }
+
+    fn __repr__(&self) -> String {
+        let p = self.bsdf.params();
+        format!(
+            "HairBsdf(sigma_a={:?}, eta={}, beta_m={}, beta_n={}, alpha={})",
+            p.sigma_a, p.eta, p.beta_m, p.beta_n, p.alpha
+        )
+    }
+
+    /// f (n, 3), with its 1/|wi.z|, and pdf (n,) for h (n,) in [-1, 1] and unit
+    /// directions wo, wi (n, 3) in the fibre's frame.
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        h: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+    ) -> PyResult<Pair<'py>> {
+        let (h, wo, wi) = (
+            Floats::rows(h, "h", 0)?,
+            Floats::rows(wo, "wo", 3)?,
+            Floats::rows(wi, "wi", 3)?,
+        );
+        let n = same_rows(&[&h, &wo, &wi])?;
+        let (h, wo, wi) = (h.values(), wo.vec3s(), wi.vec3s());
+        let (f, pdf) = py
+            .detach(|| -> hairtrace::Result<_> {
+                for i in 0..n {
+                    inputs::check_h(h[i])
+                        .and_then(|_| inputs::check_dir(Vec3::from_array(wo[i]), "wo"))
+                        .and_then(|_| inputs::check_dir(Vec3::from_array(wi[i]), "wi"))
+                        .map_err(|e| e.context(format!("element {i}")))?;
+                }
+                let (mut f, mut pdf) = (vec![0.0f32; 3 * n], vec![0.0f32; n]);
+                self.bsdf
+                    .eval_batch(h, wo, wi, bytemuck::cast_slice_mut(&mut f), &mut pdf)?;
+                Ok((f, pdf))
+            })
+            .py()?;
+        Ok((rows3(py, f)?, pdf.into_pyarray(py)))
+    }
+
+    /// The density (n,) of `sample` at wi: `eval`'s pdf alone.
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        h: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        Ok(self.eval(py, h, wo, wi)?.1)
+    }
+
+    /// Directions wi (n, 3) drawn for h (n,) and wo (n, 3) from uniform numbers u (n, 3)
+    /// in [0, 1), with f (n, 3) and pdf (n,) there; pdf 0 (wi and f zero) where the
+    /// density is zero. The path weight is f |wi.z| / pdf.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        h: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+    ) -> PyResult<Triple<'py>> {
+        let (h, wo, u) = (
+            Floats::rows(h, "h", 0)?,
+            Floats::rows(wo, "wo", 3)?,
+            Floats::rows(u, "u", 3)?,
+        );
+        let n = same_rows(&[&h, &wo, &u])?;
+        let (h, wo, u) = (h.values(), wo.vec3s(), u.vec3s());
+        let (wi, f, pdf) = py
+            .detach(|| -> hairtrace::Result<_> {
+                for i in 0..n {
+                    inputs::check_h(h[i])
+                        .and_then(|_| inputs::check_dir(Vec3::from_array(wo[i]), "wo"))
+                        .and_then(|_| inputs::check_u(u[i], "u"))
+                        .map_err(|e| e.context(format!("element {i}")))?;
+                }
+                let (mut wi, mut f, mut pdf) =
+                    (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
+                for i in 0..n {
+                    if let Some(s) = self.bsdf.sample(h[i], Vec3::from_array(wo[i]), u[i]) {
+                        wi[3 * i..3 * i + 3].copy_from_slice(&s.wi.to_array());
+                        f[3 * i..3 * i + 3].copy_from_slice(&s.f.to_array());
+                        pdf[i] = s.pdf;
+                    }
+                }
+                Ok((wi, f, pdf))
+            })
+            .py()?;
+        Ok((rows3(py, wi)?, rows3(py, f)?, pdf.into_pyarray(py)))
+    }
+}
+
+/// `values` (3n floats) as an (n, 3) array, without a copy.
+fn rows3(py: Python<'_>, values: Vec<f32>) -> PyResult<Bound<'_, PyArray2<f32>>> {
+    let n = values.len() / 3;
+    let array = Array::from_shape_vec((n, 3), values).expect("3n values");
+    Ok(array.into_pyarray(py))
+}
+
+/// `shape` + (3,), filled by `each` from the i-th input: the conversions' arrays.
+fn per_element<'py>(
+    py: Python<'py>,
+    shape: &[usize],
+    count: usize,
+    each: impl Fn(usize) -> hairtrace::Result<[f32; 3]>,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    let mut out = Vec::with_capacity(3 * count);
+    for i in 0..count {
+        let v = each(i).map_err(|e| {
+            if count > 1 {
+                e.context(format!("element {i}"))
+            } else {
+                e
+            }
+        });
+        out.extend(v.py()?);
+    }
+    let dims: Vec<usize> = shape.iter().copied().chain([3]).collect();
+    let array = Array::from_shape_vec(IxDyn(&dims), out).expect("3 values per element");
+    Ok(array.into_pyarray(py))
+}
+
+/// sigma_a (..., 3) from eumelanin and pheomelanin concentrations (each >= 0; about 8 is
+/// jet black, 1.3 brown, 0.3 blonde; pheomelanin adds red), numbers or arrays of one
+/// shape (or one of them a number).
+#[pyfunction]
+#[pyo3(signature = (eumelanin, pheomelanin=None))]
+fn sigma_a_from_melanin<'py>(
+    py: Python<'py>,
+    eumelanin: &Bound<'py, PyAny>,
+    pheomelanin: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    let eu = Floats::new(eumelanin, "eumelanin")?;
+    let zero = [0.0f32];
+    let pheo = pheomelanin
+        .map(|p| Floats::new(p, "pheomelanin"))
+        .transpose()?;
+    let (e, p) = (eu.values(), pheo.as_ref().map_or(&zero[..], Floats::values));
+    let shape = match (eu.shape(), pheo.as_ref().map(Floats::shape)) {
+        (s, None) => s.to_vec(),
+        (s, Some(t)) if s == t || p.len() == 1 => s.to_vec(),
+        (_, Some(t)) if e.len() == 1 => t.to_vec(),
+        (s, Some(t)) => {
+            return Err(PyValueError::new_err(format!(
+                "eumelanin {} and pheomelanin {}: must have one shape, or one be a number",
+                show_shape(s),
+                show_shape(t)
+            )));
+        }
+    };
+    let count = e.len().max(p.len());
+    let pick = |v: &[f32], i: usize| if v.len() == 1 { v[0] } else { v[i] };
+    per_element(py, &shape, count, |i| {
+        bsdf::sigma_a_from_melanin(pick(e, i), pick(p, i))
+    })
+}
+
+/// sigma_a (..., 3) that makes a fibre of azimuthal roughness beta_n look like the
+/// reflectance `color` (..., 3), each channel in (0, 1] (Chiang et al. 2016's fit).
+#[pyfunction]
+#[pyo3(signature = (color, beta_n=None))]
+fn sigma_a_from_color<'py>(
+    py: Python<'py>,
+    color: &Bound<'py, PyAny>,
+    beta_n: Option<f32>,
+) -> PyResult<Bound<'py, PyArrayDyn<f32>>> {
+    let color = Floats::new(color, "color")?;
+    let shape = color.shape();
+    if shape.last() != Some(&3) {
+        return Err(PyValueError::new_err(format!(
+            "color: shape {}: must be (..., 3)",
+            show_shape(shape)
+        )));
+    }
+    let beta_n = beta_n.unwrap_or(HairParams::default().beta_n);
+    let rgb = color.vec3s();
+    per_element(py, &shape[..shape.len() - 1], rgb.len(), |i| {
+        bsdf::sigma_a_from_color(rgb[i], beta_n)
+    })
+}
+
+/// The sigma_a (3,) of a named hair colour (`SIGMA_A_PRESETS`).
+#[pyfunction]
+fn sigma_a_preset<'py>(py: Python<'py>, name: &str) -> PyResult<Bound<'py, PyArray1<f32>>> {
+    Ok(bsdf::sigma_a_preset(name).py()?.to_vec().into_pyarray(py))
+}

@@ -337,7 +337,10 @@ mod tests {
         let flat = |_: usize, _: usize| 0.5;
         // One 8x8 block of 64 (a silhouette's worth) 20% brighter.
         let spot = |x: usize, y: usize| if x < 8 && y < 8 { 0.6 } else { 0.5 };
-        let (a, b) = (seeds(4, &spot, false, &mut rng), seeds(4, &flat, false, &mut rng));
+        let (a, b) = (
+            seeds(4, &spot, false, &mut rng),
+            seeds(4, &flat, false, &mut rng),
+        );
         let r = block_bias(&a, &b, 8).unwrap();
         assert!(r.over_two < 0.1 && r.z_max > 5.0, "{r:?}");
         assert_eq!(r.worst, (0, 0));

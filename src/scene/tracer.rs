@@ -64,6 +64,19 @@ const MIN_EXIT_SINE: f32 = 1e-3;
 const OFFSET_RADII: f32 = 1e-3;
 const OFFSET_ULPS: f32 = 64.0 * f32::EPSILON;
 
+/// Embree ignores a flat curve's hits closer to the ray's origin than this many of the
+/// curve's radii (its build option `EMBREE_CURVE_SELF_INTERSECTION_AVOIDANCE_FACTOR`, 2 by
+/// default in Embree 3.13 and 4, Debian's and the Embree 4 leg's builds alike): a ray
+/// leaving a strand would not see a ribbon touching it, and hair in clumps shaded too
+/// bright. A spawned ray therefore starts this far, and [`RADIUS_OVERSHOOT`] more, behind
+/// its origin, with `tnear` at the origin: the same ray, whose every hit is past Embree's
+/// blind distance (docs/measurements.md, "Real grooms: the defaults against round curves").
+const FLAT_BLIND_RADII: f32 = 2.0;
+/// How far a cubic curve's interpolated radius may exceed its largest control radius: a
+/// Catmull-Rom basis weighs its points by up to 1.25 in absolute sum (B-spline, Bezier and
+/// linear weights are positive and sum to 1).
+const RADIUS_OVERSHOOT: f32 = 1.25;
+
 /// A ray leaving a hit, with the exclusion that keeps it off the surface it left.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpawnedRay {
@@ -90,6 +103,8 @@ pub struct TracerBuilder {
     scene: SceneBuilder,
     tables: Vec<Table>,
     view: ViewDependent,
+    /// The largest control radius of the flat curves added (0 without any).
+    flat_radius: f32,
 }
 
 impl TracerBuilder {
@@ -98,12 +113,17 @@ impl TracerBuilder {
             scene: SceneBuilder::new(device, options)?,
             tables: Vec::new(),
             view: ViewDependent::default(),
+            flat_radius: 0.0,
         })
     }
 
     /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
     pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
         let (basis, shape, vertices, indices, strands, truth, parts) = curves.into_parts();
+        if shape == CurveShape::Flat {
+            let largest = vertices.as_slice().iter().fold(0.0f32, |m, v| m.max(v[3]));
+            self.flat_radius = self.flat_radius.max(largest);
+        }
         let in_parts = self.scene.options().builds_in_parts(indices.len());
         let geometry = CurveGeometry::new(
             self.scene.device(),
@@ -161,6 +181,7 @@ impl TracerBuilder {
                 .commit(&|fraction| stages.forward(Stage::Bvh, fraction))?,
             tables: self.tables,
             view: self.view,
+            flat_blind: FLAT_BLIND_RADII * RADIUS_OVERSHOOT * self.flat_radius,
         })
     }
 }
@@ -172,6 +193,9 @@ pub struct Tracer {
     scene: Scene,
     tables: Vec<Table>,
     view: ViewDependent,
+    /// The distance from a ray's origin within which Embree may ignore a flat curve's hit
+    /// ([`FLAT_BLIND_RADII`]); 0 without flat curves.
+    flat_blind: f32,
 }
 
 impl Tracer {
@@ -260,16 +284,23 @@ impl Tracer {
             #[cfg(any(test, feature = "bench-internals"))]
             (Hit::Hair(h), Escape::Filter) => (p, 0.0, self.exclusion(h, dir)),
         };
+        // Started behind its origin by Embree's blind distance for flat curves, in units of
+        // `dir`, so that every hit past the origin is one Embree reports.
+        let back = self.flat_blind / dir.length();
+        let back = if back.is_finite() { back } else { 0.0 };
         SpawnedRay {
             ray: Ray {
-                org,
+                org: org - dir * back,
                 dir,
-                tnear: 0.0,
+                tnear: back,
                 // A target nearer than the fibre's far wall leaves nothing to test.
-                tfar: (tfar - advance).max(0.0),
+                tfar: (tfar - advance).max(0.0) + back,
                 mask: u32::MAX,
             },
-            exclude,
+            exclude: exclude.map(|ex| Exclude {
+                max_t: ex.max_t + back,
+                ..ex
+            }),
         }
     }
 

@@ -5,3 +5,4 @@ mod curves_geometry;
 mod large_groom;
 mod lights;
 mod rehit;
+mod touching;

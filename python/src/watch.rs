@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyBool;
 
 /// How often the caller looks at signals and progress: Ctrl-C cancels within it, plus
-/// the tiles (16 x 16 pixels) in flight.
+/// the samples in flight, which stop at the next one.
 const POLL: Duration = Duration::from_millis(50);
 
 /// What the work reports and the caller reads: pixels done of a total, and whether to stop.

@@ -179,8 +179,8 @@ impl World {
             let found = self.tracer.find_spawned(&ray);
             rays += 1;
             let t_hit = found.as_ref().map_or(f32::INFINITY, |h| h.t);
-            let contribution =
-                self.emission(ray.ray.org, ray.ray.dir, t_hit, came, settings.strategy);
+            let (org, t_hit) = ray.start(t_hit);
+            let contribution = self.emission(org, ray.ray.dir, t_hit, came, settings.strategy);
             l += clamp(beta * contribution, events, settings);
             let Some(found) = found else { break };
             // A fixed number of requests per bounce keeps the sample sequence aligned;
@@ -247,7 +247,7 @@ impl World {
             // The BSDF's pdf costs a whole evaluation of its lobes: it is computed only
             // for a ray that may find a light next-event estimation also samples.
             let mis = settings.strategy == Strategy::Mis
-                && self.sampled_light_along(ray.ray.org, ray.ray.dir);
+                && self.sampled_light_along(ray.start(0.0).0, ray.ray.dir);
             came = Came::Bsdf {
                 pdf: if mis { shading.pdf(s.local) } else { 0.0 },
             };

@@ -84,6 +84,16 @@ pub struct SpawnedRay {
     pub exclude: Option<Exclude>,
 }
 
+impl SpawnedRay {
+    /// Where the ray really starts (Embree's origin lies `tnear` behind it,
+    /// [`FLAT_BLIND_RADII`]), and `t` of Embree's (a hit's distance) from there: what a
+    /// light's distance along the ray is measured against.
+    pub fn start(&self, t: f32) -> (Vec3, f32) {
+        let r = &self.ray;
+        (r.org + r.dir * r.tnear, t - r.tnear)
+    }
+}
+
 /// What a geometry id refers to, besides the Embree geometry.
 #[derive(Debug)]
 enum Table {

@@ -8,8 +8,12 @@ import sys
 import threading
 import time
 
+# The child answers SIGINT as an interactive Python does, however the test runner was
+# started: a shell starts background jobs with SIGINT ignored, Python then installs no
+# handler of its own, and the signal would do nothing.
 CHILD = r"""
-import sys, time
+import signal, sys, time
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import hairtrace
 scene = hairtrace.Scene.demo("furball")
 started = []

@@ -18,7 +18,8 @@ const SEEDS: [u64; 2] = [2_000_003, 2_000_004];
 const BLOCK: usize = 8;
 
 /// Frames smaller than this many pixels (the close-ups) render at four times their scene's
-/// spp: they are cheap, and more samples sharpen the blocks' test.
+/// spp: they are cheap, and more samples sharpen the blocks' test. Larger ones (the 1080p
+/// frames) render at a quarter of it, as their round tubes take minutes a render.
 const SMALL_FRAME: u32 = 100_000;
 
 /// The real-groom scenes whose files are made, and those that are not.
@@ -73,6 +74,8 @@ fn sized(ctx: &Context, mut desc: SceneDescription) -> SceneDescription {
         r.spp = 2;
     } else if r.width * r.height < SMALL_FRAME {
         r.spp *= 4;
+    } else {
+        r.spp = (r.spp / 4).max(1);
     }
     desc
 }
@@ -125,7 +128,7 @@ pub fn section(ctx: &Context) -> Result<String> {
         "The default curves (`auto`: ribbons where a strand is under a pixel, its level of \
          detail, lazy parts) against full-detail round tubes on the grooms made with \
          Blender's hair tools (bench/README.md, \"Real grooms\"), each scene as written \
-         (small frames at 4x its spp), {} seeds a side that no other render uses. Each \
+         (close-ups at 4x its spp, 1080p frames at a quarter), {} seeds a side that no other render uses. Each \
          {BLOCK}x{BLOCK} block's mean difference is divided by its noise (the seeds' \
          per-pixel variances summed over the block, calibrated once per frame by the \
          blocks' own seed-to-seed scatter, so that a filter's correlation between pixels \

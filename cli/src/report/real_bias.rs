@@ -128,8 +128,8 @@ pub fn section(ctx: &Context) -> Result<String> {
         "The default curves (`auto`: ribbons where a strand is under a pixel, its level of \
          detail, lazy parts) against full-detail round tubes on the grooms made with \
          Blender's hair tools (bench/README.md, \"Real grooms\"), each scene as written \
-         (close-ups at 4x its spp, 1080p frames at a quarter), {} seeds a side that no other render uses. Each \
-         {BLOCK}x{BLOCK} block's mean difference is divided by its noise (the seeds' \
+         (close-ups at 4x its spp, 1080p frames at a quarter), {} seeds a side that no \
+         other render uses. Each {BLOCK}x{BLOCK} block's mean difference is divided by its noise (the seeds' \
          per-pixel variances summed over the block, calibrated once per frame by the \
          blocks' own seed-to-seed scatter, so that a filter's correlation between pixels \
          is counted): without bias the z-scores' rms is about 1 (below it where the noise \

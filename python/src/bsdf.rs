@@ -111,12 +111,7 @@ impl PyHairBsdf {
         let (h, wo, wi) = (h.values(), wo.vec3s(), wi.vec3s());
         let (f, pdf) = py
             .detach(|| -> hairtrace::Result<_> {
-                for i in 0..n {
-                    inputs::check_h(h[i])
-                        .and_then(|_| inputs::check_dir(Vec3::from_array(wo[i]), "wo"))
-                        .and_then(|_| inputs::check_dir(Vec3::from_array(wi[i]), "wi"))
-                        .map_err(|e| e.context(format!("element {i}")))?;
-                }
+                check_each(h, wo, |i| inputs::check_dir(Vec3::from_array(wi[i]), "wi"))?;
                 let (mut f, mut pdf) = (vec![0.0f32; 3 * n], vec![0.0f32; n]);
                 self.bsdf
                     .eval_batch(h, wo, wi, bytemuck::cast_slice_mut(&mut f), &mut pdf)?;
@@ -156,12 +151,7 @@ impl PyHairBsdf {
         let (h, wo, u) = (h.values(), wo.vec3s(), u.vec3s());
         let (wi, f, pdf) = py
             .detach(|| -> hairtrace::Result<_> {
-                for i in 0..n {
-                    inputs::check_h(h[i])
-                        .and_then(|_| inputs::check_dir(Vec3::from_array(wo[i]), "wo"))
-                        .and_then(|_| inputs::check_u(u[i], "u"))
-                        .map_err(|e| e.context(format!("element {i}")))?;
-                }
+                check_each(h, wo, |i| inputs::check_u(u[i], "u"))?;
                 let (mut wi, mut f, mut pdf) =
                     (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
                 for i in 0..n {
@@ -176,6 +166,22 @@ impl PyHairBsdf {
             .py()?;
         Ok((rows3(py, wi)?, rows3(py, f)?, pdf.into_pyarray(py)))
     }
+}
+
+/// Checks each element's h and wo, then the rest of it with `rest(i)`, as the C ABI
+/// checks a call's arguments; an error names the element.
+fn check_each<T>(
+    h: &[f32],
+    wo: &[[f32; 3]],
+    rest: impl Fn(usize) -> hairtrace::Result<T>,
+) -> hairtrace::Result<()> {
+    for (i, (&h, &wo)) in h.iter().zip(wo).enumerate() {
+        inputs::check_h(h)
+            .and_then(|_| inputs::check_dir(Vec3::from_array(wo), "wo"))
+            .and_then(|_| rest(i))
+            .map_err(|e| e.context(format!("element {i}")))?;
+    }
+    Ok(())
 }
 
 /// `values` (3n floats) as an (n, 3) array, without a copy.

@@ -179,6 +179,19 @@ pub fn median(mut values: Vec<f64>) -> f64 {
     }
 }
 
+/// The names of the scenes folder's scene files (`*.toml`), sorted.
+pub fn all_scene_names(ctx: &Context) -> Result<Vec<String>> {
+    let dir = std::fs::read_dir(&ctx.scenes).map_err(|e| Error::io(&ctx.scenes, e))?;
+    let mut names: Vec<String> = dir
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect();
+    names.sort();
+    Ok(names)
+}
+
 /// A bench scene by name, read from the scenes folder.
 pub fn bench_scene(ctx: &Context, name: &str) -> Result<hairtrace::SceneDescription> {
     hairtrace::SceneDescription::from_file(&scene_path(&ctx.scenes, name))

@@ -5,11 +5,11 @@
 
 use super::markdown::{num, table};
 use super::render::{Built, Variant};
-use super::{Context, bench_scene};
+use super::{Context, all_scene_names, bench_scene};
+use hairtrace::Result;
 use hairtrace::description::{GroomSource, MeshSource, SceneDescription};
 use hairtrace::image::{BlockBias, block_bias};
 use hairtrace::scene::GroomShape;
-use hairtrace::{Error, Result};
 
 /// Seeds of each side; none is a timed render's or a reference's.
 const SEEDS: [u64; 2] = [2_000_003, 2_000_004];
@@ -24,17 +24,11 @@ const SMALL_FRAME: u32 = 100_000;
 
 /// The real-groom scenes whose files are made, and those that are not.
 fn scenes(ctx: &Context) -> Result<(Vec<String>, Vec<String>)> {
-    let dir = std::fs::read_dir(&ctx.scenes).map_err(|e| Error::io(&ctx.scenes, e))?;
-    let mut names: Vec<String> = dir
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-        .filter(|name| name.starts_with("real_"))
-        .collect();
-    names.sort();
     let (mut made, mut missing) = (Vec::new(), Vec::new());
-    for name in names {
+    for name in all_scene_names(ctx)?
+        .into_iter()
+        .filter(|n| n.starts_with("real_"))
+    {
         if files_exist(&bench_scene(ctx, &name)?) {
             made.push(name);
         } else {

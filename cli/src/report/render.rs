@@ -4,7 +4,7 @@
 
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
-use super::{Context, bench_scene, median};
+use super::{Context, all_scene_names, bench_scene, median};
 use hairtrace::description::{GroomSource, SceneDescription};
 use hairtrace::embree::CurveBasis;
 use hairtrace::image::{Image, compare};
@@ -102,16 +102,9 @@ pub fn scene_names(ctx: &Context) -> Result<Vec<String>> {
     if ctx.quick {
         return Ok(vec!["fur_ball".into(), "hdr_fur_ball".into()]);
     }
-    let dir = std::fs::read_dir(&ctx.scenes).map_err(|e| hairtrace::Error::io(&ctx.scenes, e))?;
-    let mut names: Vec<String> = dir
-        .filter_map(|e| e.ok())
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-        // The real grooms (made on demand by bench/real_grooms.py) are bench/peer's.
-        .filter(|name| !name.starts_with("real_"))
-        .collect();
-    names.sort();
+    let mut names = all_scene_names(ctx)?;
+    // The real grooms (made on demand by bench/real_grooms.py) have a section of their own.
+    names.retain(|name| !name.starts_with("real_"));
     Ok(names)
 }
 

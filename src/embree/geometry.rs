@@ -282,6 +282,12 @@ impl RawGeometry {
         }
     }
 
+    /// Quads per segment of a flat cubic curve (Embree records an error for other kinds).
+    fn set_ribbon_quads(&self, quads: u32) {
+        // SAFETY: live geometry, not yet committed into a scene.
+        unsafe { sys::rtcSetGeometryTessellationRate(self.0.as_ptr(), quads as f32) };
+    }
+
     /// Sets the mask, commits the geometry and reports any error Embree recorded.
     pub(super) fn commit(&self, device: &Device, mask: u32) -> Result<()> {
         // SAFETY: live geometry whose buffers are set.
@@ -427,6 +433,12 @@ fn prefetch<T>(points: &[T]) {
     let _ = points;
 }
 
+/// Ray-facing quads per segment in which Embree intersects a flat cubic curve unless told
+/// otherwise (`rtcSetGeometryTessellationRate`).
+pub const DEFAULT_RIBBON_QUADS: u32 = 4;
+/// The most quads per segment Embree cuts a flat cubic curve into: it clamps a higher rate.
+pub const MAX_RIBBON_QUADS: u32 = 16;
+
 /// Curves: one Embree curve geometry and the buffers it reads.
 #[derive(Debug)]
 pub struct CurveGeometry {
@@ -438,6 +450,8 @@ pub struct CurveGeometry {
     basis: CurveBasis,
     shape: CurveShape,
     mask: u32,
+    /// Quads per segment of a flat cubic curve, its parts' too ([`Self::with_ribbon_quads`]).
+    ribbon_quads: u32,
     vertices: SharedBuffer<[f32; 4]>,
     indices: SharedBuffer<u32>,
     parts: Option<Arc<Parts>>,
@@ -514,10 +528,35 @@ impl CurveGeometry {
             basis,
             shape,
             mask,
+            ribbon_quads: DEFAULT_RIBBON_QUADS,
             vertices,
             indices,
             parts: None,
         })
+    }
+
+    /// The same flat cubic curves intersected as `quads` ray-facing quads per segment
+    /// (1 to [`MAX_RIBBON_QUADS`]), where the default's chords would cut the curve's bends
+    /// short by more than a view allows (`scene::ribbons`). Refused for other curves, which
+    /// Embree does not cut into quads.
+    pub fn with_ribbon_quads(mut self, device: &Device, quads: u32) -> Result<Self> {
+        if self.shape != CurveShape::Flat || self.basis == CurveBasis::Linear {
+            return Err(invalid_arg!(
+                "{quads} quads per segment: only flat cubic curves are cut into quads, these \
+                 are {:?} {:?}",
+                self.shape,
+                self.basis
+            ));
+        }
+        if !(1..=MAX_RIBBON_QUADS).contains(&quads) {
+            return Err(invalid_arg!(
+                "{quads} quads per segment: Embree takes 1 to {MAX_RIBBON_QUADS}"
+            ));
+        }
+        self.ribbon_quads = quads;
+        self.raw.set_ribbon_quads(quads);
+        self.raw.commit(device, self.mask)?;
+        Ok(self)
     }
 
     /// The same geometry, cut into parts that a scene builds as scenes of their own when
@@ -637,6 +676,9 @@ impl CurveGeometry {
                 &parts.indices,
                 range,
             );
+        }
+        if self.ribbon_quads != DEFAULT_RIBBON_QUADS {
+            raw.set_ribbon_quads(self.ribbon_quads);
         }
         raw.commit(device, self.mask)?;
         Ok(raw)

@@ -31,7 +31,10 @@ mod sys;
 
 pub use device::Device;
 pub use geometry::{CurveBasis, CurveShape};
-pub(crate) use geometry::{CurveGeometry, CurvePoint, PartsCache, TriangleGeometry, padding_for};
+pub(crate) use geometry::{
+    CurveGeometry, CurvePoint, DEFAULT_RIBBON_QUADS, MAX_RIBBON_QUADS, PartsCache,
+    TriangleGeometry, padding_for,
+};
 pub use isa::Isa;
 pub use memory::MemoryMonitor;
 pub(crate) use order::{centroid, morton_order};

@@ -340,7 +340,8 @@ settings! {
         /// The tent's half-width in pixels (the box ignores it).
         filter_radius: f32 = 1.0, Range::OpenClosed(0.0, 8.0);
         /// Level of detail of `auto` grooms: the largest distance, in pixels, between a thin
-        /// strand's curve and the linear ribbons traced in its place; 0: full detail.
+        /// strand's curve and the linear ribbons traced in its place, or the quads Embree
+        /// intersects a cubic ribbon as; 0: no polylines (the quads keep the default's).
         lod_pixels: f32 = DEFAULT_LOD_PIXELS, Range::AtLeast(0.0);
         /// Whether a groom of 2^18 segments or more is built as parts of 2^10, each a BVH
         /// of its own built when a ray first reaches it: auto (from 2^20 segments, for a

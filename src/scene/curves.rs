@@ -40,7 +40,8 @@ use glam::{Vec3, Vec4};
 use super::ragged;
 use crate::bsdf::sigma_a_from_melanin;
 use crate::embree::{
-    CurveBasis, CurveShape, PartsCache, SharedBuffer, centroid, morton_order, padding_for,
+    CurveBasis, CurveShape, DEFAULT_RIBBON_QUADS, PartsCache, SharedBuffer, centroid, morton_order,
+    padding_for,
 };
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
@@ -61,6 +62,8 @@ pub struct Curves {
     ordered: bool,
     /// The parts Embree's geometry over these curves was cut into, for the next one.
     parts: PartsCache,
+    /// Quads per segment Embree intersects these curves in, when flat and cubic.
+    ribbon_quads: u32,
 }
 
 /// Where a primitive sits in its strand.
@@ -372,6 +375,7 @@ impl Curves {
             truth: None,
             ordered: false,
             parts: PartsCache::default(),
+            ribbon_quads: DEFAULT_RIBBON_QUADS,
         })
     }
 
@@ -454,6 +458,7 @@ impl Curves {
         if let Some(GroomAbsorption::Melanin(all)) = &self.strands.absorption {
             part = part.with_melanin(order.iter().map(|&s| all[s]).collect())?;
         }
+        part.ribbon_quads = self.ribbon_quads;
         let ids = self.strands.ids.as_ref();
         part.strands.ids = Some(
             order
@@ -502,6 +507,17 @@ impl Curves {
     pub fn with_shape(mut self, shape: CurveShape) -> Self {
         self.shape = shape;
         self
+    }
+
+    /// The same curves, which Embree intersects as `quads` ray-facing quads per segment
+    /// when they are flat and cubic (`CurveGeometry::with_ribbon_quads`).
+    pub fn with_ribbon_quads(mut self, quads: u32) -> Self {
+        self.ribbon_quads = quads;
+        self
+    }
+
+    pub fn ribbon_quads(&self) -> u32 {
+        self.ribbon_quads
     }
 
     /// Flat linear ribbons through `points`, `counts[i]` of them for strand i of `truth`,
@@ -686,6 +702,13 @@ impl SegmentCurve {
     pub(crate) fn derivative(&self, u: f32) -> Vec4 {
         let [_, c1, c2, c3] = self.0;
         c1 + u * (2.0 * c2 + 3.0 * u * c3)
+    }
+
+    /// Second derivative with respect to `u`: linear in `u`, so its length over [0, 1] is
+    /// largest at an end.
+    pub(crate) fn second_derivative(&self, u: f32) -> Vec4 {
+        let [_, _, c2, c3] = self.0;
+        2.0 * c2 + 6.0 * u * c3
     }
 }
 

@@ -21,7 +21,7 @@
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use crate::embree::{CurveBasis, CurveShape};
+use crate::embree::{CurveBasis, CurveShape, DEFAULT_RIBBON_QUADS, MAX_RIBBON_QUADS};
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
 use crate::scene::curves::{Curves, SegmentCurve};
@@ -150,6 +150,61 @@ pub fn polylines(
         None => None,
     };
     Ok((lines, native))
+}
+
+/// The quad counts Embree may intersect a flat cubic segment in, fewest first: its
+/// default, then up to its most.
+const RIBBON_QUADS: [u32; 3] = [DEFAULT_RIBBON_QUADS, 8, MAX_RIBBON_QUADS];
+
+/// Per strand of cubic `curves`, the fewest quads per segment of [`RIBBON_QUADS`] that keep
+/// its ribbon within `pixels` of its curve, seen from `camera` in an image `height` pixels
+/// tall; `None` where even the most do not.
+///
+/// Embree's ribbon quads run along chords of the curve, at even steps of its parameter.
+/// Where a strand turns in the view, as a crown's strands do at the silhouette, the
+/// default's chords cut the turn short, and the ribbon covers less than the strand there
+/// (docs/measurements.md, "Ribbons' quads at the silhouette"). The bound is a chord's
+/// largest distance from a curve: an eighth of its parameter step squared times the
+/// second derivative across the line of sight, largest at a segment end (it is linear).
+pub fn ribbon_quads(
+    curves: &Curves,
+    camera: &Camera,
+    height: u32,
+    pixels: f32,
+) -> Result<Vec<Option<u32>>> {
+    check_pixels(pixels)?;
+    let (eye, per_distance) = (camera.eye(), pixels * camera.pixel_spread(height));
+    let strands = curves.strands();
+    threads::scoped(0, || {
+        (0..strands.strand_count())
+            .into_par_iter()
+            .map(|s| {
+                let turn = (strands.first_segment(s).into_iter())
+                    .flat_map(|first| first.prims())
+                    .filter_map(|prim| curves.segment_curve(prim))
+                    .map(|curve| turn_over_distance(&curve, eye))
+                    .fold(0.0f32, f32::max);
+                let quads = |n: u32| (n * n) as f32 * 8.0 * per_distance;
+                RIBBON_QUADS.into_iter().find(|&n| turn <= quads(n))
+            })
+            .collect()
+    })
+}
+
+/// A segment's largest second derivative across the line of sight from `eye`, over its
+/// nearest distance from it.
+fn turn_over_distance(curve: &SegmentCurve, eye: Vec3) -> f32 {
+    let points = [0.0, 0.5, 1.0].map(|u| curve.at(u).truncate());
+    let sight = (points[1] - eye).normalize_or_zero();
+    let across = |u: f32| {
+        let d = curve.second_derivative(u).truncate();
+        (d - d.dot(sight) * sight).length()
+    };
+    let near = points
+        .iter()
+        .map(|p| p.distance(eye))
+        .fold(f32::MAX, f32::min);
+    across(0.0).max(across(1.0)) / near
 }
 
 #[derive(Default)]

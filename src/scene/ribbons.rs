@@ -3,13 +3,13 @@
 //!
 //! A ribbon facing the ray covers, seen from the ray's origin, what the tube covers, so it
 //! blocks the same light, and is hit evenly across its width as the tube is (a cubic
-//! ribbon's h is the offset across the flat quad struck: `tracer::hair_hit`). It differs in
-//! the depth of the hit
-//! (by up to a radius) and at end caps and joints, differences that a strand thinner than a
-//! pixel hides inside the pixel. A flat linear curve costs Embree 1.5-1.8x less per ray than
-//! a round one. On the bench scenes the ribbons' images differ from the tubes' by under a
-//! third of a bench render's own noise (RMSE at equal samples 2-4% higher; docs/measurements.md, "Curve
-//! shapes").
+//! ribbon's h is the offset across the flat quad struck: `tracer::hair_hit`); its hit moves
+//! to where the ray enters the tube (`tracer::tube_entry`). It differs at end caps and
+//! joints, which a strand thinner than a pixel hides inside the pixel. Embree intersects a
+//! cubic ribbon as quads along chords of its curve; each thin strand gets as many quads
+//! per segment as keep them within the level of detail's tolerance of the curve in this
+//! view ([`lod::ribbon_quads`]), and a tube where Embree's most quads do not. A flat linear
+//! curve costs Embree less per ray than a round one (docs/measurements.md, "Curve shapes").
 //!
 //! With a level of detail (`lod_pixels` > 0), the thin strands of every basis are traced
 //! as flat linear ribbons through points on their curves, as few as keep the curve within
@@ -19,7 +19,7 @@
 
 use glam::Vec3;
 
-use crate::embree::CurveShape;
+use crate::embree::{CurveBasis, CurveShape};
 use crate::error::Result;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -102,13 +102,15 @@ pub fn share_out(
         .collect();
     // Each part's geometries: polylines of the thin strands, and those too bent for
     // their budget as their own flat curves.
+    let ribbons = |curves| cubic_ribbons(curves, camera, height, lod_pixels);
     let shape = |part, curves: Curves| -> Result<Vec<Curves>> {
         Ok(match part {
             Part::Round => vec![curves.with_shape(CurveShape::Round)],
-            Part::Flat => vec![curves.with_shape(CurveShape::Flat)],
+            Part::Flat => ribbons(curves)?,
             Part::Polyline => {
                 let (lines, native) = lod::polylines(curves, camera, height, lod_pixels)?;
-                native.into_iter().chain(lines).collect()
+                let native = native.map(ribbons).transpose()?;
+                native.into_iter().flatten().chain(lines).collect()
             }
         })
     };
@@ -126,10 +128,49 @@ pub fn share_out(
     Ok(out)
 }
 
+/// Thin strands as flat curves, each intersected in as many quads per segment as keep it
+/// within the level of detail's tolerance of its curve (`lod::ribbon_quads`; without a
+/// level of detail, its default tolerance), and round where Embree's most quads do not:
+/// one geometry per quad count.
+fn cubic_ribbons(
+    curves: Curves,
+    camera: &Camera,
+    height: u32,
+    lod_pixels: f32,
+) -> Result<Vec<Curves>> {
+    if curves.basis() == CurveBasis::Linear {
+        return Ok(vec![curves.with_shape(CurveShape::Flat)]);
+    }
+    let tolerance = if lod_pixels > 0.0 {
+        lod_pixels
+    } else {
+        lod::DEFAULT_LOD_PIXELS
+    };
+    let quads = lod::ribbon_quads(&curves, camera, height, tolerance)?;
+    let drawn = |q: Option<u32>, curves: Curves| match q {
+        Some(n) => curves.with_shape(CurveShape::Flat).with_ribbon_quads(n),
+        None => curves.with_shape(CurveShape::Round),
+    };
+    let first = quads.first().copied().flatten();
+    if quads.iter().all(|&q| q == first) {
+        return Ok(vec![drawn(first, curves)]);
+    }
+    let mut kinds: Vec<Option<u32>> = quads.clone();
+    kinds.sort_unstable();
+    kinds.dedup();
+    let mut out = Vec::with_capacity(kinds.len());
+    for kind in kinds {
+        let keep: Vec<bool> = quads.iter().map(|&q| q == kind).collect();
+        if let Some(subset) = curves.subset(&keep, CurveShape::Flat)? {
+            out.push(drawn(kind, subset));
+        }
+    }
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::embree::CurveBasis;
     use glam::Vec3;
 
     /// Two vertical strands of radius 0.01 in front of a camera at the origin looking down

@@ -13,8 +13,8 @@ use super::mesh::Mesh;
 use super::stages::{Stage, StageRunner};
 use crate::Result;
 use crate::embree::{
-    CurveBasis, CurveGeometry, CurvePoint, CurveShape, Device, Exclude, Geometry, Ray, RayHit,
-    Scene, SceneBuilder, SceneOptions, SharedBuffer, TriangleGeometry,
+    CurveBasis, CurveGeometry, CurvePoint, CurveShape, DEFAULT_RIBBON_QUADS, Device, Exclude,
+    Geometry, Ray, RayHit, Scene, SceneBuilder, SceneOptions, SharedBuffer, TriangleGeometry,
 };
 
 /// Geometry mask bit of hair curves: a ray with `mask = SURFACE_MASK` ignores hair.
@@ -77,6 +77,11 @@ const FLAT_BLIND_RADII: f32 = 2.0;
 /// linear weights are positive and sum to 1).
 const RADIUS_OVERSHOOT: f32 = 1.25;
 
+/// How far, in radii, a ribbon's hit may move back along its ray to the tube's surface
+/// ([`tube_entry`]): a ray at 30 degrees to the axis enters the tube two radii before the
+/// midplane.
+const TUBE_ENTRY_RADII: f32 = 2.0;
+
 /// A ray leaving a hit, with the exclusion that keeps it off the surface it left.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SpawnedRay {
@@ -129,6 +134,7 @@ impl TracerBuilder {
 
     /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
     pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
+        let quads = curves.ribbon_quads();
         let (basis, shape, vertices, indices, strands, truth, parts) = curves.into_parts();
         if shape == CurveShape::Flat {
             let largest = vertices.as_slice().iter().fold(0.0f32, |m, v| m.max(v[3]));
@@ -143,6 +149,11 @@ impl TracerBuilder {
             indices,
             HAIR_MASK,
         )?;
+        let geometry = if quads != DEFAULT_RIBBON_QUADS {
+            geometry.with_ribbon_quads(self.scene.device(), quads)?
+        } else {
+            geometry
+        };
         let geometry = if in_parts {
             geometry.in_parts(&parts)?
         } else {
@@ -448,13 +459,21 @@ fn hair_hit(
         }
         false => (h, axis),
     };
+    // A ribbon is struck on its midplane, up to a radius behind where the tube's surface
+    // would be; rays leaving from there started inside clumps the tube keeps them out of,
+    // and dense hair shaded too dark (docs/measurements.md, "Ribbons' quads at the
+    // silhouette"). The hit moves to where the ray enters the tube around the axis.
+    let (t, p) = match geom.shape() {
+        CurveShape::Flat => tube_entry(ray, hit.t, p, axis, frame.x, c.radius),
+        CurveShape::Round => (hit.t, p),
+    };
     let ng = match geom.shape() {
         CurveShape::Round => hit.ng.try_normalize().unwrap_or(frame.z),
         // Embree reports the tangent as Ng of flat curves; the ribbon faces the ray.
         CurveShape::Flat => frame.z,
     };
     Some(HairHit {
-        t: hit.t,
+        t,
         p,
         ng,
         frame,
@@ -470,6 +489,27 @@ fn hair_hit(
         s,
         absorption,
     })
+}
+
+/// Where `ray`, which met a ribbon at `t` (point `p`), enters the cylinder of `radius`
+/// around the line through `axis` along unit `x`: its distance and point. At most
+/// [`TUBE_ENTRY_RADII`] radii before `p`, since a ray near the axis's direction runs long
+/// inside a straight cylinder where the strand bends away; `p` itself when it is on or
+/// outside the cylinder.
+fn tube_entry(ray: &Ray, t: f32, p: Vec3, axis: Vec3, x: Vec3, radius: f32) -> (f32, Vec3) {
+    let across = |v: Vec3| v - v.dot(x) * x;
+    let (w, e) = (across(p - axis), across(ray.dir));
+    let (a, b, c) = (e.dot(e), 2.0 * w.dot(e), w.dot(w) - radius * radius);
+    if a <= 0.0 || c >= 0.0 {
+        return (t, p);
+    }
+    let entry = (-b - (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a);
+    let back = entry.max(-TUBE_ENTRY_RADII * radius / ray.dir.length());
+    if back.is_finite() && back < 0.0 {
+        (t + back, p + ray.dir * back)
+    } else {
+        (t, p)
+    }
 }
 
 /// Newton steps on the closest point of the segment's axis to `p`, from Embree's u.

@@ -215,7 +215,13 @@ fn measure(points: &[[f32; 3]], basis: CurveBasis, shape: CurveShape, straight: 
                         };
                         let dir = ray.dir.as_dvec3();
                         let org = ray.org.as_dvec3();
-                        let p = org + dir * f64::from(hit.t);
+                        // Where along the strand the ray struck: a tube's surface point,
+                        // a ribbon's axis (its hit is moved to the tube's surface along the
+                        // ray, `tracer::tube_entry`, and shaded where it struck).
+                        let p = match shape {
+                            CurveShape::Round => org + dir * f64::from(hit.t),
+                            CurveShape::Flat => hit.axis.as_dvec3(),
+                        };
                         let (_, _, axis, tangent) = analytic.closest(p);
                         let y = tangent.cross(dir).normalize();
                         let h_true = if straight {

@@ -5,4 +5,5 @@ mod curves_geometry;
 mod large_groom;
 mod lights;
 mod rehit;
+mod silhouette;
 mod touching;

@@ -1,17 +1,18 @@
-//! A built scene edited through the Rust API (`BuiltScene::set_material`, `set_lights`,
-//! a new camera): no BVH build, and the image of the description built with the edits.
+//! The Rust host's scene: edits of a material, a light or the camera render as a fresh
+//! build would, without a build; new geometry and settings that need a build rebuild
+//! (never refused) and render as a fresh scene; bad edits change nothing.
 
 use std::path::Path;
 use std::sync::Arc;
 
-use crate::description::{LightDesc, MaterialDesc, SceneDescription};
+use crate::description::{
+    CameraDesc, GroomDesc, GroomSource, LightDesc, MaterialDesc, SceneDescription,
+};
 use crate::embree::Device;
 use crate::render::{Aovs, NoProgress};
-use crate::scene::camera::Camera;
-use crate::scene::detail_view::DetailView;
 use crate::scene::material::{HairColor, HairMaterial};
-use crate::{BuiltScene, Error};
-use glam::Vec3;
+use crate::scene::{GroomShape, ScalpPatch};
+use crate::{Error, Scene};
 
 /// An `auto` fur ball over a ground quad, sky and sun, seen from `z` at 32 x 32 pixels:
 /// every strand thinner than a pixel from z = 4 and farther. `brown` and `floor` are the
@@ -76,30 +77,48 @@ angular_radius_deg = 2
     SceneDescription::from_toml(&text, Path::new("."), "edits test").unwrap()
 }
 
-fn build(d: &SceneDescription) -> (BuiltScene, Arc<Device>) {
+fn build(d: &SceneDescription) -> (Scene, Arc<Device>) {
     let device = Arc::new(Device::new(Some(2)).unwrap());
     (d.build(device.clone()).unwrap(), device)
 }
 
-fn image(built: &BuiltScene) -> Vec<u32> {
-    let out = built.render(Aovs::default(), &NoProgress).unwrap();
+fn image(scene: &mut Scene) -> Vec<u32> {
+    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
     out.film.rgb().iter().map(|v| v.to_bits()).collect()
 }
 
-/// Each edit changes the image, leaves the device's build count at 1, and gives the image
-/// of the description built with it from the start.
+/// The image of `d` built afresh.
+fn fresh(d: &SceneDescription) -> Vec<u32> {
+    image(&mut build(d).0)
+}
+
+/// The `[camera]` of [`scene`] at `z`.
+fn camera(z: f32) -> CameraDesc {
+    CameraDesc {
+        eye: Some([0.0, 0.5, z]),
+        target: Some([0.0; 3]),
+        fov_deg: 40.0,
+        ..CameraDesc::default()
+    }
+}
+
+/// Each edit changes the image, leaves the scene's and the device's build counts at 1,
+/// and gives the image of the description built with it from the start.
 #[test]
-fn edits_of_a_built_scene_render_as_a_fresh_build_without_one() {
+fn edits_of_a_material_a_light_and_the_camera_render_as_a_fresh_build_without_one() {
     let (brown, red) = ([0.5447, 0.9061, 1.781], [0.1, 0.6, 1.2]);
     let (grey, blue) = ([0.6; 3], [0.2, 0.4, 0.8]);
     let (mut built, device) = build(&scene(4.0, brown, grey, false));
-    let mut last = image(&built);
-    let fresh = |d: SceneDescription| image(&build(&d).0);
-    let mut check = |built: &BuiltScene, want: SceneDescription, what: &str| {
+    let mut last = image(&mut built);
+    let mut check = |built: &mut Scene, want: SceneDescription, what: &str| {
         let now = image(built);
+        assert_eq!(built.builds(), 1, "{what} built again");
         assert_eq!(device.builds(), 1, "{what} built the BVH again");
         assert!(now != last, "{what} changed nothing");
-        assert!(now == fresh(want), "{what}: not the image of a fresh build");
+        assert!(
+            now == fresh(&want),
+            "{what}: not the image of a fresh build"
+        );
         last = now;
     };
 
@@ -109,49 +128,127 @@ fn edits_of_a_built_scene_render_as_a_fresh_build_without_one() {
         ..HairMaterial::default()
     });
     built.set_material("brown", &red_hair).unwrap();
-    check(&built, scene(4.0, red, grey, false), "a hair material");
+    check(&mut built, scene(4.0, red, grey, false), "a hair material");
     built
         .set_material("floor", &MaterialDesc::Diffuse { albedo: blue })
         .unwrap();
-    check(&built, scene(4.0, red, blue, false), "a diffuse material");
+    check(
+        &mut built,
+        scene(4.0, red, blue, false),
+        "a diffuse material",
+    );
     let with_rect = scene(4.0, red, blue, true);
-    built.set_lights(&with_rect.lights).unwrap();
-    check(&built, with_rect, "a light");
+    built.add_light(&with_rect.lights[2]).unwrap();
+    check(&mut built, with_rect, "a light");
     // Farther: every strand stays a ribbon, so the shapes hold and a fresh build agrees.
-    built.camera = camera(5.0);
-    assert!(built.world.tracer.serves(&DetailView::new(
-        built.camera,
-        32,
-        built.settings.lod_pixels
-    )));
-    check(&built, scene(5.0, red, blue, true), "a farther camera");
-
-    // Nearer and with more pixels, strands are wider than the build assumed: refused.
-    built.camera = camera(2.0);
-    built.settings.width = 800;
-    built.settings.height = 800;
-    let err = built.render(Aovs::default(), &NoProgress).unwrap_err();
-    assert!(err.to_string().contains("build the scene again"), "{err}");
-    assert_eq!(device.builds(), 1);
+    built.set_camera(&camera(5.0)).unwrap();
+    check(&mut built, scene(5.0, red, blue, true), "a farther camera");
 }
 
-/// The camera of [`scene`] at `z`.
-fn camera(z: f32) -> Camera {
-    Camera::new(Vec3::new(0.0, 0.5, z), Vec3::ZERO, Vec3::Y, 40.0, 1.0).unwrap()
+/// What the build does not serve is built again, never refused, and renders as a fresh
+/// scene: a nearer camera on `auto` strands, then each setting that needs a build; a
+/// setting that does not needs no build.
+#[test]
+fn views_and_settings_the_build_does_not_serve_build_again() {
+    let grey = [0.6; 3];
+    let brown = [0.5447, 0.9061, 1.781];
+    let (mut built, _) = build(&scene(4.0, brown, grey, false));
+    image(&mut built);
+    built.settings.spp = 2;
+    built.settings.seed = 9;
+    image(&mut built);
+    assert_eq!(built.builds(), 1, "spp and seed need no build");
+
+    // Nearer, strands are wider than the build chose their shapes for.
+    built.set_camera(&camera(2.0)).unwrap();
+    let mut want = scene(2.0, brown, grey, false);
+    want.render = built.settings;
+    assert!(image(&mut built) == fresh(&want), "a nearer camera");
+    assert_eq!(built.builds(), 2);
+
+    // A taller image: pixels smaller than the build shaped the strands for.
+    built.settings.height = 48;
+    want.render.height = 48;
+    assert!(image(&mut built) == fresh(&want), "a taller image");
+    assert_eq!(built.builds(), 3);
+    // A wider one sees them no smaller: the camera follows it, with no build.
+    built.settings.width = 48;
+    want.render.width = 48;
+    assert!(image(&mut built) == fresh(&want), "a wider image");
+    assert_eq!(built.builds(), 3);
+    for (i, (name, value)) in [("lod_pixels", "0.5"), ("curve_parts", "off")]
+        .into_iter()
+        .enumerate()
+    {
+        built.settings.set(name, value).unwrap();
+        want.render.set(name, value).unwrap();
+        assert!(image(&mut built) == fresh(&want), "{name} = {value}");
+        assert_eq!(built.builds(), 4 + i as u64, "{name} = {value} built again");
+    }
+}
+
+/// A groom added after a render builds again, and the scene renders as one made with
+/// it from the start; so does one removed.
+#[test]
+fn a_groom_added_after_a_render_builds_again_as_a_fresh_scene() {
+    let without = scene(4.0, [0.5447, 0.9061, 1.781], [0.6; 3], false);
+    let mut with = without.clone();
+    let mut scalp = GroomDesc::new(
+        GroomSource::Scalp(ScalpPatch {
+            strands: 200,
+            segments: 6,
+            ..ScalpPatch::default()
+        }),
+        "brown",
+    );
+    scalp.shape = GroomShape::Round;
+    with.grooms.push(scalp.clone());
+    let (mut built, _) = build(&without);
+    let before = image(&mut built);
+    assert_eq!(built.add_groom("groom[1]", &scalp).unwrap(), 1);
+    assert!(!built.is_built());
+    let after = image(&mut built);
+    assert_eq!(built.builds(), 2);
+    assert!(after != before, "the groom changed nothing");
+    assert!(after == fresh(&with), "not the image of a fresh scene");
+    // A name in use is refused; a removal builds again, as the scene without it.
+    assert!(built.add_groom("groom[1]", &scalp).is_err());
+    built.remove_geometry("groom[1]").unwrap();
+    assert!(
+        image(&mut built) == before,
+        "not the scene without the groom"
+    );
+    assert_eq!(built.builds(), 3);
+}
+
+/// A scene made empty and filled by name renders as its description does.
+#[test]
+fn a_scene_filled_by_name_renders_as_its_description() {
+    let d = scene(4.0, [0.5447, 0.9061, 1.781], [0.6; 3], true);
+    let mut s = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
+    s.settings = d.render;
+    s.set_camera(&d.camera).unwrap();
+    // Geometry may name a material defined later.
+    s.add_groom("fur", &d.grooms[0]).unwrap();
+    s.add_mesh("floor", &d.meshes[0]).unwrap();
+    for (name, m) in &d.materials {
+        s.set_material(name, m).unwrap();
+    }
+    for l in &d.lights {
+        s.add_light(l).unwrap();
+    }
+    assert!(image(&mut s) == fresh(&d));
+    assert_eq!(s.builds(), 1);
 }
 
 #[test]
 fn bad_edits_are_refused_and_change_nothing() {
     let d = scene(4.0, [0.5447, 0.9061, 1.781], [0.6; 3], false);
     let (mut built, _) = build(&d);
-    let before = image(&built);
+    let before = image(&mut built);
     let hair = MaterialDesc::Hair(HairMaterial::default());
     let floor = MaterialDesc::Diffuse { albedo: [0.1; 3] };
     let refused = |e: Error, words: &str| assert!(e.to_string().contains(words), "{e}");
-    refused(
-        built.set_material("nothing", &hair).unwrap_err(),
-        "\"nothing\"",
-    );
     refused(
         built.set_material("brown", &floor).unwrap_err(),
         "curves need a hair material",
@@ -169,5 +266,36 @@ fn bad_edits_are_refused_and_change_nothing() {
         angular_radius_deg: 0.0,
     }];
     refused(built.set_lights(&dark).unwrap_err(), "light[0]");
-    assert!(image(&built) == before, "a refused edit changed the image");
+    refused(
+        built
+            .set_camera(&CameraDesc {
+                eye: Some([0.0; 3]),
+                ..CameraDesc::default()
+            })
+            .unwrap_err(),
+        "camera",
+    );
+    assert!(
+        image(&mut built) == before,
+        "a refused edit changed the image"
+    );
+    assert_eq!(built.builds(), 1);
+}
+
+/// Every host's scene refuses a render whose `isa` is not its device's: the device's pin
+/// is what it renders with.
+#[test]
+fn a_render_cannot_repin_the_scene_s_device() {
+    let isa = crate::embree::Isa::widest_here().expect("an x86-64 CPU");
+    let d = scene(4.0, [0.5447, 0.9061, 1.781], [0.6; 3], false);
+    let (mut built, _) = build(&d);
+    let mut other = built.settings;
+    other.isa = Some(isa);
+    let e = (built.render_with(&other, Aovs::default(), &NoProgress)).unwrap_err();
+    assert!(e.to_string().contains("pinned"), "{e}");
+    let mut pinned =
+        Scene::from_description(&d, Arc::new(Device::pinned(Some(2), Some(isa)).unwrap())).unwrap();
+    pinned
+        .render_with(&other, Aovs::default(), &NoProgress)
+        .unwrap();
 }

@@ -4,9 +4,11 @@
 //! checks it): [`math`] and [`bsdf`] know nothing of ray tracing; [`embree`] wraps Embree
 //! and knows nothing of shading; [`image`] reads and writes pictures through OpenImageIO;
 //! [`scene`] is the scene as data plus the tracer; [`mod@render`] makes images of it;
-//! [`description`] is a scene as plain data, built into a world, and the demos;
+//! [`description`] is a scene as plain data, and the demos; [`farm`] splits a frame into
+//! tiles and assembles it;
 //! [`formats`] reads and writes every file format (TOML and pbrt scenes, USD and `.hair`
-//! grooms, OBJ and PLY meshes); [`capi`] is a thin C shell over the same Rust API. Conventions (frames, units, signs): docs/conventions.md.
+//! grooms, OBJ and PLY meshes); [`incremental`] holds [`Scene`], the one scene every host
+//! edits and renders; [`capi`] is a thin C shell over it. Conventions (frames, units, signs): docs/conventions.md.
 //!
 //! The items re-exported here are the API a Rust host builds on: the hair BSDF alone
 //! ([`HairBsdf`], [`HairParams`], [`LocalBsdf`]), or a whole render from a scene file or
@@ -14,12 +16,12 @@
 //!
 //! ```no_run
 //! use std::sync::Arc;
-//! use hairtrace::{Aovs, Device, NoProgress, SceneDescription, write_image};
+//! use hairtrace::{Aovs, Device, NoProgress, Scene, SceneDescription, write_image};
 //! # fn main() -> hairtrace::Result<()> {
-//! let device = Arc::new(Device::new(None)?);
-//! let built = SceneDescription::load("scene.toml".as_ref())?.build(device)?;
-//! let out = built.render(Aovs::default(), &NoProgress)?;
-//! let (w, h) = (built.settings.width as usize, built.settings.height as usize);
+//! let desc = SceneDescription::load("scene.toml".as_ref())?;
+//! let mut scene = Scene::from_description(&desc, Arc::new(Device::new(None)?))?;
+//! let out = scene.render(Aovs::default(), &NoProgress)?;
+//! let (w, h) = (scene.settings.width as usize, scene.settings.height as usize);
 //! write_image("out.exr".as_ref(), w, h, 3, out.film.rgb(), &Default::default())?;
 //! # Ok(()) }
 //! ```
@@ -29,13 +31,14 @@
 //!
 //! The entry points, each with an example on its page:
 //! - the BSDF alone: [`HairBsdf`] (a path vertex: `at`, then `eval` and `sample`);
-//! - a scene from a file: [`SceneDescription::load`], then [`SceneDescription::build`];
-//! - a scene in code: [`description::demo`] (a description to change before the build,
-//!   with the host's own strands as `GroomSource::ControlPoints`);
+//! - a scene from a file: [`SceneDescription::load`], then [`Scene::from_description`];
+//! - a scene in code: [`Scene::new`], then grooms, meshes, materials and lights by name,
+//!   or [`description::demo`] (a description to change first);
 //! - settings by name, as the TOML file, the CLI and the C ABI set them:
 //!   [`RenderSettings::set`];
-//! - renders from one build: [`BuiltScene::render`], [`BuiltScene::render_with`] (other
-//!   settings), [`BuiltScene::set_material`] and `set_lights` (edits without a new build);
+//! - renders: [`Scene::render`], [`Scene::render_with`] (other settings); the scene keeps
+//!   its build and builds again only where it must ([`Scene::build_for`]): an edit of a
+//!   material, a light or the camera needs none;
 //! - images: [`write_image`], [`read_image`].
 //!
 //! The tracer, the film's accumulators and the integrator are the crate's own; their tests
@@ -57,10 +60,16 @@ pub mod embree;
 mod error;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
+pub mod farm;
+/// cbindgen:ignore
+#[cfg(feature = "render")]
 pub mod formats;
 /// cbindgen:ignore
 #[cfg(feature = "render")]
 pub mod image;
+/// cbindgen:ignore
+#[cfg(feature = "render")]
+pub mod incremental;
 /// cbindgen:ignore
 pub mod math;
 mod quiet_panic;
@@ -79,7 +88,7 @@ pub use bsdf::{
     ACROSS, AcrossEval, BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf,
 };
 #[cfg(feature = "render")]
-pub use description::{BuiltScene, SceneDescription};
+pub use description::SceneDescription;
 #[cfg(feature = "render")]
 pub use embree::Device;
 pub use error::{Error, Result};
@@ -88,6 +97,8 @@ pub use error::{Error, Result};
 pub use glam;
 #[cfg(feature = "render")]
 pub use image::{read_image, write_image};
+#[cfg(feature = "render")]
+pub use incremental::Scene;
 #[cfg(feature = "render")]
 pub use render::settings::RenderSettings;
 #[cfg(feature = "render")]

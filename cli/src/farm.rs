@@ -7,8 +7,8 @@
 
 use std::path::{Path, PathBuf};
 
-use hairtrace::description::farm::{frame_path, tile_window};
 use hairtrace::embree::Isa;
+use hairtrace::farm::{frame_path, tile_window};
 use hairtrace::render::settings::RenderSettings;
 use hairtrace::{Error, Result};
 

@@ -17,11 +17,9 @@ use glam::Vec3;
 use hairtrace::bsdf::{
     DEFAULT_EUMELANIN, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset,
 };
-use hairtrace::description::farm::{self as tiles, frame_path, tile_path};
-use hairtrace::description::{
-    self, BuiltScene, GroomSource, MaterialDesc, SceneDescription, has_extension,
-};
+use hairtrace::description::{self, GroomSource, MaterialDesc, SceneDescription, has_extension};
 use hairtrace::embree::CurveBasis;
+use hairtrace::farm::{self as tiles, frame_path, tile_path};
 use hairtrace::formats::convert::{self, ConvertOptions, ConvertSource};
 use hairtrace::formats::hair::{Thickness, info_report, read_hair_file, read_hair_tag};
 use hairtrace::formats::pbrt::PbrtScene;
@@ -251,10 +249,11 @@ struct RenderArgs {
     /// before the extension: albedo (RGB), depth (camera distance), strand (strand id).
     #[arg(long, value_delimiter = ',', value_parser = ["albedo", "depth", "strand"])]
     aov: Vec<String>,
-    /// One more image from the same build, after the main one: OUT with these settings
+    /// One more image of the same scene, after the main one: OUT with these settings
     /// changed (spp, seed, fidelity knobs, a noise target...), e.g. `--variant
-    /// 'ref.exr:spp=1024 seed=9'`. Repeatable. Settings the build is made for (width,
-    /// height, isa, lod_pixels, curve_parts) are refused: they need a command of their own.
+    /// 'ref.exr:spp=1024 seed=9'`. Repeatable. A variant renders from the main image's
+    /// build unless it changes what the build depends on (lod_pixels, curve_parts, or a
+    /// size whose pixels an `auto` groom was not shaped for): then it builds again first.
     #[arg(long, value_name = "OUT:NAME=VALUE ...", value_parser = Variant::parse)]
     variant: Vec<Variant>,
     /// Render tile I of N (from 1; a grid over the frame, the same on every machine)
@@ -583,12 +582,12 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let build_start = std::time::Instant::now();
     let device = Arc::new(description.render.device()?);
     let bars = StageBars::default();
-    let built = description.build_with(device, &bars)?;
+    let mut built = description.build_with(device, &bars)?;
     bars.finish();
     let build_seconds = build_start.elapsed().as_secs_f64();
     let label = scene_label(args.scene.as_ref(), args.demo.as_deref());
     for (i, (frame, settings)) in renders.iter().enumerate() {
-        let s = render_frame(args, &built, settings, frame, &label)?;
+        let s = render_frame(args, &mut built, settings, frame, &label)?;
         // The figures of the first render: what benchmarks read.
         if let (0, Some(path)) = (i, &args.stats) {
             let json = serde_json::json!({
@@ -600,7 +599,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
                 "part_build_seconds": s.part_build_seconds,
                 "stage_seconds": Stage::ALL
                     .iter()
-                    .map(|&st| (st.name().to_owned(), built.stages.get(st).into()))
+                    .map(|&st| (st.name().to_owned(), built.stages().get(st).into()))
                     .chain([("render".to_owned(), s.seconds.into())])
                     .collect::<serde_json::Map<_, _>>(),
                 "samples": s.samples,
@@ -619,7 +618,7 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
 /// `--tile`) and its AOVs to `frame`'s names, with the render's header.
 fn render_frame(
     args: &RenderArgs,
-    built: &BuiltScene,
+    built: &mut hairtrace::Scene,
     settings: &RenderSettings,
     frame: &Path,
     label: &str,

@@ -4,7 +4,7 @@
 //! line here.
 
 use clap::{Arg, ArgAction, ArgMatches, Args, Command, FromArgMatches};
-use hairtrace::render::settings::RenderSettings;
+use hairtrace::render::settings::{Needs, RenderSettings};
 
 /// The settings a command line gives, in the order they apply: flags, then `--set`.
 #[derive(Debug, Default, Clone)]
@@ -118,19 +118,11 @@ impl Variant {
         })
     }
 
-    /// `base` with this variant's values, checked, refused when it changes what the build
-    /// was made for.
+    /// `base` with this variant's values, checked.
     pub fn settings(&self, base: &RenderSettings) -> hairtrace::Result<RenderSettings> {
         let mut settings = *base;
         self.values.apply(&mut settings)?;
         settings.validate()?;
-        if let Some(name) = settings.build_change(base) {
-            return Err(hairtrace::Error::InvalidArg(format!(
-                "--variant {}: {name} is a setting the build is made for: render it with a \
-                 command of its own",
-                self.output.display()
-            )));
-        }
         Ok(settings)
     }
 }
@@ -138,13 +130,16 @@ impl Variant {
 /// The schema as a Markdown table: what `hairtrace settings` prints and docs/settings.md
 /// holds (cli/tests checks that the two agree).
 pub fn markdown() -> String {
-    let mut out = String::from("| name | value | default | what it does |\n|---|---|---|---|\n");
+    let mut out = String::from(
+        "| name | value | default | a change builds again | what it does |\n|---|---|---|---|---|\n",
+    );
     for s in RenderSettings::schema() {
         out += &format!(
-            "| `{}` | {} | `{}` | {} |\n",
+            "| `{}` | {} | `{}` | {} | {} |\n",
             s.name,
             s.allowed().replace('|', "\\|"),
             s.default_text(),
+            if s.needs == Needs::Build { "yes" } else { "" },
             s.doc().replace('|', "\\|")
         );
     }

@@ -1,18 +1,16 @@
-//! `Scene`: a scene description kept with its build, edited by the scene file's keys. An
-//! edit of a material, the lights or the camera goes to the build as well
-//! (`BuiltScene::set_material`, `set_lights`, `set_camera`), so the next render needs no
-//! new build; a new groom or mesh drops the build. A render builds again only where the
-//! build does not serve it (`BuiltScene::serves`: a setting the build is made for, or a
-//! camera that sees `auto` strands larger than the build chose their shapes for).
+//! `Scene`: the library's scene ([`hairtrace::Scene`]), edited by the scene file's keys
+//! and rendered with settings by name. The library's scene decides when to build: an edit
+//! of a material, the lights or the camera renders without a new build, and new geometry,
+//! a setting that needs a build or a view its `auto` strands were not shaped for build
+//! again.
 
-use std::collections::BTreeSet;
 use std::path::PathBuf;
 use std::sync::Arc;
 
 use hairtrace::description::{GroomSource, demo};
 use hairtrace::render::RenderStatus;
 use hairtrace::scene::Strands;
-use hairtrace::{Aovs, BuiltScene, RenderOutput, RenderSettings, SceneDescription};
+use hairtrace::{Aovs, RenderOutput, RenderSettings, Scene, SceneDescription};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::{
     AllowTypeChange, IntoPyArray, PyArrayDescrMethods, PyArrayDyn, PyArrayLike1, PyUntypedArray,
@@ -38,19 +36,17 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
 /// The AOVs by the command line's names (`--aov albedo,depth,strand`).
 const AOV_NAMES: [&str; 3] = ["albedo", "depth", "strand"];
 
-/// A build and the materials its geometry uses (those an edit must reach).
-struct Built {
-    scene: BuiltScene,
-    materials: BTreeSet<String>,
-}
-
 /// A scene: from a file, a demo, or built up by keywords and numpy strands; rendered with
 /// settings by name. See docs/python.md.
 #[pyclass(name = "Scene", module = "hairtrace")]
 pub struct PyScene {
-    desc: SceneDescription,
-    built: Option<Built>,
-    builds: u64,
+    scene: Scene,
+    /// What error messages call the scene: a file's path, "demo NAME" or "python".
+    origin: String,
+    notes: Vec<String>,
+    /// Grooms and meshes added, for their names (`groom[i]`, `mesh[i]`).
+    grooms: usize,
+    meshes: usize,
 }
 
 /// What a render gives `hairtrace.Image`: rgb (h, w, 3), the AOVs asked for,
@@ -63,12 +59,16 @@ type Rendered<'py> = (
 );
 
 impl PyScene {
-    fn with(desc: SceneDescription) -> Self {
-        PyScene {
-            desc,
-            built: None,
-            builds: 0,
-        }
+    /// The scene `desc` describes, on a device of its settings' threads and `isa`.
+    fn with(desc: SceneDescription) -> PyResult<Self> {
+        let device = Arc::new(desc.render.device().py()?);
+        Ok(PyScene {
+            scene: Scene::from_description(&desc, device).py()?,
+            origin: desc.origin,
+            notes: desc.notes,
+            grooms: desc.grooms.len(),
+            meshes: desc.meshes.len(),
+        })
     }
 
     /// The one entry of `kind` ("groom", "mesh", "light") that `kwargs` describe.
@@ -83,7 +83,7 @@ impl PyScene {
 
     /// Settings with `kwargs` applied to the scene's, each by its name.
     fn settings_with(&self, kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<RenderSettings> {
-        let mut settings = self.desc.render;
+        let mut settings = self.scene.settings;
         for (k, v) in kwargs.into_iter().flat_map(|d| d.iter()) {
             let key: String = k.extract()?;
             settings.set(&key, &keys::setting_text(&key, &v)?).py()?;
@@ -91,37 +91,12 @@ impl PyScene {
         Ok(settings)
     }
 
-    /// The build for `settings`: the one kept where it serves them, else a new one.
-    fn build_for(&mut self, py: Python<'_>, settings: &RenderSettings) -> PyResult<&BuiltScene> {
-        if !self
-            .built
-            .as_ref()
-            .is_some_and(|b| b.scene.serves(settings))
-        {
-            self.built = None;
-            let desc = SceneDescription {
-                render: *settings,
-                ..self.desc.clone()
-            };
-            let (scene, stop) = watch::run(py, None, |w| {
-                desc.build_with(Arc::new(settings.device()?), w)
-            })?;
-            if let Some(Stop::Raised(e)) = stop {
-                return Err(e);
-            }
-            let uses = desc.grooms.iter().map(|g| &g.material);
-            let materials = uses.chain(desc.meshes.iter().map(|m| &m.material)).cloned();
-            self.built = Some(Built {
-                scene: scene.py()?,
-                materials: materials.collect(),
-            });
-            self.builds += 1;
-        }
-        Ok(&self.built.as_ref().expect("built above").scene)
-    }
-
-    fn geometry_changed(&mut self) {
-        self.built = None;
+    /// Adds `groom` as the next `groom[i]`.
+    fn add_groom_desc(&mut self, groom: &hairtrace::description::GroomDesc) -> PyResult<()> {
+        let name = format!("groom[{}]", self.grooms);
+        self.scene.add_groom(&name, groom).py()?;
+        self.grooms += 1;
+        Ok(())
     }
 }
 
@@ -130,7 +105,7 @@ impl PyScene {
     /// An empty scene, to fill with `add_groom`, `add_strands`, `add_mesh`, `set_material`,
     /// `add_light` and `set_camera`.
     #[new]
-    fn new() -> Self {
+    fn new() -> PyResult<Self> {
         Self::with(SceneDescription {
             origin: "python".into(),
             ..SceneDescription::default()
@@ -142,14 +117,14 @@ impl PyScene {
     /// camera).
     #[staticmethod]
     fn load(path: PathBuf) -> PyResult<Self> {
-        Ok(Self::with(SceneDescription::load(&path).py()?))
+        Self::with(SceneDescription::load(&path).py()?)
     }
 
     /// A built-in demo: "furball", "furnace" or "scalp".
     #[staticmethod]
     #[pyo3(signature = (name="furball"))]
     fn demo(name: &str) -> PyResult<Self> {
-        Ok(Self::with(demo(name).py()?))
+        Self::with(demo(name).py()?)
     }
 
     /// Sets render settings by name (`spp=64, filter="box", crop=(0, 0, 32, 32)`,
@@ -157,7 +132,7 @@ impl PyScene {
     /// (docs/settings.md). Nothing is set unless every one is valid.
     #[pyo3(signature = (**settings))]
     fn set(&mut self, settings: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
-        self.desc.render = self.settings_with(settings)?;
+        self.scene.settings = self.settings_with(settings)?;
         Ok(())
     }
 
@@ -165,26 +140,26 @@ impl PyScene {
     #[getter]
     fn settings(&self) -> PyResult<Vec<(&'static str, String)>> {
         (RenderSettings::schema().iter())
-            .map(|s| Ok((s.name, self.desc.render.get(s.name).py()?)))
+            .map(|s| Ok((s.name, self.scene.settings.get(s.name).py()?)))
             .collect()
     }
 
     /// The names of the materials.
     #[getter]
     fn materials(&self) -> Vec<String> {
-        self.desc.materials.keys().cloned().collect()
+        self.scene.material_names().map(String::from).collect()
     }
 
     /// Builds since the scene was made: renders that could use the last build add none.
     #[getter]
     fn builds(&self) -> u64 {
-        self.builds
+        self.scene.builds()
     }
 
     /// What the file's reader could not carry over (pbrt directives, say).
     #[getter]
     fn notes(&self) -> Vec<String> {
-        self.desc.notes.clone()
+        self.notes.clone()
     }
 
     /// Defines or replaces the material `name` by a scene file's `[materials.NAME]` keys:
@@ -196,17 +171,9 @@ impl PyScene {
         let inner = toml::Table::from_iter([(name.to_string(), table.into())]);
         let mut read = keys::read(nest("materials", inner.into()), "set_material")?;
         let material = read.materials.remove(name).expect("the one material read");
-        material
-            .prepare()
+        (self.scene.set_material(name, &material))
             .map_err(|e| e.context(format!("materials.{name}")))
-            .py()?;
-        if let Some(b) = &mut self.built {
-            if b.materials.contains(name) {
-                b.scene.set_material(name, &material).py()?;
-            }
-        }
-        self.desc.materials.insert(name.to_string(), material);
-        Ok(())
+            .py()
     }
 
     /// Adds a light by a scene file's `[[light]]` keys: `type="environment"` (`radiance`
@@ -214,9 +181,10 @@ impl PyScene {
     /// Reaches the build: no new one.
     #[pyo3(signature = (**keys))]
     fn add_light(&mut self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
-        let light = Self::entry("light", keys, "add_light")?.lights;
-        let lights = [self.desc.lights.clone(), light].concat();
-        self.set_lights_to(lights)
+        for light in Self::entry("light", keys, "add_light")?.lights {
+            self.scene.add_light(&light).py()?;
+        }
+        Ok(())
     }
 
     /// Replaces every light by those the dicts describe (each as `add_light`'s keywords).
@@ -228,7 +196,7 @@ impl PyScene {
             })?;
             all.extend(Self::entry("light", Some(d), "set_lights")?.lights);
         }
-        self.set_lights_to(all)
+        self.scene.set_lights(&all).py()
     }
 
     /// Places the camera by a scene file's `[camera]` keys (`eye`, `target`, `up`,
@@ -239,12 +207,7 @@ impl PyScene {
     fn set_camera(&mut self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
         let table = keys.map(keys::table).transpose()?.unwrap_or_default();
         let camera = keys::read(nest("camera", table.into()), "set_camera")?.camera;
-        camera.validate().map_err(|e| e.context("camera")).py()?;
-        if let Some(b) = &mut self.built {
-            b.scene.set_camera(&camera).py()?;
-        }
-        self.desc.camera = camera;
-        Ok(())
+        self.scene.set_camera(&camera).py()
     }
 
     /// Adds a groom by a scene file's `[[groom]]` keys: `file=` (.hair or USD) or
@@ -252,9 +215,9 @@ impl PyScene {
     /// `shape`, `translate`, ... The next render builds.
     #[pyo3(signature = (**keys))]
     fn add_groom(&mut self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
-        let groom = Self::entry("groom", keys, "add_groom")?.grooms;
-        self.desc.grooms.extend(groom);
-        self.geometry_changed();
+        for groom in Self::entry("groom", keys, "add_groom")?.grooms {
+            self.add_groom_desc(&groom)?;
+        }
         Ok(())
     }
 
@@ -262,9 +225,12 @@ impl PyScene {
     /// `file=`, `material`, ...). The next render builds.
     #[pyo3(signature = (**keys))]
     fn add_mesh(&mut self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
-        let mesh = Self::entry("mesh", keys, "add_mesh")?.meshes;
-        self.desc.meshes.extend(mesh);
-        self.geometry_changed();
+        for mesh in Self::entry("mesh", keys, "add_mesh")?.meshes {
+            self.scene
+                .add_mesh(&format!("mesh[{}]", self.meshes), &mesh)
+                .py()?;
+            self.meshes += 1;
+        }
         Ok(())
     }
 
@@ -311,9 +277,7 @@ impl PyScene {
         };
         strands.validate().py()?;
         groom.source = GroomSource::Strands(strands);
-        self.desc.grooms.push(groom);
-        self.geometry_changed();
-        Ok(())
+        self.add_groom_desc(&groom)
     }
 
     /// Renders with the scene's settings, changed for this render by `settings` (by name,
@@ -342,48 +306,33 @@ impl PyScene {
             p => p.cloned(),
         };
         let callback = bar.as_ref().filter(|b| !b.is_none());
-        let built = self.build_for(py, &settings)?;
-        let (out, stop) = watch::run(py, callback, |w| built.render_with(&settings, aovs, w))?;
+        let scene = &mut self.scene;
+        let (built, stop) = watch::run(py, None, |w| scene.build_for(&settings, w))?;
         if let Some(Stop::Raised(e)) = stop {
             return Err(e);
         }
-        let t = built.stages;
+        built.py()?;
+        let (out, stop) = watch::run(py, callback, |w| scene.render_with(&settings, aovs, w))?;
+        if let Some(Stop::Raised(e)) = stop {
+            return Err(e);
+        }
+        let t = scene.stages();
         let (rgb, aovs, stats, complete) = rendered(py, &out.py()?, t.read + t.curves + t.bvh)?;
         let image = py.import("hairtrace._image")?.getattr("Image")?;
         image.call1((rgb, aovs, stats, complete))
     }
 
     fn __repr__(&self) -> String {
-        let d = &self.desc;
+        let s = &self.scene;
         format!(
             "<hairtrace.Scene {}: {} grooms, {} meshes, {} materials, {} lights, {}>",
-            d.origin,
-            d.grooms.len(),
-            d.meshes.len(),
-            d.materials.len(),
-            d.lights.len(),
-            if self.built.is_some() {
-                "built"
-            } else {
-                "not built"
-            }
+            self.origin,
+            self.grooms,
+            self.meshes,
+            s.material_names().count(),
+            s.light_names().count(),
+            if s.is_built() { "built" } else { "not built" }
         )
-    }
-}
-
-impl PyScene {
-    /// Sets the lights in the description and, where built, in the build.
-    fn set_lights_to(&mut self, lights: Vec<hairtrace::description::LightDesc>) -> PyResult<()> {
-        for (i, l) in lights.iter().enumerate() {
-            l.build()
-                .map_err(|e| e.context(format!("light[{i}]")))
-                .py()?;
-        }
-        if let Some(b) = &mut self.built {
-            b.scene.set_lights(&lights).py()?;
-        }
-        self.desc.lights = lights;
-        Ok(())
     }
 }
 

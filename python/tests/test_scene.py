@@ -69,11 +69,32 @@ def test_material_light_and_camera_edits_render_as_a_fresh_build_without_one(rep
             e(fresh)
         assert np.array_equal(edited.render(), fresh.render()), f"edit {i}"
         assert edited.builds == 1 and fresh.builds == 1
-    # Other samples and seeds need no build; another image size does.
-    edited.render(spp=4, seed=3)
+    # Other samples, seeds and sizes need no build (round strands hold for any view); a
+    # setting the build depends on builds again, rather than being refused.
+    edited.render(spp=4, seed=3, width=40)
     assert edited.builds == 1
-    edited.render(width=40)
+    parts_off = edited.render(curve_parts="off")
     assert edited.builds == 2
+    fresh = hairtrace.Scene.load(path)
+    fresh.set(**SMALL)
+    for e in edits:
+        e(fresh)
+    assert np.array_equal(parts_off, fresh.render(curve_parts="off"))
+
+
+def test_a_groom_added_after_a_render_builds_again_as_a_fresh_scene(repo):
+    path = repo / "examples/scenes/fur_ball.toml"
+    scalp = dict(procedural="scalp", material="ginger", shape="round",
+                 params=dict(strands=300, segments=6, seed=2))
+    s = hairtrace.Scene.load(path)
+    s.set(**SMALL)
+    before = s.render()
+    s.add_groom(**scalp)
+    after = s.render()
+    assert s.builds == 2 and not np.array_equal(before, after)
+    fresh = hairtrace.Scene.load(path)
+    fresh.add_groom(**scalp)
+    assert np.array_equal(after, fresh.render(**SMALL)) and fresh.builds == 1
 
 
 def test_a_farther_camera_keeps_an_auto_groom_s_build():

@@ -110,7 +110,7 @@ impl Setup {
 }
 
 fn builds(h: &Handles) -> u64 {
-    h.scene().device.builds()
+    h.scene().scene.builds()
 }
 
 /// A material, a light and a camera changed one after the other on a built scene: none
@@ -328,7 +328,7 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
         angular_radius_deg: sun.2,
     });
     let device = Arc::new(Device::new(Some(2)).unwrap());
-    let built = d.build(device).unwrap();
+    let mut built = d.build(device).unwrap();
     let toml = built.render(Aovs::default(), &NoProgress).unwrap();
 
     let h = Handles::new();
@@ -380,12 +380,8 @@ fn descriptions_and_the_c_abi_frame_the_same_camera() {
     };
     let (status, rgb) = render_c(&h, &s);
     assert_eq!(status, HtStatus::HT_OK, "{}", last_error());
-    let (_, camera) = scene_mut(h.scene)
-        .ok()
-        .unwrap()
-        .prepare(&sized(40, 30), &crate::scene::NoStages)
-        .unwrap();
-    assert_eq!(camera.eye(), built.camera.eye());
+    let camera = (h.scene().scene.placed_camera(&sized(40, 30))).unwrap();
+    assert_eq!(camera.eye(), built.placed_camera(&s).unwrap().eye());
     assert!(
         bits(&rgb) == bits(toml.film.rgb()),
         "the C image is not the description's"

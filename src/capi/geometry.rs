@@ -3,20 +3,48 @@
 
 use super::scene::{HtScene, add_with_id};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
-use crate::description::assembly::Shape;
-use crate::description::{GroomDesc, GroomSource};
+use crate::description::{GroomDesc, GroomSource, MeshDesc, MeshSource};
 use crate::embree::{CurveBasis, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::formats::hair::Thickness;
-use crate::formats::mesh::read_mesh_file;
-use crate::formats::usd::read_usd_file;
-use crate::scene::GroomShape;
-use crate::scene::Strands;
-use crate::scene::curves::Curves;
-use crate::scene::framing::Framing;
-use crate::scene::mesh::Mesh;
+use crate::incremental::ControlPoints;
+use crate::scene::{GroomShape, Mesh, Strands};
 use std::ffi::c_char;
 use std::ptr::NonNull;
+
+impl HtScene {
+    /// Adds the groom shaded by material `material_id` (hair); returns its first geometry
+    /// id and how many it made.
+    fn add_groom(&mut self, groom: GroomDesc, material_id: u32) -> Result<(u32, u32)> {
+        let groom = GroomDesc {
+            material: self.check_material(material_id, true)?,
+            ..groom
+        };
+        let (name, first) = self.next_geometry();
+        let count = self.scene.add_groom(&name, &groom)?;
+        self.added(count)?;
+        Ok((first, count as u32))
+    }
+
+    /// Adds the mesh shaded by material `material_id` (diffuse); returns its geometry id.
+    fn add_mesh(&mut self, source: MeshSource, material_id: u32) -> Result<u32> {
+        let material = self.check_material(material_id, false)?;
+        let (name, id) = self.next_geometry();
+        self.scene
+            .add_mesh(&name, &MeshDesc::new(source, &material))?;
+        self.added(1)?;
+        Ok(id)
+    }
+}
+
+/// A groom of `source` drawn through `basis` as `shape`, for [`HtScene::add_groom`].
+fn groom(source: GroomSource, basis: Option<CurveBasis>, shape: GroomShape) -> GroomDesc {
+    GroomDesc {
+        basis,
+        shape,
+        ..GroomDesc::new(source, "")
+    }
+}
 
 /// The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
 pub type HtCurveBasis = u32;
@@ -199,7 +227,10 @@ pub unsafe extern "C" fn ht_scene_add_curves(
             counts: counts.to_vec(),
             colors,
         };
-        Ok(scene.add_strands(&strands, basis, shape, material_id)?)
+        let source = GroomSource::Strands(strands);
+        Ok(scene
+            .add_groom(groom(source, Some(basis), shape), material_id)?
+            .0)
     })
 }
 
@@ -304,10 +335,17 @@ fn add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
-        let curves =
-            Curves::from_control_points(vertices(points)?, counts, colors, basis, shape.built())?;
-        let frame = |f: &mut Framing| f.add_control_points(points);
-        Ok(scene.add_geometry(Shape::curves(curves, shape), material_id, frame)?)
+        let material = scene.check_material(material_id, true)?;
+        let points = ControlPoints {
+            points: vertices(points)?,
+            counts: counts.to_vec(),
+            colors,
+            basis,
+        };
+        let (name, id) = scene.next_geometry();
+        (scene.scene).add_control_points(&name, points, shape, &material)?;
+        scene.added(1)?;
+        Ok(id)
     })
 }
 
@@ -345,13 +383,10 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
             Thickness::Diameter
         };
         // Read as a scene file reads it: in the units its header says, if it says them.
-        let groom = GroomDesc {
-            basis: Some(basis),
-            ..GroomDesc::new(GroomSource::File { path, thickness }, "")
-        };
-        let mut sets = groom.placed_strands()?;
-        let strands = sets.pop().map(|s| s.strands).unwrap_or_default();
-        Ok(scene.add_strands(&strands, basis, shape, material_id)?)
+        let source = GroomSource::File { path, thickness };
+        Ok(scene
+            .add_groom(groom(source, Some(basis), shape), material_id)?
+            .0)
     })
 }
 
@@ -388,17 +423,11 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let path = read_path(path, "path")?;
         scene.check_material(material_id, true)?;
         let shape = curve_shape(shape)?;
-        let grooms = read_usd_file(&path)?;
-        let curves = (grooms.curves.iter())
-            .map(|c| c.curves(shape.built(), 1.0, |p| p))
-            .collect::<Result<Vec<_>>>()?;
-        let first = u32::try_from(scene.geometries.len())
-            .map_err(|_| invalid_arg!("too many geometries"))?;
-        let count = u32::try_from(curves.len()).map_err(|_| invalid_arg!("too many prims"))?;
-        for (c, prim) in curves.into_iter().zip(&grooms.curves) {
-            let frame = |f: &mut Framing| prim.frame(f, 1.0, |p| p);
-            scene.add_geometry(Shape::curves(c, shape), material_id, frame)?;
-        }
+        let source = GroomSource::File {
+            path,
+            thickness: Thickness::Diameter,
+        };
+        let (first, count) = scene.add_groom(groom(source, None, shape), material_id)?;
         // SAFETY: non-NULL (checked), the host's uint32_t.
         unsafe { count_out.write(count) };
         Ok(first)
@@ -447,7 +476,7 @@ pub unsafe extern "C" fn ht_scene_add_mesh(
             .transpose()?;
         let triangles: &[[u32; 3]] = host_slice(indices.cast(), triangle_count, "indices")?;
         let mesh = Mesh::new(positions, triangles.to_vec(), normals)?;
-        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id, |_| ())?)
+        Ok(scene.add_mesh(MeshSource::Triangles(mesh), material_id)?)
     })
 }
 
@@ -471,8 +500,6 @@ pub unsafe extern "C" fn ht_scene_add_mesh_file(
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
         let path = read_path(path, "path")?;
-        scene.check_material(material_id, false)?;
-        let mesh = read_mesh_file(&path)?;
-        Ok(scene.add_geometry(Shape::Mesh(mesh), material_id, |_| ())?)
+        Ok(scene.add_mesh(MeshSource::File(path), material_id)?)
     })
 }

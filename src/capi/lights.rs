@@ -2,19 +2,17 @@
 
 use super::scene::{HtScene, scene_mut};
 use super::{Failure, HtStatus, boundary, read_path, read_vec3};
-use crate::scene::envmap::Environment;
-use crate::scene::light::Light;
+use crate::description::{EnvironmentSource, LightDesc};
 use std::ffi::c_char;
 
-/// Adds a light to the scene; `light` runs inside the boundary.
+/// Adds a light to the scene (files read now); `light` runs inside the boundary.
 fn add_light(
     scene: *mut HtScene,
-    light: impl FnOnce() -> std::result::Result<Light, Failure>,
+    light: impl FnOnce() -> std::result::Result<LightDesc, Failure>,
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        scene.lights.push(light()?);
-        scene.lights_changed = true;
+        scene.scene.add_light(&light()?)?;
         Ok(())
     })
 }
@@ -34,8 +32,11 @@ pub unsafe extern "C" fn ht_scene_add_environment(
     radiance: *const f32,
 ) -> HtStatus {
     add_light(scene, || {
-        let env = Environment::uniform(read_vec3(radiance, "radiance")?)?;
-        Ok(Light::Environment(env))
+        Ok(LightDesc::Environment {
+            source: EnvironmentSource::Uniform(read_vec3(radiance, "radiance")?.to_array()),
+            rotation_deg: 0.0,
+            scale: 1.0,
+        })
     })
 }
 
@@ -58,11 +59,11 @@ pub unsafe extern "C" fn ht_scene_add_environment_map(
     scale: f32,
 ) -> HtStatus {
     add_light(scene, || {
-        let path = read_path(path, "path")?;
-        let env = Environment::from_file(&path)?
-            .with_rotation(rotation_deg)?
-            .with_scale(scale)?;
-        Ok(Light::Environment(env))
+        Ok(LightDesc::Environment {
+            source: EnvironmentSource::Map(read_path(path, "path")?),
+            rotation_deg,
+            scale,
+        })
     })
 }
 
@@ -86,12 +87,11 @@ pub unsafe extern "C" fn ht_scene_add_distant_light(
     angular_radius_deg: f32,
 ) -> HtStatus {
     add_light(scene, || {
-        let light = Light::distant(
-            read_vec3(direction, "direction")?,
-            read_vec3(irradiance, "irradiance")?,
+        Ok(LightDesc::Distant {
+            direction: read_vec3(direction, "direction")?.to_array(),
+            irradiance: read_vec3(irradiance, "irradiance")?.to_array(),
             angular_radius_deg,
-        )?;
-        Ok(light)
+        })
     })
 }
 
@@ -117,13 +117,12 @@ pub unsafe extern "C" fn ht_scene_add_rect_light(
     two_sided: bool,
 ) -> HtStatus {
     add_light(scene, || {
-        let light = Light::rect(
-            read_vec3(corner, "corner")?,
-            read_vec3(edge_u, "edge_u")?,
-            read_vec3(edge_v, "edge_v")?,
-            read_vec3(radiance, "radiance")?,
+        Ok(LightDesc::Rect {
+            corner: read_vec3(corner, "corner")?.to_array(),
+            edge_u: read_vec3(edge_u, "edge_u")?.to_array(),
+            edge_v: read_vec3(edge_v, "edge_v")?.to_array(),
+            radiance: read_vec3(radiance, "radiance")?.to_array(),
             two_sided,
-        )?;
-        Ok(light)
+        })
     })
 }

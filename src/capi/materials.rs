@@ -6,9 +6,9 @@ use super::bsdf::HtHairParams;
 use super::scene::{HtScene, add_with_id, scene_mut};
 use super::{Failure, HtStatus, boundary, read_host, read_vec3};
 use crate::bsdf::HairParams;
-use crate::bsdf::diffuse::Diffuse;
+use crate::description::MaterialDesc;
 use crate::error::invalid_arg;
-use crate::scene::material::{HairColor, HairMaterial, Material};
+use crate::scene::{HairColor, HairMaterial};
 
 /// How a hair material varies over the groom, deterministically from the seed, the
 /// strand and the position along it.
@@ -85,7 +85,7 @@ pub unsafe extern "C" fn ht_scene_add_hair_material_varied(
 ) -> HtStatus {
     add_with_id(scene, material_id, "material_id", |scene| {
         let material = hair_material(params, variation)?;
-        push_material(scene, material)
+        Ok(scene.add_material(&material)?)
     })
 }
 
@@ -118,19 +118,19 @@ pub unsafe extern "C" fn ht_scene_set_hair_material(
             variation
         };
         let material = hair_material(params, variation)?;
-        Ok(scene.set_material(material_id, material)?)
+        Ok(scene.set_material(material_id, &material)?)
     })
 }
 
-/// The hair material of the host's parameters and variation, checked and prepared.
+/// The hair material of the host's parameters and variation (checked when the scene
+/// takes it).
 fn hair_material(
     params: *const HtHairParams,
     variation: *const HtHairVariation,
-) -> std::result::Result<Material, Failure> {
+) -> std::result::Result<MaterialDesc, Failure> {
     let p = read_host(params, "params")?;
     let v = read_host(variation, "variation")?;
-    let material = varied_material(p.into(), &v)?;
-    Ok(Material::Hair(Box::new(material.prepare()?)))
+    Ok(MaterialDesc::Hair(varied_material(p.into(), &v)?))
 }
 
 /// The hair material of parameters `p` varied as `v` says (`use_vertex_colors` checked;
@@ -177,8 +177,8 @@ pub unsafe extern "C" fn ht_scene_add_diffuse_material(
     material_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, material_id, "material_id", |scene| {
-        let diffuse = Diffuse::new(read_vec3(albedo, "albedo")?)?;
-        push_material(scene, Material::Diffuse(diffuse))
+        let albedo = read_vec3(albedo, "albedo")?.to_array();
+        Ok(scene.add_material(&MaterialDesc::Diffuse { albedo })?)
     })
 }
 
@@ -200,14 +200,7 @@ pub unsafe extern "C" fn ht_scene_set_diffuse_material(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        let diffuse = Diffuse::new(read_vec3(albedo, "albedo")?)?;
-        Ok(scene.set_material(material_id, Material::Diffuse(diffuse))?)
+        let albedo = read_vec3(albedo, "albedo")?.to_array();
+        Ok(scene.set_material(material_id, &MaterialDesc::Diffuse { albedo })?)
     })
-}
-
-fn push_material(scene: &mut HtScene, material: Material) -> std::result::Result<u32, Failure> {
-    let id =
-        u32::try_from(scene.materials.len()).map_err(|_| invalid_arg!("too many materials"))?;
-    scene.materials.push(material);
-    Ok(id)
 }

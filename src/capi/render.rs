@@ -8,10 +8,9 @@ use super::{
 };
 use crate::error::invalid_arg;
 use crate::image::{WriteOptions, write_image};
-use crate::render::renderer::render;
 use crate::render::settings::RenderSettings;
 use crate::render::{Aovs, NoProgress, Progress, RenderStatus};
-use crate::scene::stages::{NoStages, Stage, StageProgress};
+use crate::scene::{NoStages, Stage, StageProgress};
 use std::cell::Cell;
 use std::ffi::{c_char, c_void};
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -151,7 +150,8 @@ fn build(
         }
         None => &NoStages,
     };
-    scene.prepare(settings, sink)?;
+    scene.check_framed()?;
+    scene.scene.build_for(settings, sink)?;
     Ok(())
 }
 
@@ -285,8 +285,8 @@ fn render_into(
         depth: depth.is_some(),
         strand_id: strand_id.is_some(),
     };
-    let (world, camera) = scene.prepare(settings, &NoStages)?;
-    let out = render(world, &camera, settings, aovs, progress)?;
+    scene.check_framed()?;
+    let out = scene.scene.render_with(settings, aovs, progress)?;
     let film = &out.film;
     rgb.copy_from_slice(film.rgb());
     for (host, aov) in [

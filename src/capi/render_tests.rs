@@ -752,7 +752,7 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
     // The shapes of the last build (the scene's own camera and height keep it).
     let shapes = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
-        let world = scene.world.as_ref().expect("built");
+        let world = scene.scene.world().expect("built");
         (world.tracer.scene().geometries().iter())
             .map(|g| match g {
                 Geometry::Curves(c) => c.shape(),
@@ -760,7 +760,7 @@ fn auto_curves_render_as_ribbons_or_tubes_for_each_view() {
             })
             .collect::<Vec<_>>()
     };
-    let builds = |h: &Handles| h.scene().device.builds();
+    let builds = |h: &Handles| h.scene().scene.builds();
     // Roots 0.008 wide, 3 to 5 units from an eye with a 40-degree view: a pixel wide at
     // 273 to 455 pixels of image height. At 32 every strand is a ribbon; at 1000 every
     // strand a tube (a 16-pixel crop keeps that render small); at 350, both.
@@ -819,7 +819,7 @@ fn scene_build_reports_its_progress_and_the_render_reuses_it() {
     let s = settings(24);
     let tracer_of = |h: &Handles| {
         let scene = scene_mut(h.scene).ok().unwrap();
-        scene.world.as_ref().map(|w| &raw const w.tracer)
+        scene.scene.world().map(|w| &raw const w.tracer)
     };
     let mut calls: Vec<f64> = Vec::new();
     let user = (&raw mut calls).cast::<c_void>();

@@ -1,6 +1,7 @@
-//! One scene, three front ends: a TOML scene file, the C ABI, and a USD groom in either
-//! render the same pixels, because they build through the same assembly
-//! (`description::assembly`) and frame an automatic camera the same way.
+//! One scene, every front end: a TOML scene file, the C ABI, the Rust `Scene` filled by
+//! name, and a USD groom in each render the same pixels, because they are one scene type
+//! (`crate::Scene`) that frames an automatic camera the same way. (Python's is checked
+//! against the command line and the C library in python/tests/test_same_pixels.py.)
 
 use super::HtStatus;
 use super::geometry::*;
@@ -8,12 +9,17 @@ use super::lights::*;
 use super::scene::*;
 use super::scene_tests::{Handles, last_error, small_fur};
 use super::settings_tests::Named;
+use crate::Scene;
 use crate::bsdf::HairParams;
-use crate::description::{SceneDescription, has_extension};
+use crate::description::{
+    CameraDesc, EnvironmentSource, GroomDesc, GroomSource, LightDesc, MaterialDesc,
+    SceneDescription, has_extension,
+};
 use crate::embree::{CurveBasis, Device};
 use crate::formats::convert::{ConvertOptions, ConvertSource, convert};
 use crate::formats::hair::{Thickness, write_hair_file};
 use crate::render::{Aovs, NoProgress};
+use crate::scene::{GroomShape, HairColor, HairMaterial};
 use std::ffi::CString;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -69,8 +75,57 @@ fn toml_render(file: &Path, camera: bool) -> Vec<u32> {
         file.display().to_string()
     );
     let desc = SceneDescription::from_toml(&text, Path::new("."), "same.toml").unwrap();
-    let built = desc.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
+    let mut built = desc.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
     let out = built.render(Aovs::default(), &NoProgress).unwrap();
+    out.film.rgb().iter().map(|v| v.to_bits()).collect()
+}
+
+/// The same through the Rust API: an empty `Scene` filled by name, settings by field.
+fn rust_render(file: &Path, camera: bool) -> Vec<u32> {
+    let mut scene = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
+    (scene.settings.width, scene.settings.height) = SIZE;
+    for (k, v) in SETTINGS {
+        scene.settings.set(k, v).unwrap();
+    }
+    if camera {
+        let view = CameraDesc {
+            eye: Some(EYE),
+            target: Some([0.0; 3]),
+            fov_deg: 40.0,
+            ..CameraDesc::default()
+        };
+        scene.set_camera(&view).unwrap();
+    }
+    let hair = HairMaterial {
+        color: HairColor::SigmaA(HairParams::default().sigma_a),
+        ..HairMaterial::default()
+    };
+    scene
+        .set_material("hair", &MaterialDesc::Hair(hair))
+        .unwrap();
+    let source = GroomSource::File {
+        path: file.to_path_buf(),
+        thickness: Thickness::Diameter,
+    };
+    let groom = GroomDesc {
+        basis: has_extension(file, "hair").then_some(CurveBasis::BSpline),
+        shape: GroomShape::Auto,
+        ..GroomDesc::new(source, "hair")
+    };
+    scene.add_groom("fur", &groom).unwrap();
+    let sky = LightDesc::Environment {
+        source: EnvironmentSource::Uniform(SKY),
+        rotation_deg: 0.0,
+        scale: 1.0,
+    };
+    scene.add_light(&sky).unwrap();
+    let sun = LightDesc::Distant {
+        direction: SUN_DIR,
+        irradiance: SUN,
+        angular_radius_deg: 0.0,
+    };
+    scene.add_light(&sun).unwrap();
+    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
     out.film.rgb().iter().map(|v| v.to_bits()).collect()
 }
 
@@ -142,13 +197,15 @@ fn assert_same(got: &[u32], want: &[u32], what: &str) {
 }
 
 #[test]
-fn toml_c_and_usd_render_the_same_scene_bit_for_bit() {
+fn toml_c_rust_and_usd_render_the_same_scene_bit_for_bit() {
     let (hair, usda) = groom_files();
     let reference = toml_render(&hair, true);
     assert!(reference.iter().any(|&v| f32::from_bits(v) > 0.0));
     assert_same(&toml_render(&usda, true), &reference, "TOML, USD groom");
     assert_same(&c_render(c_hair(&hair), true), &reference, "C, .hair groom");
     assert_same(&c_render(c_usd(&usda), true), &reference, "C, USD groom");
+    assert_same(&rust_render(&hair, true), &reference, "Rust, .hair groom");
+    assert_same(&rust_render(&usda, true), &reference, "Rust, USD groom");
     // Without a camera, C and TOML frame the same content alike. (A USD groom is framed
     // by its authored bounds widened by its largest radius, a `.hair` one point by point,
     // so the two sources frame a little differently.)
@@ -157,6 +214,11 @@ fn toml_c_and_usd_render_the_same_scene_bit_for_bit() {
         &c_render(c_hair(&hair), false),
         &framed,
         "C framed, .hair groom",
+    );
+    assert_same(
+        &rust_render(&hair, false),
+        &framed,
+        "Rust framed, .hair groom",
     );
     let framed = toml_render(&usda, false);
     assert_same(

@@ -1,27 +1,15 @@
 //! Devices and scenes through the C ABI: materials, curves and meshes from host buffers or
 //! files, lights and the camera, added one call at a time.
 //!
-//! The scene keeps what the host added (curves already converted for Embree) and builds
-//! the Embree scene on the first render, by the same assembly as scene files
-//! (`description::assembly`), then reuses it: adding geometry rebuilds it on
-//! the next render; adding a light, changing a material's parameters and a camera for
-//! which the `auto` curves' shapes still hold keep it.
+//! `HtScene` is a shell over the library's [`Scene`], which keeps the geometry, decides
+//! when to build and edits its build: the shell turns C ids into the scene's names
+//! (material `id` is named by its number, geometry ids only count what was added).
 
 use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
-use crate::description::assembly::{Assembly, Shape};
-use crate::embree::{CurveBasis, Device, Isa};
+use crate::Scene;
+use crate::description::{CameraDesc, MaterialDesc};
+use crate::embree::{Device, Isa};
 use crate::error::{Result, invalid_arg};
-use crate::render::integrator::World;
-use crate::render::settings::{CurveParts, RenderSettings};
-use crate::scene::Strands;
-use crate::scene::camera::Camera;
-use crate::scene::curves::Curves;
-use crate::scene::detail_view::DetailView;
-use crate::scene::framing::Framing;
-use crate::scene::light::Light;
-use crate::scene::material::Material;
-use crate::scene::ribbons::GroomShape;
-use crate::scene::stages::{StageProgress, StageRunner};
 use crate::validate::{length, non_negative, positive};
 use std::ffi::c_char;
 use std::sync::Arc;
@@ -46,93 +34,61 @@ pub struct HtDevice {
 /// grooms, share them (or add everything before the first render) and free the scene
 /// when done.
 pub struct HtScene {
-    pub(super) device: Arc<Device>,
-    pub(super) materials: Vec<Material>,
-    pub(super) geometries: Vec<Geometry>,
-    pub(super) lights: Vec<Light>,
-    pub(super) camera: Option<Camera>,
-    /// Aperture radius and focus distance of a thin lens, validated; kept apart from the
-    /// camera so that either may be set first, and the framing camera gets it too.
-    pub(super) lens: Option<(f32, f32)>,
-    /// What a render without a camera frames, grown as geometry is added.
-    pub(super) framing: Framing,
-    /// The last build; None until the first render and after geometry is added.
-    pub(super) world: Option<World>,
-    /// The index in `geometries` of each Embree geometry of `world` (`auto` curves may
-    /// make several).
-    pub(super) built_from: Vec<usize>,
-    /// Lights were added since `world` was built.
-    pub(super) lights_changed: bool,
-    /// The `curve_parts` setting `world` was built with: a render asking another builds
-    /// again.
-    pub(super) built_parts: CurveParts,
-}
-
-pub(super) struct Geometry {
-    pub(super) shape: Shape,
-    pub(super) material: u32,
+    pub(super) scene: Scene,
+    /// Material ids handed out: id `i` is the scene's material named `i`.
+    pub(super) materials: u32,
+    /// Geometry ids handed out (a USD stage takes one per prim).
+    pub(super) geometries: u32,
 }
 
 impl HtScene {
+    /// The scene's name of material `id`.
+    pub(super) fn material_name(id: u32) -> String {
+        id.to_string()
+    }
+
     /// The material `id` for a geometry; hair goes on curves, diffuse on meshes.
-    pub(super) fn check_material(&self, id: u32, on_curves: bool) -> Result<()> {
-        self.material(id)?
-            .check_suits(&format!("material_id = {id}"), on_curves)
-    }
-
-    fn material(&self, id: u32) -> Result<&Material> {
-        self.materials.get(id as usize).ok_or_else(|| {
-            invalid_arg!(
-                "material_id = {id}: the scene has {} materials",
-                self.materials.len()
-            )
-        })
-    }
-
-    /// Adds polyline strands converted for `basis` and `shape`, framed by their points.
-    pub(super) fn add_strands(
-        &mut self,
-        strands: &Strands,
-        basis: CurveBasis,
-        shape: GroomShape,
-        material: u32,
-    ) -> Result<u32> {
-        let curves = Curves::from_strands(strands, basis, shape.built())?;
-        self.add_geometry(Shape::curves(curves, shape), material, |f| {
-            f.add_strands(strands)
-        })
-    }
-
-    /// Adds a geometry; the next render builds again. A mesh is framed by its vertices,
-    /// curves by what `frame_curves` adds from the points the host gave (`Framing`). The
-    /// scene keeps the curves [shared](Shape::shared), so that a build's copy costs none.
-    pub(super) fn add_geometry(
-        &mut self,
-        shape: Shape,
-        material: u32,
-        frame_curves: impl FnOnce(&mut Framing),
-    ) -> Result<u32> {
-        let id = u32::try_from(self.geometries.len())
-            .map_err(|_| invalid_arg!("too many geometries"))?;
-        match &shape {
-            Shape::Mesh(m) => self.framing.add_mesh(&m.positions),
-            Shape::Curves(_) | Shape::AutoCurves(_) => frame_curves(&mut self.framing),
+    pub(super) fn check_material(&self, id: u32, on_curves: bool) -> Result<String> {
+        let what = format!("material_id = {id}");
+        if id >= self.materials {
+            return Err(invalid_arg!(
+                "{what}: the scene has {} materials",
+                self.materials
+            ));
         }
-        self.geometries.push(Geometry {
-            shape: shape.shared(),
-            material,
-        });
-        self.world = None;
-        Ok(id)
+        let name = Self::material_name(id);
+        let material = self
+            .scene
+            .material(&name)
+            .expect("every id below the count");
+        material.check_suits(&what, on_curves)?;
+        Ok(name)
+    }
+
+    /// A new geometry's name, and the id of its first Embree geometry; `count` ids are
+    /// taken once it is added ([`Self::added`]).
+    pub(super) fn next_geometry(&self) -> (String, u32) {
+        (format!("geometry[{}]", self.geometries), self.geometries)
+    }
+
+    /// Takes `count` geometry ids.
+    pub(super) fn added(&mut self, count: usize) -> Result<()> {
+        self.geometries = u32::try_from(count)
+            .ok()
+            .and_then(|n| self.geometries.checked_add(n))
+            .ok_or_else(|| invalid_arg!("too many geometries"))?;
+        Ok(())
     }
 
     /// Gives material `id` new parameters, of the same kind (hair or diffuse), without a
-    /// new build: the built world's geometries that use it take it at once.
-    pub(super) fn set_material(&mut self, id: u32, material: Material) -> Result<()> {
+    /// new build.
+    pub(super) fn set_material(&mut self, id: u32, material: &MaterialDesc) -> Result<()> {
         let what = format!("material_id = {id}");
-        let old = self.material(id)?;
-        if std::mem::discriminant(old) != std::mem::discriminant(&material) {
-            let kind = if matches!(old, Material::Hair(_)) {
+        let name = Self::material_name(id);
+        let old = (self.scene.material(&name))
+            .ok_or_else(|| invalid_arg!("{what}: the scene has {} materials", self.materials))?;
+        if std::mem::discriminant(old) != std::mem::discriminant(material) {
+            let kind = if matches!(old, MaterialDesc::Hair(_)) {
                 "hair"
             } else {
                 "diffuse"
@@ -141,103 +97,44 @@ impl HtScene {
                 "{what} is a {kind} material, and a material keeps its kind: add a new one"
             ));
         }
-        if let Some(world) = &mut self.world {
-            for (embree_id, &g) in self.built_from.iter().enumerate() {
-                if self.geometries[g].material == id {
-                    world.set_material(embree_id as u32, material.clone())?;
-                }
-            }
-        }
-        self.materials[id as usize] = material;
-        Ok(())
+        self.scene.set_material(&name, material)
     }
 
-    /// The host's camera, or the one that frames the geometry as added, for an image of
-    /// `aspect` (width over height), with the host's lens.
-    fn camera(&self, aspect: f32) -> Result<Camera> {
-        let camera = match self.camera {
-            Some(c) => c.with_aspect(aspect)?,
-            None => self
-                .framing
-                .camera(aspect, Camera::DEFAULT_FOV_Y_DEG)
-                .ok_or_else(|| {
-                    invalid_arg!(
-                        "the scene has no geometry to frame: set a camera with \
-                         ht_scene_set_camera"
-                    )
-                })??,
-        };
-        match self.lens {
-            Some((aperture_radius, focus_distance)) => {
-                camera.with_thin_lens(aperture_radius, focus_distance)
-            }
-            None => Ok(camera),
-        }
+    /// Adds a material and returns its id.
+    pub(super) fn add_material(&mut self, material: &MaterialDesc) -> Result<u32> {
+        let id = self.materials;
+        let next = id
+            .checked_add(1)
+            .ok_or_else(|| invalid_arg!("too many materials"))?;
+        self.scene
+            .set_material(&Self::material_name(id), material)?;
+        self.materials = next;
+        Ok(id)
     }
 
-    /// The world to render, built or updated as needed (the BVH build reporting to
-    /// `progress`), and the camera for an image of `width` x `height` pixels. One build
-    /// at most: the automatic camera is framed without one. A build is kept while nothing
-    /// was added, the view still suits its `auto` curves' shapes (`Tracer::serves`) and
-    /// `curve_parts` is unchanged; new lights are weighed again on it.
+    /// Refuses a render that has nothing to frame, in the C ABI's words.
+    pub(super) fn check_framed(&self) -> Result<()> {
+        match self.scene.camera().eye.is_none() && self.geometries == 0 {
+            true => Err(invalid_arg!(
+                "the scene has no geometry to frame: set a camera with ht_scene_set_camera"
+            )),
+            false => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+impl HtScene {
+    /// Builds where needed for `settings`; the world and the camera of such a render.
     pub(crate) fn prepare(
         &mut self,
-        settings: &RenderSettings,
-        progress: &dyn StageProgress,
-    ) -> Result<(&World, Camera)> {
-        let (width, height) = (settings.width, settings.height);
-        if self.lights.is_empty() {
-            return Err(invalid_arg!(
-                "the scene has no light: add an environment, distant or rect light"
-            ));
-        }
-        // A C host's device is its own (`ht_device_new_pinned`): a render cannot re-pin it.
-        if let Some(isa) = settings.isa.filter(|&isa| Some(isa) != self.device.isa()) {
-            return Err(invalid_arg!(
-                "isa = {isa}: this scene's device runs {}; pin the device with \
-                 ht_device_new_pinned(threads, \"{isa}\", ...) instead",
-                self.device
-                    .isa()
-                    .map_or("the widest kernels this CPU runs".into(), |d| {
-                        format!("{d} kernels")
-                    })
-            ));
-        }
-        let camera = self.camera(width as f32 / height as f32)?;
-        let view = DetailView::new(camera, height, settings.lod_pixels);
-        if (self.world.as_ref())
-            .is_some_and(|w| !w.tracer.serves(&view) || self.built_parts != settings.curve_parts)
-        {
-            self.world = None;
-        }
-        match &mut self.world {
-            Some(world) if self.lights_changed => world.set_lights(self.lights.clone())?,
-            Some(_) => {}
-            None => {
-                let mut assembly = Assembly::keeping_curves();
-                for g in &self.geometries {
-                    let material = self.materials[g.material as usize].clone();
-                    assembly.add(g.shape.clone(), material, "");
-                }
-                let built = assembly.build(
-                    self.device.clone(),
-                    self.lights.clone(),
-                    &view,
-                    settings,
-                    &mut StageRunner::new(progress),
-                )?;
-                for (g, kept) in self.geometries.iter_mut().zip(built.curves) {
-                    if let Some(curves) = kept {
-                        g.shape.keep(curves);
-                    }
-                }
-                self.world = Some(built.world);
-                self.built_from = built.built_from;
-                self.built_parts = settings.curve_parts;
-            }
-        }
-        self.lights_changed = false;
-        Ok((self.world.as_ref().expect("built above"), camera))
+        settings: &crate::render::settings::RenderSettings,
+        progress: &dyn crate::scene::StageProgress,
+    ) -> Result<(&crate::render::integrator::World, crate::scene::Camera)> {
+        self.check_framed()?;
+        self.scene.build_for(settings, progress)?;
+        let camera = self.scene.placed_camera(settings)?;
+        Ok((self.scene.world().expect("built"), camera))
     }
 }
 
@@ -360,17 +257,9 @@ pub unsafe extern "C" fn ht_scene_new(device: *const HtDevice, out: *mut *mut Ht
         let device = unsafe { &*non_null_mut(device.cast_mut(), "device")? };
         let out = non_null_mut(out, "out")?;
         let scene = Box::new(HtScene {
-            device: device.device.clone(),
-            materials: Vec::new(),
-            geometries: Vec::new(),
-            lights: Vec::new(),
-            camera: None,
-            lens: None,
-            framing: Framing::default(),
-            world: None,
-            built_from: Vec::new(),
-            built_parts: CurveParts::Auto,
-            lights_changed: false,
+            scene: Scene::new(device.device.clone()),
+            materials: 0,
+            geometries: 0,
         });
         // SAFETY: non-NULL (checked), the host's HtScene*.
         unsafe { out.write(Box::into_raw(scene)) };
@@ -419,15 +308,14 @@ pub unsafe extern "C" fn ht_scene_set_camera(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        let camera = Camera::new(
-            read_vec3(eye, "eye")?,
-            read_vec3(target, "target")?,
-            read_vec3(up, "up")?,
-            fov_y_deg,
-            1.0,
-        )?;
-        scene.camera = Some(camera);
-        Ok(())
+        let camera = CameraDesc {
+            eye: Some(read_vec3(eye, "eye")?.to_array()),
+            target: Some(read_vec3(target, "target")?.to_array()),
+            up: read_vec3(up, "up")?.to_array(),
+            fov_deg: fov_y_deg,
+            ..scene.scene.camera().clone()
+        };
+        Ok(scene.scene.set_camera(&camera)?)
     })
 }
 
@@ -455,7 +343,11 @@ pub unsafe extern "C" fn ht_scene_set_thin_lens(
         positive("focus_distance", focus_distance)?;
         length("aperture_radius", aperture_radius)?;
         length("focus_distance", focus_distance)?;
-        scene.lens = Some((aperture_radius, focus_distance));
-        Ok(())
+        let camera = CameraDesc {
+            aperture_radius,
+            focus_distance: Some(focus_distance),
+            ..scene.scene.camera().clone()
+        };
+        Ok(scene.scene.set_camera(&camera)?)
     })
 }

@@ -8,7 +8,6 @@ use super::materials::*;
 use super::scene::*;
 use crate::capi::bsdf::ht_hair_params_default;
 use crate::capi::ht_last_error;
-use crate::description::assembly::Shape;
 use crate::embree::{MemoryMonitor, padding_for};
 use crate::formats::hair::{Thickness, write_hair_file};
 use crate::scene::NoStages;
@@ -305,7 +304,7 @@ fn null_handles_and_pointers_are_reported() {
             HT_OK
         );
         assert_eq!(id, 2);
-        assert!(h.scene().geometries.is_empty() && h.scene().lights.is_empty());
+        assert!(h.scene().geometries == 0 && h.scene().scene.light_names().count() == 0);
     }
 }
 
@@ -340,7 +339,7 @@ fn invalid_values_name_the_argument_and_add_nothing() {
             INVALID,
             "albedo",
         );
-        assert!(h.scene().materials.is_empty());
+        assert!(h.scene().materials == 0);
 
         let hair = h.hair_material();
         let diffuse = h.diffuse_material([0.8; 3]);
@@ -430,7 +429,7 @@ fn invalid_values_name_the_argument_and_add_nothing() {
         fails(s, HtStatus::HT_ERR_IO, "/nonexistent/groom.hair");
         let s = ht_scene_add_mesh_file(h.scene, c"head.stl".as_ptr(), diffuse, &mut id);
         fails(s, INVALID, "head.stl");
-        assert!(h.scene().geometries.is_empty());
+        assert!(h.scene().geometries == 0);
 
         fails(
             ht_scene_add_environment(h.scene, nan.as_ptr()),
@@ -466,7 +465,7 @@ fn invalid_values_name_the_argument_and_add_nothing() {
             HtStatus::HT_ERR_IO,
             "sky.exr",
         );
-        assert!(h.scene().lights.is_empty());
+        assert!(h.scene().scene.light_names().count() == 0);
         let y = [0.0f32, 1.0, 0.0];
         fails(
             ht_scene_set_camera(h.scene, one.as_ptr(), zero.as_ptr(), y.as_ptr(), 0.0),
@@ -478,7 +477,7 @@ fn invalid_values_name_the_argument_and_add_nothing() {
             INVALID,
             "distinct",
         );
-        assert!(h.scene().camera.is_none());
+        assert!(h.scene().scene.camera().eye.is_none());
     }
 }
 
@@ -513,7 +512,7 @@ fn geometry_from_buffers_and_files_gets_consecutive_ids() {
         };
         let s = ht_scene_add_curves_xyzr(h.scene, &xyzr_desc, hair, &mut id);
         assert_eq!((s, id), (HtStatus::HT_OK, 1), "{}", last_error());
-        let Shape::Curves(c) = &h.scene().geometries[1].shape else {
+        let Some(c) = h.scene().scene.kept_curves(1) else {
             panic!("curves expected");
         };
         assert_eq!((c.vertices(), c.indices()), (&xyzr[..], &[0u32, 4, 5][..]));
@@ -550,7 +549,7 @@ fn geometry_from_buffers_and_files_gets_consecutive_ids() {
         assert_eq!((s, id), (HtStatus::HT_OK, 3), "{}", last_error());
         std::fs::remove_dir_all(&dir).unwrap();
         assert_eq!(h.add_triangle(diffuse), HtStatus::HT_OK);
-        assert_eq!(h.scene().geometries.len(), 5);
+        assert_eq!(h.scene().geometries as usize, 5);
     }
 }
 
@@ -590,10 +589,10 @@ fn shared_xyzr_points_are_checked_then_read_in_place() {
             ..desc
         };
         fails(add(&short), INVALID, "counts add up");
-        assert!(h.scene().geometries.is_empty());
+        assert!(h.scene().geometries == 0);
 
         assert_eq!(add(&desc), HtStatus::HT_OK, "{}", last_error());
-        let Shape::Curves(c) = &h.scene().geometries[0].shape else {
+        let Some(c) = h.scene().scene.kept_curves(0) else {
             panic!("curves expected");
         };
         assert_eq!(c.vertices().as_ptr().cast(), desc.points);
@@ -607,13 +606,8 @@ fn shared_xyzr_points_are_checked_then_read_in_place() {
 /// Bytes hairtrace holds for a scene of curves: what it keeps to rebuild, and the built
 /// tracer (what the two share counted once, `SharedBuffer::heap_bytes`).
 fn held_bytes(scene: &HtScene) -> usize {
-    let kept: usize = (scene.geometries.iter())
-        .map(|g| match &g.shape {
-            Shape::Curves(c) | Shape::AutoCurves(c) => c.heap_bytes(),
-            Shape::Mesh(_) => unreachable!("curves only"),
-        })
-        .sum();
-    kept + scene.world.as_ref().map_or(0, |w| w.tracer.heap_bytes())
+    let kept = scene.scene.kept_curves_bytes();
+    kept + scene.scene.world().map_or(0, |w| w.tracer.heap_bytes())
 }
 
 /// Memory of a built groom through each entry point: sharing saves the one copy of the
@@ -640,7 +634,7 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
                 ht_scene_add_curves_xyzr
             };
             let h = Handles::new();
-            let monitor = MemoryMonitor::attach(h.scene().device.clone());
+            let monitor = MemoryMonitor::attach(h.scene().scene.device().clone());
             let hair = h.hair_material();
             assert_eq!(add(h.scene, &desc, hair, &mut 0), HtStatus::HT_OK);
             add_sky(&h);
@@ -652,7 +646,7 @@ fn shared_xyzr_points_cost_neither_hairtrace_nor_embree_memory() {
             let held = held_bytes(h.scene());
             // The scene's curves and the tracer's read the same points: the host's,
             // or, copied, one copy in spatial order behind an `Arc`.
-            let Shape::Curves(c) = &h.scene().geometries[0].shape else {
+            let Some(c) = h.scene().scene.kept_curves(0) else {
                 panic!("curves expected");
             };
             let at = c.vertices().as_ptr();
@@ -691,7 +685,7 @@ fn tracer_points(scene: &HtScene) -> *const [f32; 4] {
 
 /// The built tracer's first geometry.
 fn tracer_curves(scene: &HtScene) -> &crate::embree::CurveGeometry {
-    let world = scene.world.as_ref().expect("built");
+    let world = scene.scene.world().expect("built");
     match world.tracer.scene().geometry(0) {
         Some(crate::embree::Geometry::Curves(c)) => c,
         _ => panic!("curves expected"),
@@ -746,16 +740,13 @@ fn rebuilt_as_built_once(strands: &Strands, settings: &crate::render::settings::
     let hair = h.hair_material();
     assert_eq!(h.add_strands(strands, hair), HtStatus::HT_OK);
     add_sky(&h);
-    let given = match &h.scene().geometries[0].shape {
-        Shape::Curves(c) => c.vertices().to_vec(),
-        _ => panic!("curves expected"),
-    };
+    let given = h.scene().scene.kept_curves(0).unwrap().vertices().to_vec();
     render(&h);
     let ordered = tracer_points(h.scene());
     let parts = tracer_curves(h.scene()).parts().map(<[_]>::as_ptr);
     let large = settings.curve_parts == crate::render::settings::CurveParts::On;
     assert_eq!(parts.is_some(), large);
-    let Shape::Curves(kept) = &h.scene().geometries[0].shape else {
+    let Some(kept) = h.scene().scene.kept_curves(0) else {
         panic!("curves expected");
     };
     assert_eq!(kept.vertices().as_ptr(), ordered);
@@ -767,7 +758,7 @@ fn rebuilt_as_built_once(strands: &Strands, settings: &crate::render::settings::
 
     let floor = h.diffuse_material([0.5; 3]);
     assert_eq!(h.add_triangle(floor), HtStatus::HT_OK);
-    assert!(h.scene().world.is_none());
+    assert!(!h.scene().scene.is_built());
     let rebuilt = render(&h);
     assert_eq!(tracer_points(h.scene()), ordered);
     assert_eq!(tracer_curves(h.scene()).parts().map(<[_]>::as_ptr), parts);
@@ -822,11 +813,11 @@ fn usd_file_adds_one_geometry_per_basis_curves_prim() {
         let missing = c"/nonexistent/groom.usda";
         let s = ht_scene_add_usd_file(h.scene, missing.as_ptr(), 0, hair, &mut first, &mut count);
         fails(s, HtStatus::HT_ERR_IO, "/nonexistent/groom.usda");
-        assert!(h.scene().geometries.is_empty());
+        assert!(h.scene().geometries == 0);
         let s = ht_scene_add_usd_file(h.scene, path.as_ptr(), 0, hair, &mut first, &mut count);
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
         assert_eq!((first, count), (0, 10));
-        assert_eq!(h.scene().geometries.len(), 10);
+        assert_eq!(h.scene().geometries as usize, 10);
         let s = ht_scene_add_usd_file(h.scene, path.as_ptr(), 0, hair, &mut first, &mut count);
         assert_eq!((s, first, count), (HtStatus::HT_OK, 10, 10));
     }

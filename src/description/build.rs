@@ -1,33 +1,30 @@
-//! Turning a description into a renderable world: every value checked, files read,
-//! grooms and meshes built into one Embree scene, the camera placed.
-
-use std::collections::BTreeMap;
-use std::sync::Arc;
+//! What each entry of a description becomes: grooms read and converted into curves,
+//! meshes read and placed, materials and lights checked, the camera placed
+//! ([`crate::Scene::from_description`] drives them).
 
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 
-use super::assembly::{Assembly, Shape, scene_options};
+use super::assembly::scene_options;
 use super::{
-    BuiltScene, CameraDesc, EnvironmentSource, GroomDesc, GroomSource, GroomStrands, LightDesc,
-    MaterialDesc, MeshDesc, MeshSource, SceneDescription, StrandCurves, Transform,
+    CameraDesc, EnvironmentSource, GroomDesc, GroomSource, GroomStrands, LightDesc, MaterialDesc,
+    MeshDesc, MeshSource, SceneDescription, StrandCurves, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
-use crate::embree::{CurveBasis, Device};
-use crate::error::{Error, Result, invalid_arg};
+use crate::embree::CurveBasis;
+use crate::error::{Result, invalid_arg};
 use crate::render::Aovs;
 use crate::render::renderer::film_bytes_and_uniform;
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
 use crate::scene::curves::{Curves, placed};
-use crate::scene::detail_view::DetailView;
 use crate::scene::envmap::Environment;
-use crate::scene::footprint::{self, CurvesSize, available_bytes};
+use crate::scene::footprint::{self, CurvesSize};
 use crate::scene::framing::Framing;
 use crate::scene::light::Light;
-use crate::scene::material::Material;
+use crate::scene::material::{Material, check_kind};
 use crate::scene::mesh::Mesh;
 use crate::scene::shapes;
-use crate::scene::stages::{NoStages, Stage, StageProgress, StageRunner};
+use crate::scene::stages::{Stage, StageRunner};
 use crate::validate::{self, positive};
 
 use crate::formats::hair::{HairTag, read_hair_file, read_hair_tag};
@@ -36,110 +33,6 @@ use crate::formats::units::StageUnits;
 use crate::formats::usd::{Layout, Wrap, is_usd_path, read_usd_file};
 
 impl SceneDescription {
-    /// Checks every value, reads the files, builds the grooms and meshes into one Embree
-    /// scene on `device`, and places the camera. Cheap checks (settings, materials and their
-    /// assignment, lights) come before any groom is read or built, so that a typo does not
-    /// wait for a large groom.
-    pub fn build(&self, device: Arc<Device>) -> Result<BuiltScene> {
-        self.build_with(device, &NoStages)
-    }
-
-    /// [`build`](Self::build), reporting each stage's progress to `progress` and timing
-    /// it in [`BuiltScene::stages`].
-    pub fn build_with(
-        &self,
-        device: Arc<Device>,
-        progress: &dyn StageProgress,
-    ) -> Result<BuiltScene> {
-        let settings = self.render;
-        settings.validate().map_err(|e| self.error("render", e))?;
-        let mut prepared = BTreeMap::new();
-        for (name, m) in &self.materials {
-            let material = m
-                .prepare()
-                .map_err(|e| self.error(&format!("materials.{name}"), e))?;
-            prepared.insert(name.as_str(), material);
-        }
-        let assign = |kind: &str, i: usize, name: &str, hair: bool| {
-            self.assigned(&prepared, name, hair)
-                .cloned()
-                .map_err(|e| self.error(&format!("{kind}[{i}].material"), e))
-        };
-        let groom_materials = (self.grooms.iter().enumerate())
-            .map(|(i, g)| assign("groom", i, &g.material, true))
-            .collect::<Result<Vec<_>>>()?;
-        let mesh_materials = (self.meshes.iter().enumerate())
-            .map(|(i, m)| assign("mesh", i, &m.material, false))
-            .collect::<Result<Vec<_>>>()?;
-        if self.lights.is_empty() {
-            return Err(invalid_arg!(
-                "{}: no lights: add a [[light]] (environment, distant or rect)",
-                self.origin
-            ));
-        }
-        let lights = self
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(i, l)| l.build().map_err(|e| self.error(&format!("light[{i}]"), e)))
-            .collect::<Result<Vec<_>>>()?;
-
-        self.check_memory(available_bytes())?;
-
-        let mut stages = StageRunner::new(progress);
-        let mut framing = Framing::default();
-        let (grooms, reads) = (self.grooms.len(), self.grooms.len() + self.meshes.len());
-        let mut assembly = Assembly::default();
-        // The material name of each part, for `BuiltScene::set_material`.
-        let mut names = Vec::with_capacity(reads);
-        for (i, g) in self.grooms.iter().enumerate() {
-            let at = format!("groom[{i}]");
-            let curves = g
-                .curves(&mut stages, (i, grooms, reads), &mut framing)
-                .map_err(|e| self.error(&at, e))?;
-            for c in curves {
-                let shape = Shape::curves(c, g.shape);
-                assembly.add(shape, groom_materials[i].clone(), self.at(&at));
-                names.push(g.material.clone());
-            }
-        }
-        for (i, (m, material)) in self.meshes.iter().zip(mesh_materials).enumerate() {
-            let at = format!("mesh[{i}]");
-            let mesh = stages
-                .run(Stage::Read, (grooms + i, reads), |_| m.mesh())
-                .map_err(|e| self.error(&at, e))?;
-            // A ground quad is the stage, not the subject: framing it would shrink the
-            // subject to a speck.
-            if !matches!(m.source, MeshSource::Ground { .. }) {
-                framing.add_mesh(&mesh.positions);
-            }
-            assembly.add(Shape::Mesh(mesh), material, self.at(&at));
-            names.push(m.material.clone());
-        }
-        // A scene without grooms (or meshes) still goes through every stage.
-        stages.report(Stage::Read, 1.0)?;
-        stages.report(Stage::Curves, 1.0)?;
-        let aspect = settings.width as f32 / settings.height as f32;
-        let camera = self
-            .camera
-            .build(&framing, aspect)
-            .map_err(|e| self.error("camera", e))?;
-        let view = DetailView::new(camera, settings.height, settings.lod_pixels);
-        let built = assembly.build(device, lights, &view, &settings, &mut stages)?;
-        Ok(BuiltScene {
-            world: built.world,
-            camera,
-            settings,
-            stages: stages.times(),
-            framing,
-            sources: built
-                .built_from
-                .into_iter()
-                .map(|p| names[p].clone())
-                .collect(),
-        })
-    }
-
     /// Refuses the description when its render's film, or its procedural grooms (whose
     /// sizes are known before anything is made) with the film, would need more than
     /// `available` bytes at their peak (see [`footprint`]); grooms from files are checked
@@ -174,41 +67,15 @@ impl SceneDescription {
         footprint::check_fits(&sizes, needed, "at their peak", available)
             .map_err(|e| e.context(&self.origin))
     }
-
-    /// The prepared material `name`, if it exists and suits the geometry.
-    fn assigned<'a>(
-        &self,
-        prepared: &'a BTreeMap<&str, Material>,
-        name: &str,
-        hair: bool,
-    ) -> Result<&'a Material> {
-        let material = prepared.get(name).ok_or_else(|| {
-            let defined: Vec<&str> = prepared.keys().copied().collect();
-            invalid_arg!(
-                "no material named {name:?} (defined: {})",
-                if defined.is_empty() {
-                    "none".to_string()
-                } else {
-                    defined.join(", ")
-                }
-            )
-        })?;
-        material.check_suits(&format!("{name:?}"), hair)?;
-        Ok(material)
-    }
-
-    /// `e` with this description's origin and the entry or key `at` in front, same kind.
-    fn error(&self, at: &str, e: Error) -> Error {
-        e.context(self.at(at))
-    }
-
-    /// The entry or key `at` of this description, as errors name it.
-    fn at(&self, at: &str) -> String {
-        format!("{}: {at}", self.origin)
-    }
 }
 
 impl MaterialDesc {
+    /// Whether the material suits curves (`on_curves`: hair) or meshes (diffuse), without
+    /// preparing it; `what` names it in the error.
+    pub fn check_suits(&self, what: &str, on_curves: bool) -> Result<()> {
+        check_kind(what, matches!(self, MaterialDesc::Hair(_)), on_curves)
+    }
+
     /// The material, every value checked: a host that edits a scene checks an edit with
     /// it before there is a build to take it.
     pub fn prepare(&self) -> Result<Material> {
@@ -334,7 +201,7 @@ impl GroomDesc {
     /// build's stages: one geometry, or one per BasisCurves prim of a USD file (laid out by
     /// the prim's own basis and wrap, placed by the entry's transform). Adds the groom to
     /// `framing`.
-    fn curves(
+    pub(crate) fn curves(
         &self,
         stages: &mut StageRunner,
         (i, grooms, reads): (usize, usize, usize),
@@ -551,7 +418,7 @@ impl CameraDesc {
 
     /// The camera for an image of `aspect`, framing `framing` when no eye and target are
     /// given.
-    pub(super) fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
+    pub(crate) fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
         let (camera, target) = match (self.eye, self.target) {
             (Some(eye), Some(target)) => {
                 let (eye, target) = (Vec3::from_array(eye), Vec3::from_array(target));

@@ -40,7 +40,7 @@ pub const DEMOS: [&str; 3] = ["furball", "furnace", "scalp"];
 /// let source = GroomSource::ControlPoints { points, counts: vec![3, 3], basis };
 /// scene.grooms = vec![GroomDesc::new(source, "hair")];
 /// scene.render.set("spp", "64")?;
-/// let built = scene.build(Arc::new(scene.render.device()?))?;
+/// let mut built = scene.build(Arc::new(scene.render.device()?))?;
 /// let image = built.render(Aovs::default(), &NoProgress)?.film;
 /// # let _ = image;
 /// # Ok(()) }

@@ -1,7 +1,8 @@
 //! Scene descriptions: a TOML description of a render (settings, camera, materials, grooms,
 //! meshes, lights), the built-in demos and the quick look at a bare groom. All of them are
 //! a [`SceneDescription`], plain data that a caller may adjust (the CLI's `--spp`,
-//! `--width`, ...) before [`SceneDescription::build`] turns it into a renderable world.
+//! `--width`, ...) before [`crate::Scene::from_description`] (or
+//! [`SceneDescription::build`]) makes a scene of it.
 //!
 //! # The file format
 //!
@@ -93,7 +94,6 @@
 pub(crate) mod assembly;
 mod build;
 mod demos;
-pub mod farm;
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -101,21 +101,15 @@ use std::path::PathBuf;
 use serde::Deserialize;
 
 use crate::embree::CurveBasis;
-use crate::error::{Result, invalid_arg};
 use crate::formats::hair::Thickness;
 use crate::formats::units::StageUnits;
 use crate::formats::usd::Layout;
-use crate::render::integrator::World;
-use crate::render::renderer::{self, RenderOutput};
 use crate::render::settings::RenderSettings;
-use crate::render::{Aovs, Progress};
 use crate::scene::GroomShape;
 use crate::scene::camera::Camera;
-use crate::scene::framing::Framing;
 use crate::scene::groom::{FurBall, ScalpPatch};
 use crate::scene::material::HairMaterial;
 use crate::scene::mesh::Mesh;
-use crate::scene::stages::StageTimes;
 use crate::scene::strands::Strands;
 
 pub use demos::{DEMOS, demo, quick_look};
@@ -345,135 +339,6 @@ pub enum EnvironmentSource {
 pub fn has_extension(path: &std::path::Path, ext: &str) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case(ext))
-}
-
-/// What a render needs, built from a description. Materials and lights can be changed
-/// on it without a new build ([`BuiltScene::set_material`], [`BuiltScene::set_lights`]),
-/// and so can the camera ([`BuiltScene::set_camera`]) and the settings, as long as the
-/// curves' view-dependent shapes still hold for them ([`BuiltScene::serves`]; a render
-/// refuses a view they no longer serve).
-pub struct BuiltScene {
-    pub(crate) world: World,
-    pub camera: Camera,
-    pub settings: RenderSettings,
-    /// Seconds each build stage took.
-    pub stages: StageTimes,
-    /// The name of each geometry's material, by geometry id.
-    sources: Vec<String>,
-    /// What the automatic camera frames, kept so that a new `[camera]` frames what the
-    /// build's did.
-    framing: Framing,
-}
-
-impl BuiltScene {
-    /// Renders the scene as built, its film and AOVs as `aovs` asks.
-    pub fn render(&self, aovs: Aovs, progress: &dyn Progress) -> Result<RenderOutput> {
-        self.render_with(&self.settings, aovs, progress)
-    }
-
-    /// Renders the scene as built with other settings, without a new build: more samples,
-    /// another seed, a noise target. Refused when the settings ask for a view the build's
-    /// curve shapes do not serve (more pixels, a finer level of detail).
-    ///
-    /// ```no_run
-    /// # use std::sync::Arc;
-    /// # use hairtrace::{Aovs, Device, NoProgress, SceneDescription};
-    /// # fn main() -> hairtrace::Result<()> {
-    /// let built = SceneDescription::load("scene.toml".as_ref())?.build(Arc::new(Device::new(None)?))?;
-    /// let preview = built.render(Aovs::default(), &NoProgress)?;
-    /// let mut finer = built.settings.clone();
-    /// finer.spp *= 16;
-    /// let final_frame = built.render_with(&finer, Aovs::default(), &NoProgress)?;
-    /// # let _ = (preview, final_frame);
-    /// # Ok(()) }
-    /// ```
-    pub fn render_with(
-        &self,
-        settings: &RenderSettings,
-        aovs: Aovs,
-        progress: &dyn Progress,
-    ) -> Result<RenderOutput> {
-        renderer::render(&self.world, &self.camera, settings, aovs, progress)
-    }
-
-    /// Gives the material `name` new parameters on every geometry that uses it, without a
-    /// new build: the next render is the one of the description built with `material`.
-    /// Refused (nothing changed) when no geometry uses `name` or when the material does not
-    /// suit its geometries.
-    ///
-    /// A look-development loop: one build, then one render per edit.
-    ///
-    /// ```no_run
-    /// use std::sync::Arc;
-    /// use hairtrace::description::{LightDesc, MaterialDesc};
-    /// use hairtrace::scene::{HairColor, HairMaterial};
-    /// use hairtrace::{Aovs, Device, NoProgress, SceneDescription};
-    /// # fn main() -> hairtrace::Result<()> {
-    /// let scene = SceneDescription::load("scene.toml".as_ref())?;
-    /// let mut built = scene.build(Arc::new(scene.render.device()?))?;
-    /// let first = built.render(Aovs::default(), &NoProgress)?;
-    /// let blond = HairMaterial {
-    ///     color: HairColor::Melanin { eumelanin: 0.3, pheomelanin: 0.1 },
-    ///     ..HairMaterial::default()
-    /// };
-    /// built.set_material("hair", &MaterialDesc::Hair(blond))?;
-    /// built.set_lights(&[LightDesc::Distant {
-    ///     direction: [0.0, 1.0, 1.0],
-    ///     irradiance: [3.0; 3],
-    ///     angular_radius_deg: 1.0,
-    /// }])?;
-    /// let second = built.render(Aovs::default(), &NoProgress)?; // no BVH build
-    /// # Ok(()) }
-    /// ```
-    pub fn set_material(&mut self, name: &str, material: &MaterialDesc) -> Result<()> {
-        let prepared = material.prepare()?;
-        let users: Vec<u32> = (self.sources.iter().enumerate())
-            .filter(|(_, s)| *s == name)
-            .map(|(g, _)| g as u32)
-            .collect();
-        if users.is_empty() {
-            return Err(invalid_arg!(
-                "no geometry of the scene uses a material named {name:?}"
-            ));
-        }
-        let what = format!("material {name:?}");
-        for &g in &users {
-            let on_curves = self.world.tracer.strands(g).is_some();
-            prepared.check_suits(&what, on_curves)?;
-        }
-        for g in users {
-            self.world.set_material(g, prepared.clone())?;
-        }
-        Ok(())
-    }
-
-    /// Places the camera as the `[camera]` table `camera` says, without a new build: an
-    /// automatic camera frames the built grooms as the build's did, for the built image's
-    /// aspect. A render refuses a camera the build does not serve ([`Self::serves`]).
-    pub fn set_camera(&mut self, camera: &CameraDesc) -> Result<()> {
-        let aspect = self.settings.width as f32 / self.settings.height as f32;
-        self.camera = camera.build(&self.framing, aspect)?;
-        Ok(())
-    }
-
-    /// Whether a render of the camera with `settings` can use this build: the curves'
-    /// view-dependent shapes hold for it (a view that sees them no smaller) and the
-    /// settings change none of [`BUILD_SETTINGS`](crate::render::settings::BUILD_SETTINGS).
-    pub fn serves(&self, settings: &RenderSettings) -> bool {
-        settings.build_change(&self.settings).is_none()
-            && renderer::serves(&self.world, &self.camera, settings)
-    }
-
-    /// Replaces the lights without a new build.
-    pub fn set_lights(&mut self, lights: &[LightDesc]) -> Result<()> {
-        let lights = (lights.iter().enumerate())
-            .map(|(i, l)| l.build().map_err(|e| e.context(format!("light[{i}]"))))
-            .collect::<Result<Vec<_>>>()?;
-        if lights.is_empty() {
-            return Err(invalid_arg!("no lights: give at least one"));
-        }
-        self.world.set_lights(lights)
-    }
 }
 
 #[cfg(test)]

@@ -19,21 +19,8 @@ use rayon::prelude::*;
 use super::order::{centroid, median_split};
 use super::{Device, sys};
 use crate::error::invalid_arg;
-pub use crate::math::CurveBasis;
+pub use crate::math::{CurveBasis, CurveShape};
 use crate::{Error, Result, threads};
-
-/// The surface Embree builds around a curve.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum CurveShape {
-    /// A true tube (swept sphere): the reference for close-ups.
-    Round,
-    /// A ribbon that always faces the ray: faster, approximate when seen up close.
-    Flat,
-}
-
-impl CurveShape {
-    pub const ALL: [CurveShape; 2] = [CurveShape::Round, CurveShape::Flat];
-}
 
 fn curve_type(basis: CurveBasis, shape: CurveShape) -> sys::RTCGeometryType {
     use sys::RTCGeometryType as T;

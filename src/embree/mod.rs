@@ -44,14 +44,16 @@ pub(crate) use scene::{SceneBuilder, cancelled};
 
 // The groom bench (`benches/groom.rs`) traces through Embree directly beside the tracer; the
 // `bench-internals` feature opens what it needs. No host should use them.
+/// Control points a host shares with Embree rather than copies (`Scene::add_control_points`).
+pub use geometry::SharedBuffer;
 #[cfg(feature = "bench-internals")]
 pub use scene::{PartsRule, Scene, SceneOptions};
 #[cfg(not(feature = "bench-internals"))]
 pub(crate) use scene::{PartsRule, Scene, SceneOptions};
 #[cfg(feature = "bench-internals")]
-pub use {geometry::Geometry, geometry::SharedBuffer, query::Ray, query::RayHit};
+pub use {geometry::Geometry, query::Ray, query::RayHit};
 #[cfg(not(feature = "bench-internals"))]
-pub(crate) use {geometry::Geometry, geometry::SharedBuffer, query::Ray, query::RayHit};
+pub(crate) use {geometry::Geometry, query::Ray, query::RayHit};
 
 /// The Embree version hairtrace was built against, as `major.minor.patch`, read from the
 /// installed `rtcore_config.h` at build time.

@@ -1,10 +1,25 @@
-//! The curve bases strands are drawn with, and the one home of their maths: which control
+//! The curve bases strands are drawn with and the surface a curve is traced as
+//! ([`CurveShape`]): domain types of every layer from Embree's wrapper up, so they live
+//! below it. This file is also the one home of the bases' maths: which control
 //! points a segment reads, its polynomial (evaluation and derivatives: the level of detail,
 //! sampling a curve into polylines) and the same segment in Bezier form (bounds from the
 //! control hull, conversions between bases). Every layer that draws, bounds, converts or
 //! reads curves asks these, so that no two of them can disagree on a basis.
 
 use std::ops::{Add, Div, Mul, Sub};
+
+/// The surface built around a curve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CurveShape {
+    /// A true tube (swept sphere): the reference for close-ups.
+    Round,
+    /// A ribbon that always faces the ray: faster, approximate when seen up close.
+    Flat,
+}
+
+impl CurveShape {
+    pub const ALL: [CurveShape; 2] = [CurveShape::Round, CurveShape::Flat];
+}
 
 /// How the control points of a curve segment are interpolated.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -8,7 +8,7 @@ pub(crate) mod frame;
 pub(crate) mod lanes;
 pub(crate) mod sampling;
 
-pub use curve_basis::CurveBasis;
+pub use curve_basis::{CurveBasis, CurveShape};
 pub use frame::{Frame, hair_frame_offset};
 pub use lanes::Lanes;
 

@@ -187,6 +187,8 @@ pub struct Setting {
     /// The doc comment's lines.
     doc: &'static [&'static str],
     pub range: Range,
+    /// Whether a render with another value needs a build of its own.
+    pub needs: Needs,
     kind: fn() -> String,
     default: fn() -> String,
     get: fn(&RenderSettings) -> String,
@@ -240,11 +242,11 @@ macro_rules! settings {
     (
         $(#[$rmeta:meta])*
         pub struct RenderSettings {
-            $( $(#[doc = $rdoc:literal])* $rname:ident : $rty:ty = $rdefault:expr, $rrange:expr; )*
+            $( $(#[doc = $rdoc:literal])* $rname:ident : $rty:ty = $rdefault:expr, $rrange:expr, $rneeds:ident; )*
         }
         $(#[$pmeta:meta])*
         pub struct PathSettings {
-            $( $(#[doc = $pdoc:literal])* $pname:ident : $pty:ty = $pdefault:expr, $prange:expr; )*
+            $( $(#[doc = $pdoc:literal])* $pname:ident : $pty:ty = $pdefault:expr, $prange:expr, $pneeds:ident; )*
         }
     ) => {
         $(#[$rmeta])*
@@ -279,6 +281,7 @@ macro_rules! settings {
                 name: stringify!($rname),
                 doc: &[$($rdoc),*],
                 range: $rrange,
+                needs: Needs::$rneeds,
                 kind: <$rty as Value>::kind,
                 default: || Value::show(&RenderSettings::default().$rname),
                 get: |s| Value::show(&s.$rname),
@@ -289,6 +292,7 @@ macro_rules! settings {
                 name: stringify!($pname),
                 doc: &[$($pdoc),*],
                 range: $prange,
+                needs: Needs::$pneeds,
                 kind: <$pty as Value>::kind,
                 default: || Value::show(&PathSettings::default().$pname),
                 get: |s| Value::show(&s.path.$pname),
@@ -306,49 +310,48 @@ settings! {
     /// them.
     pub struct RenderSettings {
         /// Image width in pixels.
-        width: u32 = 640, Range::Closed(1.0, MAX_SIDE as f64);
+        width: u32 = 640, Range::Closed(1.0, MAX_SIDE as f64), Render;
         /// Image height in pixels.
-        height: u32 = 480, Range::Closed(1.0, MAX_SIDE as f64);
+        height: u32 = 480, Range::Closed(1.0, MAX_SIDE as f64), Render;
         /// Samples per pixel; with a noise target or a time budget, the most.
-        spp: u32 = 16, Range::AtLeast(1.0);
+        spp: u32 = 16, Range::AtLeast(1.0), Render;
         /// Stop once the estimated noise (RMSE relative to the image's mean) is at most this;
         /// none: render all spp.
-        noise_target: Option<f32> = None, Range::Above(0.0);
+        noise_target: Option<f32> = None, Range::Above(0.0), Render;
         /// Stop before a pass that would end past this many seconds of rendering; none: no
         /// limit.
-        time_budget: Option<f32> = None, Range::Above(0.0);
+        time_budget: Option<f32> = None, Range::Above(0.0), Render;
         /// Where samples go: noise (a pilot pass of 8 spp, then, where the pilot says it
         /// pays, each pixel's share in proportion to its noise over the square root of its
         /// cost, unbiased; the same number of samples over each 32 x 32 block; taken from 9
         /// to 2^22 spp, uniform outside) or uniform (spp in every pixel).
-        allocation: Allocation = Allocation::Noise, Range::Any;
+        allocation: Allocation = Allocation::Noise, Range::Any, Render;
         /// The image depends only on the scene, the settings and this seed.
-        seed: u64 = 0, Range::Any;
+        seed: u64 = 0, Range::Any, Render;
         /// Worker threads; none: one per hardware thread.
-        threads: Option<usize> = None, Range::AtLeast(1.0);
+        threads: Option<usize> = None, Range::AtLeast(1.0), Render;
         /// Pin Embree's kernels to one instruction set, so that crops rendered on different
-        /// CPUs assemble bit for bit (docs/farm.md); none: the widest this CPU runs. Through
-        /// the C ABI the device's pin decides (`ht_device_new_pinned`): a render asking
+        /// CPUs assemble bit for bit (docs/farm.md); none: the widest this CPU runs. A scene's
+        /// device holds the pin (`Device::pinned`, `ht_device_new_pinned`): a render asking
         /// another is refused.
-        isa: Option<Isa> = None, Range::Any;
+        isa: Option<Isa> = None, Range::Any, Build;
         /// Render only the pixels [x0, x1) x [y0, y1) of the full frame, exactly as the full
         /// render has them; none: the full frame.
-        crop: Option<[u32; 4]> = None, Range::Any;
+        crop: Option<[u32; 4]> = None, Range::Any, Render;
         /// Pixel filter: tent (thin strands alias under a box) or box (one pixel, as
         /// renderers that use it).
-        filter: Filter = Filter::Tent, Range::Any;
+        filter: Filter = Filter::Tent, Range::Any, Render;
         /// The tent's half-width in pixels (the box ignores it).
-        filter_radius: f32 = 1.0, Range::OpenClosed(0.0, 8.0);
+        filter_radius: f32 = 1.0, Range::OpenClosed(0.0, 8.0), Render;
         /// Level of detail of `auto` grooms: the largest distance, in pixels, between a thin
         /// strand's curve and the linear ribbons traced in its place, or the quads Embree
         /// intersects a cubic ribbon as; 0: no polylines (the quads keep the default's).
-        lod_pixels: f32 = DEFAULT_LOD_PIXELS, Range::AtLeast(0.0);
+        lod_pixels: f32 = DEFAULT_LOD_PIXELS, Range::AtLeast(0.0), Build;
         /// Whether a groom of 2^18 segments or more is built as parts of 2^10, each a BVH
         /// of its own built when a ray first reaches it: auto (from 2^20 segments, for a
         /// render of fewer than 3 camera samples per segment, where the faster build
-        /// outweighs the slower rays: docs/large-grooms.md), on or off. Read by the build:
-        /// a C ABI scene builds again when it changes.
-        curve_parts: CurveParts = CurveParts::Auto, Range::Any;
+        /// outweighs the slower rays: docs/large-grooms.md), on or off.
+        curve_parts: CurveParts = CurveParts::Auto, Range::Any, Build;
     }
 
     /// How paths are traced and ended, and the hair BSDF's fidelity knobs.
@@ -356,37 +359,37 @@ settings! {
         /// Longest path, in scattering events. 256 keeps a white fur ball's furnace above
         /// 0.9999 (white fibres scatter for hundreds of bounces); Russian roulette ends most
         /// paths far earlier.
-        max_depth: u32 = 256, Range::AtLeast(1.0);
+        max_depth: u32 = 256, Range::AtLeast(1.0), Render;
         /// Russian roulette may end a path after this many events. 2 always traces the ray
         /// that leaves the first hit: 1.2-1.25x more efficient than 1 or 3 on the bench
         /// scenes.
-        rr_depth: u32 = 2, Range::AtLeast(1.0);
+        rr_depth: u32 = 2, Range::AtLeast(1.0), Render;
         /// Russian roulette's survival: sqrt (of the path throughput's largest channel:
         /// keeps long chains through light hair) or throughput (pbrt's rule).
-        roulette: Roulette = Roulette::SqrtThroughput, Range::Any;
+        roulette: Roulette = Roulette::SqrtThroughput, Range::Any, Render;
         /// Upper bound on the luminance of one contribution of indirect light (biased, cuts
         /// fireflies); none: no clamping.
-        clamp_indirect: Option<f32> = None, Range::Above(0.0);
+        clamp_indirect: Option<f32> = None, Range::Above(0.0), Render;
         /// How light is gathered: mis (the renderer), light or bsdf (one strategy alone,
         /// which tests use to show that MIS is unbiased).
-        strategy: Strategy = Strategy::Mis, Range::Any;
+        strategy: Strategy = Strategy::Mis, Range::Any, Render;
         /// Past this many scattering events a hair BSDF is one merged lobe (the same
         /// energy, no azimuthal highlights: less noise on light hair, at a bias); none: the
         /// exact model at every event. At most max_depth.
-        deep_bounce_depth: Option<u32> = None, Range::AtLeast(1.0);
+        deep_bounce_depth: Option<u32> = None, Range::AtLeast(1.0), Render;
         /// Hair lobes whose attenuation is below this fraction of the total are dropped;
         /// 0: every lobe. Measured to save no time on the bench scenes.
-        lobe_cull: f32 = 0.0, Range::ClosedOpen(0.0, 1.0);
+        lobe_cull: f32 = 0.0, Range::ClosedOpen(0.0, 1.0), Render;
         /// Shadow-ray roulette: a light sample contributing less than this to the pixel
         /// (largest channel) traces its shadow ray with probability contribution /
         /// threshold, reweighted (unbiased); 0: every shadow ray.
-        light_threshold: f32 = 0.03, Range::AtLeast(0.0);
+        light_threshold: f32 = 0.03, Range::AtLeast(0.0), Render;
         /// Where next-event estimation evaluates a hair BSDF across the fibre: across (the
         /// mean over eight offsets, the hit's among them: the same image in expectation,
         /// 1.5-2.5x less variance per sample under small lights; not at a camera ray's hit on
         /// a strand wider than its pixel, whose highlights the image resolves) or hit (the
         /// hit's offset alone).
-        light_offsets: LightOffsets = LightOffsets::Across, Range::Any;
+        light_offsets: LightOffsets = LightOffsets::Across, Range::Any, Render;
     }
 }
 
@@ -451,10 +454,15 @@ pub enum Filter {
     Box,
 }
 
-/// The settings a build is made for (the film's shape, Embree's kernels, the curves'
-/// level of detail and parts): a render that changes one needs a build of its own. The
-/// command line's variants and the Python package decide by this list alone.
-pub const BUILD_SETTINGS: [&str; 5] = ["width", "height", "isa", "lod_pixels", "curve_parts"];
+/// What a change of a setting costs: another render, or a build first (Embree's kernels,
+/// the curves' level of detail and parts). The image's size is `Render`: the camera is
+/// placed at each render, and the view check (`renderer::serves`) builds again for pixels
+/// smaller than the `auto` curves were shaped for. `Scene` reads this alone.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Needs {
+    Render,
+    Build,
+}
 
 /// Largest accepted image side, so that a typo cannot ask for terabytes.
 pub(crate) const MAX_SIDE: u32 = 1 << 15;
@@ -530,12 +538,13 @@ impl RenderSettings {
         Ok(())
     }
 
-    /// The first of [`BUILD_SETTINGS`] whose value differs from `built`'s (the settings a
-    /// scene was built for): None when a render with these settings can use that build.
-    pub fn build_change(&self, built: &RenderSettings) -> Option<&'static str> {
-        BUILD_SETTINGS
-            .into_iter()
-            .find(|name| self.get(name).ok() != built.get(name).ok())
+    /// The first setting that [needs a build](Needs::Build) whose value differs from
+    /// `built`'s (the settings a scene was built for): None when a render with these
+    /// settings can use that build.
+    pub(crate) fn build_change(&self, built: &RenderSettings) -> Option<&'static str> {
+        (SETTINGS.iter())
+            .find(|s| s.needs == Needs::Build && (s.get)(self) != (s.get)(built))
+            .map(|s| s.name)
     }
 
     /// The crop window, or the full frame.

@@ -49,6 +49,17 @@ impl Framing {
 
     /// The vertices of a mesh, framed only when the scene has no hair. (A scene file
     /// leaves its ground quads out: framing the stage would shrink the subject.)
+    /// Adds what `other` frames: the frame of two sets of geometry is the frame of both.
+    pub fn merge(&mut self, other: &Framing) {
+        for (mine, theirs) in [
+            (&mut self.hair, other.hair),
+            (&mut self.meshes, other.meshes),
+        ] {
+            mine.lo = mine.lo.min(theirs.lo);
+            mine.hi = mine.hi.max(theirs.hi);
+        }
+    }
+
     pub fn add_mesh(&mut self, positions: &[[f32; 3]]) {
         for p in positions {
             self.meshes.add(Vec3::from_array(*p), 0.0);

@@ -18,15 +18,21 @@ impl Material {
     /// Checks that the material suits the geometry: hair on curves (`on_curves`), diffuse
     /// on meshes. `what` names the material in the error.
     pub fn check_suits(&self, what: &str, on_curves: bool) -> Result<()> {
-        match (self, on_curves) {
-            (Material::Hair(_), true) | (Material::Diffuse(_), false) => Ok(()),
-            (Material::Diffuse(_), true) => Err(invalid_arg!(
-                "{what} is a diffuse material; curves need a hair material"
-            )),
-            (Material::Hair(_), false) => Err(invalid_arg!(
-                "{what} is a hair material; meshes need a diffuse material"
-            )),
-        }
+        check_kind(what, matches!(self, Material::Hair(_)), on_curves)
+    }
+}
+
+/// Whether a material of its kind (`hair` or diffuse) suits curves (`on_curves`) or meshes:
+/// [`Material::check_suits`] for a material not prepared yet.
+pub(crate) fn check_kind(what: &str, hair: bool, on_curves: bool) -> Result<()> {
+    match (hair, on_curves) {
+        (true, true) | (false, false) => Ok(()),
+        (false, true) => Err(invalid_arg!(
+            "{what} is a diffuse material; curves need a hair material"
+        )),
+        (true, false) => Err(invalid_arg!(
+            "{what} is a hair material; meshes need a diffuse material"
+        )),
     }
 }
 

@@ -32,6 +32,7 @@ pub mod tracer;
 #[cfg(not(feature = "bench-internals"))]
 pub(crate) mod tracer;
 
+pub use crate::math::{CurveBasis, CurveShape};
 pub use camera::Camera;
 pub use envmap::Environment;
 pub use groom::{FurBall, HairStyle, ScalpPatch};

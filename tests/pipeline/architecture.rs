@@ -7,13 +7,14 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// Top-level modules from the bottom up; a module may use its own layer and those below.
-const LAYERS: [&[&str]; 7] = [
+const LAYERS: [&[&str]; 8] = [
     &["error", "quiet_panic", "threads", "validate"],
     &["math"],
     &["bsdf", "embree", "image"],
     &["scene"],
-    &["render"],
+    &["render", "farm"],
     &["description", "formats"],
+    &["incremental"],
     &["capi"],
 ];
 

@@ -28,7 +28,7 @@ fn render_rows(machine: Isa, pin: Option<Isa>, y0: u32, y1: u32) -> Vec<u32> {
     let device = Arc::new(Device::with_config(&config).unwrap());
     let mut d = scene();
     d.render.crop = Some([0, y0, W, y1]);
-    let built = d.build(device).unwrap();
+    let mut built = d.build(device).unwrap();
     let out = built.render(Aovs::default(), &NoProgress).unwrap();
     out.film.rgb().iter().map(|v| v.to_bits()).collect()
 }

@@ -453,7 +453,7 @@ fn the_fixture_renders() {
         d.render.spp,
         d.render.threads,
     ) = (48, 36, 2, Some(1));
-    let built = d.build(Arc::new(Device::new(Some(1)).unwrap())).unwrap();
+    let mut built = d.build(Arc::new(Device::new(Some(1)).unwrap())).unwrap();
     let aovs = Aovs {
         strand_id: true,
         ..Aovs::default()

@@ -94,7 +94,7 @@ fn stages_come_in_order_and_finish() {
             .any(|&(s, f)| s == Stage::Bvh && f > 0.0 && f < 1.0),
         "no progress inside the BVH build: {calls:?}"
     );
-    let times = built.stages;
+    let times = built.stages();
     assert!(Stage::ALL.iter().all(|&s| times.get(s) >= 0.0));
     assert!(times.bvh > 0.0 && times.read > 0.0 && times.curves > 0.0);
 }

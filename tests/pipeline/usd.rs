@@ -133,7 +133,7 @@ fn every_fixture_renders_a_visible_image() {
         desc.render.width = 48;
         desc.render.height = 32;
         desc.render.spp = 1;
-        let built = desc.build(device.clone()).unwrap();
+        let mut built = desc.build(device.clone()).unwrap();
         let aovs = Aovs {
             strand_id: true,
             ..Aovs::default()
@@ -198,7 +198,7 @@ fn a_z_up_stage_renders_upright_in_metres() {
     );
     assert!((placed[0].strands.radii[0] - 0.002).abs() < 1e-9);
     (desc.render.width, desc.render.height, desc.render.spp) = (48, 48, 1);
-    let built = desc.build(Arc::new(Device::new(Some(1)).unwrap())).unwrap();
+    let mut built = desc.build(Arc::new(Device::new(Some(1)).unwrap())).unwrap();
     let aovs = Aovs {
         strand_id: true,
         ..Aovs::default()
@@ -511,10 +511,10 @@ fn scene_files_take_usd_grooms() {
     let mut eyes = Vec::new();
     for t in [0.0, 5.0] {
         let desc = SceneDescription::from_toml(&scene(t), &fixtures(), "usd.toml").unwrap();
-        let built = desc.build(device.clone()).unwrap();
+        let mut built = desc.build(device.clone()).unwrap();
         let out = built.render(Aovs::default(), &NoProgress).unwrap();
         assert!(out.film.rgb().iter().all(|v| v.is_finite()));
-        eyes.push(built.camera.eye());
+        eyes.push(built.placed_camera(&built.settings).unwrap().eye());
     }
     assert!((eyes[1].x - eyes[0].x - 5.0).abs() < 1e-3, "{eyes:?}");
 }

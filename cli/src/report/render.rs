@@ -138,7 +138,7 @@ pub fn fewer_strands(desc: &mut SceneDescription, factor: usize) {
 }
 
 /// A built variant, ready to render at any spp and seed.
-pub struct Built(hairtrace::BuiltScene);
+pub struct Built(hairtrace::Scene);
 
 impl Built {
     pub fn new(v: &Variant) -> Result<Built> {

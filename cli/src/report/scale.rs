@@ -133,9 +133,9 @@ fn measure(desc: &SceneDescription, strands: usize) -> Result<Point> {
     let monitor = MemoryMonitor::attach(device.clone());
     let rss = rss_mib();
     let start = Instant::now();
-    let built = desc.build(device)?;
+    let mut built = desc.build(device)?;
     let build = start.elapsed().as_secs_f64();
-    let stages = Stage::ALL.map(|s| built.stages.get(s));
+    let stages = Stage::ALL.map(|s| built.stages().get(s));
     let first = built.render(Aovs::default(), &NoProgress)?.stats;
     let rss_mib = rss_mib() - rss;
     let embree_mib = monitor.peak() as f64 / (1024.0 * 1024.0);

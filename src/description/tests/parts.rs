@@ -14,7 +14,8 @@ fn parts_built(width: u32, height: u32, parts: &str, strands: usize) -> usize {
     fur_ball_of(width, height, parts, strands)
         .build(Arc::new(Device::new(None).unwrap()))
         .unwrap()
-        .world
+        .world()
+        .unwrap()
         .tracer
         .scene()
         .part_count()
@@ -75,21 +76,21 @@ fn a_large_groom_is_built_in_parts_as_the_setting_says() {
 #[test]
 fn a_render_builds_the_parts_it_reaches_and_fails_with_one_that_fails() {
     let device = Arc::new(Device::new(None).unwrap());
-    let built = fur_ball(8, 8, "on").build(device.clone()).unwrap();
-    let scene = built.world.tracer.scene();
-    assert_eq!(scene.parts_built().built, 0);
+    let mut built = fur_ball(8, 8, "on").build(device.clone()).unwrap();
+    let parts_built = |b: &crate::Scene| b.world().unwrap().tracer.scene().parts_built().built;
+    assert_eq!(parts_built(&built), 0);
     let first = built.render(Aovs::default(), &NoProgress).unwrap().stats;
     assert!(
         first.parts_built > 0 && first.part_build_seconds > 0.0,
         "{first:?}"
     );
-    assert_eq!(scene.parts_built().built, first.parts_built);
+    assert_eq!(parts_built(&built), first.parts_built);
     assert!(first.first_tile_seconds.is_some_and(|t| t <= first.seconds));
     // A second render of the same view reaches no part the first did not.
     let again = built.render(Aovs::default(), &NoProgress).unwrap().stats;
     assert_eq!(again.parts_built, 0);
 
-    let built = fur_ball(8, 8, "on").build(device.clone()).unwrap();
+    let mut built = fur_ball(8, 8, "on").build(device.clone()).unwrap();
     device.refuse_allocations(true);
     let failed = built.render(Aovs::default(), &NoProgress);
     device.refuse_allocations(false);
@@ -105,7 +106,7 @@ fn parts_built_as_rays_reach_them_keep_threads_and_crops_exact() {
     let device = Arc::new(Device::new(None).unwrap());
     let desc = fur_ball(40, 30, "on");
     let run = |threads, crop| {
-        let built = desc.build(device.clone()).unwrap();
+        let mut built = desc.build(device.clone()).unwrap();
         let settings = crate::RenderSettings {
             threads: Some(threads),
             crop,

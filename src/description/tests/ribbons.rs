@@ -63,7 +63,7 @@ radiance = [1, 1, 1]
 }
 
 fn render(d: &SceneDescription, aovs: Aovs) -> RenderOutput {
-    let built = d.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
+    let mut built = d.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
     built.render(aovs, &NoProgress).unwrap()
 }
 
@@ -78,7 +78,7 @@ fn curve_shapes(d: &SceneDescription) -> Vec<CurveShape> {
 
 fn curve_kinds(d: &SceneDescription) -> Vec<(CurveBasis, CurveShape)> {
     let built = d.build(Arc::new(Device::new(Some(2)).unwrap())).unwrap();
-    (built.world.tracer.scene().geometries().iter())
+    (built.world().unwrap().tracer.scene().geometries().iter())
         .filter_map(|g| match g {
             Geometry::Curves(c) => Some((c.basis(), c.shape())),
             _ => None,

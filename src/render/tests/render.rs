@@ -441,7 +441,7 @@ fn furnace_demo_is_a_furnace() {
     d.render.spp = 8;
     let spp = d.render.spp as f32;
     let device = Arc::new(Device::new(Some(2)).unwrap());
-    let built = d.build(device).unwrap();
+    let mut built = d.build(device).unwrap();
     let aovs = Aovs {
         albedo: true,
         ..Aovs::default()

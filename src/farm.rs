@@ -4,9 +4,10 @@
 //! do not belong together rather than pasting a frame no single render would give.
 //!
 //! A tile is an EXR whose data window is its crop of the full frame and whose header holds
-//! [`header`]'s `hairtrace:*` attributes. Assembly checks that every tile is there, holds
-//! the window the rule gives it, and agrees with the others on every attribute but the
-//! window, so that the frame it writes is bit for bit the whole-frame render (docs/farm.md).
+//! [`header`](crate::farm::header)'s `hairtrace:*` attributes. Assembly checks that every
+//! tile is there, holds the window the rule gives it, and agrees with the others on every
+//! attribute but the window, so that the frame it writes is bit for bit the whole-frame
+//! render (docs/farm.md).
 
 use std::path::{Path, PathBuf};
 
@@ -128,7 +129,10 @@ pub struct Assembled {
 /// another window, or one whose header disagrees with the first tile's is refused, and the
 /// error names the tile and the attribute.
 pub fn assemble(frame: &Path, count: u32) -> Result<Assembled> {
-    if !super::has_extension(frame, "exr") {
+    if !frame
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"))
+    {
         return Err(invalid_arg!(
             "{}: a frame assembled from tiles is an EXR (float pixels, and the header that \
              says what rendered them)",

@@ -6,9 +6,9 @@
 //! ribbon's h is the offset across the flat quad struck: `tracer::hair_hit`); its hit moves
 //! to where the ray enters the tube (`tracer::tube_entry`). It differs at end caps and
 //! joints, which a strand thinner than a pixel hides inside the pixel. Embree intersects a
-//! cubic ribbon as quads along chords of its curve; each thin strand gets as many quads
+//! cubic ribbon as quads along chords of its curve; thin strands get as many quads
 //! per segment as keep them within the level of detail's tolerance of the curve in this
-//! view ([`lod::ribbon_quads`]), and a tube where Embree's most quads do not. A flat linear
+//! view ([`lod::ribbon_quads`]), up to Embree's most. A flat linear
 //! curve costs Embree less per ray than a round one (docs/measurements.md, "Curve shapes").
 //!
 //! With a level of detail (`lod_pixels` > 0), the thin strands of every basis are traced
@@ -19,7 +19,7 @@
 
 use glam::Vec3;
 
-use crate::embree::{CurveBasis, CurveShape};
+use crate::embree::{CurveBasis, CurveShape, DEFAULT_RIBBON_QUADS, MAX_RIBBON_QUADS};
 use crate::error::Result;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -106,11 +106,11 @@ pub fn share_out(
     let shape = |part, curves: Curves| -> Result<Vec<Curves>> {
         Ok(match part {
             Part::Round => vec![curves.with_shape(CurveShape::Round)],
-            Part::Flat => ribbons(curves)?,
+            Part::Flat => vec![ribbons(curves)?],
             Part::Polyline => {
                 let (lines, native) = lod::polylines(curves, camera, height, lod_pixels)?;
                 let native = native.map(ribbons).transpose()?;
-                native.into_iter().flatten().chain(lines).collect()
+                native.into_iter().chain(lines).collect()
             }
         })
     };
@@ -128,18 +128,15 @@ pub fn share_out(
     Ok(out)
 }
 
-/// Thin strands as flat curves, each intersected in as many quads per segment as keep it
-/// within the level of detail's tolerance of its curve (`lod::ribbon_quads`; without a
-/// level of detail, its default tolerance), and round where Embree's most quads do not:
-/// one geometry per quad count.
-fn cubic_ribbons(
-    curves: Curves,
-    camera: &Camera,
-    height: u32,
-    lod_pixels: f32,
-) -> Result<Vec<Curves>> {
+/// Thin strands as flat curves, intersected in as many quads per segment as keep every
+/// strand within the level of detail's tolerance of its curve (`lod::ribbon_quads`;
+/// without a level of detail, its default tolerance), at most Embree's most. One geometry
+/// for all: a geometry per count copied the groom's points, a second copy of the largest
+/// grooms at the peak (docs/measurements.md, "Ribbons' quads at the silhouette").
+fn cubic_ribbons(curves: Curves, camera: &Camera, height: u32, lod_pixels: f32) -> Result<Curves> {
+    let curves = curves.with_shape(CurveShape::Flat);
     if curves.basis() == CurveBasis::Linear {
-        return Ok(vec![curves.with_shape(CurveShape::Flat)]);
+        return Ok(curves);
     }
     let tolerance = if lod_pixels > 0.0 {
         lod_pixels
@@ -147,25 +144,11 @@ fn cubic_ribbons(
         lod::DEFAULT_LOD_PIXELS
     };
     let quads = lod::ribbon_quads(&curves, camera, height, tolerance)?;
-    let drawn = |q: Option<u32>, curves: Curves| match q {
-        Some(n) => curves.with_shape(CurveShape::Flat).with_ribbon_quads(n),
-        None => curves.with_shape(CurveShape::Round),
-    };
-    let first = quads.first().copied().flatten();
-    if quads.iter().all(|&q| q == first) {
-        return Ok(vec![drawn(first, curves)]);
-    }
-    let mut kinds: Vec<Option<u32>> = quads.clone();
-    kinds.sort_unstable();
-    kinds.dedup();
-    let mut out = Vec::with_capacity(kinds.len());
-    for kind in kinds {
-        let keep: Vec<bool> = quads.iter().map(|&q| q == kind).collect();
-        if let Some(subset) = curves.subset(&keep, CurveShape::Flat)? {
-            out.push(drawn(kind, subset));
-        }
-    }
-    Ok(out)
+    let most = (quads.iter())
+        .map(|q| q.unwrap_or(MAX_RIBBON_QUADS))
+        .max()
+        .unwrap_or(DEFAULT_RIBBON_QUADS);
+    Ok(curves.with_ribbon_quads(most))
 }
 
 #[cfg(test)]

@@ -156,9 +156,9 @@ pub fn polylines(
 /// default, then up to its most.
 const RIBBON_QUADS: [u32; 3] = [DEFAULT_RIBBON_QUADS, 8, MAX_RIBBON_QUADS];
 
-/// Per strand of cubic `curves`, the fewest quads per segment of [`RIBBON_QUADS`] that keep
-/// its ribbon within `pixels` of its curve, seen from `camera` in an image `height` pixels
-/// tall; `None` where even the most do not.
+/// The fewest quads per segment of [`RIBBON_QUADS`] that keep every ribbon of cubic
+/// `curves` within `pixels` of its curve, seen from `camera` in an image `height` pixels
+/// tall; the most where even they do not.
 ///
 /// Embree's ribbon quads run along chords of the curve, at even steps of its parameter.
 /// Where a strand turns in the view, as a crown's strands do at the silhouette, the
@@ -166,29 +166,18 @@ const RIBBON_QUADS: [u32; 3] = [DEFAULT_RIBBON_QUADS, 8, MAX_RIBBON_QUADS];
 /// (docs/measurements.md, "Ribbons' quads at the silhouette"). The bound is a chord's
 /// largest distance from a curve: an eighth of its parameter step squared times the
 /// second derivative across the line of sight, largest at a segment end (it is linear).
-pub fn ribbon_quads(
-    curves: &Curves,
-    camera: &Camera,
-    height: u32,
-    pixels: f32,
-) -> Result<Vec<Option<u32>>> {
+pub fn ribbon_quads(curves: &Curves, camera: &Camera, height: u32, pixels: f32) -> Result<u32> {
     check_pixels(pixels)?;
     let (eye, per_distance) = (camera.eye(), pixels * camera.pixel_spread(height));
-    let strands = curves.strands();
-    threads::scoped(0, || {
-        (0..strands.strand_count())
+    let turn = threads::scoped(0, || {
+        (0..curves.indices().len() as u32)
             .into_par_iter()
-            .map(|s| {
-                let turn = (strands.first_segment(s).into_iter())
-                    .flat_map(|first| first.prims())
-                    .filter_map(|prim| curves.segment_curve(prim))
-                    .map(|curve| turn_over_distance(&curve, eye))
-                    .fold(0.0f32, f32::max);
-                let quads = |n: u32| (n * n) as f32 * 8.0 * per_distance;
-                RIBBON_QUADS.into_iter().find(|&n| turn <= quads(n))
-            })
-            .collect()
-    })
+            .filter_map(|prim| curves.segment_curve(prim))
+            .map(|curve| turn_over_distance(&curve, eye))
+            .reduce(|| 0.0, f32::max)
+    })?;
+    let within = |n: u32| turn <= (n * n) as f32 * 8.0 * per_distance;
+    Ok((RIBBON_QUADS.into_iter().find(|&n| within(n))).unwrap_or(MAX_RIBBON_QUADS))
 }
 
 /// A segment's largest second derivative across the line of sight from `eye`, over its

@@ -19,7 +19,7 @@
 
 use glam::Vec3;
 
-use crate::embree::{CurveBasis, CurveShape, DEFAULT_RIBBON_QUADS, MAX_RIBBON_QUADS};
+use crate::embree::{CurveBasis, CurveShape};
 use crate::error::Result;
 use crate::scene::camera::Camera;
 use crate::scene::curves::Curves;
@@ -144,11 +144,7 @@ fn cubic_ribbons(curves: Curves, camera: &Camera, height: u32, lod_pixels: f32) 
         lod::DEFAULT_LOD_PIXELS
     };
     let quads = lod::ribbon_quads(&curves, camera, height, tolerance)?;
-    let most = (quads.iter())
-        .map(|q| q.unwrap_or(MAX_RIBBON_QUADS))
-        .max()
-        .unwrap_or(DEFAULT_RIBBON_QUADS);
-    Ok(curves.with_ribbon_quads(most))
+    Ok(curves.with_ribbon_quads(quads))
 }
 
 #[cfg(test)]

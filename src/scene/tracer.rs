@@ -78,8 +78,8 @@ const FLAT_BLIND_RADII: f32 = 2.0;
 const RADIUS_OVERSHOOT: f32 = 1.25;
 
 /// How far, in radii, a ribbon's hit may move back along its ray to the tube's surface
-/// ([`tube_entry`]): a ray at 30 degrees to the axis enters the tube two radii before the
-/// midplane.
+/// ([`tube_entry`]): a ray at angle a to the axis enters the tube up to 1 / sin(a) radii
+/// before the midplane, so rays within 30 degrees of the axis are held at this.
 const TUBE_ENTRY_RADII: f32 = 2.0;
 
 /// A ray leaving a hit, with the exclusion that keeps it off the surface it left.

@@ -14,7 +14,8 @@ use crate::scene::ribbons::share_out;
 use crate::scene::tracer::{Tracer, TracerBuilder};
 use glam::Vec3;
 
-/// Image height, in pixels, of the test camera: at distance 1 a pixel is 0.0054 wide.
+/// Image height, in pixels, of the test camera (30 degrees tall): a pixel at distance 1 is
+/// 2 tan(15 degrees) / HEIGHT wide.
 const HEIGHT: u32 = 100;
 const RADIUS: f32 = 0.001;
 /// The hairpin's bend radius: about two pixels.

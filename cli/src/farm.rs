@@ -321,7 +321,7 @@ esac
 }
 
 /// "F" or "FIRST-LAST".
-fn parse_frames(text: &str) -> Result<(u32, u32)> {
+pub fn parse_frames(text: &str) -> Result<(u32, u32)> {
     let bad = || {
         Error::InvalidArg(format!(
             "--frames {text:?}: must be F or FIRST-LAST (whole numbers, FIRST <= LAST)"

@@ -113,9 +113,10 @@ struct FarmArgs {
     /// A built-in scene instead of a file: furball (the default), furnace, scalp.
     #[arg(long, conflicts_with = "scene")]
     demo: Option<String>,
-    /// The frames, F or FIRST-LAST; frame F is rendered with seed F.
-    #[arg(long, default_value = "1")]
-    frames: String,
+    /// The frames, F or FIRST-LAST; frame F is rendered with seed F, and an animated
+    /// scene's groom files are read at it. Default: the scene's `[animation] frames`, else 1.
+    #[arg(long)]
+    frames: Option<String>,
     /// Tiles per frame (a grid, `render --tile`).
     #[arg(long, default_value_t = 4)]
     tiles: u32,
@@ -262,8 +263,10 @@ struct RenderArgs {
     /// `hairtrace assemble`.
     #[arg(long, value_name = "I/N", value_parser = parse_tile)]
     tile: Option<(u32, u32)>,
-    /// The frame number: replaces the run of # in -o (`frame.####.exr` with 7:
-    /// `frame.0007.exr`) and is written into the image's header.
+    /// The frame number: the frame of the animation the scene's groom files are read at
+    /// (USD time samples, the file of a `groom.####.hair` sequence), replacing the scene's
+    /// own `[animation] frame`; it also replaces the run of # in -o (`frame.####.exr` with
+    /// 7: `frame.0007.exr`) and is written into the image's header.
     #[arg(long = "frame")]
     frame_number: Option<u32>,
 }
@@ -518,6 +521,9 @@ impl RenderArgs {
 fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     let frame = args.checked_frame(&args.output)?;
     let mut description = load_scene(args.scene.as_ref(), args.demo.as_deref())?;
+    if let Some(f) = args.frame_number {
+        description.at_frame(f64::from(f))?;
+    }
     if let Some(sigma_a) = args.preset {
         if !args
             .scene
@@ -816,11 +822,21 @@ fn farm_job(args: &FarmArgs) -> hairtrace::Result<()> {
     };
     let output =
         std::path::absolute(&args.output).map_err(|e| hairtrace::Error::io(&args.output, e))?;
+    let frames = match (&args.frames, description.frames) {
+        (Some(frames), _) => frames.clone(),
+        (None, Some((first, last))) => format!("{first}-{last}"),
+        (None, None) => "1".into(),
+    };
+    // The shot's own frames refuse one outside them here, before anything is submitted.
+    let (first, last) = farm::parse_frames(&frames)?;
+    for f in [first, last] {
+        description.clone().at_frame(f64::from(f))?;
+    }
     let job = farm::Job::new(
         scene,
         &description.render,
         &args.settings,
-        &args.frames,
+        &frames,
         args.tiles,
         output,
         args.hairtrace.clone(),

@@ -857,3 +857,62 @@ fn what_a_peer_cannot_render_is_refused() {
         assert_one_line_error(&o, expect);
     }
 }
+
+/// `info` says an animated stage's time range and what moves; `render --frame` reads the
+/// groom at that frame (a frame past the stage's animation is refused in one line).
+#[test]
+fn info_lists_the_animation_and_render_reads_the_frame() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap();
+    let usda = root.join("examples/scenes/swaying.usda");
+    let o = hairtrace(&["info", usda.to_str().unwrap()]);
+    assert!(o.status.success(), "{o:?}");
+    let text = stdout(&o);
+    assert!(
+        text.contains(
+            "time:     time codes 1 to 24 (frames 1 to 24), 24 time codes and 24 frames per second"
+        ),
+        "{text}"
+    );
+    assert!(text.contains("animated: /Groom/hair.points"), "{text}");
+
+    let scene = root.join("examples/scenes/swaying.toml");
+    let pattern = tmp("cli_sway.#.exr");
+    let render = |frame: &str| {
+        hairtrace(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--spp",
+            "1",
+            "--seed",
+            "1",
+            "--frame",
+            frame,
+            "-o",
+            &pattern,
+        ])
+    };
+    for frame in ["1", "12"] {
+        let o = render(frame);
+        assert!(o.status.success(), "{o:?}");
+    }
+    let pixels = |p: &str| {
+        hairtrace::image::read_image(std::path::Path::new(p))
+            .unwrap()
+            .pixels
+    };
+    let (a, b) = (tmp("cli_sway.1.exr"), tmp("cli_sway.12.exr"));
+    assert!(
+        pixels(&a) != pixels(&b),
+        "the groom moves between frames 1 and 12"
+    );
+    assert_one_line_error(
+        &render("30"),
+        "frame 30 is outside the shot's frames 1 to 24",
+    );
+}

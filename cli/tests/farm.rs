@@ -368,6 +368,33 @@ fn openjd_cli_runs_the_farm_template_into_the_whole_frames() {
     }
 }
 
+/// `farm SCENE SIZE --frames FRAMES --tiles 2` into `DIR/out/f.##.exr`, its Open Job
+/// Description template run by openjd-cli with the scene given at submission: farm's
+/// output.
+fn run_scene_job(openjd: &Path, dir: &Path, scene: &Path, size: &[&str], frames: &str) -> Output {
+    let template = dir.join("job.json");
+    let output = dir.join("out/f.##.exr");
+    let mut args = vec!["farm", text(scene)];
+    args.extend(size);
+    args.extend([
+        "--frames",
+        frames,
+        "--tiles",
+        "2",
+        "--output",
+        text(&output),
+    ]);
+    args.extend(["--hairtrace", env!("CARGO_BIN_EXE_hairtrace")]);
+    args.extend(["--openjd", text(&template)]);
+    let farm = ok(hairtrace(&args));
+    run_job(
+        openjd,
+        &template,
+        &["-p", &format!("Scene={}", text(scene))],
+    );
+    farm
+}
+
 /// A scene file outside the template's folder: the template gives `Scene` no default (the
 /// specification takes none outside its folder), farm says so, and the job runs with the
 /// scene given at submission into the whole frame.
@@ -378,28 +405,12 @@ fn openjd_cli_runs_a_scene_file_given_at_submission() {
     std::fs::create_dir(dir.join("out")).unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
     let scene = root.join("examples/scenes/fur_ball.toml");
-    let template = dir.join("job.json");
     let size = [
         "--width", "32", "--height", "24", "--spp", "1", "--isa", "sse2",
     ];
-    let mut args = vec!["farm", text(&scene)];
-    args.extend(size);
-    args.extend(["--frames", "3", "--tiles", "2", "--output"]);
-    let output = dir.join("out/f.##.exr");
-    args.extend([
-        text(&output),
-        "--hairtrace",
-        env!("CARGO_BIN_EXE_hairtrace"),
-    ]);
-    args.extend(["--openjd", text(&template)]);
-    let farm = ok(hairtrace(&args));
+    let farm = run_scene_job(&openjd, &dir, &scene, &size, "3");
     let note = String::from_utf8_lossy(&farm.stderr);
     assert!(note.contains("Scene has no default"), "{note}");
-    run_job(
-        &openjd,
-        &template,
-        &["-p", &format!("Scene={}", text(&scene))],
-    );
     let mut whole = vec!["render", text(&scene)];
     whole.extend(size);
     let pattern = dir.join("whole.#.exr");
@@ -408,9 +419,74 @@ fn openjd_cli_runs_a_scene_file_given_at_submission() {
     assert_same_frame(&dir.join("out/f.03.exr"), &dir.join("whole.3.exr"));
 }
 
+/// Three frames of an animated groom (examples/scenes/swaying.toml: USD time samples) run
+/// by openjd-cli, 2 tiles each: every assembled frame equals the whole render of that frame
+/// bit for bit, and the shot's frames are the job's by default.
+#[test]
+fn openjd_cli_renders_the_frames_of_an_animated_groom() {
+    let Some(openjd) = openjd() else { return };
+    let dir = scratch("farm_openjd_animated");
+    std::fs::create_dir(dir.join("out")).unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
+    let scene = root.join("examples/scenes/swaying.toml");
+    let size = [
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--spp",
+        "1",
+        "--isa",
+        "sse2",
+        "--threads",
+        "1",
+    ];
+    run_scene_job(&openjd, &dir, &scene, &size, "1-3");
+    for f in ["1", "2", "3"] {
+        let mut whole = vec!["render", text(&scene)];
+        whole.extend(size);
+        let pattern = dir.join("whole.#.exr");
+        whole.extend(["--seed", f, "--frame", f, "-o", text(&pattern)]);
+        ok(hairtrace(&whole));
+        assert_same_frame(
+            &dir.join(format!("out/f.0{f}.exr")),
+            &dir.join(format!("whole.{f}.exr")),
+        );
+    }
+    // Without --frames, the job is the shot's frames; one outside them is refused.
+    let shot = dir.join("shot.json");
+    let mut args = vec!["farm", text(&scene)];
+    args.extend(size);
+    let output = dir.join("out/f.##.exr");
+    args.extend(["--output", text(&output), "--openjd", text(&shot)]);
+    ok(hairtrace(&args));
+    assert!(text_of(&shot).contains("\"1-24\""), "{}", text_of(&shot));
+    let mut args = vec!["farm", text(&scene)];
+    args.extend(size);
+    args.extend([
+        "--frames",
+        "20-30",
+        "--output",
+        text(&output),
+        "--openjd",
+        text(&shot),
+    ]);
+    let refused = hairtrace(&args);
+    let err = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        !refused.status.success() && err.contains("frame 30 is outside the shot's frames 1 to 24"),
+        "{err}"
+    );
+}
+
+fn text_of(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap()
+}
+
 /// The Slurm job script of `hairtrace farm`, submitted to a one-node Slurm cluster that
-/// `scripts/slurm-farm` starts on localhost (and stops): both assembled frames equal the
-/// whole renders bit for bit. The daemons run as root, so other users skip it.
+/// `scripts/slurm-farm` starts on localhost (and stops): three frames of an animated groom,
+/// each assembled frame equal to the whole render of that frame bit for bit. The daemons
+/// run as root, so other users skip it.
 #[test]
 fn slurm_runs_the_farm_job_array_into_the_whole_frames() {
     // SAFETY: geteuid has no preconditions.
@@ -426,7 +502,7 @@ fn slurm_runs_the_farm_job_array_into_the_whole_frames() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "scripts/slurm-farm failed: {err}");
     assert!(
-        err.contains("both frames equal the whole renders bit for bit"),
+        err.contains("every frame equals the whole render of that frame bit for bit"),
         "{err}"
     );
 }

@@ -383,7 +383,11 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
             Thickness::Diameter
         };
         // Read as a scene file reads it: in the units its header says, if it says them.
-        let source = GroomSource::File { path, thickness };
+        let source = GroomSource::File {
+            path,
+            thickness,
+            frame: None,
+        };
         Ok(scene
             .add_groom(groom(source, Some(basis), shape), material_id)?
             .0)
@@ -426,6 +430,7 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
         let source = GroomSource::File {
             path,
             thickness: Thickness::Diameter,
+            frame: None,
         };
         let (first, count) = scene.add_groom(groom(source, None, shape), material_id)?;
         // SAFETY: non-NULL (checked), the host's uint32_t.

@@ -106,6 +106,7 @@ fn rust_render(file: &Path, camera: bool) -> Vec<u32> {
     let source = GroomSource::File {
         path: file.to_path_buf(),
         thickness: Thickness::Diameter,
+        frame: None,
     };
     let groom = GroomDesc {
         basis: has_extension(file, "hair").then_some(CurveBasis::BSpline),

@@ -2,6 +2,8 @@
 //! meshes read and placed, materials and lights checked, the camera placed
 //! ([`crate::Scene::from_description`] drives them).
 
+use std::path::{Path, PathBuf};
+
 use glam::{Affine3A, EulerRot, Quat, Vec3};
 
 use super::assembly::scene_options;
@@ -27,12 +29,39 @@ use crate::scene::shapes;
 use crate::scene::stages::{Stage, StageRunner};
 use crate::validate::{self, positive};
 
+use crate::farm::frame_path;
 use crate::formats::hair::{HairTag, read_hair_file, read_hair_tag};
 use crate::formats::mesh::read_mesh_file;
 use crate::formats::units::StageUnits;
-use crate::formats::usd::{Layout, Wrap, is_usd_path, read_usd_file};
+use crate::formats::usd::{Layout, Wrap, is_usd_path, read_usd_file_at};
 
 impl SceneDescription {
+    /// Renders frame `frame` of the shot: every groom file is read at it (see
+    /// [`GroomSource::File`]). Refused outside the `[animation]` table's `frames`; a USD
+    /// stage refuses a frame outside its own animation when it is read.
+    pub fn at_frame(&mut self, frame: f64) -> Result<()> {
+        if !frame.is_finite() {
+            return Err(invalid_arg!(
+                "{}: frame {frame}: must be finite",
+                self.origin
+            ));
+        }
+        if let Some((first, last)) = self.frames
+            && !(first as f64..=last as f64).contains(&frame)
+        {
+            return Err(invalid_arg!(
+                "{}: frame {frame} is outside the shot's frames {first} to {last}",
+                self.origin
+            ));
+        }
+        for g in &mut self.grooms {
+            if let GroomSource::File { frame: f, .. } = &mut g.source {
+                *f = Some(frame);
+            }
+        }
+        Ok(())
+    }
+
     /// Refuses the description when its render's film, or its procedural grooms (whose
     /// sizes are known before anything is made) with the film, would need more than
     /// `available` bytes at their peak (see [`footprint`]); grooms from files are checked
@@ -156,8 +185,8 @@ impl GroomDesc {
     /// be any curve's.
     pub fn strand_curves(&self) -> Result<StrandCurves> {
         let tag = match &self.source {
-            GroomSource::File { path, .. } if self.basis.is_none() && !is_usd_path(path) => {
-                read_hair_tag(path)?
+            GroomSource::File { path, frame, .. } if self.basis.is_none() && !is_usd_path(path) => {
+                read_hair_tag(&frame_file(path, *frame)?)?
             }
             _ => None,
         };
@@ -213,8 +242,10 @@ impl GroomDesc {
         let place = |p: [f32; 3]| affine.transform_point3(Vec3::from_array(p)).to_array();
         let shape = self.shape.built();
         match &self.source {
-            GroomSource::File { path, .. } if is_usd_path(path) => {
-                let file = stages.run(Stage::Read, (i, reads), |_| read_usd_file(path))?;
+            GroomSource::File { path, frame, .. } if is_usd_path(path) => {
+                let file = stages.run(Stage::Read, (i, reads), |_| {
+                    read_usd_file_at(&frame_file(path, *frame)?, *frame)
+                })?;
                 for c in &file.curves {
                     c.frame(framing, radius_factor, place);
                 }
@@ -279,8 +310,8 @@ impl GroomDesc {
             }])
         };
         match &self.source {
-            GroomSource::File { path, .. } if is_usd_path(path) => {
-                let file = read_usd_file(path)?;
+            GroomSource::File { path, frame, .. } if is_usd_path(path) => {
+                let file = read_usd_file_at(&frame_file(path, *frame)?, *frame)?;
                 Ok((file.curves.iter())
                     .map(|c| GroomStrands {
                         prim: Some(c.path.clone()),
@@ -290,9 +321,14 @@ impl GroomDesc {
                     })
                     .collect())
             }
-            GroomSource::File { path, thickness } => {
-                let tag = read_hair_tag(path)?;
-                one(read_hair_file(path, *thickness)?, tag)
+            GroomSource::File {
+                path,
+                thickness,
+                frame,
+            } => {
+                let path = frame_file(path, *frame)?;
+                let tag = read_hair_tag(&path)?;
+                one(read_hair_file(&path, *thickness)?, tag)
             }
             GroomSource::FurBall(f) => one(f.build()?, None),
             GroomSource::Scalp(s) => one(s.build()?, None),
@@ -327,6 +363,38 @@ impl GroomDesc {
         }
         Ok(sets)
     }
+}
+
+/// The file a groom reads at `frame`: `path` itself, or for a sequence of per-frame files
+/// (a run of # in its file name) the file of that frame, which must exist.
+fn frame_file(path: &Path, frame: Option<f64>) -> Result<PathBuf> {
+    let sequence = path
+        .file_name()
+        .is_some_and(|n| n.to_string_lossy().contains('#'));
+    if !sequence {
+        return Ok(path.to_path_buf());
+    }
+    let at = |why: String| invalid_arg!("{}: {why}", path.display());
+    let frame = frame.ok_or_else(|| {
+        at(
+            "a sequence of per-frame files: give the frame to render (`render --frame F`, \
+            or `frame` in the scene's [animation] table)"
+                .into(),
+        )
+    })?;
+    if !(frame >= 0.0 && frame.fract() == 0.0 && frame <= f64::from(u32::MAX)) {
+        return Err(at(format!(
+            "frame {frame}: a sequence's files are numbered by whole frames >= 0"
+        )));
+    }
+    let file = frame_path(path, frame as u32)?;
+    if !file.is_file() {
+        return Err(at(format!(
+            "frame {frame}: {} does not exist (the sequence has no file for that frame)",
+            file.display()
+        )));
+    }
+    Ok(file)
 }
 
 impl MeshDesc {

@@ -72,6 +72,7 @@ pub fn quick_look(hair_file: &Path) -> Result<SceneDescription> {
     let file = GroomSource::File {
         path: hair_file.to_path_buf(),
         thickness: Thickness::default(),
+        frame: None,
     };
     Ok(SceneDescription {
         materials: BTreeMap::from([(

@@ -32,8 +32,13 @@
 //! type = "diffuse"
 //! albedo = [0.6, 0.45, 0.4]
 //!
+//! [animation]              # optional: the frame grooms read from animated files
+//! frame = 12               # USD time samples at this frame, `groom.####.hair` -> groom.0012.hair
+//! frames = [1, 48]         # the shot's frames: a frame outside them is refused
+//!
 //! [[groom]]
-//! file = "curly.hair"      # relative to the scene file's folder
+//! file = "curly.hair"      # relative to the scene file's folder; a run of # in the name
+//!                          # is a sequence of per-frame files (needs a frame)
 //! thickness = "diameter"   # how the file's thickness is read: "diameter" (default) or "radius"
 //! basis = "bspline"        # "linear", "bezier", "bspline" or "catmull_rom": needed for a
 //!                          # .hair file that does not say its own (only `convert` writes it);
@@ -125,6 +130,8 @@ pub struct SceneDescription {
     pub grooms: Vec<GroomDesc>,
     pub meshes: Vec<MeshDesc>,
     pub lights: Vec<LightDesc>,
+    /// The `[animation]` table's `frames`: the first and last frame of the shot.
+    pub frames: Option<(i64, i64)>,
     /// What error messages call this description: the scene file's path, or "demo NAME".
     pub origin: String,
     /// What the file's reader could not carry over (a pbrt file's unsupported directives,
@@ -216,6 +223,10 @@ pub enum GroomSource {
     File {
         path: PathBuf,
         thickness: Thickness,
+        /// The frame of its animation the file is read at: a USD stage's time samples
+        /// there, the file of that number in a sequence (a run of # in the path's file
+        /// name). None: a still (a stage's default values, else its first samples).
+        frame: Option<f64>,
     },
     FurBall(FurBall),
     Scalp(ScalpPatch),

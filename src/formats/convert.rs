@@ -168,6 +168,7 @@ fn read_grooms(
                 let file = GroomSource::File {
                     path: path.to_path_buf(),
                     thickness: opts.thickness,
+                    frame: None,
                 };
                 let groom = GroomDesc {
                     basis: opts.basis,

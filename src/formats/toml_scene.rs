@@ -68,7 +68,15 @@ impl SceneDescription {
                 .set(key.get_ref(), &text)
                 .map_err(|e| invalid_arg!("{at}: render.{}", e.detail()))?;
         }
-        Ok(SceneDescription {
+        let animation = raw.animation.unwrap_or_default();
+        if let Some([first, last]) = animation.frames
+            && first > last
+        {
+            return Err(invalid_arg!(
+                "{origin}: animation.frames = [{first}, {last}]: the first frame is after the last"
+            ));
+        }
+        let mut desc = SceneDescription {
             notes: Vec::new(),
             render,
             camera: raw.camera,
@@ -76,8 +84,13 @@ impl SceneDescription {
             grooms,
             meshes,
             lights,
+            frames: animation.frames.map(|[first, last]| (first, last)),
             origin: origin.to_string(),
-        })
+        };
+        if let Some(frame) = animation.frame {
+            desc.at_frame(frame)?;
+        }
+        Ok(desc)
     }
 }
 
@@ -109,6 +122,7 @@ fn setting_text(value: &toml::Value) -> Option<String> {
 struct RawScene {
     #[serde(default)]
     render: BTreeMap<Spanned<String>, Spanned<toml::Value>>,
+    animation: Option<RawAnimation>,
     #[serde(default)]
     camera: CameraDesc,
     #[serde(default)]
@@ -119,6 +133,14 @@ struct RawScene {
     mesh: Vec<Spanned<RawMesh>>,
     #[serde(default)]
     light: Vec<Spanned<RawLight>>,
+}
+
+/// The `[animation]` table.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawAnimation {
+    frame: Option<f64>,
+    frames: Option<[i64; 2]>,
 }
 
 #[derive(Deserialize)]
@@ -537,6 +559,7 @@ impl RawGroom {
                 GroomSource::File {
                     path: base_dir.join(file),
                     thickness: self.thickness.map(Thickness::from).unwrap_or_default(),
+                    frame: None,
                 }
             }
             (None, Some(kind)) => {

@@ -598,7 +598,8 @@ fn quick_look_frames_a_hair_file_and_paths_follow_the_scene_file() {
         desc.grooms[0].source,
         GroomSource::File {
             path: dir.join("ball.hair"),
-            thickness: Thickness::Radius
+            thickness: Thickness::Radius,
+            frame: None,
         }
     );
     let built = desc.build(device()).unwrap();

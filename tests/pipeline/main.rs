@@ -4,6 +4,7 @@
 //! its own package, cli/tests). One test binary, so that the crate (with Embree and
 //! OpenImageIO) is linked once.
 
+mod animation;
 mod architecture;
 mod description;
 mod farm;

@@ -591,6 +591,7 @@ impl Reader {
             })
             .collect();
         Ok(SceneDescription {
+            frames: None,
             render: RenderSettings {
                 width,
                 height,

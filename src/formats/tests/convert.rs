@@ -223,6 +223,7 @@ fn usd_of_every_cubic_basis_and_wrap_round_trips_through_hair() {
                 GroomSource::File {
                     path: path.to_path_buf(),
                     thickness: Thickness::Diameter,
+                    frame: None,
                 },
                 "",
             )

@@ -9,6 +9,7 @@ mod layout;
 mod prim;
 mod resolver;
 mod text_arrays;
+mod time;
 mod write;
 
 use std::fmt::Write as _;
@@ -25,6 +26,8 @@ use crate::scene::curves::{Curves, placed};
 use crate::scene::framing::Framing;
 
 pub use layout::{Interpolation, Layout, Wrap};
+use time::ReadAt;
+pub use time::{Animation, Clock};
 pub use write::{CurvesToWrite, ROOT_PRIM, write_usd_file};
 
 /// Bytes a USD file may have: the reader keeps the whole stage in memory.
@@ -36,15 +39,32 @@ pub struct UsdGrooms {
     /// The stage's `upAxis` and `metersPerUnit` (USD's fallbacks, Y and 0.01, where not
     /// authored): every prim's curves are turned and scaled by them into the world.
     pub units: StageUnits,
+    pub clock: Clock,
     pub curves: Vec<UsdCurves>,
     /// Paths and types of the prims that are not BasisCurves (nor plain Xforms or Scopes).
     pub ignored: Vec<String>,
+}
+
+impl UsdGrooms {
+    /// The animation's time codes: the stage's `startTimeCode` to `endTimeCode` where both
+    /// are authored, else the span of the grooms' samples; None for a still.
+    pub fn time_range(&self) -> Option<(f64, f64)> {
+        let animated = (self.curves.iter()).any(|c| !c.animation.attributes.is_empty());
+        let span = (self.curves.iter().filter_map(|c| c.animation.span))
+            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
+        match self.clock.authored_range {
+            Some(range) if animated => Some(range),
+            _ if animated => span,
+            _ => None,
+        }
+    }
 }
 
 /// One BasisCurves prim, in world space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UsdCurves {
     pub path: String,
+    pub animation: Animation,
     /// The stage's units: `control` and `bounds` are in them, [`UsdCurves::curves`] and
     /// [`UsdCurves::frame`] bring them into the world.
     pub units: StageUnits,
@@ -152,9 +172,17 @@ impl UsdCurves {
     }
 }
 
-/// Reads and composes the stage at `path` and converts each BasisCurves prim. Errors name
-/// the file (and the prim when one is at fault).
+/// Reads and composes the stage at `path` and converts each BasisCurves prim, each
+/// attribute's default value (else its earliest sample). Errors name the file (and the prim
+/// when one is at fault).
 pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
+    read_usd_file_at(path, None)
+}
+
+/// [`read_usd_file`] at frame `frame` of the stage's animation (see `time`), or as a still
+/// when None. A frame outside the animation's time range is refused; any frame of a stage
+/// that has no time samples reads its one still.
+pub fn read_usd_file_at(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> {
     let at = |e: Error| e.context(path.display());
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.len() > MAX_FILE_BYTES {
@@ -176,7 +204,7 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
         let fast = if is_text_layer(path) {
             std::panic::catch_unwind(|| {
                 let _quiet = crate::quiet_panic::Quiet::enter();
-                read_lifting(name, meta.len())
+                read_lifting(name, meta.len(), frame)
             })
             .unwrap_or(Ok(None))?
         } else {
@@ -187,6 +215,7 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
             None => read_stage(
                 &open(name, resolver::CheckingResolver::default())?,
                 meta.len(),
+                frame,
             ),
         }
     });
@@ -220,7 +249,7 @@ fn open(name: &str, resolver: resolver::CheckingResolver) -> Result<Stage> {
 /// The grooms with the numeric arrays of text layers lifted out before openusd parses
 /// them and put back after (see `text_arrays`); `None` when anything went otherwise, an
 /// error for a malformed tuple, which openusd would read without a word.
-fn read_lifting(name: &str, file_bytes: u64) -> Result<Option<UsdGrooms>> {
+fn read_lifting(name: &str, file_bytes: u64, frame: Option<f64>) -> Result<Option<UsdGrooms>> {
     let lifted = resolver::Lifted::default();
     let Ok(stage) = open(name, resolver::CheckingResolver::lifting(lifted.clone())) else {
         return Ok(None);
@@ -239,16 +268,24 @@ fn read_lifting(name: &str, file_bytes: u64) -> Result<Option<UsdGrooms>> {
             return Ok(None);
         }
     }
-    let grooms = read_stage(&stage, file_bytes).ok();
+    let grooms = read_stage(&stage, file_bytes, frame).ok();
     // A text layer opened after the arrays were put back would hold placeholders.
     Ok(grooms.filter(|_| resolver::lock(&lifted).is_empty()))
 }
 
-/// The grooms of a composed stage. `file_bytes` bounds what any count may ask for.
-/// Composition is lazy: its errors (cycles, missing layers) are known once every prim has
-/// been visited.
-fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
+/// The grooms of a composed stage, at `frame` or as a still. `file_bytes` bounds what any
+/// count may ask for. Composition is lazy: its errors (cycles, missing layers) are known
+/// once every prim has been visited.
+fn read_stage(stage: &Stage, file_bytes: u64, frame: Option<f64>) -> Result<UsdGrooms> {
     let units = stage_units(stage)?;
+    let clock = Clock::of(stage)?;
+    let (at, when) = match frame {
+        None => (ReadAt::Still, String::new()),
+        Some(f) => {
+            let t = clock.time_code(f);
+            (ReadAt::Code(t), format!(" at frame {f} (time code {t})"))
+        }
+    };
     let mut paths = Vec::new();
     stage
         .traverse(PrimPredicate::DEFAULT, |p| paths.push(p.clone()))
@@ -264,21 +301,34 @@ fn read_stage(stage: &Stage, file_bytes: u64) -> Result<UsdGrooms> {
             .unwrap_or_default();
         match kind.as_str() {
             "BasisCurves" => curves.push(
-                prim::read_basis_curves(stage, p, file_bytes, units)
-                    .map_err(|e| e.context(p.as_str()))?,
+                prim::read_basis_curves(stage, p, file_bytes, (units, &clock), at)
+                    .map_err(|e| e.context(format!("{}{when}", p.as_str())))?,
             ),
             "" | "Xform" | "Scope" => {}
             other => ignored.push(format!("{} ({other})", p.as_str())),
         }
     }
-    match stage.composition_errors().first() {
-        Some(e) => Err(invalid_arg!("composition failed: {e}")),
-        None => Ok(UsdGrooms {
-            units,
-            curves,
-            ignored,
-        }),
+    if let Some(e) = stage.composition_errors().first() {
+        return Err(invalid_arg!("composition failed: {e}"));
     }
+    let grooms = UsdGrooms {
+        units,
+        clock,
+        curves,
+        ignored,
+    };
+    if let (Some(f), Some((start, end))) = (frame, grooms.time_range()) {
+        let t = clock.time_code(f);
+        if !(start..=end).contains(&t) {
+            return Err(invalid_arg!(
+                "frame {f} (time code {t}) is outside the animation: time codes {start} to \
+                 {end}, frames {} to {}",
+                clock.frame(start),
+                clock.frame(end)
+            ));
+        }
+    }
+    Ok(grooms)
 }
 
 /// The stage's `upAxis` and `metersPerUnit`, USD's fallback for each one not authored.
@@ -312,6 +362,23 @@ pub fn is_usd_path(path: &Path) -> bool {
 pub fn info_report(grooms: &UsdGrooms) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "stage:    {}", grooms.units.describe());
+    let clock = &grooms.clock;
+    match grooms.time_range() {
+        Some((start, end)) => {
+            let _ = writeln!(
+                s,
+                "time:     time codes {start} to {end} (frames {} to {}), {} time codes and {} \
+                 frames per second",
+                clock.frame(start),
+                clock.frame(end),
+                clock.codes_per_second,
+                clock.frames_per_second
+            );
+        }
+        None => {
+            let _ = writeln!(s, "time:     a still (no attribute has two time samples)");
+        }
+    }
     for c in &grooms.curves {
         let (lo, hi) = c.world_corners().fold(
             ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
@@ -348,6 +415,9 @@ pub fn info_report(grooms: &UsdGrooms) -> String {
             "  colours:  {}",
             if c.colors.is_some() { "yes" } else { "no" }
         );
+        if !c.animation.attributes.is_empty() {
+            let _ = writeln!(s, "  animated: {}", c.animation.attributes.join(", "));
+        }
     }
     if grooms.curves.is_empty() {
         let _ = writeln!(s, "no BasisCurves prims");

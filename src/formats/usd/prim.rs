@@ -4,40 +4,22 @@
 use openusd::gf::Matrix4d;
 use openusd::schemas::geom::{BasisCurves, Xform, Xformable};
 use openusd::sdf::{self, Value};
-use openusd::usd::{Attribute, Stage, TimeCode};
+use openusd::usd::{Attribute, Prim, Stage};
 
 use super::UsdCurves;
 use super::layout::{Interpolation, Layout};
+use super::time::{self, Animation, Clock, Motion, ReadAt, failed};
 use crate::error::{Result, invalid_arg};
 use crate::formats::units::StageUnits;
 use crate::validate;
-
-/// The attribute's default value, or its earliest time sample when only samples are
-/// authored (the reader renders one frame: the first).
-fn value(attr: &Attribute) -> Result<Option<Value>> {
-    let err = |e| failed(attr.path(), e);
-    if let Some(v) = attr.get::<Value>().map_err(err)? {
-        return Ok(Some(v));
-    }
-    let times = attr.time_sample_times().map_err(err)?;
-    match times.first() {
-        Some(&t) => attr.get_at::<Value>(TimeCode::new(t)).map_err(err),
-        None => Ok(None),
-    }
-}
-
-/// An error of the USD library about `path`, its causes included.
-fn failed(path: &sdf::Path, e: impl std::fmt::Display) -> crate::Error {
-    invalid_arg!("{}: {e:#}", path.as_str())
-}
 
 fn wrong_type(what: &str, expected: &str, v: &Value) -> crate::Error {
     let actual: &'static str = v.into();
     invalid_arg!("{what}: expected {expected}, found {actual}")
 }
 
-fn token(attr: &Attribute, what: &str, fallback: &str) -> Result<String> {
-    match value(attr)? {
+fn token(value: Option<Value>, what: &str, fallback: &str) -> Result<String> {
+    match value {
         None => Ok(fallback.to_string()),
         Some(Value::Token(t)) => Ok(t.as_str().to_string()),
         Some(Value::String(s)) => Ok(s),
@@ -45,8 +27,8 @@ fn token(attr: &Attribute, what: &str, fallback: &str) -> Result<String> {
     }
 }
 
-fn floats(attr: &Attribute, what: &str) -> Result<Option<Vec<f32>>> {
-    match value(attr)? {
+fn floats(value: Option<Value>, what: &str) -> Result<Option<Vec<f32>>> {
+    match value {
         None => Ok(None),
         Some(Value::FloatVec(v)) => Ok(Some(v)),
         Some(Value::DoubleVec(v)) => Ok(Some(v.into_iter().map(|x| x as f32).collect())),
@@ -54,8 +36,8 @@ fn floats(attr: &Attribute, what: &str) -> Result<Option<Vec<f32>>> {
     }
 }
 
-fn vec3s(attr: &Attribute, what: &str) -> Result<Option<Vec<[f32; 3]>>> {
-    match value(attr)? {
+fn vec3s(value: Option<Value>, what: &str) -> Result<Option<Vec<[f32; 3]>>> {
+    match value {
         None => Ok(None),
         Some(Value::Vec3fVec(v)) => Ok(Some(v.into_iter().map(Into::into).collect())),
         Some(Value::Vec3dVec(v)) => Ok(Some(
@@ -85,10 +67,15 @@ fn interpolation(attr: &Attribute, what: &str, fallback: Interpolation) -> Resul
 
 /// The prim's local-to-world matrix (row vectors, as USD writes them): its own xformOps
 /// and every ancestor's, stopping at a `!resetXformStack!`.
-fn world_transform(stage: &Stage, path: &sdf::Path, curves: &BasisCurves) -> Result<Matrix4d> {
+fn world_transform(
+    stage: &Stage,
+    path: &sdf::Path,
+    curves: &BasisCurves,
+    when: ReadAt,
+) -> Result<Matrix4d> {
     let err = failed;
     let mut m = curves
-        .local_to_parent_transform(TimeCode::EARLIEST)
+        .local_to_parent_transform(when.transform_time())
         .map_err(|e| err(path, e))?;
     let mut reset = curves.resets_xform_stack().map_err(|e| err(path, e))?;
     let mut at = path.parent();
@@ -98,11 +85,11 @@ fn world_transform(stage: &Stage, path: &sdf::Path, curves: &BasisCurves) -> Res
         match Xform::get(stage, p.clone()).map_err(|e| err(&p, e))? {
             Some(x) => {
                 m = m * x
-                    .local_to_parent_transform(TimeCode::EARLIEST)
+                    .local_to_parent_transform(when.transform_time())
                     .map_err(|e| err(&p, e))?;
                 reset = x.resets_xform_stack().map_err(|e| err(&p, e))?;
             }
-            None if value(&order)?.is_some() => {
+            None if when.value(&order)?.is_some() => {
                 return Err(invalid_arg!(
                     "ancestor {} has xformOps but is not an Xform: this reader follows the \
                      transforms of Xform ancestors only",
@@ -178,18 +165,24 @@ pub(super) fn read_basis_curves(
     stage: &Stage,
     path: &sdf::Path,
     file_bytes: u64,
-    units: StageUnits,
+    (units, clock): (StageUnits, &Clock),
+    at: ReadAt,
 ) -> Result<UsdCurves> {
     let curves = BasisCurves::get(stage, path.clone())
         .map_err(|e| invalid_arg!("{e:#}"))?
         .ok_or_else(|| invalid_arg!("not a BasisCurves prim"))?;
     let prim = stage.prim(path.clone());
     let attr = |name: &str| prim.attribute(name);
-    let kind = token(&attr("type"), "type", "cubic")?;
-    let basis = token(&attr("basis"), "basis", "bezier")?;
-    let layout = Layout::named(&kind, &basis, &token(&attr("wrap"), "wrap", "nonperiodic")?)?;
-    let points = vec3s(&attr("points"), "points")?.ok_or_else(|| invalid_arg!("no points"))?;
-    let raw_counts = match value(&attr("curveVertexCounts"))? {
+    let value = |name: &str| at.value(&attr(name));
+    let kind = token(value("type")?, "type", "cubic")?;
+    let basis = token(value("basis")?, "basis", "bezier")?;
+    let layout = Layout::named(
+        &kind,
+        &basis,
+        &token(value("wrap")?, "wrap", "nonperiodic")?,
+    )?;
+    let points = points_at(&prim, at, clock)?.ok_or_else(|| invalid_arg!("no points"))?;
+    let raw_counts = match value("curveVertexCounts")? {
         Some(Value::IntVec(v)) => v,
         Some(v) => return Err(wrong_type("curveVertexCounts", "int[]", &v)),
         None => return Err(invalid_arg!("no curveVertexCounts")),
@@ -225,7 +218,7 @@ pub(super) fn read_basis_curves(
     validate::positions("point", &points)?;
 
     let widths_attr = attr("widths");
-    let widths = floats(&widths_attr, "widths")?
+    let widths = floats(at.value(&widths_attr)?, "widths")?
         .ok_or_else(|| invalid_arg!("no widths: the fibres' diameters must be authored"))?;
     let widths_interp = interpolation(&widths_attr, "widths", Interpolation::Vertex)?;
     let want = expected_len(widths_interp, layout, &counts, &segs)?;
@@ -243,7 +236,7 @@ pub(super) fn read_basis_curves(
     }
 
     let color_attr = attr("primvars:displayColor");
-    let colors = vec3s(&color_attr, "primvars:displayColor")?;
+    let colors = vec3s(at.value(&color_attr)?, "primvars:displayColor")?;
     let color_interp = interpolation(
         &color_attr,
         "primvars:displayColor",
@@ -268,14 +261,14 @@ pub(super) fn read_basis_curves(
         }
     }
 
-    let melanin = read_melanin(&attr("primvars:melanin"), counts.len())?;
+    let melanin = read_melanin(at, &attr("primvars:melanin"), counts.len())?;
     if melanin.is_some() && colors.is_some() {
         return Err(invalid_arg!(
             "both primvars:displayColor and primvars:melanin are authored: give one"
         ));
     }
 
-    let m = world_transform(stage, path, &curves)?;
+    let m = world_transform(stage, path, &curves, at)?;
     let scale = uniform_scale(&m)?;
     let world: Vec<[f32; 3]> = points.iter().map(|&p| transform_point(&m, p)).collect();
     validate::positions("point (in world space)", &world)?;
@@ -369,8 +362,10 @@ pub(super) fn read_basis_curves(
             control[i][3]
         ));
     }
+    let animation = animation(stage, path)?;
     Ok(UsdCurves {
         path: path.as_str().to_string(),
+        animation,
         units,
         layout,
         authored_counts: counts.iter().map(|&n| n as u32).collect(),
@@ -385,10 +380,80 @@ pub(super) fn read_basis_curves(
     })
 }
 
+/// The prim's points at `at`: moved by their velocities from the sample before, where
+/// those are authored there (UsdGeomPointBased's rule), else as [`ReadAt::value`] gives
+/// them; refused between two samples of different counts with no velocities.
+fn points_at(prim: &Prim, at: ReadAt, clock: &Clock) -> Result<Option<Vec<[f32; 3]>>> {
+    let points = prim.attribute("points");
+    let read = |t: ReadAt| vec3s(t.value(&points)?, "points");
+    let ReadAt::Code(t) = at else {
+        return read(at);
+    };
+    let Some((lo, hi)) = time::between(&time::sample_times(&points)?, t) else {
+        return read(at);
+    };
+    let before = read(ReadAt::Code(lo))?.unwrap_or_default();
+    let velocities = prim.attribute("velocities");
+    if time::sample_times(&velocities)?.contains(&lo) {
+        let at_lo = |name: &str| vec3s(ReadAt::Code(lo).value(&prim.attribute(name))?, name);
+        let motion = Motion {
+            velocities: at_lo("velocities")?.unwrap_or_default(),
+            accelerations: at_lo("accelerations")?,
+        };
+        let counts = [Some(&motion.velocities), motion.accelerations.as_ref()];
+        if let Some(n) = counts
+            .into_iter()
+            .flatten()
+            .find(|v| v.len() != before.len())
+        {
+            return Err(invalid_arg!(
+                "velocities or accelerations at time code {lo}: {} values for {} points",
+                n.len(),
+                before.len()
+            ));
+        }
+        return Ok(Some(
+            motion.moved(&before, (t - lo) / clock.codes_per_second),
+        ));
+    }
+    let after = read(ReadAt::Code(hi))?.unwrap_or_default();
+    if before.len() != after.len() {
+        return Err(invalid_arg!(
+            "points: the samples at time codes {lo} ({} points) and {hi} ({} points) differ \
+             in count and no velocities are authored at {lo}: the points between them are \
+             undefined",
+            before.len(),
+            after.len()
+        ));
+    }
+    read(at)
+}
+
+/// What of the prim at `path` moves.
+fn animation(stage: &Stage, path: &sdf::Path) -> Result<Animation> {
+    let mut a = Animation::default();
+    let mut at = Some(path.clone());
+    while let Some(p) = at.filter(|p| *p != sdf::Path::abs_root()) {
+        let prim = stage.prim(p.clone());
+        for attr in prim.attributes().map_err(|e| failed(&p, e))? {
+            let times = time::sample_times(&attr)?;
+            if let (Some(&first), Some(&last)) = (times.first(), times.last()) {
+                let (lo, hi) = a.span.unwrap_or((first, last));
+                a.span = Some((lo.min(first), hi.max(last)));
+            }
+            if times.len() > 1 {
+                a.attributes.push(attr.path().as_str().to_string());
+            }
+        }
+        at = p.parent();
+    }
+    Ok(a)
+}
+
 /// `primvars:melanin`, eumelanin per curve (constant or uniform), if authored.
-fn read_melanin(attr: &Attribute, curves: usize) -> Result<Option<Vec<f32>>> {
+fn read_melanin(at: ReadAt, attr: &Attribute, curves: usize) -> Result<Option<Vec<f32>>> {
     const WHAT: &str = "primvars:melanin";
-    let Some(values) = floats(attr, WHAT)? else {
+    let Some(values) = floats(at.value(attr)?, WHAT)? else {
         return Ok(None);
     };
     let per_curve = match interpolation(attr, WHAT, Interpolation::Constant)? {

@@ -476,7 +476,7 @@ mod tests {
         let name = path.to_str().unwrap();
         let bytes = std::fs::metadata(path).unwrap().len();
         let read = open(name, resolver::CheckingResolver::default())
-            .and_then(|stage| read_stage(&stage, bytes))
+            .and_then(|stage| read_stage(&stage, bytes, None))
             .map_err(|e| e.context(path.display()));
         format!("{read:?}")
     }
@@ -534,7 +534,7 @@ mod tests {
             let text = std::fs::read(&path).unwrap();
             assert!(lift(text).is_ok(), "{}", path.display());
             let bytes = std::fs::metadata(&path).unwrap().len();
-            let fast = read_lifting(path.to_str().unwrap(), bytes)
+            let fast = read_lifting(path.to_str().unwrap(), bytes, None)
                 .unwrap()
                 .unwrap_or_else(|| panic!("{}: the fast path gave up", path.display()));
             assert_eq!(

@@ -602,6 +602,11 @@ enum HtStatus ht_hair_point_init_strand(const struct HtHairPrepared *prepared,
 #if defined(HT_RENDER)
 
 /**
+ * The most time steps of strands in motion: Embree's limit.
+ */
+#define HT_MAX_TIME_STEPS 129
+
+/**
  * An Embree device: its thread pool builds the scenes made on it. Create one per
  * process and share it between scenes. Thread safe.
  */
@@ -937,6 +942,33 @@ enum HtStatus ht_scene_add_curves_xyzr(struct HtScene *scene,
  */
 enum HtStatus ht_scene_add_curves_xyzr_shared(struct HtScene *scene,
                                               const struct HtCurvesXyzr *desc,
+                                              uint32_t material_id,
+                                              uint32_t *geom_id);
+
+/**
+ * Adds strands of float4 control points laid out for the basis that move over the
+ * shutter (copied, as `ht_scene_add_curves_xyzr`), shaded by the hair material
+ * `material_id`; writes the geometry id. `desc->points` are the control points at the
+ * first of `later_step_count + 1` time steps spread evenly over the shutter (the settings
+ * `shutter_open` and `shutter_close`: the first step where it opens, the last where it
+ * closes; docs/c-abi.md); `later_points[k]` points to the `4 * desc->point_count` floats
+ * of the same control points at step k + 1, laid out alike. Between two steps a point
+ * moves in a straight line. With `later_step_count` 0 (`later_points` may then be NULL)
+ * this is `ht_scene_add_curves_xyzr`.
+ *
+ * Statuses: as `ht_scene_add_curves_xyzr`, and `HT_ERR_NULL_ARG` for `later_points` or
+ * one of its pointers NULL when it is read; `HT_ERR_INVALID_ARG` for more than
+ * `HT_MAX_TIME_STEPS - 1` later steps, or a NaN, infinite or out-of-range value at a
+ * step (the message names the step).
+ *
+ * # Safety
+ * As `ht_scene_add_curves_xyzr`, and `later_points` is NULL or points to
+ * `later_step_count` pointers, each NULL or to `4 * desc->point_count` readable floats.
+ */
+enum HtStatus ht_scene_add_curves_xyzr_motion(struct HtScene *scene,
+                                              const struct HtCurvesXyzr *desc,
+                                              const float *const *later_points,
+                                              size_t later_step_count,
                                               uint32_t material_id,
                                               uint32_t *geom_id);
 

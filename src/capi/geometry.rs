@@ -4,7 +4,7 @@
 use super::scene::{HtScene, add_with_id};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
 use crate::description::{GroomDesc, GroomSource, MeshDesc, MeshSource};
-use crate::embree::{CurveBasis, SharedBuffer};
+use crate::embree::{CurveBasis, MAX_TIME_STEPS, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::formats::hair::Thickness;
 use crate::incremental::ControlPoints;
@@ -255,7 +255,11 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr(
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
-    add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+    let still = LaterSteps {
+        points: std::ptr::null(),
+        count: 0,
+    };
+    add_curves_xyzr(scene, desc, still, material_id, geom_id, |points| {
         Ok(points.to_vec().into())
     })
 }
@@ -287,7 +291,11 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr_shared(
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
-    add_curves_xyzr(scene, desc, material_id, geom_id, |points| {
+    let still = LaterSteps {
+        points: std::ptr::null(),
+        count: 0,
+    };
+    add_curves_xyzr(scene, desc, still, material_id, geom_id, |points| {
         if points.as_ptr() as usize % EMBREE_VERTEX_ALIGN != 0 {
             return Err(invalid_arg!(
                 "desc->points = {:?} is not aligned to {EMBREE_VERTEX_ALIGN} bytes: shared \
@@ -304,14 +312,61 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr_shared(
     })
 }
 
-/// The body of both `ht_scene_add_curves_xyzr` entry points; `vertices` turns the checked
-/// host array of control points into the buffer Embree reads.
+/// The most time steps of strands in motion: Embree's limit.
+pub const HT_MAX_TIME_STEPS: usize = 129;
+const _: () = assert!(HT_MAX_TIME_STEPS == MAX_TIME_STEPS);
+
+/// Adds strands of float4 control points laid out for the basis that move over the
+/// shutter (copied, as `ht_scene_add_curves_xyzr`), shaded by the hair material
+/// `material_id`; writes the geometry id. `desc->points` are the control points at the
+/// first of `later_step_count + 1` time steps spread evenly over the shutter (the settings
+/// `shutter_open` and `shutter_close`: the first step where it opens, the last where it
+/// closes; docs/c-abi.md); `later_points[k]` points to the `4 * desc->point_count` floats
+/// of the same control points at step k + 1, laid out alike. Between two steps a point
+/// moves in a straight line. With `later_step_count` 0 (`later_points` may then be NULL)
+/// this is `ht_scene_add_curves_xyzr`.
+///
+/// Statuses: as `ht_scene_add_curves_xyzr`, and `HT_ERR_NULL_ARG` for `later_points` or
+/// one of its pointers NULL when it is read; `HT_ERR_INVALID_ARG` for more than
+/// `HT_MAX_TIME_STEPS - 1` later steps, or a NaN, infinite or out-of-range value at a
+/// step (the message names the step).
+///
+/// # Safety
+/// As `ht_scene_add_curves_xyzr`, and `later_points` is NULL or points to
+/// `later_step_count` pointers, each NULL or to `4 * desc->point_count` readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_add_curves_xyzr_motion(
+    scene: *mut HtScene,
+    desc: *const HtCurvesXyzr,
+    later_points: *const *const f32,
+    later_step_count: usize,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    let later = LaterSteps {
+        points: later_points,
+        count: later_step_count,
+    };
+    add_curves_xyzr(scene, desc, later, material_id, geom_id, |points| {
+        Ok(points.to_vec().into())
+    })
+}
+
+/// The host's control points at the time steps after the first.
+struct LaterSteps {
+    points: *const *const f32,
+    count: usize,
+}
+
+/// The body of the `ht_scene_add_curves_xyzr` entry points; `vertices` turns each checked
+/// host array of control points (one per time step) into a buffer Embree reads.
 fn add_curves_xyzr(
     scene: *mut HtScene,
     desc: *const HtCurvesXyzr,
+    later: LaterSteps,
     material_id: u32,
     geom_id: *mut u32,
-    vertices: impl FnOnce(&[[f32; 4]]) -> std::result::Result<SharedBuffer<[f32; 4]>, Failure>,
+    vertices: impl Fn(&[[f32; 4]]) -> std::result::Result<SharedBuffer<[f32; 4]>, Failure>,
 ) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
         let d = read_host(desc, "desc")?;
@@ -335,9 +390,25 @@ fn add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
+        if later.count >= HT_MAX_TIME_STEPS {
+            return Err(invalid_arg!(
+                "later_step_count = {}: at most {} (HT_MAX_TIME_STEPS - 1)",
+                later.count,
+                HT_MAX_TIME_STEPS - 1
+            )
+            .into());
+        }
+        let later_points = host_slice(later.points, later.count, "later_points")?;
+        let later_steps = (later_points.iter().enumerate())
+            .map(|(k, &p)| {
+                let name = format!("later_points[{k}]");
+                vertices(host_slice(p.cast(), d.point_count, &name)?)
+            })
+            .collect::<std::result::Result<_, Failure>>()?;
         let material = scene.check_material(material_id, true)?;
         let points = ControlPoints {
             points: vertices(points)?,
+            later_steps,
             counts: counts.to_vec(),
             colors,
             basis,

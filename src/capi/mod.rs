@@ -27,6 +27,8 @@ pub mod settings;
 mod settings_tests;
 // After `scene` and `settings`, so that the header declares them before the render that
 // takes them.
+#[cfg(all(test, feature = "render"))]
+mod motion_tests;
 #[cfg(feature = "render")]
 pub mod render;
 #[cfg(all(test, feature = "render"))]

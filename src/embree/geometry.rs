@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use super::order::{centroid, median_split};
 use super::{Device, sys};
 use crate::error::invalid_arg;
+use crate::math::time_step;
 pub use crate::math::{CurveBasis, CurveShape};
 use crate::{Error, Result, threads};
 
@@ -236,10 +237,32 @@ impl RawGeometry {
         buffer: &SharedBuffer<T>,
     ) {
         // SAFETY: the caller's contract; the whole buffer.
-        unsafe { self.share_range(kind, format, buffer, 0..buffer.len()) }
+        unsafe { self.share_range(kind, format, buffer, 0, 0..buffer.len()) }
     }
 
-    /// Binds the elements `range` of `buffer` to `kind`, slot 0.
+    /// Binds each of `steps` as the control points of its time step (its slot of the
+    /// vertex buffer), after telling Embree how many there are.
+    ///
+    /// # Safety
+    /// As for [`Self::share`], for every buffer; at most [`MAX_TIME_STEPS`] of them.
+    unsafe fn share_steps(&self, steps: &[SharedBuffer<[f32; 4]>]) {
+        // SAFETY: live geometry, not yet committed; the count is checked by the caller.
+        unsafe { sys::rtcSetGeometryTimeStepCount(self.0.as_ptr(), steps.len() as u32) };
+        for (slot, step) in (0u32..).zip(steps) {
+            // SAFETY: the caller's contract, for this buffer.
+            unsafe {
+                self.share_range(
+                    sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
+                    sys::RTCFormat::RTC_FORMAT_FLOAT4,
+                    step,
+                    slot,
+                    0..step.len(),
+                )
+            }
+        }
+    }
+
+    /// Binds the elements `range` of `buffer` to `kind`, slot `slot`.
     ///
     /// # Safety
     /// As for [`Self::share`]; `range` lies inside the buffer.
@@ -248,6 +271,7 @@ impl RawGeometry {
         kind: sys::RTCBufferType,
         format: sys::RTCFormat,
         buffer: &SharedBuffer<T>,
+        slot: u32,
         range: Range<usize>,
     ) {
         debug_assert!(range.start <= range.end && range.end <= buffer.len());
@@ -259,7 +283,7 @@ impl RawGeometry {
             sys::rtcSetSharedGeometryBuffer(
                 self.0.as_ptr(),
                 kind,
-                0,
+                slot,
                 format,
                 buffer.as_ptr().cast::<c_void>(),
                 range.start * size_of::<T>(),
@@ -309,6 +333,22 @@ pub struct CurvePoint {
     pub d2p_du2: [f32; 3],
 }
 
+impl CurvePoint {
+    /// The point a fraction `f` of the way from `self` to `other`.
+    fn lerp(&self, other: &CurvePoint, f: f32) -> CurvePoint {
+        let mix = |a: [f32; 3], b: [f32; 3]| std::array::from_fn(|i| a[i] + f * (b[i] - a[i]));
+        CurvePoint {
+            p: mix(self.p, other.p),
+            radius: self.radius + f * (other.radius - self.radius),
+            dp_du: mix(self.dp_du, other.dp_du),
+            d2p_du2: mix(self.d2p_du2, other.d2p_du2),
+        }
+    }
+}
+
+/// The most time steps of one geometry (Embree's limit).
+pub const MAX_TIME_STEPS: usize = sys::RTC_MAX_TIME_STEP_COUNT as usize;
+
 /// Geometries of at least this many segments may be cut into parts of at most
 /// [`PART_SEGMENTS`] ([`CurveGeometry::in_parts`]), which a scene builds as one small
 /// Embree scene each, when a ray first reaches it (`lazy.rs`, [`Parts`]). On the bench
@@ -347,12 +387,14 @@ struct Parts {
 pub(super) type Bounds = ([f32; 3], [f32; 3]);
 
 impl Parts {
+    /// Parts of the segments `indices` over the control points of every time step in
+    /// `steps`: cut by the first step's centres, each bounded over all of them.
     fn new(
         basis: CurveBasis,
-        vertices: &SharedBuffer<[f32; 4]>,
+        steps: &[SharedBuffer<[f32; 4]>],
         indices: &SharedBuffer<u32>,
     ) -> Result<Self> {
-        let (points, first) = (vertices.as_slice(), indices.as_slice());
+        let (points, first) = (steps[0].as_slice(), indices.as_slice());
         let span = basis.points_per_segment();
         let (segments, ranges) = median_split(first.len(), PART_SEGMENTS, |s| {
             let f = first[s] as usize;
@@ -362,7 +404,18 @@ impl Parts {
         let (ordered, bounds) = threads::scoped(0, || {
             let ordered: Vec<u32> = segments.par_iter().map(|&s| first[s as usize]).collect();
             let bounds = (ranges.par_iter())
-                .map(|r| hull_bounds(basis, points, &ordered[r.start as usize..r.end as usize]))
+                .map(|r| {
+                    let firsts = &ordered[r.start as usize..r.end as usize];
+                    (steps.iter())
+                        .map(|step| hull_bounds(basis, step.as_slice(), firsts))
+                        .reduce(|(lo, hi), (l, h)| {
+                            (
+                                std::array::from_fn(|i| lo[i].min(l[i])),
+                                std::array::from_fn(|i| hi[i].max(h[i])),
+                            )
+                        })
+                        .unwrap_or(([0.0; 3], [0.0; 3]))
+                })
                 .collect();
             (ordered, bounds)
         })?;
@@ -439,7 +492,9 @@ pub struct CurveGeometry {
     mask: u32,
     /// Quads per segment of a flat cubic curve, its parts' too ([`Self::with_ribbon_quads`]).
     ribbon_quads: u32,
-    vertices: SharedBuffer<[f32; 4]>,
+    /// The control points at each time step, spread evenly over the shutter: one for a
+    /// geometry that does not move.
+    steps: Box<[SharedBuffer<[f32; 4]>]>,
     indices: SharedBuffer<u32>,
     parts: Option<Arc<Parts>>,
 }
@@ -459,9 +514,8 @@ impl PartialEq for PartsCache {
 }
 
 impl CurveGeometry {
-    /// Builds and commits a curve geometry. `vertices` are (x, y, z, radius) control points,
-    /// `indices` hold the first control point of each segment. Every segment must fit in the
-    /// vertex buffer (checked: Embree itself would read out of bounds).
+    /// A curve geometry that does not move: [`Self::in_motion`] of one time step.
+    #[cfg(test)]
     pub fn new(
         device: &Device,
         basis: CurveBasis,
@@ -470,8 +524,38 @@ impl CurveGeometry {
         indices: SharedBuffer<u32>,
         mask: u32,
     ) -> Result<Self> {
+        Self::in_motion(device, basis, shape, vec![vertices], indices, mask)
+    }
+
+    /// Builds and commits a curve geometry. `steps` hold the (x, y, z, radius) control
+    /// points at each of 1 to [`MAX_TIME_STEPS`] time steps spread evenly over the shutter
+    /// (`math::time_steps`; one for curves that do not move), every step as many points,
+    /// laid out alike; `indices` hold the first control point of each segment. Every
+    /// segment must fit in the vertex buffer (checked: Embree itself would read out of
+    /// bounds).
+    pub fn in_motion(
+        device: &Device,
+        basis: CurveBasis,
+        shape: CurveShape,
+        steps: Vec<SharedBuffer<[f32; 4]>>,
+        indices: SharedBuffer<u32>,
+        mask: u32,
+    ) -> Result<Self> {
+        if !(1..=MAX_TIME_STEPS).contains(&steps.len()) {
+            return Err(invalid_arg!(
+                "{} time steps: Embree takes 1 to {MAX_TIME_STEPS}",
+                steps.len()
+            ));
+        }
+        if let Some(k) = steps.iter().position(|s| s.len() != steps[0].len()) {
+            return Err(invalid_arg!(
+                "time step {k} has {} control points, time step 0 {}",
+                steps[k].len(),
+                steps[0].len()
+            ));
+        }
         let span = basis.points_per_segment() as u64;
-        let count = vertices.len() as u64;
+        let count = steps[0].len() as u64;
         if let Some(i) = indices
             .as_slice()
             .iter()
@@ -490,19 +574,18 @@ impl CurveGeometry {
             ));
         }
         // Embree's aligned 16-byte loads crash on misaligned points (a Vec's come from malloc).
-        if vertices.as_ptr() as usize % EMBREE_LOAD_BYTES != 0 {
-            let at = vertices.as_ptr();
+        if let Some(step) = steps
+            .iter()
+            .find(|s| s.as_ptr() as usize % EMBREE_LOAD_BYTES != 0)
+        {
+            let at = step.as_ptr();
             return Err(invalid_arg!("points at {at:?} are not aligned to 16 bytes"));
         }
         let raw = RawGeometry::new(device, curve_type(basis, shape))?;
-        // SAFETY: both buffers move into the returned value next to `raw`, which is dropped
-        // before them.
+        // SAFETY: the buffers move into the returned value next to `raw`, which is dropped
+        // before them; the step count is checked above.
         unsafe {
-            raw.share(
-                sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
-                sys::RTCFormat::RTC_FORMAT_FLOAT4,
-                &vertices,
-            );
+            raw.share_steps(&steps);
             raw.share(
                 sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
                 sys::RTCFormat::RTC_FORMAT_UINT,
@@ -516,7 +599,7 @@ impl CurveGeometry {
             shape,
             mask,
             ribbon_quads: DEFAULT_RIBBON_QUADS,
-            vertices,
+            steps: steps.into_boxed_slice(),
             indices,
             parts: None,
         })
@@ -558,7 +641,7 @@ impl CurveGeometry {
         let parts = match cached {
             Some(parts) => parts.clone(),
             None => {
-                let parts = Arc::new(Parts::new(self.basis, &self.vertices, &self.indices)?);
+                let parts = Arc::new(Parts::new(self.basis, &self.steps, &self.indices)?);
                 // Already set (another build got there first): as good as this one.
                 let _ = cache.0.set(parts.clone());
                 parts
@@ -581,9 +664,27 @@ impl CurveGeometry {
         self.mask
     }
 
-    /// Control points (x, y, z, radius), as Embree reads them.
+    /// Control points (x, y, z, radius), as Embree reads them: the first time step's.
+    #[cfg(test)]
     pub fn vertices(&self) -> &[[f32; 4]] {
-        self.vertices.as_slice()
+        self.steps[0].as_slice()
+    }
+
+    /// The control points at each time step, from the first.
+    pub fn steps(&self) -> impl Iterator<Item = &[[f32; 4]]> {
+        self.steps.iter().map(SharedBuffer::as_slice)
+    }
+
+    /// Control point `i` at `time` (a fraction of the shutter, `math::time_steps`): the
+    /// blend of its two time steps around it. `None` when `i` is out of range.
+    pub fn point_at(&self, i: usize, time: f32) -> Option<Vec4> {
+        let (step, f) = time_step(time, self.steps.len());
+        let a = Vec4::from_array(*self.steps[step].as_slice().get(i)?);
+        if f == 0.0 {
+            return Some(a);
+        }
+        let b = Vec4::from_array(self.steps[step + 1].as_slice()[i]);
+        Some(a + f * (b - a))
     }
 
     /// First control point of each segment (primitive).
@@ -606,7 +707,8 @@ impl CurveGeometry {
                 + size_of_val(&*p.ranges)
                 + size_of_val(&*p.bounds)
         });
-        self.vertices.heap_bytes() + self.indices.heap_bytes() + parts
+        let steps: usize = self.steps.iter().map(SharedBuffer::heap_bytes).sum();
+        steps + self.indices.heap_bytes() + parts
     }
 
     /// The parts a scene builds as scenes of their own ([`PARTS_FROM_SEGMENTS`]), as
@@ -652,15 +754,12 @@ impl CurveGeometry {
         // SAFETY: the buffers belong to `self`, which the caller keeps alive for as long as
         // the handle; the range lies inside the index buffer (checked).
         unsafe {
-            raw.share(
-                sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
-                sys::RTCFormat::RTC_FORMAT_FLOAT4,
-                &self.vertices,
-            );
+            raw.share_steps(&self.steps);
             raw.share_range(
                 sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
                 sys::RTCFormat::RTC_FORMAT_UINT,
                 &parts.indices,
+                0,
                 range,
             );
         }
@@ -671,15 +770,27 @@ impl CurveGeometry {
         Ok(raw)
     }
 
-    /// The curve of segment `prim` at parameter `u` in [0, 1]: a lerp for linear curves,
-    /// `rtcInterpolate` for cubic ones, so it is exactly the curve Embree intersects.
-    /// `None` when `prim` is out of range.
-    pub fn interpolate(&self, prim: u32, u: f32) -> Option<CurvePoint> {
+    /// The curve of segment `prim` at parameter `u` in [0, 1] and at `time` (a fraction of
+    /// the shutter): the blend of the curves at the two time steps around it
+    /// (`math::time_steps`), each a lerp for linear curves and `rtcInterpolate` for cubic
+    /// ones, so it is exactly the curve Embree intersects. `None` when `prim` is out of
+    /// range.
+    pub fn interpolate(&self, prim: u32, u: f32, time: f32) -> Option<CurvePoint> {
+        let (step, f) = time_step(time, self.steps.len());
+        let a = self.interpolate_step(prim, u, step)?;
+        if f == 0.0 {
+            return Some(a);
+        }
+        Some(a.lerp(&self.interpolate_step(prim, u, step + 1)?, f))
+    }
+
+    /// [`Self::interpolate`] at time step `step` (< the step count).
+    fn interpolate_step(&self, prim: u32, u: f32, step: usize) -> Option<CurvePoint> {
         let &first = self.indices().get(prim as usize)?;
         if self.basis == CurveBasis::Linear {
             // A straight segment needs no call into Embree: its point and radius are a
             // lerp of the two control points (both inside the buffer: checked in `new`).
-            let v = self.vertices();
+            let v = self.steps[step].as_slice();
             let (a, b) = (v[first as usize], v[first as usize + 1]);
             let u = u.clamp(0.0, 1.0);
             let lerp = |i: usize| a[i] + u * (b[i] - a[i]);
@@ -702,7 +813,7 @@ impl CurveGeometry {
             u: u.clamp(0.0, 1.0),
             v: 0.0,
             bufferType: sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
-            bufferSlot: 0,
+            bufferSlot: step as u32,
             P: p.0.as_mut_ptr(),
             dPdu: dp.0.as_mut_ptr(),
             ddPdudu: ddp.0.as_mut_ptr(),
@@ -919,7 +1030,7 @@ pub(crate) mod tests {
             let c = CurveGeometry::new(&device, linear, round, vertices, indices, 1).unwrap();
             assert_eq!(embree_vertices(&c), ptr);
             assert_eq!(c.heap_bytes(), ours);
-            assert_eq!(c.interpolate(2, 1.0).unwrap().p[0], c.vertices()[3][0]);
+            assert_eq!(c.interpolate(2, 1.0, 0.0).unwrap().p[0], c.vertices()[3][0]);
         }
         let floats = NonNull::from(&host[1..]).cast::<f32>();
         for offset in [1, 2, 3] {
@@ -1037,7 +1148,7 @@ pub(crate) mod tests {
                     1,
                 )
                 .unwrap();
-                let last = geometry.interpolate(segments as u32 - 1, 1.0).unwrap();
+                let last = geometry.interpolate(segments as u32 - 1, 1.0, 0.0).unwrap();
                 assert!(last.p.iter().all(|v| v.is_finite()), "{basis:?}");
                 scene.attach(geometry).unwrap();
                 let scene = scene.commit(&|_| true).unwrap();
@@ -1146,7 +1257,7 @@ pub(crate) mod tests {
                     let (x, y) = (column as f32 * 0.1, (j as f32 + 0.3) / segments as f32);
                     let ray = Ray::new(Vec3::new(x, y, -1.0), Vec3::Z);
                     let hit = scene.intersect(&ray, None).unwrap();
-                    let on = geometry.interpolate(hit.prim_id, hit.u).unwrap();
+                    let on = geometry.interpolate(hit.prim_id, hit.u, 0.0).unwrap();
                     let at = ray.point_at(hit.t);
                     assert!((Vec3::from(on.p) - at).length() < 2.0 * radius, "{basis:?}");
                     let strand = hit.prim_id / segments;
@@ -1176,6 +1287,96 @@ pub(crate) mod tests {
         let small = CurveGeometry::new(&device, linear, round, v, vec![0].into(), 1).unwrap();
         let small = small.in_parts(&PartsCache::default()).unwrap();
         assert!(small.parts().is_none());
+    }
+
+    /// Curves in motion are met where the ray's time puts them, whole and in parts (whose
+    /// bounds must then hold every time step), and interpolated there: 512 x 512 vertical
+    /// one-segment strands that move 3 along z over the shutter, far past where they start.
+    #[test]
+    fn curves_in_motion_are_met_where_the_rays_time_puts_them() {
+        use crate::embree::{Ray, SceneBuilder, SceneOptions};
+        use glam::Vec3;
+        let device = Arc::new(Device::new(Some(2)).unwrap());
+        let (side, radius, travel) = (512u32, 0.01f32, 3.0f32);
+        for (basis, parts) in [
+            (CurveBasis::Linear, false),
+            (CurveBasis::Linear, true),
+            (CurveBasis::CatmullRom, true),
+            (CurveBasis::Bezier, false),
+        ] {
+            let span = basis.points_per_segment() as u32;
+            let strand = |dz: f32| -> Vec<[f32; 4]> {
+                (0..side * side)
+                    .flat_map(|s| {
+                        let (x, z) = ((s % side) as f32 * 0.1, (s / side) as f32 * 0.1 + dz);
+                        (0..span).map(move |k| [x, k as f32 / (span - 1) as f32, z, radius])
+                    })
+                    .collect()
+            };
+            let steps = vec![strand(0.0).into(), strand(travel).into()];
+            let indices: Vec<u32> = (0..side * side).map(|s| s * span).collect();
+            let geometry = CurveGeometry::in_motion(
+                &device,
+                basis,
+                CurveShape::Round,
+                steps,
+                indices.into(),
+                1,
+            )
+            .unwrap();
+            let geometry = match parts {
+                true => geometry.in_parts(&PartsCache::default()).unwrap(),
+                false => geometry,
+            };
+            assert_eq!(geometry.parts().is_some(), parts);
+            let mut scene = SceneBuilder::new(device.clone(), SceneOptions::default()).unwrap();
+            scene.attach(geometry).unwrap();
+            let scene = scene.commit(&|_| true).unwrap();
+            let Some(Geometry::Curves(geometry)) = scene.geometry(0) else {
+                panic!("curves")
+            };
+            for time in [0.0, 0.25, 1.0] {
+                for column in [0, 17, side - 1] {
+                    let ray = Ray {
+                        time,
+                        ..Ray::new(Vec3::new(column as f32 * 0.1, 0.5, -1.0), Vec3::Z)
+                    };
+                    let hit = scene.intersect(&ray, None).unwrap();
+                    let z = travel * time;
+                    let at = ray.point_at(hit.t);
+                    assert!((at.z - z).abs() < 2.0 * radius, "{basis:?} at {time}: {at}");
+                    assert_eq!(hit.prim_id, column, "{basis:?} at {time}");
+                    let on = geometry.interpolate(hit.prim_id, hit.u, time).unwrap();
+                    assert!((Vec3::from(on.p) - at).length() < 2.0 * radius, "{basis:?}");
+                    let p = geometry
+                        .point_at(column as usize * span as usize, time)
+                        .unwrap();
+                    assert!((p.z - z).abs() < 1e-5, "{basis:?} at {time}: {p}");
+                }
+            }
+        }
+    }
+
+    /// Time steps of other point counts, or none, or more than Embree takes, are refused.
+    #[test]
+    fn time_steps_must_match() {
+        let device = Device::new(Some(1)).unwrap();
+        let make = |steps: Vec<SharedBuffer<[f32; 4]>>| {
+            let (linear, round) = (CurveBasis::Linear, CurveShape::Round);
+            CurveGeometry::in_motion(&device, linear, round, steps, vec![0].into(), 1)
+                .unwrap_err()
+                .to_string()
+        };
+        let two = || SharedBuffer::new(vec![[0.0, 0.0, 0.0, 0.1]; 2]);
+        let three = SharedBuffer::new(vec![[0.0, 0.0, 0.0, 0.1]; 3]);
+        let e = make(vec![two(), three]);
+        assert!(
+            e.contains("time step 1 has 3 control points, time step 0 2"),
+            "{e}"
+        );
+        assert!(make(Vec::new()).contains("0 time steps"));
+        let e = make((0..=MAX_TIME_STEPS).map(|_| two()).collect());
+        assert!(e.contains("time steps: Embree takes 1 to"), "{e}");
     }
 
     /// A part's bounds hold every point of its segments' surfaces, Catmull-Rom's bulges
@@ -1212,7 +1413,7 @@ pub(crate) mod tests {
                 for at in range.clone().step_by(7) {
                     let segment = parts.segments[at as usize];
                     for k in 0..=16 {
-                        let c = geometry.interpolate(segment, k as f32 / 16.0).unwrap();
+                        let c = geometry.interpolate(segment, k as f32 / 16.0, 0.0).unwrap();
                         let (p, r) = (Vec3::from(c.p), Vec3::splat(c.radius));
                         assert!(
                             (p - r).cmpge(lo).all() && (p + r).cmple(hi).all(),
@@ -1255,11 +1456,11 @@ pub(crate) mod tests {
             1,
         )
         .unwrap();
-        let mid = c.interpolate(0, 0.5).unwrap();
+        let mid = c.interpolate(0, 0.5, 0.0).unwrap();
         assert_eq!(mid.p, [1.0, 0.0, 0.0]);
         assert!((mid.radius - 0.2).abs() < 1e-6);
         assert_eq!(mid.dp_du, [2.0, 0.0, 0.0]);
         assert_eq!(mid.d2p_du2, [0.0; 3]);
-        assert!(c.interpolate(1, 0.5).is_none());
+        assert!(c.interpolate(1, 0.5, 0.0).is_none());
     }
 }

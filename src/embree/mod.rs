@@ -32,7 +32,7 @@ mod sys;
 pub use device::Device;
 pub use geometry::{CurveBasis, CurveShape};
 pub(crate) use geometry::{
-    CurveGeometry, CurvePoint, DEFAULT_RIBBON_QUADS, MAX_RIBBON_QUADS, PartsCache,
+    CurveGeometry, CurvePoint, DEFAULT_RIBBON_QUADS, MAX_RIBBON_QUADS, MAX_TIME_STEPS, PartsCache,
     TriangleGeometry, padding_for,
 };
 pub use isa::Isa;

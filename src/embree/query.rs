@@ -21,6 +21,9 @@ pub struct Ray {
     pub tfar: f32,
     /// Only geometries whose mask shares a bit with this one are hit.
     pub mask: u32,
+    /// When in the shutter the ray is traced, as a fraction of it in [0, 1]: where curves in
+    /// motion are (`math::time_steps`). Geometry that does not move ignores it.
+    pub time: f32,
 }
 
 impl Ray {
@@ -32,6 +35,7 @@ impl Ray {
             tnear: 0.0,
             tfar: f32::INFINITY,
             mask: u32::MAX,
+            time: 0.0,
         }
     }
 
@@ -58,7 +62,7 @@ impl Ray {
             dir_x: self.dir.x,
             dir_y: self.dir.y,
             dir_z: self.dir.z,
-            time: 0.0,
+            time: self.time,
             tfar: self.tfar,
             mask: self.mask,
             id: 0,

@@ -112,6 +112,10 @@ struct Built {
 /// never copied.
 pub struct ControlPoints {
     pub points: SharedBuffer<[f32; 4]>,
+    /// For strands that move over the shutter, the same control points at each later time
+    /// step, `points` being the first (`Curves::in_motion`); empty for strands that stay
+    /// put.
+    pub later_steps: Vec<SharedBuffer<[f32; 4]>>,
     /// Points per strand.
     pub counts: Vec<u32>,
     /// One linear RGB value per segment end (segments + 1 per strand), if any.
@@ -327,8 +331,9 @@ impl Scene {
         Ok(n)
     }
 
-    /// Adds strands of control points laid out for their basis (`points.points` shared, not
-    /// copied), drawn with `shape` and shaded by the material named `material`.
+    /// Adds strands of control points laid out for their basis (`points.points` and its
+    /// later time steps shared, not copied), drawn with `shape` and shaded by the material
+    /// named `material`. The automatic camera frames them at every time step.
     pub fn add_control_points(
         &mut self,
         name: &str,
@@ -338,15 +343,22 @@ impl Scene {
     ) -> Result<()> {
         self.check_free(name)?;
         let mut framing = Framing::default();
-        framing.add_control_points(points.points.as_slice());
-        let curves = Curves::from_control_points(
-            points.points,
-            &points.counts,
-            points.colors,
-            points.basis,
-            shape.built(),
-        )
-        .map_err(|e| self.error(name, e))?;
+        let steps = std::iter::once(points.points).chain(points.later_steps);
+        let curves = (steps.enumerate())
+            .map(|(k, step)| {
+                framing.add_control_points(step.as_slice());
+                let curves = Curves::from_control_points(
+                    step,
+                    &points.counts,
+                    points.colors.clone(),
+                    points.basis,
+                    shape.built(),
+                );
+                curves.map_err(|e| e.context(format!("time step {k}")))
+            })
+            .collect::<Result<Vec<_>>>()
+            .and_then(Curves::in_motion)
+            .map_err(|e| self.error(name, e))?;
         let shapes = vec![Shape::curves(curves, shape)];
         self.add(name, shapes, material, framing, true);
         Ok(())

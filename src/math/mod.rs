@@ -7,10 +7,12 @@ pub(crate) mod fast;
 pub(crate) mod frame;
 pub(crate) mod lanes;
 pub(crate) mod sampling;
+pub mod time_steps;
 
 pub use curve_basis::{CurveBasis, CurveShape};
 pub use frame::{Frame, hair_frame_offset};
 pub use lanes::Lanes;
+pub use time_steps::time_step;
 
 /// A 64-bit finaliser with full avalanche (the SplitMix64 output function): nearby keys,
 /// such as neighbouring pixels or strand ids, get unrelated hashes.

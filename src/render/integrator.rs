@@ -143,18 +143,18 @@ impl World {
         Ok(())
     }
 
-    /// Radiance arriving along the camera ray (org, dir), what its first hit reports for
+    /// Radiance arriving along the camera ray `camera_ray` (at its time, a fraction of the
+    /// shutter, which every ray of the path keeps), what its first hit reports for
     /// the AOVs (None when it escapes or when `aovs` is false), and the number of rays
     /// traced. `pixel_spread` is the side of the ray's pixel per unit distance from the eye
-    /// (`Camera::pixel_spread`; `dir` is a unit vector).
+    /// (`Camera::pixel_spread`; the ray's direction is a unit vector).
     ///
     /// A path of at most `max_depth` scattering events traces up to `max_depth + 1`
     /// closest-hit rays: the last one only looks for emission, so that BSDF sampling
     /// reaches exactly as deep as next-event estimation and MIS stays unbiased at the cap.
     pub fn radiance(
         &self,
-        org: Vec3,
-        dir: Vec3,
+        camera_ray: Ray,
         settings: &PathSettings,
         aovs: bool,
         pixel_spread: f32,
@@ -165,7 +165,7 @@ impl World {
         let mut l = Vec3::ZERO;
         let mut beta = Vec3::ONE;
         let mut ray = SpawnedRay {
-            ray: Ray::new(org, dir),
+            ray: camera_ray,
             exclude: None,
         };
         // How `ray` was made, for MIS on the emission it finds.

@@ -11,6 +11,7 @@ use super::rounds::{Rounds, Stops, Taken};
 use super::sampler::PixelSampler;
 use super::settings::{Allocation, RenderSettings};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
+use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::scene::camera::Camera;
 use crate::scene::detail_view::DetailView;
@@ -212,6 +213,7 @@ pub fn render(
     };
     let mut rounds = Rounds::new(passes, pilot.is_some(), stops);
     let parts_before = world.tracer.scene().parts_built();
+    let motion_blur = settings.motion_blur();
     let first_tile = OnceLock::new();
     let start = Instant::now();
     // One pool of workers for every round: `render_tiles` runs on it.
@@ -260,9 +262,12 @@ pub fn render(
                             [0.5; 2]
                         };
                         let (org, dir) = camera.ray(image_point, lens);
+                        let ray = Ray {
+                            time: if motion_blur { sampler.time() } else { 0.0 },
+                            ..Ray::new(org, dir)
+                        };
                         let (radiance, first, traced) = world.radiance(
-                            org,
-                            dir,
+                            ray,
                             &settings.path,
                             aovs.any(),
                             pixel_spread,

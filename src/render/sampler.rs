@@ -22,6 +22,10 @@ use crate::math::mix64;
 /// blocks is lost).
 const BLOCK_BITS: u32 = 16;
 
+/// What [`PixelSampler::time`] mixes into the pixel's seed, in place of a request number:
+/// far from any request count a path reaches.
+const TIME_KEY: u64 = 0x7469_6d65_0000_0000;
+
 /// A cursor over one pixel sample's dimensions. Cheap to create (a few hashes): make one
 /// per camera sample.
 #[derive(Debug, Clone)]
@@ -66,6 +70,15 @@ impl PixelSampler {
     pub fn next_4d(&mut self) -> [f32; 4] {
         let s = self.next_sequence();
         owen_sobol(self.index, s)
+    }
+
+    /// The sample's time, in [0, 1): its fraction of the shutter. A dimension of its own,
+    /// seeded apart from the requests, so that it is stratified across the pixel's samples
+    /// as a request's first dimension is, and that a render with motion blur asks the other
+    /// numbers exactly as one without it does. It takes no request: call it at any point.
+    pub fn time(&self) -> f32 {
+        let s = mix64(self.seed ^ TIME_KEY);
+        owen_sobol::<1>(self.index, (s >> 32) as u32)[0]
     }
 
     /// Passes over one request that this path does not need (a lens sample for a
@@ -202,6 +215,43 @@ mod tests {
             }
             assert!(strata.iter().flatten().all(|&c| c == 1), "{strata:?}");
             assert!(grid.iter().all(|&c| c == 1), "8x8 strata: {grid:?}");
+        }
+    }
+
+    #[test]
+    fn the_time_is_stratified_and_apart_from_the_requests() {
+        for pixel in [(0, 0), (7, 3)] {
+            let mut strata = [0u8; 64];
+            for i in 0..64 {
+                let s = PixelSampler::new(5, pixel, i);
+                let t = s.time();
+                assert!((0.0..1.0).contains(&t), "{t}");
+                strata[(t * 64.0) as usize] += 1;
+                // Asking it changes none of the requests.
+                let mut asked = s.clone();
+                let _ = asked.time();
+                let mut plain = PixelSampler::new(5, pixel, i);
+                assert_eq!(asked.next_4d(), plain.next_4d());
+            }
+            assert!(strata.iter().all(|&c| c == 1), "{strata:?}");
+        }
+        let n = 4096;
+        let times: Vec<f32> = (0..n)
+            .map(|i| PixelSampler::new(1, (10, 10), i).time())
+            .collect();
+        let bound = 4.0 / (n as f64).sqrt();
+        for request in 0..3 {
+            let other: Vec<f32> = (0..n)
+                .map(|i| {
+                    let mut s = PixelSampler::new(1, (10, 10), i);
+                    for _ in 0..request {
+                        s.next_4d();
+                    }
+                    s.next_2d()[0]
+                })
+                .collect();
+            let r = correlation(&times, &other);
+            assert!(r.abs() < bound, "request {request}: correlation {r}");
         }
     }
 

@@ -352,6 +352,14 @@ settings! {
         /// render of fewer than 3 camera samples per segment, where the faster build
         /// outweighs the slower rays: docs/large-grooms.md), on or off.
         curve_parts: CurveParts = CurveParts::Auto, Range::Any, Build;
+        /// When the shutter opens, in frames from the frame's time (negative: before it).
+        /// Curves in motion hold their time steps spread evenly from the opening to the
+        /// closing, and each camera sample, with every ray of its path, is traced at a time
+        /// of its own in between (motion blur); equal to shutter_close: no blur, every ray
+        /// at the opening.
+        shutter_open: f32 = 0.0, Range::Any, Render;
+        /// When the shutter closes, in frames from the frame's time: at least shutter_open.
+        shutter_close: f32 = 0.0, Range::Any, Render;
     }
 
     /// How paths are traced and ended, and the hair BSDF's fidelity knobs.
@@ -526,6 +534,13 @@ impl RenderSettings {
                 ));
             }
         }
+        if self.shutter_close < self.shutter_open {
+            return Err(invalid_arg!(
+                "shutter_close = {}: the shutter closes before it opens (shutter_open = {})",
+                self.shutter_close,
+                self.shutter_open
+            ));
+        }
         if let Some(n) = self.path.deep_bounce_depth {
             if n > self.path.max_depth {
                 return Err(invalid_arg!(
@@ -545,6 +560,12 @@ impl RenderSettings {
         (SETTINGS.iter())
             .find(|s| s.needs == Needs::Build && (s.get)(self) != (s.get)(built))
             .map(|s| s.name)
+    }
+
+    /// Whether the shutter stays open for a while: each camera sample then has a time of
+    /// its own.
+    pub fn motion_blur(&self) -> bool {
+        self.shutter_close > self.shutter_open
     }
 
     /// The crop window, or the full frame.

@@ -40,8 +40,8 @@ use glam::{Vec3, Vec4};
 use super::ragged;
 use crate::bsdf::sigma_a_from_melanin;
 use crate::embree::{
-    CurveBasis, CurveShape, DEFAULT_RIBBON_QUADS, PartsCache, SharedBuffer, centroid, morton_order,
-    padding_for,
+    CurveBasis, CurveShape, DEFAULT_RIBBON_QUADS, MAX_TIME_STEPS, PartsCache, SharedBuffer,
+    centroid, morton_order, padding_for,
 };
 use crate::error::{Result, invalid_arg};
 use crate::scene::Strands;
@@ -54,6 +54,10 @@ pub struct Curves {
     basis: CurveBasis,
     shape: CurveShape,
     vertices: SharedBuffer<[f32; 4]>,
+    /// The control points at the time steps after the first (`vertices`), spread evenly
+    /// over the shutter ([`Curves::in_motion`]), laid out alike; empty for curves that do
+    /// not move.
+    later_steps: Vec<SharedBuffer<[f32; 4]>>,
     indices: SharedBuffer<u32>,
     strands: StrandIndex,
     /// The curves these `Curves::polylines` stand for.
@@ -370,6 +374,7 @@ impl Curves {
             basis,
             shape,
             vertices,
+            later_steps: Vec::new(),
             indices: SharedBuffer::new(indices),
             strands: StrandIndex::new((0..strands).map(segments), colors)?,
             truth: None,
@@ -377,6 +382,59 @@ impl Curves {
             parts: PartsCache::default(),
             ribbon_quads: DEFAULT_RIBBON_QUADS,
         })
+    }
+
+    /// Curves that move over the shutter: `steps[k]` are the curves at time step k of 1 to
+    /// `MAX_TIME_STEPS`, spread evenly over it (step 0 where it opens, the last where it
+    /// closes; `math::time_steps`). Every step must have the basis, the strands and each
+    /// strand's number of control points of step 0, whose shape, colours or melanin and
+    /// ribbon quads the curves keep (the points of each were checked when it was made).
+    pub fn in_motion(steps: Vec<Curves>) -> Result<Curves> {
+        if !(1..=MAX_TIME_STEPS).contains(&steps.len()) {
+            return Err(invalid_arg!(
+                "{} time steps: curves in motion take 1 to {MAX_TIME_STEPS}",
+                steps.len()
+            ));
+        }
+        if let Some(k) =
+            (steps.iter()).position(|c| !c.later_steps.is_empty() || c.truth.is_some() || c.ordered)
+        {
+            return Err(invalid_arg!(
+                "time step {k}: curves as made from points, not curves in motion, a level of \
+                 detail or curves reordered"
+            ));
+        }
+        let mut steps = steps.into_iter();
+        let Some(mut first) = steps.next() else {
+            return Err(invalid_arg!("no time steps"));
+        };
+        for (k, step) in (1..).zip(steps) {
+            if step.basis != first.basis {
+                return Err(invalid_arg!(
+                    "time step {k} holds {:?} curves, time step 0 {:?}",
+                    step.basis,
+                    first.basis
+                ));
+            }
+            let strands = first.strands.strand_count();
+            if step.strands.strand_count() != strands {
+                return Err(invalid_arg!(
+                    "time step {k} has {} strands, time step 0 {strands}",
+                    step.strands.strand_count()
+                ));
+            }
+            let points = |c: &Curves, s| c.strand_points(s).len();
+            if let Some(s) = (0..strands).find(|&s| points(&step, s) != points(&first, s)) {
+                return Err(invalid_arg!(
+                    "time step {k}: strand {s} has {} control points, at time step 0 {} (a \
+                     strand keeps its points over the shutter)",
+                    points(&step, s),
+                    points(&first, s)
+                ));
+            }
+            first.later_steps.push(step.vertices);
+        }
+        Ok(first)
     }
 
     /// The strands that `keep` marks (one flag per strand), copied into curves of their own
@@ -405,7 +463,8 @@ impl Curves {
     /// the caller shares (a C host's memory, an `Arc` it made) are kept where they are, as
     /// are curves already in order (ordered here before, and kept: a C scene's rebuilds).
     pub fn spatially_ordered(mut self) -> Result<Curves> {
-        if self.ordered || !self.vertices.is_ours() {
+        let ours = self.vertices.is_ours() && self.later_steps.iter().all(SharedBuffer::is_ours);
+        if self.ordered || !ours {
             return Ok(self);
         }
         let order = morton_order(self.strands.strand_count(), |s| {
@@ -426,6 +485,9 @@ impl Curves {
     /// keeps its curves so, and hands each build a clone that costs no copy.
     pub fn shared(mut self) -> Curves {
         self.vertices = self.vertices.into_shared();
+        self.later_steps = (self.later_steps.into_iter())
+            .map(SharedBuffer::into_shared)
+            .collect();
         self.indices = self.indices.into_shared();
         self
     }
@@ -442,6 +504,14 @@ impl Curves {
         let vertices = ragged::filled(&sizes, padding_for::<[f32; 4]>(), |i, out| {
             out.copy_from_slice(self.strand_points(order[i]));
         })?;
+        let later_steps = (1..self.time_steps())
+            .map(|step| {
+                ragged::filled(&sizes, padding_for::<[f32; 4]>(), |i, out| {
+                    out.copy_from_slice(self.strand_points_at(order[i], step));
+                })
+                .map(SharedBuffer::from)
+            })
+            .collect::<Result<_>>()?;
         let colors = match &self.strands.absorption {
             // Segments + 1 colours per strand: s strands' extra ones come before.
             Some(GroomAbsorption::Colors(all)) => {
@@ -459,6 +529,7 @@ impl Curves {
             part = part.with_melanin(order.iter().map(|&s| all[s]).collect())?;
         }
         part.ribbon_quads = self.ribbon_quads;
+        part.later_steps = later_steps;
         let ids = self.strands.ids.as_ref();
         part.strands.ids = Some(
             order
@@ -469,13 +540,19 @@ impl Curves {
         Ok(Some(part))
     }
 
-    /// The control points strand `s` reads (`s` < the strand count).
+    /// The control points strand `s` reads (`s` < the strand count), at the first time
+    /// step.
     pub fn strand_points(&self, s: usize) -> &[[f32; 4]] {
+        self.strand_points_at(s, 0)
+    }
+
+    /// The control points strand `s` reads at time step `step` (< [`Self::time_steps`]).
+    pub fn strand_points_at(&self, s: usize, step: usize) -> &[[f32; 4]] {
         let starts = &self.strands.segment_starts;
         let first = self.indices();
         let start = first[starts[s] as usize] as usize;
         let end = first[starts[s + 1] as usize - 1] as usize + self.basis.points_per_segment();
-        &self.vertices()[start..end]
+        &self.step_vertices(step)[start..end]
     }
 
     /// The same curves with one (eumelanin, pheomelanin) pair per strand as the groom's
@@ -530,6 +607,11 @@ impl Curves {
         counts: &[u32],
         params: Vec<f32>,
     ) -> Result<Curves> {
+        if truth.time_steps() > 1 {
+            return Err(invalid_arg!(
+                "polylines of curves in motion: a level of detail is of curves that stay put"
+            ));
+        }
         if counts.len() != truth.strands.strand_count() || params.len() != points.len() {
             return Err(invalid_arg!(
                 "{} polylines of {} points with {} parameters for {} strands",
@@ -559,12 +641,16 @@ impl Curves {
         self.truth.as_ref()
     }
 
-    /// The polynomial of segment `prim`.
+    /// The polynomial of segment `prim` at the first time step.
     pub(crate) fn segment_curve(&self, prim: u32) -> Option<SegmentCurve> {
+        self.segment_curve_at(prim, 0)
+    }
+
+    /// The polynomial of segment `prim` at time step `step`; `None` past the steps.
+    pub(crate) fn segment_curve_at(&self, prim: u32, step: usize) -> Option<SegmentCurve> {
         let first = *self.indices().get(prim as usize)? as usize;
-        let points = self
-            .vertices()
-            .get(first..first + self.basis.points_per_segment())?;
+        let points =
+            (self.steps().nth(step)?).get(first..first + self.basis.points_per_segment())?;
         Some(SegmentCurve::new(self.basis, points))
     }
 
@@ -576,9 +662,30 @@ impl Curves {
         self.shape
     }
 
-    /// Control points (x, y, z, radius) as Embree will read them.
+    /// Control points (x, y, z, radius) as Embree will read them, at the first time step.
     pub fn vertices(&self) -> &[[f32; 4]] {
         self.vertices.as_slice()
+    }
+
+    /// Time steps over the shutter ([`Self::in_motion`]): 1 for curves that do not move.
+    pub fn time_steps(&self) -> usize {
+        1 + self.later_steps.len()
+    }
+
+    /// The control points at time step `step` (< [`Self::time_steps`]), laid out as
+    /// [`Self::vertices`].
+    pub fn step_vertices(&self, step: usize) -> &[[f32; 4]] {
+        match step {
+            0 => self.vertices(),
+            k => self.later_steps[k - 1].as_slice(),
+        }
+    }
+
+    /// The control points at each time step, from the first.
+    pub fn steps(&self) -> impl Iterator<Item = &[[f32; 4]]> {
+        std::iter::once(&self.vertices)
+            .chain(&self.later_steps)
+            .map(SharedBuffer::as_slice)
     }
 
     /// First control point of each segment.
@@ -594,6 +701,9 @@ impl Curves {
     /// their owner's, not counted).
     pub fn heap_bytes(&self) -> usize {
         self.vertices.heap_bytes()
+            + (self.later_steps.iter())
+                .map(SharedBuffer::heap_bytes)
+                .sum::<usize>()
             + self.indices.heap_bytes()
             + self.strands.heap_bytes()
             + self.truth.as_ref().map_or(0, |t| t.heap_bytes())
@@ -604,7 +714,9 @@ impl Curves {
         (
             self.basis,
             self.shape,
-            self.vertices,
+            std::iter::once(self.vertices)
+                .chain(self.later_steps)
+                .collect(),
             self.indices,
             self.strands,
             self.truth,
@@ -613,12 +725,13 @@ impl Curves {
     }
 }
 
-/// What [`Curves::into_parts`] gives: basis, shape, control points, index buffer, the
-/// strand table, the true curves of a polyline and the cache of Embree's parts.
+/// What [`Curves::into_parts`] gives: basis, shape, the control points of each time step,
+/// index buffer, the strand table, the true curves of a polyline and the cache of Embree's
+/// parts.
 pub(crate) type CurveParts = (
     CurveBasis,
     CurveShape,
-    SharedBuffer<[f32; 4]>,
+    Vec<SharedBuffer<[f32; 4]>>,
     SharedBuffer<u32>,
     StrandIndex,
     Option<Arc<TrueCurves>>,

@@ -95,7 +95,8 @@ impl ViewDependent {
     }
 
     /// Whether `new` may render `scene` as built: [`DetailView::holds_for`] at every
-    /// control point of the view-dependent geometries; always, without any.
+    /// control point of the view-dependent geometries, at each of their time steps; always,
+    /// without any.
     pub fn holds_for(&self, scene: &Scene, new: &DetailView) -> bool {
         let Some(built) = &self.view else {
             return true;
@@ -103,7 +104,7 @@ impl ViewDependent {
         self.geometries
             .iter()
             .all(|&id| match scene.geometries().get(id as usize) {
-                Some(Geometry::Curves(c)) => built.holds_for(new, c.vertices()),
+                Some(Geometry::Curves(c)) => c.steps().all(|step| built.holds_for(new, step)),
                 _ => true,
             })
     }

@@ -9,7 +9,9 @@
 //! here (procedural, or read from a `.hair` file) also briefly holds its polylines next to
 //! its converted copy, and its curves next to their copy in spatial order;
 //! [`conversion_bytes`] is the larger of those moments. Level of detail changes only
-//! the sizes it passes in: fewer segments, a cheaper basis or shape per part.
+//! the sizes it passes in: fewer segments, a cheaper basis or shape per part. Curves in
+//! motion hold their control points once per time step, and Embree's motion-blur BVH is
+//! counted once per step too: an upper bound, not yet measured (docs/measurements.md).
 
 use crate::embree::{CurveBasis, CurveShape, SceneOptions};
 use crate::error::{Result, invalid_arg};
@@ -25,8 +27,10 @@ pub struct CurvesSize {
     pub strands: u64,
     /// Curve segments (Embree primitives), all strands together.
     pub segments: u64,
-    /// Control points Embree reads.
+    /// Control points Embree reads, at one time step.
     pub control_points: u64,
+    /// Time steps over the shutter (`Curves::in_motion`): 1 for curves that stay put.
+    pub time_steps: u64,
     pub basis: CurveBasis,
     pub shape: CurveShape,
     /// Built in parts (`SceneOptions::builds_in_parts`): two more u32 per segment.
@@ -58,6 +62,7 @@ impl CurvesSize {
             strands,
             segments,
             control_points: strands.saturating_mul(per_strand),
+            time_steps: 1,
             basis,
             shape,
             in_parts: in_parts(options, segments),
@@ -71,18 +76,20 @@ impl CurvesSize {
             strands: curves.strands().strand_count() as u64,
             segments,
             control_points: curves.vertices().len() as u64,
+            time_steps: curves.time_steps() as u64,
             basis: curves.basis(),
             shape: curves.shape(),
             in_parts: in_parts(options, segments),
         }
     }
 
-    /// Bytes of the buffers hairtrace keeps for these curves: float4 control points, one
+    /// Bytes of the buffers hairtrace keeps for these curves: float4 control points at
+    /// each time step, one
     /// u32 index per segment (three in parts: the index buffer in the order of Embree's
     /// parts and each of its segments' own number), the strand table (two u32 per strand,
     /// its first segment and, in spatial order, its number; one per 32 segments).
     pub fn curve_bytes(&self) -> u64 {
-        let points = self.control_points.saturating_mul(16);
+        let points = (self.control_points.saturating_mul(16)).saturating_mul(self.time_steps);
         let indices = if self.in_parts { 12 } else { 4 };
         let segments = self.segments.saturating_mul(indices) + self.segments / 8;
         points
@@ -90,10 +97,12 @@ impl CurvesSize {
             .saturating_add(self.strands.saturating_mul(8))
     }
 
-    /// Bytes Embree holds at the peak of the BVH build over these curves, `compact` or not.
+    /// Bytes Embree holds at the peak of the BVH build over these curves, `compact` or not:
+    /// a static BVH's once per time step.
     pub fn bvh_bytes(&self, compact: bool) -> u64 {
-        self.segments
+        (self.segments)
             .saturating_mul(bvh_bytes_per_segment(self.basis, compact))
+            .saturating_mul(self.time_steps)
     }
 
     /// "1000000 strands x 16 segments, catmull_rom round".
@@ -109,7 +118,14 @@ impl CurvesSize {
             CurveShape::Round => "round",
             CurveShape::Flat => "flat",
         };
-        format!("{} strands x {per} segments, {basis} {shape}", self.strands)
+        let steps = match self.time_steps {
+            1 => String::new(),
+            k => format!(" at {k} time steps"),
+        };
+        format!(
+            "{} strands x {per} segments, {basis} {shape}{steps}",
+            self.strands
+        )
     }
 }
 
@@ -285,18 +301,28 @@ mod tests {
             ..FurBall::default()
         };
         let strands = ball.build().unwrap();
-        for parts in [PartsRule::Never, PartsRule::Always] {
+        let curves = || Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Flat);
+        for (parts, steps) in [
+            (PartsRule::Never, 1),
+            (PartsRule::Always, 1),
+            (PartsRule::Never, 3),
+            (PartsRule::Always, 2),
+        ] {
             // As a build holds them: in spatial order, with each strand's own number.
-            let curves = Curves::from_strands(&strands, CurveBasis::CatmullRom, CurveShape::Flat)
+            let curves = (0..steps)
+                .map(|_| curves())
+                .collect::<Result<Vec<_>>>()
+                .and_then(Curves::in_motion)
                 .and_then(Curves::spatially_ordered)
                 .unwrap();
+            assert_eq!(curves.time_steps(), steps);
             let estimate = CurvesSize::of(&curves, &options(parts)).curve_bytes() as f64;
             let mut builder = TracerBuilder::new(device.clone(), options(parts)).unwrap();
             builder.add_curves(curves).unwrap();
             let held = builder.build().unwrap().heap_bytes() as f64;
             assert!(
                 (held / estimate - 1.0).abs() < 2e-3,
-                "{parts:?}: {held} against {estimate}"
+                "{parts:?} x {steps} steps: {held} against {estimate}"
             );
         }
     }

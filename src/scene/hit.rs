@@ -69,6 +69,9 @@ pub struct HairHit {
     /// The groom's absorption here, when it gives one
     /// ([`super::curves::StrandIndex::absorption`]).
     pub absorption: Option<HairColor>,
+    /// The time of the ray that hit (`Ray::time`), at which the strand was met and is
+    /// shaded, and which the rays leaving it keep.
+    pub time: f32,
 }
 
 /// A hit on a triangle mesh.
@@ -86,6 +89,8 @@ pub struct SurfaceHit {
     /// Barycentric coordinates of vertices 1 and 2.
     pub u: f32,
     pub v: f32,
+    /// The time of the ray that hit (`Ray::time`), which the rays leaving it keep.
+    pub time: f32,
 }
 
 /// The closest hit of a ray.
@@ -114,6 +119,14 @@ impl Hit {
         match self {
             Hit::Hair(h) => h.geom_id,
             Hit::Surface(s) => s.geom_id,
+        }
+    }
+
+    /// The time of the ray that hit.
+    pub fn time(&self) -> f32 {
+        match self {
+            Hit::Hair(h) => h.time,
+            Hit::Surface(s) => s.time,
         }
     }
 

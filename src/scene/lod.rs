@@ -166,13 +166,16 @@ const RIBBON_QUADS: [u32; 3] = [DEFAULT_RIBBON_QUADS, 8, MAX_RIBBON_QUADS];
 /// (docs/measurements.md, "Ribbons' quads at the silhouette"). The bound is a chord's
 /// largest distance from a curve: an eighth of its parameter step squared times the
 /// second derivative across the line of sight, largest at a segment end (it is linear).
+/// Curves in motion take the largest turn over their time steps: between two steps the
+/// curve's second derivative is the blend of theirs, no longer than the longer of them.
 pub fn ribbon_quads(curves: &Curves, camera: &Camera, height: u32, pixels: f32) -> Result<u32> {
     check_pixels(pixels)?;
     let (eye, per_distance) = (camera.eye(), pixels * camera.pixel_spread(height));
+    let steps = curves.time_steps();
     let turn = threads::scoped(0, || {
         (0..curves.indices().len() as u32)
             .into_par_iter()
-            .filter_map(|prim| curves.segment_curve(prim))
+            .flat_map_iter(|prim| (0..steps).filter_map(move |k| curves.segment_curve_at(prim, k)))
             .map(|curve| turn_over_distance(&curve, eye))
             .reduce(|| 0.0, f32::max)
     })?;

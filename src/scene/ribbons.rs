@@ -57,16 +57,17 @@ impl From<CurveShape> for GroomShape {
     }
 }
 
-/// One flag per strand: whether every control point's diameter is at most one pixel of an
-/// image `height` pixels tall, seen from `camera`'s eye at the point's distance.
+/// One flag per strand: whether every control point's diameter, at every time step, is at
+/// most one pixel of an image `height` pixels tall, seen from `camera`'s eye at the point's
+/// distance.
 pub fn thin_strands(curves: &Curves, camera: &Camera, height: u32) -> Vec<bool> {
     let (eye, spread) = (camera.eye(), camera.pixel_spread(height));
     (0..curves.strands().strand_count())
         .map(|s| {
-            curves
-                .strand_points(s)
-                .iter()
-                .all(|&[x, y, z, r]| 2.0 * r <= spread * eye.distance(Vec3::new(x, y, z)))
+            (0..curves.time_steps()).all(|step| {
+                (curves.strand_points_at(s, step).iter())
+                    .all(|&[x, y, z, r]| 2.0 * r <= spread * eye.distance(Vec3::new(x, y, z)))
+            })
         })
         .collect()
 }
@@ -84,7 +85,8 @@ enum Part {
 /// `curves` (built round) as the geometries an `auto` groom is traced with: its thick
 /// strands round, its thin ones ([`thin_strands`]) flat, or with `lod_pixels` > 0 as
 /// polylines within that many pixels of their curves; without a copy when all are one
-/// kind.
+/// kind. Curves in motion keep their thin strands flat curves: a polyline is chosen for
+/// one shape of a strand, and the ribbons' quads are chosen over every time step.
 pub fn share_out(
     curves: Curves,
     camera: &Camera,
@@ -92,7 +94,7 @@ pub fn share_out(
     lod_pixels: f32,
 ) -> Result<Vec<Curves>> {
     lod::check_pixels(lod_pixels)?;
-    let thin_part = if lod_pixels > 0.0 {
+    let thin_part = if lod_pixels > 0.0 && curves.time_steps() == 1 {
         Part::Polyline
     } else {
         Part::Flat

@@ -4,7 +4,7 @@
 
 use std::sync::Arc;
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use super::curves::{Curves, StrandIndex, StrandSegment, TrueCurves};
 use super::detail_view::{DetailView, ViewDependent};
@@ -135,20 +135,15 @@ impl TracerBuilder {
     /// Adds curves (mask [`HAIR_MASK`]) and returns their geometry id.
     pub fn add_curves(&mut self, curves: Curves) -> Result<u32> {
         let quads = curves.ribbon_quads();
-        let (basis, shape, vertices, indices, strands, truth, parts) = curves.into_parts();
+        let (basis, shape, steps, indices, strands, truth, parts) = curves.into_parts();
         if shape == CurveShape::Flat {
-            let largest = vertices.as_slice().iter().fold(0.0f32, |m, v| m.max(v[3]));
+            let largest =
+                (steps.iter().flat_map(|s| s.as_slice())).fold(0.0f32, |m, v| m.max(v[3]));
             self.flat_radius = self.flat_radius.max(largest);
         }
         let in_parts = self.scene.options().builds_in_parts(indices.len());
-        let geometry = CurveGeometry::new(
-            self.scene.device(),
-            basis,
-            shape,
-            vertices,
-            indices,
-            HAIR_MASK,
-        )?;
+        let geometry =
+            CurveGeometry::in_motion(self.scene.device(), basis, shape, steps, indices, HAIR_MASK)?;
         let geometry = if quads != DEFAULT_RIBBON_QUADS {
             geometry.with_ribbon_quads(self.scene.device(), quads)?
         } else {
@@ -317,6 +312,7 @@ impl Tracer {
                 // A target nearer than the fibre's far wall leaves nothing to test.
                 tfar: (tfar - advance).max(0.0) + back,
                 mask: u32::MAX,
+                time: from.time(),
             },
             exclude: exclude.map(|ex| Exclude {
                 max_t: ex.max_t + back,
@@ -357,7 +353,7 @@ impl Tracer {
         let reach = EXIT_RADII * h.radius / sine;
         // Segments that distance can span, from the length of this one (at least its
         // neighbours on each side, for the joints).
-        let chord = segment_chord(geom, h.prim_id);
+        let chord = segment_chord(geom, h.prim_id, h.time);
         let k = if chord > 0.0 {
             ((reach / chord).ceil() as u32).saturating_add(1)
         } else {
@@ -383,9 +379,9 @@ impl Tracer {
                 let hair = hair_hit(ray, hit, p, geom, strands, at, truth.as_deref())?;
                 Some(Hit::Hair(hair))
             }
-            (Geometry::Triangles(geom), Table::Mesh { normals }) => {
-                Some(Hit::Surface(surface_hit(hit, p, geom, normals.as_deref())?))
-            }
+            (Geometry::Triangles(geom), Table::Mesh { normals }) => Some(Hit::Surface(
+                surface_hit(hit, p, ray.time, geom, normals.as_deref())?,
+            )),
             _ => None,
         }
     }
@@ -418,10 +414,12 @@ fn hair_hit(
     truth: Option<&TrueCurves>,
 ) -> Option<HairHit> {
     let flat_cubic = geom.shape() == CurveShape::Flat && geom.basis() != CurveBasis::Linear;
+    // Curves in motion are shaded where the ray met them: at its time.
+    let time = ray.time;
     let (u, c) = if flat_cubic {
-        project_onto_axis(geom, hit.prim_id, hit.u, p)?
+        project_onto_axis(geom, hit.prim_id, hit.u, p, time)?
     } else {
-        (hit.u, geom.interpolate(hit.prim_id, hit.u)?)
+        (hit.u, geom.interpolate(hit.prim_id, hit.u, time)?)
     };
     let axis = Vec3::from_array(c.p);
     // A polyline's hit takes the true curve's tangent, position and colour there.
@@ -434,12 +432,19 @@ fn hair_hit(
         Some((d, s, absorption)) => (
             Some(d)
                 .filter(|d| usable(*d, c.radius))
-                .unwrap_or_else(|| tangent(geom, hit.prim_id, Vec3::ZERO, c.radius, &at)),
+                .unwrap_or_else(|| tangent(geom, hit.prim_id, Vec3::ZERO, c.radius, &at, time)),
             s,
             absorption,
         ),
         None => (
-            tangent(geom, hit.prim_id, Vec3::from_array(c.dp_du), c.radius, &at),
+            tangent(
+                geom,
+                hit.prim_id,
+                Vec3::from_array(c.dp_du),
+                c.radius,
+                &at,
+                time,
+            ),
             at.s(u),
             strands.absorption(&at, u),
         ),
@@ -488,6 +493,7 @@ fn hair_hit(
         strand: at,
         s,
         absorption,
+        time,
     })
 }
 
@@ -522,9 +528,10 @@ fn project_onto_axis(
     prim: u32,
     u: f32,
     p: Vec3,
+    time: f32,
 ) -> Option<(f32, CurvePoint)> {
     let mut u = u;
-    let mut c = geom.interpolate(prim, u)?;
+    let mut c = geom.interpolate(prim, u, time)?;
     for _ in 0..2 {
         let (q, d1, d2) = (
             Vec3::from_array(c.p) - p,
@@ -536,7 +543,7 @@ fn project_onto_axis(
             break;
         }
         u = (u - q.dot(d1) / slope).clamp(0.0, 1.0);
-        c = geom.interpolate(prim, u)?;
+        c = geom.interpolate(prim, u, time)?;
     }
     Some((u, c))
 }
@@ -551,16 +558,18 @@ fn usable(t: Vec3, radius: f32) -> bool {
 
 /// The curve tangent at the hit: the segment direction for linear curves, the derivative
 /// for cubic ones; where that vanishes, the chord of the segment, then of its neighbours
-/// (nearest first) in the same strand. Zero only when the whole strand is one point.
+/// (nearest first) in the same strand, all at `time`. Zero only when the whole strand is
+/// one point.
 fn tangent(
     geom: &CurveGeometry,
     prim: u32,
     derivative: Vec3,
     radius: f32,
     at: &StrandSegment,
+    time: f32,
 ) -> Vec3 {
     let first = if geom.basis() == CurveBasis::Linear {
-        chord(geom, prim)
+        chord(geom, prim, time)
     } else {
         derivative
     };
@@ -572,31 +581,35 @@ fn tangent(
         .flat_map(|k| [prim.checked_sub(k), prim.checked_add(k)])
         .flatten()
         .filter(|q| prims.contains(q))
-        .map(|q| chord(geom, q))
+        .map(|q| chord(geom, q, time))
         .find(|&t| t.is_finite() && t != Vec3::ZERO)
         .unwrap_or(Vec3::ZERO)
 }
 
-/// Start-to-end vector of segment `prim`: v1 - v0 for linear curves, from the curve itself
-/// for cubic ones.
-fn chord(geom: &CurveGeometry, prim: u32) -> Vec3 {
+/// Start-to-end vector of segment `prim` at `time`: v1 - v0 for linear curves, from the
+/// curve itself for cubic ones.
+fn chord(geom: &CurveGeometry, prim: u32, time: f32) -> Vec3 {
     if geom.basis() == CurveBasis::Linear {
         let Some(&first) = geom.indices().get(prim as usize) else {
             return Vec3::ZERO;
         };
-        let v = geom.vertices();
-        let p = |i: u32| Vec3::from_slice(&v[i as usize][..3]);
+        let p = |i: u32| {
+            geom.point_at(i as usize, time)
+                .unwrap_or(Vec4::ZERO)
+                .truncate()
+        };
         return p(first + 1) - p(first);
     }
     let end = |u| {
-        geom.interpolate(prim, u)
+        geom.interpolate(prim, u, time)
             .map_or(Vec3::ZERO, |c| Vec3::from_array(c.p))
     };
     end(1.0) - end(0.0)
 }
 
-/// Approximate segment length from its control points, for neighbour counts only.
-fn segment_chord(geom: &CurveGeometry, prim: u32) -> f32 {
+/// Approximate segment length from its control points at `time`, for neighbour counts
+/// only.
+fn segment_chord(geom: &CurveGeometry, prim: u32, time: f32) -> f32 {
     let Some(&first) = geom.indices().get(prim as usize) else {
         return 0.0;
     };
@@ -605,14 +618,18 @@ fn segment_chord(geom: &CurveGeometry, prim: u32) -> f32 {
         CurveBasis::BSpline | CurveBasis::CatmullRom => (first + 1, first + 2),
         CurveBasis::Bezier => (first, first + 3),
     };
-    let v = geom.vertices();
-    let p = |i: u32| Vec3::from_slice(&v[i as usize][..3]);
+    let p = |i: u32| {
+        geom.point_at(i as usize, time)
+            .unwrap_or(Vec4::ZERO)
+            .truncate()
+    };
     p(a).distance(p(b))
 }
 
 fn surface_hit(
     hit: &RayHit,
     p: Vec3,
+    time: f32,
     geom: &TriangleGeometry,
     normals: Option<&[[f32; 3]]>,
 ) -> Option<SurfaceHit> {
@@ -638,6 +655,7 @@ fn surface_hit(
         prim_id: hit.prim_id,
         u: hit.u,
         v: hit.v,
+        time,
     })
 }
 
@@ -677,9 +695,9 @@ mod tests {
         );
         let g = geometry(&t);
         let at = t.strands(0).unwrap().locate(0).unwrap();
-        let root = g.interpolate(0, 0.0).unwrap();
+        let root = g.interpolate(0, 0.0, 0.0).unwrap();
         assert_eq!(root.dp_du, [0.0; 3]);
-        let x = tangent(g, 0, Vec3::from_array(root.dp_du), root.radius, &at);
+        let x = tangent(g, 0, Vec3::from_array(root.dp_du), root.radius, &at, 0.0);
         assert!(x.normalize().dot(Vec3::X) > 1.0 - 1e-6, "{x}");
 
         // A zero-length first segment of a linear strand takes its neighbour's direction.
@@ -695,7 +713,7 @@ mod tests {
             .unwrap(),
         );
         let at = t.strands(0).unwrap().locate(0).unwrap();
-        let x = tangent(geometry(&t), 0, Vec3::ZERO, 0.1, &at);
+        let x = tangent(geometry(&t), 0, Vec3::ZERO, 0.1, &at, 0.0);
         assert_eq!(x.normalize(), Vec3::X);
 
         // A strand that is a single point has no tangent; the frame copes (see hit.rs).
@@ -710,7 +728,10 @@ mod tests {
             .unwrap(),
         );
         let at = t.strands(0).unwrap().locate(1).unwrap();
-        assert_eq!(tangent(geometry(&t), 1, Vec3::ZERO, 0.1, &at), Vec3::ZERO);
+        assert_eq!(
+            tangent(geometry(&t), 1, Vec3::ZERO, 0.1, &at, 0.0),
+            Vec3::ZERO
+        );
     }
 
     #[test]
@@ -874,7 +895,10 @@ mod tests {
                 // Rays across the second strand's curve, from +z.
                 let t = 0.05 + 0.0225 * k as f32 * 8.0;
                 let prim = 8 + (t as u32).min(7);
-                let on = geometry(&exact).interpolate(prim, t.fract()).unwrap().p;
+                let on = geometry(&exact)
+                    .interpolate(prim, t.fract(), 0.0)
+                    .unwrap()
+                    .p;
                 let across = 0.5 * RADIUS * ((k % 7) as f32 / 3.0 - 1.0);
                 let ray = Ray::new(Vec3::from_array(on) + Vec3::new(0.0, across, 5.0), -Vec3::Z);
                 let (Some(Hit::Hair(e)), Some(Hit::Hair(f))) =
@@ -889,7 +913,7 @@ mod tests {
                 } else {
                     joints = joints.max(angle);
                 }
-                let chord = chord(geometry(&fast), f.prim_id).normalize();
+                let chord = chord(geometry(&fast), f.prim_id, 0.0).normalize();
                 worst_chord = worst_chord.max(chord.angle_between(e.frame.x));
                 worst_s = worst_s.max((f.s - e.s).abs());
                 let colour = |h: &HairHit| match h.absorption {

@@ -1,6 +1,7 @@
 //! The render layer's tests that need more than one module: the camera, film and tiles
-//! contract, renders end to end, and renders that adapt.
+//! contract, renders end to end, renders that adapt, and motion blur.
 
 mod adaptive;
 mod camera_film;
+mod motion;
 pub(crate) mod render;

@@ -375,7 +375,6 @@ fn clamp_indirect_touches_only_indirect_light() {
 /// exactly the full frame's pixels.
 #[test]
 fn renders_are_deterministic_across_threads_and_crops() {
-    let world = lit_world();
     let base = RenderSettings {
         width: 40,
         height: 30,
@@ -383,8 +382,14 @@ fn renders_are_deterministic_across_threads_and_crops() {
         seed: 11,
         ..RenderSettings::default()
     };
+    assert_deterministic(&lit_world(), base, "lit fur");
+}
+
+/// `world` rendered with `base` (a 40 x 30 frame) gives the same bits on one thread and on
+/// two, and its [`CROP`] those pixels of the full frame.
+pub(crate) fn assert_deterministic(world: &World, base: RenderSettings, what: &str) {
     let run =
-        |s: RenderSettings| render(&world, &camera(), &s, Aovs::default(), &NoProgress).unwrap();
+        |s: RenderSettings| render(world, &camera(), &s, Aovs::default(), &NoProgress).unwrap();
     let one = run(RenderSettings {
         threads: Some(1),
         ..base
@@ -394,7 +399,7 @@ fn renders_are_deterministic_across_threads_and_crops() {
         ..base
     });
     let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-    assert_eq!(bits(one.film.rgb()), bits(two.film.rgb()));
+    assert_eq!(bits(one.film.rgb()), bits(two.film.rgb()), "{what}");
     let crop = run(RenderSettings {
         crop: Some(CROP),
         threads: Some(2),

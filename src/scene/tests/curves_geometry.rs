@@ -394,8 +394,8 @@ fn every_basis_reaches_root_and_tip() {
                 panic!("no curves");
             };
             let last = g.segment_count() as u32 - 1;
-            let root = Vec3::from(g.interpolate(0, 0.0).unwrap().p);
-            let tip = Vec3::from(g.interpolate(last, 1.0).unwrap().p);
+            let root = Vec3::from(g.interpolate(0, 0.0, 0.0).unwrap().p);
+            let tip = Vec3::from(g.interpolate(last, 1.0, 0.0).unwrap().p);
             let root_err = root.distance(Vec3::from(points[0])) / length;
             let tip_err = tip.distance(Vec3::from(*points.last().unwrap())) / length;
             assert!(

@@ -29,11 +29,14 @@ use crate::scene::shapes;
 use crate::scene::stages::{Stage, StageRunner};
 use crate::validate::{self, positive};
 
+use crate::embree::MAX_TIME_STEPS;
 use crate::farm::frame_path;
 use crate::formats::hair::{HairTag, read_hair_file, read_hair_tag};
 use crate::formats::mesh::read_mesh_file;
 use crate::formats::units::StageUnits;
-use crate::formats::usd::{Layout, Wrap, is_usd_path, read_usd_file_at};
+use crate::formats::usd::{
+    Layout, UsdGrooms, Wrap, is_usd_path, read_usd_file_at, read_usd_file_near,
+};
 
 impl SceneDescription {
     /// Renders frame `frame` of the shot: every groom file is read at it (see
@@ -228,13 +231,15 @@ impl GroomDesc {
 
     /// The Embree curves of the groom, `part` = (index, grooms, files to read) of the
     /// build's stages: one geometry, or one per BasisCurves prim of a USD file (laid out by
-    /// the prim's own basis and wrap, placed by the entry's transform). Adds the groom to
-    /// `framing`.
+    /// the prim's own basis and wrap, placed by the entry's transform). A USD file read at
+    /// a frame, with `shutter` (open, close, in frames from it) open, gives curves in
+    /// motion over it ([`usd_steps`]). Adds the groom, at every time step, to `framing`.
     pub(crate) fn curves(
         &self,
         stages: &mut StageRunner,
         (i, grooms, reads): (usize, usize, usize),
         framing: &mut Framing,
+        shutter: (f32, f32),
     ) -> Result<Vec<Curves>> {
         let (affine, scale) = self.transform.affine()?;
         positive("radius_scale", self.radius_scale)?;
@@ -243,15 +248,24 @@ impl GroomDesc {
         let shape = self.shape.built();
         match &self.source {
             GroomSource::File { path, frame, .. } if is_usd_path(path) => {
-                let file = stages.run(Stage::Read, (i, reads), |_| {
-                    read_usd_file_at(&frame_file(path, *frame)?, *frame)
+                let steps = stages.run(Stage::Read, (i, reads), |_| {
+                    usd_steps(&frame_file(path, *frame)?, *frame, shutter)
                 })?;
-                for c in &file.curves {
+                for c in steps.iter().flat_map(|s| &s.curves) {
                     c.frame(framing, radius_factor, place);
                 }
                 stages.run(Stage::Curves, (i, grooms), |_| {
-                    (file.curves.iter())
-                        .map(|c| c.curves(shape, radius_factor, place))
+                    (0..steps[0].curves.len())
+                        .map(|prim| {
+                            let mut at = (steps.iter())
+                                .map(|s| s.curves[prim].curves(shape, radius_factor, place))
+                                .collect::<Result<Vec<_>>>()?;
+                            if at.len() == 1 {
+                                return Ok(at.remove(0));
+                            }
+                            (Curves::in_motion(at))
+                                .map_err(|e| e.context(&steps[0].curves[prim].path))
+                        })
                         .collect()
                 })
             }
@@ -363,6 +377,28 @@ impl GroomDesc {
         }
         Ok(sets)
     }
+}
+
+/// The USD stage at `path` at `frame`, or, with `shutter` open at a frame of an animated
+/// stage, at the time steps of its motion: where the shutter opens, where it closes and
+/// evenly between, as many as take in every time sample inside it (Embree's steps are
+/// even), at most Embree's most. The steps may reach past the animation's first or last
+/// frame, where its values hold.
+fn usd_steps(path: &Path, frame: Option<f64>, (open, close): (f32, f32)) -> Result<Vec<UsdGrooms>> {
+    let still = read_usd_file_at(path, frame)?;
+    let Some(f) = frame.filter(|_| close > open && still.time_range().is_some()) else {
+        return Ok(vec![still]);
+    };
+    let (open, close) = (f + f64::from(open), f + f64::from(close));
+    let clock = still.clock;
+    let inside = still.samples_between(clock.time_code(open), clock.time_code(close));
+    let count = (inside + 2).min(MAX_TIME_STEPS);
+    (0..count)
+        .map(|k| {
+            let at = open + (close - open) * k as f64 / (count - 1) as f64;
+            read_usd_file_near(path, Some(at))
+        })
+        .collect()
 }
 
 /// The file a groom reads at `frame`: `path` itself, or for a sequence of per-frame files

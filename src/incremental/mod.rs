@@ -299,9 +299,10 @@ impl Scene {
         self.geometries.iter().map(|g| g.name.as_str())
     }
 
-    /// Adds the groom `name` (its files read and its curves converted now), shaded by the
-    /// material named `groom.material`, which may be defined later; the next render builds
-    /// again. Returns the number of curve geometries it made: one, or one per
+    /// Adds the groom `name` (its files read and its curves converted now; a USD groom at
+    /// a frame over the shutter of the scene's settings now, `GroomDesc::curves`), shaded by
+    /// the material named `groom.material`, which may be defined later; the next render
+    /// builds again. Returns the number of curve geometries it made: one, or one per
     /// BasisCurves prim of a USD stage. A name in use is refused.
     pub fn add_groom(&mut self, name: &str, groom: &GroomDesc) -> Result<usize> {
         let mut stages = StageRunner::new(&NoStages);
@@ -321,7 +322,9 @@ impl Scene {
     ) -> Result<usize> {
         self.check_free(name)?;
         let mut framing = Framing::default();
-        let curves = (groom.curves(stages, part, &mut framing)).map_err(|e| self.error(name, e))?;
+        let shutter = (self.settings.shutter_open, self.settings.shutter_close);
+        let curves =
+            (groom.curves(stages, part, &mut framing, shutter)).map_err(|e| self.error(name, e))?;
         let n = curves.len();
         let shapes = curves
             .into_iter()

@@ -11,8 +11,9 @@ use hairtrace::description::SceneDescription;
 use hairtrace::embree::Device;
 use hairtrace::formats::hair::{Thickness, write_hair_file};
 use hairtrace::formats::usd::{read_usd_file, read_usd_file_at};
-use hairtrace::scene::Strands;
-use hairtrace::{Aovs, NoProgress};
+use hairtrace::incremental::ControlPoints;
+use hairtrace::scene::{GroomShape, Strands};
+use hairtrace::{Aovs, NoProgress, Scene};
 
 fn scratch(tag: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("hairtrace-anim-{tag}-{}", std::process::id()));
@@ -272,4 +273,50 @@ fn a_hair_sequence_reads_the_file_of_the_frame() {
         "[animation]\nframe = 1.5",
     )));
     assert!(e.contains("whole frames"), "{e}");
+}
+
+/// With the shutter open, a USD groom read at a frame moves over it: its curves are the
+/// stage read where the shutter opens and where it closes (and evenly between, taking in
+/// the samples inside), the same bits as a host's strands given those two time steps.
+#[test]
+fn an_open_shutter_reads_the_stage_at_its_time_steps() {
+    let dir = scratch("shutter");
+    let path = dir.join("anim.usda");
+    std::fs::write(&path, animated()).unwrap();
+    let mut desc = scene(&dir, "anim.usda", "[animation]\nframe = 1");
+    desc.render.set("shutter_close", "1").unwrap();
+    let blurred = pixels(desc.clone());
+    desc.render.set("shutter_close", "0").unwrap();
+    assert!(
+        blurred != pixels(desc.clone()),
+        "the groom moves over the shutter"
+    );
+
+    // The same strands from host buffers at frames 1 and 2, where the shutter opens and
+    // closes (no sample lies between).
+    let at = |frame| {
+        read_usd_file_at(&path, Some(frame))
+            .unwrap()
+            .curves
+            .remove(0)
+    };
+    let (open, close) = (at(1.0), at(2.0));
+    let mut host = desc.clone();
+    host.grooms.clear();
+    host.render.set("shutter_close", "1").unwrap();
+    let mut scene =
+        Scene::from_description(&host, Arc::new(Device::new(Some(1)).unwrap())).unwrap();
+    let points = ControlPoints {
+        points: open.control.into(),
+        later_steps: vec![close.control.into()],
+        counts: open.control_counts,
+        colors: None,
+        basis: open.layout.basis,
+    };
+    scene
+        .add_control_points("hair", points, GroomShape::Auto, "h")
+        .unwrap();
+    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
+    let host_pixels: Vec<u32> = out.film.rgb().iter().map(|v| v.to_bits()).collect();
+    assert!(host_pixels == blurred);
 }

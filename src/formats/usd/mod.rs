@@ -46,6 +46,18 @@ pub struct UsdGrooms {
 }
 
 impl UsdGrooms {
+    /// The time codes strictly between `open` and `close` at which any prim's animated
+    /// attributes have samples.
+    pub fn samples_between(&self, open: f64, close: f64) -> usize {
+        let mut times: Vec<f64> = (self.curves.iter())
+            .flat_map(|c| c.animation.times.iter().copied())
+            .filter(|&t| open < t && t < close)
+            .collect();
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        times.len()
+    }
+
     /// The animation's time codes: the stage's `startTimeCode` to `endTimeCode` where both
     /// are authored, else the span of the grooms' samples; None for a still.
     pub fn time_range(&self) -> Option<(f64, f64)> {
@@ -183,6 +195,26 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
 /// when None. A frame outside the animation's time range is refused; any frame of a stage
 /// that has no time samples reads its one still.
 pub fn read_usd_file_at(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> {
+    let grooms = read_usd_file_near(path, frame)?;
+    if let (Some(f), Some((start, end))) = (frame, grooms.time_range()) {
+        let t = grooms.clock.time_code(f);
+        if !(start..=end).contains(&t) {
+            return Err(invalid_arg!(
+                "{}: frame {f} (time code {t}) is outside the animation: time codes {start} \
+                 to {end}, frames {} to {}",
+                path.display(),
+                grooms.clock.frame(start),
+                grooms.clock.frame(end)
+            ));
+        }
+    }
+    Ok(grooms)
+}
+
+/// [`read_usd_file_at`] at a frame that may lie outside the animation, where values hold
+/// at its first or last samples: a time step of a shutter that opens before the first
+/// frame or closes after the last.
+pub fn read_usd_file_near(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> {
     let at = |e: Error| e.context(path.display());
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.len() > MAX_FILE_BYTES {
@@ -311,24 +343,12 @@ fn read_stage(stage: &Stage, file_bytes: u64, frame: Option<f64>) -> Result<UsdG
     if let Some(e) = stage.composition_errors().first() {
         return Err(invalid_arg!("composition failed: {e}"));
     }
-    let grooms = UsdGrooms {
+    Ok(UsdGrooms {
         units,
         clock,
         curves,
         ignored,
-    };
-    if let (Some(f), Some((start, end))) = (frame, grooms.time_range()) {
-        let t = clock.time_code(f);
-        if !(start..=end).contains(&t) {
-            return Err(invalid_arg!(
-                "frame {f} (time code {t}) is outside the animation: time codes {start} to \
-                 {end}, frames {} to {}",
-                clock.frame(start),
-                clock.frame(end)
-            ));
-        }
-    }
-    Ok(grooms)
+    })
 }
 
 /// The stage's `upAxis` and `metersPerUnit`, USD's fallback for each one not authored.

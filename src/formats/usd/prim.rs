@@ -443,10 +443,13 @@ fn animation(stage: &Stage, path: &sdf::Path) -> Result<Animation> {
             }
             if times.len() > 1 {
                 a.attributes.push(attr.path().as_str().to_string());
+                a.times.extend(&times);
             }
         }
         at = p.parent();
     }
+    a.times.sort_by(f64::total_cmp);
+    a.times.dedup();
     Ok(a)
 }
 

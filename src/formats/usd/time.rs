@@ -70,6 +70,8 @@ impl Clock {
 pub struct Animation {
     pub attributes: Vec<String>,
     pub span: Option<(f64, f64)>,
+    /// Every time code any of those attributes has a sample at, ascending.
+    pub times: Vec<f64>,
 }
 
 /// When a read takes each attribute's value: its default (else its earliest sample, for a

@@ -109,7 +109,7 @@ fn huang(c: &mut Criterion, inp: &Inputs) {
     g.bench_function("point", |b| {
         b.iter(|| {
             for i in 0..N {
-                black_box(bsdf.near(inp.h[i], v(inp.wo[i]), major));
+                black_box(bsdf.near(inp.h[i], v(inp.wo[i]), major, [0.5; 2]));
             }
         })
     });
@@ -118,9 +118,9 @@ fn huang(c: &mut Criterion, inp: &Inputs) {
             .map(|i| {
                 let (h, wo) = (inp.h[i], v(inp.wo[i]));
                 if far {
-                    bsdf.far(h, wo, major)
+                    bsdf.far(h, wo, major, [0.5; 2])
                 } else {
-                    bsdf.near(h, wo, major)
+                    bsdf.near(h, wo, major, [0.5; 2])
                 }
             })
             .collect();

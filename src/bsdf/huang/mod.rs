@@ -12,8 +12,9 @@
 //! How it is computed, staged by what it depends on (docs/conventions.md, section 4b):
 //! - [`HuangBsdf::new`]: parameters alone.
 //! - the point (h, wo): the entry on the section and its tilted normal (the mesonormal);
-//!   a fixed set of microfacet normals visible from wo (`ENTRY_NODES`, drawn from the
-//!   distribution of visible normals at fixed numbers) for the refractions in, each
+//!   a set of microfacet normals visible from wo (`ENTRY_NODES`, drawn from the
+//!   distribution of visible normals at a lattice of numbers, shifted by the point's
+//!   jitter) for the refractions in, each
 //!   followed across the section to the second interface; there, a fixed set of internal
 //!   reflections (`REFLECT_NODES`) followed to the third. Every path ends at an *exit*: an
 //!   internal direction, the inner normal there and the path's RGB weight (Fresnel,
@@ -38,6 +39,7 @@ mod point;
 mod section;
 
 pub use params::HuangParams;
+use point::FAR_SHIFTS;
 pub use point::HuangPoint;
 
 use super::longitudinal::LongitudinalLobe;
@@ -51,7 +53,7 @@ use glam::{Vec2, Vec3};
 /// use hairtrace::glam::{Vec2, Vec3};
 /// use hairtrace::{HuangBsdf, HuangParams};
 /// let bsdf = HuangBsdf::new(&HuangParams { aspect: 0.65, ..HuangParams::default() })?;
-/// let point = bsdf.near(0.5, Vec3::Z, Vec2::X); // h = 0.5, seen along z, major axis along y
+/// let point = bsdf.near(0.5, Vec3::Z, Vec2::X, [0.5; 2]); // h = 0.5, seen along z, major along y
 /// let light = point.eval(Vec3::new(0.0, 0.6, 0.8));
 /// assert!(light.pdf >= 0.0 && light.f.min_element() >= 0.0);
 /// if let Some(next) = point.sample([0.3, 0.6, 0.9]) {
@@ -86,18 +88,21 @@ impl HuangBsdf {
         &self.params
     }
 
-    /// The near field: the fibre seen at the offset h (in [-1, 1], clamped) from wo, its
-    /// section's major axis along the (y, z) direction `major` (normalised here; a
-    /// direction of zero or non-finite length is taken as y: the rule of
-    /// docs/conventions.md, section 4b).
-    pub fn near(&self, h: f32, wo: Vec3, major: Vec2) -> HuangPoint {
-        HuangPoint::near(self, h, wo, major)
+    /// The near field: the fibre seen at the offset h (in [-1, 1], clamped; NaN is 0) from
+    /// wo, its section's major axis along the (y, z) direction `major` (normalised here; a
+    /// direction of zero or non-finite length is taken as y), the fixed nodes shifted by
+    /// `jitter` (modulo 1; not finite is 0). A renderer passes fresh uniform numbers as
+    /// `jitter` at each hit, so that the nodes average to the model's integral over the
+    /// first interfaces; any fixed jitter gives a deterministic model. The rules are those
+    /// of docs/conventions.md, section 4b.
+    pub fn near(&self, h: f32, wo: Vec3, major: Vec2, jitter: [f32; 2]) -> HuangPoint {
+        HuangPoint::new(self, h, wo, major, jitter, 1)
     }
 
     /// The far field: the fibre averaged across its width, stratified from h (see the
-    /// module doc); h uniform over [-1, 1] makes it unbiased.
-    pub fn far(&self, h: f32, wo: Vec3, major: Vec2) -> HuangPoint {
-        HuangPoint::far(self, h, wo, major)
+    /// module doc); h uniform over [-1, 1] makes it unbiased. Arguments as [`Self::near`].
+    pub fn far(&self, h: f32, wo: Vec3, major: Vec2, jitter: [f32; 2]) -> HuangPoint {
+        HuangPoint::new(self, h, wo, major, jitter, FAR_SHIFTS)
     }
 }
 

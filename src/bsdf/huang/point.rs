@@ -7,6 +7,7 @@ use crate::bsdf::fresnel::{fresnel_dielectric, fresnel_inside};
 use crate::bsdf::pick::{U_MIN, pick};
 use crate::bsdf::{BsdfEval, BsdfSample, LocalBsdf, inv_cos};
 use crate::math::cos_from_sin;
+use crate::math::sampling::ONE_MINUS_EPSILON;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, TAU};
 
@@ -17,18 +18,20 @@ const REFLECT_NODES: usize = 3;
 const TT_EXITS: usize = ENTRY_NODES;
 const EXITS: usize = ENTRY_NODES * (1 + REFLECT_NODES);
 /// Offsets a far-field point averages.
-pub(crate) const FAR_SHIFTS: usize = 4;
+pub(super) const FAR_SHIFTS: usize = 4;
 /// Below this (y, z) length an internal direction runs along the fibre and never meets
 /// the far side: its path is dropped.
 const MIN_CROSSING: f32 = 1e-6;
 
-/// Node k of a rank-1 lattice of `n` points in [0, 1)^2 with generator `g`: spread evenly
-/// in both coordinates.
-fn lattice(k: usize, n: usize, g: usize) -> [f32; 2] {
+/// Node k of a rank-1 lattice of `n` points in [0, 1)^2 with generator `g` (spread evenly
+/// in both coordinates), shifted by `jitter` modulo 1.
+fn lattice(k: usize, n: usize, g: usize, jitter: [f32; 2]) -> [f32; 2] {
     let n = n as f32;
-    let x = (k as f32 + 0.5) / n;
-    let y = ((k * g) as f32 + 0.5) / n;
-    [x, y - y.floor()]
+    let wrap = |x: f32| (x - x.floor()).min(ONE_MINUS_EPSILON);
+    [
+        wrap(k as f32 / n + jitter[0]),
+        wrap((k * g) as f32 / n + jitter[1]),
+    ]
 }
 
 /// Where a path meets its last interface from inside: the internal direction reversed
@@ -81,16 +84,17 @@ pub struct HuangPoint {
 }
 
 impl HuangPoint {
-    pub(super) fn near(bsdf: &HuangBsdf, h: f32, wo: Vec3, major: Vec2) -> Self {
-        Self::with_shifts(bsdf, h, wo, major, 1)
-    }
-
-    pub(super) fn far(bsdf: &HuangBsdf, h: f32, wo: Vec3, major: Vec2) -> Self {
-        Self::with_shifts(bsdf, h, wo, major, FAR_SHIFTS)
-    }
-
-    fn with_shifts(bsdf: &HuangBsdf, h: f32, wo: Vec3, major: Vec2, shifts: usize) -> Self {
+    /// The point at the offsets h + 2k / `shifts` (k < `shifts`, wrapped into [-1, 1]).
+    pub(super) fn new(
+        bsdf: &HuangBsdf,
+        h: f32,
+        wo: Vec3,
+        major: Vec2,
+        jitter: [f32; 2],
+        shifts: usize,
+    ) -> Self {
         let h = if h.is_nan() { 0.0 } else { h.clamp(-1.0, 1.0) };
+        let jitter = jitter.map(|x| if x.is_finite() { x } else { 0.0 });
         let major = major.try_normalize().unwrap_or(Vec2::X);
         let section = Section::new(bsdf.params.aspect, major);
         let azimuth = Vec2::new(wo.y, wo.z).try_normalize().unwrap_or(Vec2::X);
@@ -99,7 +103,7 @@ impl HuangPoint {
         for (k, p) in paths.iter_mut().enumerate().take(shifts) {
             let x = h + 2.0 * k as f32 / shifts as f32;
             let x = if x > 1.0 { x - 2.0 } else { x };
-            *p = Paths::new(bsdf, &section, x, wo, azimuth);
+            *p = Paths::new(bsdf, &section, x, wo, azimuth, jitter);
         }
         Self {
             bsdf: *bsdf,
@@ -227,7 +231,14 @@ impl Paths {
         lobe_pdf: [0.0; 4],
     };
 
-    fn new(bsdf: &HuangBsdf, section: &Section, h: f32, wo: Vec3, view: Vec2) -> Self {
+    fn new(
+        bsdf: &HuangBsdf,
+        section: &Section,
+        h: f32,
+        wo: Vec3,
+        view: Vec2,
+        jitter: [f32; 2],
+    ) -> Self {
         let q1 = section.entry(view, h);
         let m = mesonormal(bsdf, section.normal(q1));
         let cos_om = wo.dot(m);
@@ -241,7 +252,7 @@ impl Paths {
         p.g1_o = ggx.g1(cos_om);
         let eta = bsdf.params.eta;
         for k in 0..ENTRY_NODES {
-            let wh = ggx.sample_visible(m, wo, lattice(k, ENTRY_NODES, 2));
+            let wh = ggx.sample_visible(m, wo, lattice(k, ENTRY_NODES, 2, jitter));
             let c = wo.dot(wh);
             if c <= 0.0 {
                 continue;
@@ -268,7 +279,8 @@ impl Paths {
                 weight,
             };
             for j in 0..REFLECT_NODES {
-                let wh2 = ggx.sample_visible(n2, v, lattice(j, REFLECT_NODES, 2));
+                let wh2 =
+                    ggx.sample_visible(n2, v, lattice(j, REFLECT_NODES, 2, [jitter[1], jitter[0]]));
                 let c2 = v.dot(wh2);
                 if c2 <= 0.0 {
                     continue;
@@ -292,10 +304,17 @@ impl Paths {
                     cos_vn: cos_v3,
                     weight: arriving,
                 };
-                // Past TRT: the light reflected at the third interface (smooth Fresnel)
+                // Past TRT: the light the third interface reflects (its Fresnel, total
+                // internal reflection included, at the same nodes of its visible normals)
                 // crosses again and again, each crossing absorbed as the mean of the two
                 // before, each interface letting out 1 - F: a geometric series.
-                let f3 = fresnel_inside(cos_v3, eta);
+                let f3 = (0..REFLECT_NODES)
+                    .map(|i| {
+                        let wh3 = ggx.sample_visible(n3, v3, lattice(i, REFLECT_NODES, 2, jitter));
+                        fresnel_inside(v3.dot(wh3).max(0.0), eta)
+                    })
+                    .sum::<f32>()
+                    / REFLECT_NODES as f32;
                 let a = (a1 * a2).powf(0.5);
                 let denom = Vec3::ONE - a * f3;
                 let series = a * (1.0 - f3) * f3 / denom;

@@ -46,7 +46,9 @@ impl Section {
         // |q0 + t qd| = 1, the root nearer the viewer.
         let a = qd.length_squared();
         let b = q0.dot(qd);
-        let c = (q0.length_squared() - 1.0).min(0.0);
+        // q0 may lie outside the section (the line's nearest point to the centre is not q0
+        // on a turned ellipse): c > 0 is then right, and the roots are still real.
+        let c = q0.length_squared() - 1.0;
         let t = (-b + (b * b - a * c).max(0.0).sqrt()) / a;
         (q0 + qd * t).normalize()
     }

@@ -74,7 +74,14 @@ fn huang_sampling_matches_pdf_chi_square() {
         let b = huang([0.0, 0.3, 1.0], c.eta, c.roughness, c.aspect, c.alpha);
         let (s, co) = c.major_deg.to_radians().sin_cos();
         let wo = v3(dir_deg(c.theta_o, c.phi_o));
-        let p = point(&b, c.far, c.h, wo, Vec2::new(co, s));
+        let p = point(
+            &b,
+            c.far,
+            c.h,
+            wo,
+            Vec2::new(co, s),
+            [c.major_deg / 360.0 + 0.5, 0.3],
+        );
         let mut g = rng(46);
         let mut counts = vec![0.0; GRID.cells()];
         let mut lost = 0usize;

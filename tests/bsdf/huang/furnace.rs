@@ -13,7 +13,7 @@ use glam::{Vec2, Vec3};
 use rand::Rng;
 
 /// The lowest albedo a non-absorbing fibre may have, over the configurations below.
-const MIN_ALBEDO: f64 = 0.35;
+const MIN_ALBEDO: f64 = 0.40;
 
 #[test]
 fn huang_white_furnace() {
@@ -33,12 +33,14 @@ fn huang_white_furnace() {
             let r = (1.0 - z * z).sqrt();
             let wo = Vec3::new(z, r * phi.cos(), r * phi.sin());
             let turn: f32 = g.random_range(0.0..std::f32::consts::TAU);
+            let jitter = [g.random(), g.random()];
             let p = point(
                 &b,
                 false,
                 g.random_range(-1.0..1.0),
                 wo,
                 Vec2::from_angle(turn),
+                jitter,
             );
             for _ in 0..500 {
                 if let Some(s) = p.sample(random_u(&mut g)) {
@@ -76,7 +78,14 @@ fn huang_sample_weights_integrate_eval() {
     let results = par_map(&cases, |&(roughness, aspect, alpha, far, h, theta_deg)| {
         let b = huang([0.2, 0.4, 0.8], 1.55, roughness, aspect, alpha);
         let (s, c) = theta_deg.to_radians().sin_cos();
-        let p = point(&b, far, h, Vec3::new(s, 0.0, c), Vec2::from_angle(0.7));
+        let p = point(
+            &b,
+            far,
+            h,
+            Vec3::new(s, 0.0, c),
+            Vec2::from_angle(0.7),
+            [0.2, 0.9],
+        );
         let quad: f64 = grid
             .integrate(
                 |w| {

@@ -4,6 +4,7 @@
 
 mod chi2;
 mod furnace;
+mod reference;
 mod sweep;
 
 use glam::{Vec2, Vec3};
@@ -21,10 +22,17 @@ pub fn huang(sigma_a: [f32; 3], eta: f32, roughness: f32, aspect: f32, alpha: f3
 }
 
 /// The near or far point.
-pub fn point(b: &HuangBsdf, far: bool, h: f32, wo: Vec3, major: Vec2) -> HuangPoint {
+pub fn point(
+    b: &HuangBsdf,
+    far: bool,
+    h: f32,
+    wo: Vec3,
+    major: Vec2,
+    jitter: [f32; 2],
+) -> HuangPoint {
     if far {
-        b.far(h, wo, major)
+        b.far(h, wo, major, jitter)
     } else {
-        b.near(h, wo, major)
+        b.near(h, wo, major, jitter)
     }
 }

@@ -58,7 +58,12 @@ fn huang_sweep_is_finite() {
             _ => Vec2::from_angle(g.random_range(0.0..7.0)),
         };
         let wo = random_dir(&mut g);
-        let p = point(&b, g.random(), h, wo, major);
+        let jitter = match g.random_range(0..5) {
+            0 => [f32::NAN, 2.5],
+            1 => [0.0, 0.99999994],
+            _ => [g.random(), g.random()],
+        };
+        let p = point(&b, g.random(), h, wo, major, jitter);
         let mut wis = vec![wo, -wo, random_dir(&mut g), random_dir(&mut g)];
         if let Some(s) = p.sample(random_u(&mut g)) {
             assert!(
@@ -80,17 +85,28 @@ fn huang_sweep_is_finite() {
     }
 }
 
-/// A major axis of no direction is y, and a NaN h is 0 (docs/conventions.md).
+/// A major axis of no direction is y, a NaN h is 0, a jitter is taken modulo 1 and one
+/// that is not finite is 0 (docs/conventions.md, section 4b).
 #[test]
 fn huang_stated_rules() {
     let b = huang([0.3; 3], 1.55, 0.3, 0.6, 2.0);
     let wo = Vec3::new(0.2, 0.0, 0.98).normalize();
     let wi = Vec3::new(-0.1, 0.7, 0.3).normalize();
-    let want = b.near(0.4, wo, Vec2::X).eval(wi);
-    assert_eq!(b.near(0.4, wo, Vec2::ZERO).eval(wi), want);
-    assert_eq!(b.near(0.4, wo, Vec2::NAN).eval(wi), want);
+    let j = [0.25, 0.5];
+    let want = b.near(0.4, wo, Vec2::X, j).eval(wi);
+    assert_eq!(b.near(0.4, wo, Vec2::ZERO, j).eval(wi), want);
+    assert_eq!(b.near(0.4, wo, Vec2::NAN, j).eval(wi), want);
+    // Modulo 1 up to the rounding of the shifted nodes.
+    let shifted = b.near(0.4, wo, Vec2::X, [1.25, -0.5]).eval(wi);
+    assert!((shifted.f - want.f).abs().max_element() < 1e-5 * want.f.max_element());
+    assert!((shifted.pdf - want.pdf).abs() < 1e-5 * want.pdf);
+    let zero = b.near(0.4, wo, Vec2::X, [0.0; 2]).eval(wi);
     assert_eq!(
-        b.near(f32::NAN, wo, Vec2::X).eval(wi),
-        b.near(0.0, wo, Vec2::X).eval(wi)
+        b.near(0.4, wo, Vec2::X, [f32::NAN, f32::INFINITY]).eval(wi),
+        zero
+    );
+    assert_eq!(
+        b.near(f32::NAN, wo, Vec2::X, j).eval(wi),
+        b.near(0.0, wo, Vec2::X, j).eval(wi)
     );
 }

@@ -3,4 +3,5 @@
 
 mod adaptive;
 mod camera_film;
+mod huang;
 pub(crate) mod render;

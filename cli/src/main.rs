@@ -390,19 +390,24 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
                 *s += e / STEPS as f32;
             }
         }
-        let cell = |v: Vec3| format!("{:.3} {:.3} {:.3}", v.x, v.y, v.z);
         let total = sum.iter().copied().sum::<Vec3>();
-        println!(
-            "{:>7}°  {:^20}  {:^20}  {:^20}  {:^20}  {:^20}",
-            deg,
-            cell(sum[0]),
-            cell(sum[1]),
-            cell(sum[2]),
-            cell(sum[3]),
-            cell(total)
-        );
+        print_lobe_row(deg, sum, total);
     }
     Ok(())
+}
+
+/// One row of `lobes`: theta_o, the four lobes' RGB and a last RGB column.
+fn print_lobe_row(deg: f32, lobes: [Vec3; 4], last: Vec3) {
+    let cell = |v: Vec3| format!("{:.3} {:.3} {:.3}", v.x, v.y, v.z);
+    println!(
+        "{:>7}°  {:^20}  {:^20}  {:^20}  {:^20}  {:^20}",
+        deg,
+        cell(lobes[0]),
+        cell(lobes[1]),
+        cell(lobes[2]),
+        cell(lobes[3]),
+        cell(last)
+    );
 }
 
 /// `lobes` for the Huang model: each lobe's energy before its last interface's masking
@@ -457,16 +462,7 @@ fn huang_lobes(args: &LobesArgs, chiang: &HairParams) -> hairtrace::Result<()> {
                 }
             }
         }
-        let cell = |v: Vec3| format!("{:.3} {:.3} {:.3}", v.x, v.y, v.z);
-        println!(
-            "{:>7}°  {:^20}  {:^20}  {:^20}  {:^20}  {:^20}",
-            deg,
-            cell(sum[0]),
-            cell(sum[1]),
-            cell(sum[2]),
-            cell(sum[3]),
-            cell(albedo)
-        );
+        print_lobe_row(deg, sum, albedo);
     }
     Ok(())
 }

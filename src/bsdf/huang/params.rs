@@ -1,9 +1,8 @@
 //! The parameters of the Huang model and their validation.
 
-use super::super::limits::{ALPHA_MAX_DEG, ASPECT_MIN, ETA_MAX, check_beta};
+use super::super::limits::{ASPECT_MIN, check_beta, check_shared};
 use super::super::params::HairParams;
 use crate::error::{Result, invalid_arg};
-use crate::validate::non_negative;
 
 /// Parameters of the Huang 2022 hair model (units and ranges: docs/conventions.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,27 +36,13 @@ impl Default for HuangParams {
 impl HuangParams {
     /// Checks every parameter against its range; the error names the first bad one.
     pub fn validate(&self) -> Result<()> {
-        for (c, &s) in self.sigma_a.iter().enumerate() {
-            non_negative(&format!("sigma_a[{c}]"), s)?;
-        }
-        if !(self.eta > 1.0 && self.eta <= ETA_MAX) {
-            return Err(invalid_arg!(
-                "eta = {}: must be in (1, {ETA_MAX}]",
-                self.eta
-            ));
-        }
+        check_shared(&self.sigma_a, self.eta, self.alpha)?;
         check_beta("roughness", self.roughness)?;
         if !(self.aspect >= ASPECT_MIN && self.aspect <= 1.0) {
             return Err(invalid_arg!(
                 "aspect = {}: must be in [{ASPECT_MIN}, 1] (minor over major axis; give the \
                  major axis's direction to turn the section)",
                 self.aspect
-            ));
-        }
-        if self.alpha.is_nan() || self.alpha.abs() > ALPHA_MAX_DEG {
-            return Err(invalid_arg!(
-                "alpha = {} degrees: must be in [-{ALPHA_MAX_DEG}, {ALPHA_MAX_DEG}]",
-                self.alpha
             ));
         }
         Ok(())

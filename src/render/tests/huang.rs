@@ -4,7 +4,8 @@
 //! own loss.
 
 use super::render::{
-    assert_quadrants_agree, camera, fur_world, mean, quadrant_means_over, quadrant_settings,
+    assert_quadrants_agree, camera, fur_world, lit_lights, mean, quadrant_means_over,
+    quadrant_settings,
 };
 use crate::render::renderer::render;
 use crate::render::settings::{PathSettings, RenderSettings, Strategy};
@@ -29,20 +30,9 @@ fn huang(sigma_a: [f32; 3]) -> HairMaterial {
 /// they do only if the pdf MIS weighs with is the sampler's.
 #[test]
 fn huang_mis_agrees_with_light_and_bsdf_sampling() {
-    let lights = vec![
-        Light::Environment(Environment::uniform(Vec3::splat(0.2)).unwrap()),
-        Light::rect(
-            Vec3::new(-1.0, 2.5, -1.0),
-            Vec3::new(2.0, 0.0, 0.0),
-            Vec3::new(0.0, 0.0, 2.0),
-            Vec3::splat(1.5),
-            false,
-        )
-        .unwrap(),
-    ];
     let world = fur_world(
         huang(HairMaterial::default().color.sigma_a(0.3).unwrap()),
-        lights,
+        lit_lights(),
         2000,
     );
     let means = |strategy| {

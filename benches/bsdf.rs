@@ -1,10 +1,12 @@
 //! Single-thread cost of the hair BSDF entry points on random in-range inputs.
 //! `eval_batch` is reported per evaluation (throughput in elements) so that it compares
-//! directly with the scalar `eval`.
+//! directly with the scalar `eval`. The `huang` group: the Huang model's points (near
+//! and far field, an elliptical fibre of aspect 0.65) on the same inputs.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec2;
 use glam::Vec3;
-use hairtrace::{HairBsdf, HairParams};
+use hairtrace::{HairBsdf, HairParams, HuangBsdf, HuangParams};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::hint::black_box;
@@ -90,6 +92,53 @@ fn bench(c: &mut Criterion) {
             black_box(&f);
         })
     });
+    g.finish();
+    huang(c, &inp);
+}
+
+fn huang(c: &mut Criterion, inp: &Inputs) {
+    let bsdf = HuangBsdf::new(&HuangParams {
+        aspect: 0.65,
+        ..HuangParams::default()
+    })
+    .unwrap();
+    let v = |a: [f32; 3]| Vec3::from_array(a);
+    let major = Vec2::from_angle(0.5);
+    let mut g = c.benchmark_group("huang");
+    g.throughput(Throughput::Elements(N as u64));
+    g.bench_function("point", |b| {
+        b.iter(|| {
+            for i in 0..N {
+                black_box(bsdf.near(inp.h[i], v(inp.wo[i]), major, [0.5; 2]));
+            }
+        })
+    });
+    for (name, far) in [("near", false), ("far", true)] {
+        let points: Vec<_> = (0..N)
+            .map(|i| {
+                let (h, wo) = (inp.h[i], v(inp.wo[i]));
+                if far {
+                    bsdf.far(h, wo, major, [0.5; 2])
+                } else {
+                    bsdf.near(h, wo, major, [0.5; 2])
+                }
+            })
+            .collect();
+        g.bench_function(format!("{name}_point_eval"), |b| {
+            b.iter(|| {
+                for (i, p) in points.iter().enumerate() {
+                    black_box(p.eval(v(inp.wi[i])));
+                }
+            })
+        });
+        g.bench_function(format!("{name}_point_sample"), |b| {
+            b.iter(|| {
+                for (i, p) in points.iter().enumerate() {
+                    black_box(p.sample(inp.u[i]));
+                }
+            })
+        });
+    }
     g.finish();
 }
 

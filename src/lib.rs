@@ -85,7 +85,8 @@ mod threads;
 mod validate;
 
 pub use bsdf::{
-    ACROSS, AcrossEval, BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, Lobes, LocalBsdf,
+    ACROSS, AcrossEval, BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, HuangBsdf,
+    HuangParams, HuangPoint, Lobes, LocalBsdf,
 };
 #[cfg(feature = "render")]
 pub use description::SceneDescription;

@@ -29,7 +29,7 @@ use hairtrace::render::settings::RenderSettings;
 use hairtrace::render::{Aovs, Progress, RenderStats};
 use hairtrace::scene::HairColor;
 use hairtrace::scene::{GroomShape, Stage, StageProgress};
-use hairtrace::{HairBsdf, HairParams};
+use hairtrace::{HairBsdf, HairParams, HuangBsdf, HuangParams};
 use indicatif::{ProgressBar, ProgressStyle};
 use settings::{SettingArgs, Variant};
 use std::path::{Path, PathBuf};
@@ -307,6 +307,15 @@ struct LobesArgs {
     /// Index of refraction.
     #[arg(long, default_value_t = HairParams::default().eta)]
     eta: f32,
+    /// The hair model: chiang (round fibres) or huang (elliptical, GGX microfacets).
+    #[arg(long, default_value = "chiang", value_parser = ["chiang", "huang"])]
+    model: String,
+    /// Huang's GGX roughness, [0.01, 1].
+    #[arg(long, default_value_t = HuangParams::default().roughness)]
+    roughness: f32,
+    /// Huang's aspect (minor over major axis), [0.05, 1]; the major axis faces the viewer.
+    #[arg(long, default_value_t = HuangParams::default().aspect)]
+    aspect: f32,
 }
 
 /// N comma-separated values, e.g. "0.8,0.5,0.3" or "0,0,64,48".
@@ -357,6 +366,9 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
         beta_n: args.beta_n,
         alpha: args.alpha,
     };
+    if args.model == "huang" {
+        return huang_lobes(args, &params);
+    }
     let bsdf = HairBsdf::new(&params)?;
     println!(
         "sigma_a = ({:.4}, {:.4}, {:.4}), eta {}, beta_m {}, beta_n {}, alpha {} deg",
@@ -381,17 +393,79 @@ fn lobes(args: &LobesArgs) -> hairtrace::Result<()> {
                 *s += e / STEPS as f32;
             }
         }
-        let cell = |v: Vec3| format!("{:.3} {:.3} {:.3}", v.x, v.y, v.z);
         let total = sum.iter().copied().sum::<Vec3>();
-        println!(
-            "{:>7}°  {:^20}  {:^20}  {:^20}  {:^20}  {:^20}",
-            deg,
-            cell(sum[0]),
-            cell(sum[1]),
-            cell(sum[2]),
-            cell(sum[3]),
-            cell(total)
-        );
+        print_lobe_row(deg, sum, total);
+    }
+    Ok(())
+}
+
+/// One row of `lobes`: theta_o, the four lobes' RGB and a last RGB column.
+fn print_lobe_row(deg: f32, lobes: [Vec3; 4], last: Vec3) {
+    let cell = |v: Vec3| format!("{:.3} {:.3} {:.3}", v.x, v.y, v.z);
+    println!(
+        "{:>7}°  {:^20}  {:^20}  {:^20}  {:^20}  {:^20}",
+        deg,
+        cell(lobes[0]),
+        cell(lobes[1]),
+        cell(lobes[2]),
+        cell(lobes[3]),
+        cell(last)
+    );
+}
+
+/// `lobes` for the Huang model: each lobe's energy before its last interface's masking
+/// (an upper bound) and the albedo its sampler measures (the model's true energy), both
+/// averaged over the fibre's width.
+fn huang_lobes(args: &LobesArgs, chiang: &HairParams) -> hairtrace::Result<()> {
+    let params = HuangParams {
+        sigma_a: chiang.sigma_a,
+        eta: chiang.eta,
+        roughness: args.roughness,
+        aspect: args.aspect,
+        alpha: chiang.alpha,
+    };
+    let bsdf = HuangBsdf::new(&params)?;
+    let s = params.sigma_a;
+    println!(
+        "sigma_a = ({:.4}, {:.4}, {:.4}), eta {}, roughness {}, aspect {}, alpha {} deg (Huang)",
+        s[0], s[1], s[2], params.eta, params.roughness, params.aspect, params.alpha
+    );
+    println!(
+        "lobe energy (R G B) before the last interface's masking, and the albedo sampled, averaged over h"
+    );
+    println!(
+        "{:>8}  {:^20}  {:^20}  {:^20}  {:^20}  {:^20}",
+        "theta_o", "R", "TT", "TRT", "residual", "albedo"
+    );
+    const STEPS: usize = 200;
+    const SAMPLES: usize = 256;
+    for deg in [0.0f32, 15.0, 30.0, 45.0, 60.0, 75.0, 85.0] {
+        let t = deg.to_radians();
+        let wo = Vec3::new(t.sin(), 0.0, t.cos());
+        let mut sum = [Vec3::ZERO; 4];
+        let mut albedo = Vec3::ZERO;
+        for i in 0..STEPS {
+            let h = -1.0 + (2 * i + 1) as f32 / STEPS as f32;
+            let jitter = [
+                (i as f32 * 0.618_034).fract(),
+                (i as f32 * 0.414_214).fract(),
+            ];
+            let point = bsdf.near(h, wo, glam::Vec2::X, jitter);
+            for (s, e) in sum.iter_mut().zip(point.lobe_energies()) {
+                *s += e / STEPS as f32;
+            }
+            for k in 0..SAMPLES {
+                let u = [
+                    (k as f32 + 0.5) / SAMPLES as f32,
+                    (k as f32 * 0.754_878).fract(),
+                    (k as f32 * 0.569_840).fract(),
+                ];
+                if let Some(x) = point.sample(u) {
+                    albedo += x.f * x.wi.z.abs() / x.pdf / (STEPS * SAMPLES) as f32;
+                }
+            }
+        }
+        print_lobe_row(deg, sum, albedo);
     }
     Ok(())
 }

@@ -16,9 +16,11 @@
 //! against error", has what each costs and buys).
 
 use super::azimuthal::{TrimmedLogistic, azimuthal_scale};
+use super::fresnel::fresnel_dielectric;
 use super::longitudinal::{LongitudinalLobe, MpConstants, longitudinal_variance};
 use super::params::HairParams;
-use super::{BsdfEval, BsdfSample, LocalBsdf, WeightedSample};
+use super::pick::{U_MIN, pick};
+use super::{BsdfEval, BsdfSample, LocalBsdf, MIN_COS_WI, WeightedSample, inv_cos};
 use crate::error::{Result, invalid_arg};
 use crate::math::fast::atan2;
 use crate::math::{Lanes, cos_from_sin};
@@ -29,9 +31,6 @@ use wide::{f32x4, f32x8};
 
 /// Number of explicit lobes (R, TT, TRT); the residual lobe comes after them.
 const EXPLICIT_LOBES: usize = 3;
-/// Below this |wi.z| the 1/|wi.z| factor is skipped, as pbrt does at exactly zero; the
-/// threshold keeps f finite for every unit wi (the largest lobe value is ~1e7).
-const MIN_COS_WI: f32 = 1e-20;
 
 /// The hair BSDF for one parameter set, with every parameter-only constant precomputed.
 /// Plain numbers only (`Copy`), so a copy can travel inside a self-contained point.
@@ -425,17 +424,6 @@ impl HairBsdf {
     }
 }
 
-/// 1/|wi.z|, or 1 where |wi.z| is below [`MIN_COS_WI`].
-#[inline(always)]
-fn inv_cos(wi_z: f32) -> f32 {
-    let cos_wi = wi_z.abs();
-    if cos_wi > MIN_COS_WI {
-        1.0 / cos_wi
-    } else {
-        1.0
-    }
-}
-
 /// The index of the residual lobe, after the explicit ones.
 const RESIDUAL: usize = EXPLICIT_LOBES;
 
@@ -618,7 +606,7 @@ impl HairBsdf {
     #[inline(always)]
     fn draw(&self, at: &Vertex, u: [f32; 3]) -> (Vec3, usize) {
         let o = &at.o;
-        let (p, u_phi) = pick_lobe(&o.lobe_pdf, u[0]);
+        let (p, u_phi) = pick(&o.lobe_pdf, u[0]);
         // u = 0 stands for [0, 2^-24): its midpoint keeps the far tails, where the f32
         // density underflows, from being sampled with a whole 2^-24 of probability.
         let (u_phi, u_theta) = (u_phi.max(U_MIN), u[1].max(U_MIN));
@@ -645,64 +633,6 @@ impl HairBsdf {
         );
         (wi, p)
     }
-}
-
-/// Picks a lobe with probability `lobe_pdf[p]` and rescales u into [0, 1) for reuse. A u
-/// that rounding carries past the weights goes to the last lobe of nonzero weight.
-fn pick_lobe(lobe_pdf: &[f32; 4], u: f32) -> (usize, f32) {
-    let last = lobe_pdf.iter().rposition(|&w| w > 0.0).unwrap_or(RESIDUAL);
-    let mut u = u;
-    for (p, &w) in lobe_pdf.iter().enumerate().take(last) {
-        if u < w {
-            return (p, (u / w).min(ONE_MINUS_EPSILON));
-        }
-        u -= w;
-    }
-    let w = lobe_pdf[last];
-    (
-        last,
-        if w > 0.0 {
-            (u / w).clamp(0.0, ONE_MINUS_EPSILON)
-        } else {
-            0.0
-        },
-    )
-}
-
-/// Half the spacing of uniform f32 numbers in [0, 1).
-const U_MIN: f32 = 1.0 / 33_554_432.0;
-/// The largest f32 below one.
-const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
-
-/// Unpolarised Fresnel reflectance F from outside into a dielectric of index eta > 1 at
-/// incidence cosine cos_i in [0, 1], and its complement 1 - F computed on its own: near
-/// grazing incidence F is within a few ulps of 1 and 1 - F by subtraction would keep
-/// none of its digits. F is 1 and 1 - F is 0 at grazing incidence; never divides by zero.
-/// Written with e = eta^2 - 1 = (eta - 1)(eta + 1) factored out of both amplitudes, so that
-/// an index just above 1 keeps its precision instead of cancelling in (eta c - cos t).
-#[inline(always)]
-fn fresnel_dielectric<T: Lanes>(cos_i: T, eta: T) -> (T, T) {
-    let one = T::splat(1.0);
-    let e = (eta - one) * (eta + one);
-    let q = e.sqrt();
-    let c2 = cos_i * cos_i;
-    // w = eta cos_t = sqrt(eta^2 - sin_i^2) by Snell's law. At grazing incidence it is q
-    // exactly, so both ratios below are exactly 1 and F is exactly 1 (no leak into 1 - F).
-    let w = (e + c2).sqrt();
-    let inv_perp = one / (cos_i + w);
-    let inv_par = one / (eta * eta * cos_i + w);
-    // Amplitudes with e factored out: r_perp = (c - w) / (c + w) = -e / (c + w)^2 and
-    // r_par = (eta^2 c - w) / (eta^2 c + w) = e ((e + 2) c^2 - 1) / (eta^2 c + w)^2.
-    let perp = q * inv_perp;
-    let r_perp = perp * perp;
-    let par = q * inv_par;
-    let r_par = par * par * ((e + T::splat(2.0)) * c2 - one);
-    // Rounding can lift the grazing value just above 1, which would leak into 1 - F.
-    let f = (T::splat(0.5) * (r_par * r_par + r_perp * r_perp)).min(one);
-    // 1 - r^2 = 4 c w / (c + w)^2 for perp and 4 eta^2 c w / (eta^2 c + w)^2 for par.
-    let eta2 = eta * eta;
-    let t = T::splat(2.0) * cos_i * w * (inv_perp * inv_perp + eta2 * inv_par * inv_par);
-    (f, t.min(one))
 }
 
 /// wo's azimuth as a (y, z) direction of length 1e-4 to sqrt(2); (1, 0) along the tangent,

@@ -5,17 +5,21 @@
 pub(crate) mod absorption;
 pub(crate) mod azimuthal;
 pub(crate) mod diffuse;
+mod fresnel;
 pub(crate) mod hair;
+pub(crate) mod huang;
 pub mod inputs;
 mod limits;
 pub(crate) mod longitudinal;
 pub(crate) mod params;
+mod pick;
 
 pub use absorption::{SIGMA_A_PRESETS, sigma_a_from_color, sigma_a_from_melanin, sigma_a_preset};
 pub use diffuse::Diffuse;
 pub use diffuse::DiffusePoint;
 pub(crate) use hair::OwnedPoint;
 pub use hair::{ACROSS, AcrossEval, HairBsdf, HairPoint, Lobes};
+pub use huang::{HuangBsdf, HuangParams, HuangPoint};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
 pub use params::{DEFAULT_EUMELANIN, HairParams};
 
@@ -66,5 +70,19 @@ pub trait LocalBsdf {
             wi: s.wi,
             weight: s.f * s.wi.z.abs() / s.pdf,
         })
+    }
+}
+
+/// Below this |wi.z| the 1/|wi.z| factor is skipped, as pbrt does at exactly zero; the
+/// threshold keeps f finite for every unit wi (the largest lobe value is ~1e7).
+pub(crate) const MIN_COS_WI: f32 = 1e-20;
+/// 1/|wi.z|, or 1 where |wi.z| is below [`MIN_COS_WI`].
+#[inline(always)]
+pub(crate) fn inv_cos(wi_z: f32) -> f32 {
+    let cos_wi = wi_z.abs();
+    if cos_wi > MIN_COS_WI {
+        1.0 / cos_wi
+    } else {
+        1.0
     }
 }

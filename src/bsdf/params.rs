@@ -1,9 +1,8 @@
 //! The user-facing parameters of the hair BSDF and their validation.
 
 use super::absorption::sigma_a_from_melanin;
-use super::limits::{ALPHA_MAX_DEG, ETA_MAX, check_beta};
-use crate::error::{Result, invalid_arg};
-use crate::validate::non_negative;
+use super::limits::{check_beta, check_shared};
+use crate::error::Result;
 
 /// Parameters of the Chiang 2016 hair model (units and ranges: docs/conventions.md).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -41,23 +40,9 @@ impl HairParams {
     /// Checks every parameter against its range; the error names the first bad one.
     /// Out-of-range values are refused rather than clamped, so a mistake is seen.
     pub fn validate(&self) -> Result<()> {
-        for (c, &s) in self.sigma_a.iter().enumerate() {
-            non_negative(&format!("sigma_a[{c}]"), s)?;
-        }
-        if !(self.eta > 1.0 && self.eta <= ETA_MAX) {
-            return Err(invalid_arg!(
-                "eta = {}: must be in (1, {ETA_MAX}]",
-                self.eta
-            ));
-        }
+        check_shared(&self.sigma_a, self.eta, self.alpha)?;
         check_beta("beta_m", self.beta_m)?;
         check_beta("beta_n", self.beta_n)?;
-        if self.alpha.is_nan() || self.alpha.abs() > ALPHA_MAX_DEG {
-            return Err(invalid_arg!(
-                "alpha = {} degrees: must be in [-{ALPHA_MAX_DEG}, {ALPHA_MAX_DEG}]",
-                self.alpha
-            ));
-        }
         Ok(())
     }
 }

@@ -8,7 +8,7 @@ use super::{Failure, HtStatus, boundary, read_host, read_vec3};
 use crate::bsdf::HairParams;
 use crate::description::MaterialDesc;
 use crate::error::invalid_arg;
-use crate::scene::{HairColor, HairMaterial};
+use crate::scene::{HairColor, HairMaterial, HairModel};
 
 /// How a hair material varies over the groom, deterministically from the seed, the
 /// strand and the position along it.
@@ -158,6 +158,7 @@ pub(super) fn varied_material(
             }
         },
         seed: v.seed,
+        model: HairModel::Chiang,
     })
 }
 

@@ -28,6 +28,12 @@
 //! melanin = [1.3, 0.2]     # then, optional: eta, beta_m, beta_n, alpha (degrees),
 //! beta_m = 0.3             # absorption_variation, roughness_variation, tip_absorption,
 //!                          # use_vertex_colors, seed (see HairMaterial)
+//! [materials.curly]
+//! type = "hair"
+//! color = [0.4, 0.25, 0.15]
+//! model = "huang"          # elliptical fibres (docs/conventions.md 4b); default "chiang"
+//! roughness = 0.3          # huang only: GGX roughness in [0.01, 1]; beta_m does not apply
+//! aspect = 0.65            # huang only: minor over major axis, in [0.05, 1]
 //! [materials.skin]
 //! type = "diffuse"
 //! albedo = [0.6, 0.45, 0.4]

@@ -21,7 +21,7 @@ use crate::error::{Error, Result, invalid_arg};
 use crate::render::settings::RenderSettings;
 use crate::scene::GroomShape;
 use crate::scene::groom::{FurBall, HairStyle, ScalpPatch};
-use crate::scene::material::{HairColor, HairMaterial};
+use crate::scene::material::{HairColor, HairMaterial, HairModel};
 
 impl SceneDescription {
     /// Reads and checks a scene file; relative paths in it are relative to its folder.
@@ -161,7 +161,18 @@ struct RawMaterial {
     tip_absorption: Option<f32>,
     use_vertex_colors: Option<bool>,
     seed: Option<u64>,
+    model: Option<ModelKey>,
+    roughness: Option<f32>,
+    aspect: Option<f32>,
     albedo: Option<[f32; 3]>,
+}
+
+/// A hair material's `model`.
+#[derive(Deserialize, Clone, Copy, PartialEq)]
+#[serde(rename_all = "snake_case")]
+enum ModelKey {
+    Chiang,
+    Huang,
 }
 
 #[derive(Deserialize, Clone, Copy)]
@@ -480,6 +491,30 @@ impl RawMaterial {
                     }
                 };
                 let d = HairMaterial::default();
+                let model = match self.model.unwrap_or(ModelKey::Chiang) {
+                    ModelKey::Chiang => {
+                        reject(
+                            "a hair material of model \"chiang\" (the default; `model = \"huang\"` \
+                             takes them)",
+                            &[
+                                ("roughness", self.roughness.is_some()),
+                                ("aspect", self.aspect.is_some()),
+                            ],
+                        )?;
+                        HairModel::Chiang
+                    }
+                    ModelKey::Huang => {
+                        reject(
+                            "a hair material of model \"huang\" (its roughness is `roughness`)",
+                            &[("beta_m", self.beta_m.is_some())],
+                        )?;
+                        let h = crate::bsdf::HuangParams::default();
+                        HairModel::Huang {
+                            roughness: self.roughness.unwrap_or(h.roughness),
+                            aspect: self.aspect.unwrap_or(h.aspect),
+                        }
+                    }
+                };
                 Ok(MaterialDesc::Hair(HairMaterial {
                     color,
                     eta: self.eta.unwrap_or(d.eta),
@@ -493,6 +528,7 @@ impl RawMaterial {
                     tip_absorption: self.tip_absorption.unwrap_or(d.tip_absorption),
                     use_vertex_colors: self.use_vertex_colors.unwrap_or(d.use_vertex_colors),
                     seed: self.seed.unwrap_or(d.seed),
+                    model,
                 }))
             }
             MaterialKind::Diffuse => {
@@ -514,6 +550,9 @@ impl RawMaterial {
                     tip_absorption,
                     use_vertex_colors,
                     seed,
+                    model,
+                    roughness,
+                    aspect,
                 } = &self;
                 reject(
                     "a diffuse material",
@@ -531,6 +570,9 @@ impl RawMaterial {
                         ("tip_absorption", tip_absorption.is_some()),
                         ("use_vertex_colors", use_vertex_colors.is_some()),
                         ("seed", seed.is_some()),
+                        ("model", model.is_some()),
+                        ("roughness", roughness.is_some()),
+                        ("aspect", aspect.is_some()),
                     ],
                 )?;
                 Ok(MaterialDesc::Diffuse {

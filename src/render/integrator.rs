@@ -12,11 +12,13 @@ use super::sampler::PixelSampler;
 use super::settings::{LightOffsets, PathSettings, Roulette, Strategy};
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
-use crate::bsdf::{ACROSS, DiffusePoint, HairBsdf, HairPoint, Lobes, LocalBsdf};
+use crate::bsdf::{
+    ACROSS, DiffusePoint, HairBsdf, HairPoint, HuangBsdf, HuangPoint, Lobes, LocalBsdf,
+};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
-use crate::math::{Frame, luminance};
+use crate::math::{Frame, luminance, mix64};
 use crate::scene::hit::{HairHit, Hit, SurfaceHit};
 use crate::scene::light::{Light, LightEval};
 use crate::scene::material::Material;
@@ -219,10 +221,16 @@ impl World {
             let varied_bsdf;
             let shading = match (&hit, self.materials.get(hit.geom_id() as usize)) {
                 (Hit::Hair(h), Some(Material::Hair(m))) => {
-                    varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
-                    let across = settings.light_offsets == LightOffsets::Across
-                        && (events > 0 || 2.0 * h.radius <= pixel_spread * h.t);
-                    Shading::hair(h, &varied_bsdf, wo_world, settings.lobes(events), across)
+                    // The strand narrower than its pixel, or seen by a bounce: the BSDF
+                    // averaged across the fibre serves.
+                    let thin = events > 0 || 2.0 * h.radius <= pixel_spread * h.t;
+                    if let Some(b) = m.huang_at(h.strand.id, h.s, h.absorption) {
+                        Shading::huang(h, &b, wo_world, thin, jitter(u_rr, u_lobe, events))
+                    } else {
+                        varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
+                        let across = settings.light_offsets == LightOffsets::Across && thin;
+                        Shading::hair(h, &varied_bsdf, wo_world, settings.lobes(events), across)
+                    }
                 }
                 (Hit::Surface(s), Some(Material::Diffuse(d))) => Shading::diffuse(s, *d, wo_world),
                 _ => break,
@@ -436,7 +444,18 @@ struct Shading<'a> {
 /// and BSDF sampling.
 enum Point<'a> {
     Hair(HairPoint<'a>),
+    /// Boxed: a far-field point holds the paths of four offsets.
+    Huang(Box<HuangPoint>),
     Diffuse(DiffusePoint),
+}
+
+/// The Huang model's node jitter at a hit (`HuangBsdf::near`): two numbers hashed from the
+/// bounce's own, so that the pixel sampler's sequence keeps its layout for every model.
+fn jitter(u_rr: f32, u_lobe: f32, events: u32) -> [f32; 2] {
+    let key = (u64::from(u_rr.to_bits()) << 32) | u64::from(u_lobe.to_bits());
+    let z = mix64(key ^ u64::from(events).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+    let unit = |bits: u64| (bits >> 40) as f32 / (1u64 << 24) as f32;
+    [unit(z), unit(z << 24)]
 }
 
 impl<'a> Shading<'a> {
@@ -445,6 +464,23 @@ impl<'a> Shading<'a> {
             frame: h.frame,
             point: Point::Hair(bsdf.at_lobes(h.h, h.frame.to_local(wo_world), lobes)),
             across,
+        }
+    }
+
+    /// The Huang model at a hair hit: its far field where `far` (the strand narrower than
+    /// its pixel, or a bounce), else the near field at the hit's offset.
+    fn huang(h: &HairHit, bsdf: &HuangBsdf, wo_world: Vec3, far: bool, jitter: [f32; 2]) -> Self {
+        let wo = h.frame.to_local(wo_world);
+        let major = h.major_axis();
+        let point = if far {
+            bsdf.far(h.h, wo, major, jitter)
+        } else {
+            bsdf.near(h.h, wo, major, jitter)
+        };
+        Shading {
+            frame: h.frame,
+            point: Point::Huang(Box::new(point)),
+            across: false,
         }
     }
 
@@ -460,6 +496,7 @@ impl<'a> Shading<'a> {
     fn local(&self) -> &dyn LocalBsdf {
         match &self.point {
             Point::Hair(p) => p,
+            Point::Huang(p) => p.as_ref(),
             Point::Diffuse(p) => p,
         }
     }

@@ -6,7 +6,7 @@
 //! length leaks into h. In f64 both errors vanish and what remains is the f32 error of the
 //! inputs themselves.
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::curves::StrandSegment;
 use super::material::HairColor;
@@ -73,6 +73,28 @@ pub struct HairHit {
     /// shaded, and which the rays leaving it keep.
     pub time: f32,
 }
+
+impl HairHit {
+    /// The major axis of an elliptical fibre's section here, as a (y, z) direction of the
+    /// hit's frame: world up (+y) made perpendicular to the tangent, or world +x where the
+    /// tangent is within about 0.06 degrees of vertical. A property of the fibre, not of
+    /// the ray, so that camera and shadow rays see one section (docs/conventions.md,
+    /// section 4b); a groom's curve normals are not read yet.
+    pub(crate) fn major_axis(&self) -> Vec2 {
+        let x = self.frame.x;
+        let off = |a: Vec3| a - x * x.dot(a);
+        let m = off(Vec3::Y);
+        let m = if m.length_squared() > MIN_MAJOR_AXIS_SQUARED {
+            m
+        } else {
+            off(Vec3::X)
+        };
+        Vec2::new(m.dot(self.frame.y), m.dot(self.frame.z))
+    }
+}
+
+/// Below this squared length world up is too near the tangent to orient the section.
+const MIN_MAJOR_AXIS_SQUARED: f32 = 1e-6;
 
 /// A hit on a triangle mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,7 +2,9 @@
 //! variation, and a diffuse surface for scalps, heads and floors.
 
 use crate::bsdf::diffuse::Diffuse;
-use crate::bsdf::{HairBsdf, HairParams, sigma_a_from_color, sigma_a_from_melanin};
+use crate::bsdf::{
+    HairBsdf, HairParams, HuangBsdf, HuangParams, sigma_a_from_color, sigma_a_from_melanin,
+};
 use crate::error::{Result, invalid_arg};
 use crate::math::mix64;
 use crate::validate::positive;
@@ -62,6 +64,17 @@ impl HairColor {
     }
 }
 
+/// Which hair model a material scatters with (docs/conventions.md, sections 4 and 4b).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum HairModel {
+    /// Chiang et al. 2016, round fibres: `beta_m` and `beta_n` are its roughnesses.
+    #[default]
+    Chiang,
+    /// Huang et al. 2022, elliptical fibres of GGX roughness `roughness` and minor over
+    /// major axis `aspect`; `beta_m` is unused and `beta_n` only inverts a `color`.
+    Huang { roughness: f32, aspect: f32 },
+}
+
 /// A hair material: the BSDF parameters plus how they vary over the groom. Variation is
 /// deterministic: it depends only on the seed, the strand id and the position along it.
 #[derive(Debug, Clone, PartialEq)]
@@ -85,6 +98,7 @@ pub struct HairMaterial {
     /// per-point colours (inverted at `beta_n`) or its per-strand melanin (as it is).
     pub use_vertex_colors: bool,
     pub seed: u64,
+    pub model: HairModel,
 }
 
 impl Default for HairMaterial {
@@ -102,6 +116,7 @@ impl Default for HairMaterial {
             tip_absorption: 1.0,
             use_vertex_colors: false,
             seed: 0,
+            model: HairModel::Chiang,
         }
     }
 }
@@ -112,6 +127,8 @@ pub struct PreparedHair {
     material: HairMaterial,
     base: HairParams,
     uniform: Option<HairBsdf>,
+    /// The Huang model's BSDF when nothing varies (with [`HairModel::Huang`]).
+    uniform_huang: Option<HuangBsdf>,
 }
 
 impl HairMaterial {
@@ -140,11 +157,38 @@ impl HairMaterial {
         } else {
             Some(HairBsdf::new(&base)?)
         };
+        let huang = self.huang_params(base, 1.0)?;
+        let uniform_huang = match huang {
+            Some(p) if !varies => Some(HuangBsdf::new(&p)?),
+            _ => None,
+        };
         Ok(PreparedHair {
             material: self.clone(),
             base,
             uniform,
+            uniform_huang,
         })
+    }
+
+    /// The Huang model's parameters from (possibly varied) `p`, its roughness scaled by
+    /// `roughness_factor` and kept in range; None for the Chiang model. Checked.
+    fn huang_params(&self, p: HairParams, roughness_factor: f32) -> Result<Option<HuangParams>> {
+        let HairModel::Huang { roughness, aspect } = self.model else {
+            return Ok(None);
+        };
+        let params = HuangParams {
+            sigma_a: p.sigma_a,
+            eta: p.eta,
+            roughness: if roughness_factor == 1.0 {
+                roughness
+            } else {
+                (roughness * roughness_factor).clamp(0.01, 1.0)
+            },
+            aspect,
+            alpha: p.alpha,
+        };
+        params.validate()?;
+        Ok(Some(params))
     }
 }
 
@@ -189,10 +233,15 @@ impl HairMaterial {
         let absorption = (1.0 + self.absorption_variation * (2.0 * ua - 1.0))
             * (1.0 + (self.tip_absorption - 1.0) * s.clamp(0.0, 1.0));
         p.sigma_a = p.sigma_a.map(|v| (v * absorption).min(f32::MAX));
-        let roughness = 1.0 + self.roughness_variation * (2.0 * ur - 1.0);
+        let roughness = self.roughness_factor(ur);
         p.beta_m = (p.beta_m * roughness).clamp(0.01, 1.0);
         p.beta_n = (p.beta_n * roughness).clamp(0.01, 1.0);
         p
+    }
+
+    /// The factor a strand's roughnesses are scaled by, from its uniform number `ur`.
+    fn roughness_factor(&self, ur: f32) -> f32 {
+        1.0 + self.roughness_variation * (2.0 * ur - 1.0)
     }
 }
 
@@ -224,6 +273,27 @@ impl PreparedHair {
                     .expect("varied parameters stay in range"),
             ),
         }
+    }
+}
+
+impl PreparedHair {
+    /// The Huang model's BSDF at a hit ([`Self::bsdf_at`]'s variation); None for a material
+    /// of the Chiang model.
+    pub(crate) fn huang_at(
+        &self,
+        strand: u32,
+        s: f32,
+        groom: Option<HairColor>,
+    ) -> Option<HuangBsdf> {
+        if let Some(b) = self.uniform_huang {
+            return Some(b);
+        }
+        let varied = self.params_at(strand, s, groom);
+        let [_, ur] = strand_uniforms(self.material.seed, strand);
+        let factor = self.material.roughness_factor(ur);
+        // Valid by construction: the base was checked, the variation is clamped into range.
+        let p = self.material.huang_params(varied, factor).ok()??;
+        HuangBsdf::new(&p).ok()
     }
 }
 

@@ -37,7 +37,7 @@ pub use camera::Camera;
 pub use envmap::Environment;
 pub use groom::{FurBall, HairStyle, ScalpPatch};
 pub use light::{Light, LightEval, LightSample};
-pub use material::{HairColor, HairMaterial, Material};
+pub use material::{HairColor, HairMaterial, HairModel, Material};
 pub use mesh::Mesh;
 pub use ribbons::GroomShape;
 pub use stages::{NoStages, Stage, StageProgress, StageTimes};

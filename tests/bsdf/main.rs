@@ -9,6 +9,7 @@ mod across;
 mod chi2;
 mod fidelity;
 mod furnace;
+mod huang;
 mod lobes;
 mod normalisation;
 mod sampling;

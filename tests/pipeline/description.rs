@@ -15,8 +15,8 @@ use hairtrace::formats::hair::{Thickness, write_hair_file};
 use hairtrace::render::PixelFilter;
 use hairtrace::render::settings::Roulette;
 use hairtrace::scene::GroomShape;
-use hairtrace::scene::HairColor;
 use hairtrace::scene::{FurBall, HairStyle};
+use hairtrace::scene::{HairColor, HairModel};
 
 /// The camera a render of the scene's own settings uses.
 fn placed(scene: &hairtrace::Scene) -> hairtrace::scene::Camera {
@@ -266,6 +266,50 @@ fn absorption_presets_by_name() {
         "albedo = [0.6, 0.5, 0.4]\npreset = \"black\"",
     ));
     assert_contains(&e, &["materials.skin.preset", "diffuse"]);
+}
+
+/// `model = "huang"` takes `roughness` and `aspect`; each model refuses the other's keys,
+/// and a bad aspect fails the build naming the material.
+#[test]
+fn hair_models_by_name() {
+    let huang = BASE.replace(
+        "melanin = [1.3, 0.2]",
+        "melanin = [1.3, 0.2]\nmodel = \"huang\"\nroughness = 0.2\naspect = 0.65",
+    );
+    let MaterialDesc::Hair(h) = &parse(&huang).unwrap().materials["brown"] else {
+        panic!("a hair material");
+    };
+    assert_eq!(
+        h.model,
+        HairModel::Huang {
+            roughness: 0.2,
+            aspect: 0.65
+        }
+    );
+    let MaterialDesc::Hair(h) = &parse(BASE).unwrap().materials["brown"] else {
+        panic!("a hair material");
+    };
+    assert_eq!(h.model, HairModel::Chiang);
+    let e =
+        parse_error(&BASE.replace("melanin = [1.3, 0.2]", "melanin = [1.3, 0.2]\naspect = 0.7"));
+    assert_contains(&e, &["materials.brown.aspect", "model \"chiang\""]);
+    let e = parse_error(&huang.replace("roughness = 0.2", "beta_m = 0.2"));
+    assert_contains(&e, &["materials.brown.beta_m", "model \"huang\""]);
+    let e = parse_error(&BASE.replace(
+        "melanin = [1.3, 0.2]",
+        "melanin = [1.3, 0.2]\nmodel = \"marschner\"",
+    ));
+    assert_contains(&e, &["test.toml:", "marschner", "chiang", "huang"]);
+    let e = build_error(&huang.replace("aspect = 0.65", "aspect = 1.5")).to_string();
+    assert_contains(&e, &["brown", "aspect = 1.5"]);
+    // The scene renders: a thin groom, the far field.
+    let mut desc = parse(&huang).unwrap();
+    shrink(&mut desc);
+    let mut scene = hairtrace::Scene::from_description(&desc, device()).unwrap();
+    let image = scene
+        .render(Default::default(), &hairtrace::NoProgress)
+        .unwrap();
+    assert!(image.film.rgb().iter().all(|v| v.is_finite() && *v >= 0.0));
 }
 
 #[test]

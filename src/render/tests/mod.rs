@@ -3,5 +3,6 @@
 
 mod adaptive;
 mod camera_film;
+mod huang;
 mod motion;
 pub(crate) mod render;

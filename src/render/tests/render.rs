@@ -93,7 +93,12 @@ fn white_fur_ball_of_30k_strands_keeps_the_furnace_within_a_thousandth() {
 
 /// A brown fur ball lit by three non-delta lights of different kinds.
 pub(crate) fn lit_world() -> World {
-    let lights = vec![
+    fur_world(HairMaterial::default(), lit_lights(), 2000)
+}
+
+/// The lights of [`lit_world`]: a dim sky, a distant light and a rect.
+pub(crate) fn lit_lights() -> Vec<Light> {
+    vec![
         Light::Environment(Environment::uniform(Vec3::splat(0.2)).unwrap()),
         Light::distant(Vec3::new(1.0, 1.0, 1.0), Vec3::new(2.0, 1.8, 1.5), 10.0).unwrap(),
         Light::rect(
@@ -104,8 +109,7 @@ pub(crate) fn lit_world() -> World {
             false,
         )
         .unwrap(),
-    ];
-    fur_world(HairMaterial::default(), lights, 2000)
+    ]
 }
 
 /// Light-only, BSDF-only and MIS estimate the same image: the means of each image

@@ -1,0 +1,489 @@
+//! The Huang model at one point (h, wo): the light paths through the section, what each
+//! gives toward wi, and the sampler whose density is their sum (module doc of `huang`).
+
+use super::section::Section;
+use super::{Ggx, HuangBsdf};
+use crate::bsdf::fresnel::{fresnel_dielectric, fresnel_inside};
+use crate::bsdf::pick::{U_MIN, pick};
+use crate::bsdf::{BsdfEval, BsdfSample, LocalBsdf, inv_cos};
+use crate::math::cos_from_sin;
+use crate::math::sampling::ONE_MINUS_EPSILON;
+use glam::{Vec2, Vec3};
+use std::f32::consts::{FRAC_1_PI, TAU};
+
+/// Microfacet normals of the first interface that each point follows into the fibre.
+const ENTRY_NODES: usize = 5;
+/// Internal reflections at the second interface followed from each of them (TRT).
+const REFLECT_NODES: usize = 3;
+const TT_EXITS: usize = ENTRY_NODES;
+const EXITS: usize = ENTRY_NODES * (1 + REFLECT_NODES);
+/// Offsets a far-field point averages.
+pub(super) const FAR_SHIFTS: usize = 4;
+/// Below this (y, z) length an internal direction runs along the fibre and never meets
+/// the far side: its path is dropped.
+const MIN_CROSSING: f32 = 1e-6;
+
+/// Node k of a rank-1 lattice of `n` points in [0, 1)^2 with generator `g` (spread evenly
+/// in both coordinates), shifted by `jitter` modulo 1.
+fn lattice(k: usize, n: usize, g: usize, jitter: [f32; 2]) -> [f32; 2] {
+    let n = n as f32;
+    let wrap = |x: f32| (x - x.floor()).min(ONE_MINUS_EPSILON);
+    [
+        wrap(k as f32 / n + jitter[0]),
+        wrap((k * g) as f32 / n + jitter[1]),
+    ]
+}
+
+/// Where a path meets its last interface from inside: the internal direction reversed
+/// (`v`, away from the surface, into the fibre), the inner mesonormal there (`n`),
+/// dot(v, n) (> 0 on a path that arrives; 0 marks none) and the path's RGB weight.
+#[derive(Debug, Clone, Copy)]
+struct Exit {
+    v: Vec3,
+    n: Vec3,
+    cos_vn: f32,
+    weight: Vec3,
+}
+
+/// The lobes, in the order of a point's sampling weights.
+const R: usize = 0;
+const TT: usize = 1;
+const TRT: usize = 2;
+const RESIDUAL: usize = 3;
+
+/// One offset's paths.
+#[derive(Debug, Clone, Copy)]
+struct Paths {
+    /// The entry's mesonormal.
+    m: Vec3,
+    /// dot(wo, m); the point sends nothing where it is <= 0.
+    cos_om: f32,
+    g1_o: f32,
+    /// TT's exits, then TRT's.
+    exits: [Exit; EXITS],
+    /// Each exit's probability within its lobe.
+    exit_pdf: [f32; EXITS],
+    /// The residual lobe's RGB energy.
+    residual: Vec3,
+    /// Probability of sampling R, TT, TRT, the residual.
+    lobe_pdf: [f32; 4],
+}
+
+/// [`HuangBsdf`] at a point; see [`HuangBsdf::near`] and [`HuangBsdf::far`].
+#[derive(Debug, Clone, Copy)]
+pub struct HuangPoint {
+    bsdf: HuangBsdf,
+    wo: Vec3,
+    sin_to: f32,
+    cos_to: f32,
+    /// wo's azimuth as a unit (y, z) direction; y along the tangent.
+    azimuth: Vec2,
+    /// The offsets' paths; the first `shifts` are used.
+    paths: [Paths; FAR_SHIFTS],
+    shifts: usize,
+}
+
+impl HuangPoint {
+    /// The point at the offsets h + 2k / `shifts` (k < `shifts`, wrapped into [-1, 1]).
+    pub(super) fn new(
+        bsdf: &HuangBsdf,
+        h: f32,
+        wo: Vec3,
+        major: Vec2,
+        jitter: [f32; 2],
+        shifts: usize,
+    ) -> Self {
+        let h = if h.is_nan() { 0.0 } else { h.clamp(-1.0, 1.0) };
+        let jitter = jitter.map(|x| if x.is_finite() { x } else { 0.0 });
+        let major = major.try_normalize().unwrap_or(Vec2::X);
+        let section = Section::new(bsdf.params.aspect, major);
+        let azimuth = Vec2::new(wo.y, wo.z).try_normalize().unwrap_or(Vec2::X);
+        let sin_to = wo.x.clamp(-1.0, 1.0);
+        let mut paths = [Paths::NONE; FAR_SHIFTS];
+        for (k, p) in paths.iter_mut().enumerate().take(shifts) {
+            let x = h + 2.0 * k as f32 / shifts as f32;
+            let x = if x > 1.0 { x - 2.0 } else { x };
+            *p = Paths::new(bsdf, &section, x, wo, azimuth, jitter);
+        }
+        Self {
+            bsdf: *bsdf,
+            wo,
+            sin_to,
+            cos_to: cos_from_sin(sin_to),
+            azimuth,
+            paths,
+            shifts,
+        }
+    }
+
+    /// f and pdf toward the unit direction wi.
+    pub fn eval(&self, wi: Vec3) -> BsdfEval {
+        let mut f = Vec3::ZERO;
+        let mut pdf = 0.0;
+        let sin_ti = wi.x.clamp(-1.0, 1.0);
+        let residual =
+            self.bsdf
+                .residual
+                .eval(sin_ti, cos_from_sin(sin_ti), self.sin_to, self.cos_to)
+                * (0.5 * FRAC_1_PI);
+        for p in &self.paths[..self.shifts] {
+            let (pf, ppdf) = p.eval(&self.bsdf, self.wo, wi, residual);
+            f += pf;
+            pdf += ppdf;
+        }
+        let scale = 1.0 / self.shifts as f32;
+        BsdfEval {
+            f: f * (scale * inv_cos(wi.z)),
+            pdf: pdf * scale,
+        }
+    }
+
+    /// A direction drawn from `u` in [0, 1)^3: `u[0]` picks the offset (far field), the
+    /// lobe and the exit, rescaled after each choice, and then the residual's azimuth;
+    /// `u[1]`, `u[2]` the microfacet normal or the residual's theta. None where the density
+    /// there is zero or the draw met total internal reflection.
+    pub fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        let n = self.shifts as f32;
+        let k = ((u[0] * n) as usize).min(self.shifts - 1);
+        let u0 = (u[0] * n - k as f32).clamp(0.0, 1.0);
+        let wi = self.paths[k].draw(self, [u0, u[1].max(U_MIN), u[2]])?;
+        let e = self.eval(wi);
+        (e.pdf > 0.0 && e.f.is_finite()).then_some(BsdfSample {
+            wi,
+            f: e.f,
+            pdf: e.pdf,
+        })
+    }
+
+    /// The RGB energy of R, TT, TRT and the residual leaving wo, averaged over the
+    /// point's offsets, without the masking of the last interface (an upper bound of the
+    /// albedo, for the lobes' balance).
+    pub fn lobe_energies(&self) -> [Vec3; 4] {
+        let mut out = [Vec3::ZERO; 4];
+        for p in &self.paths[..self.shifts] {
+            let e = p.energies(&self.bsdf);
+            for (o, e) in out.iter_mut().zip(e) {
+                *o += e / self.shifts as f32;
+            }
+        }
+        out
+    }
+}
+
+impl LocalBsdf for HuangPoint {
+    fn eval(&self, wi: Vec3) -> BsdfEval {
+        HuangPoint::eval(self, wi)
+    }
+
+    fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        HuangPoint::sample(self, u)
+    }
+}
+
+/// The mesonormal over the outward (y, z) normal `n`: tilted toward +x by the cuticle.
+fn mesonormal(bsdf: &HuangBsdf, n: Vec2) -> Vec3 {
+    let (s, c) = bsdf.tilt;
+    Vec3::new(s, c * n.x, c * n.y)
+}
+
+/// exp(-sigma_a len) per channel.
+fn transmittance(bsdf: &HuangBsdf, len: f32) -> Vec3 {
+    let s = bsdf.params.sigma_a;
+    Vec3::new(
+        (-s[0] * len).exp(),
+        (-s[1] * len).exp(),
+        (-s[2] * len).exp(),
+    )
+}
+
+fn mean(v: Vec3) -> f32 {
+    (v.x + v.y + v.z) * (1.0 / 3.0)
+}
+
+/// Follows the internal direction `d` (travel, unit) from `q` across the section: the
+/// exit point, the inner mesonormal there and the transmittance; None when `d` does not
+/// cross the section or meets the far side from outside its mesonormal.
+fn cross(bsdf: &HuangBsdf, section: &Section, q: Vec2, d: Vec3) -> Option<(Vec2, Vec3, Vec3)> {
+    let dyz = Vec2::new(d.y, d.z);
+    let len_yz = dyz.length();
+    if len_yz < MIN_CROSSING {
+        return None;
+    }
+    let (q2, chord) = section.chord(q, dyz / len_yz)?;
+    let n_in = -mesonormal(bsdf, section.normal(q2));
+    // The path must reach the far surface from inside (travel against the inner normal).
+    (d.dot(n_in) < 0.0).then(|| (q2, n_in, transmittance(bsdf, chord / len_yz)))
+}
+
+impl Paths {
+    const NONE: Paths = Paths {
+        m: Vec3::Z,
+        cos_om: 0.0,
+        g1_o: 0.0,
+        exits: [Exit {
+            v: Vec3::Z,
+            n: Vec3::Z,
+            cos_vn: 0.0,
+            weight: Vec3::ZERO,
+        }; EXITS],
+        exit_pdf: [0.0; EXITS],
+        residual: Vec3::ZERO,
+        lobe_pdf: [0.0; 4],
+    };
+
+    fn new(
+        bsdf: &HuangBsdf,
+        section: &Section,
+        h: f32,
+        wo: Vec3,
+        view: Vec2,
+        jitter: [f32; 2],
+    ) -> Self {
+        let q1 = section.entry(view, h);
+        let m = mesonormal(bsdf, section.normal(q1));
+        let cos_om = wo.dot(m);
+        let mut p = Paths::NONE;
+        if cos_om.is_nan() || cos_om <= 0.0 {
+            return p;
+        }
+        p.m = m;
+        p.cos_om = cos_om;
+        let ggx = &bsdf.ggx;
+        p.g1_o = ggx.g1(cos_om);
+        let eta = bsdf.params.eta;
+        for k in 0..ENTRY_NODES {
+            let wh = ggx.sample_visible(m, wo, lattice(k, ENTRY_NODES, 2, jitter));
+            let c = wo.dot(wh);
+            if c <= 0.0 {
+                continue;
+            }
+            // Refraction in: wt travels into the fibre.
+            let (_, t) = fresnel_dielectric(c, eta);
+            let cos_t = cos_from_sin((1.0 - c * c).max(0.0).sqrt() / eta);
+            let wt = -wo / eta + wh * (c / eta - cos_t);
+            let cos_tm = wt.dot(m);
+            if cos_tm >= 0.0 {
+                continue;
+            }
+            let w_in = t * ggx.g2_over_g1(cos_om, cos_tm) / ENTRY_NODES as f32;
+            let Some((q2, n2, a1)) = cross(bsdf, section, q1, wt) else {
+                continue;
+            };
+            let v = -wt;
+            let cos_vn = v.dot(n2);
+            let weight = a1 * w_in;
+            p.exits[k] = Exit {
+                v,
+                n: n2,
+                cos_vn,
+                weight,
+            };
+            for j in 0..REFLECT_NODES {
+                let wh2 =
+                    ggx.sample_visible(n2, v, lattice(j, REFLECT_NODES, 2, [jitter[1], jitter[0]]));
+                let c2 = v.dot(wh2);
+                if c2 <= 0.0 {
+                    continue;
+                }
+                let wr = wh2 * (2.0 * c2) - v;
+                let cos_rn = wr.dot(n2);
+                if cos_rn <= 0.0 {
+                    continue;
+                }
+                let w_r =
+                    fresnel_inside(c2, eta) * ggx.g2_over_g1(cos_vn, cos_rn) / REFLECT_NODES as f32;
+                let Some((_, n3, a2)) = cross(bsdf, section, q2, wr) else {
+                    continue;
+                };
+                let v3 = -wr;
+                let cos_v3 = v3.dot(n3);
+                let arriving = weight * w_r * a2;
+                p.exits[TT_EXITS + k * REFLECT_NODES + j] = Exit {
+                    v: v3,
+                    n: n3,
+                    cos_vn: cos_v3,
+                    weight: arriving,
+                };
+                // Past TRT: the light the third interface reflects (its Fresnel, total
+                // internal reflection included, at the same nodes of its visible normals)
+                // crosses again and again, each crossing absorbed as the mean of the two
+                // before, each interface letting out 1 - F: a geometric series.
+                let f3 = (0..REFLECT_NODES)
+                    .map(|i| {
+                        let wh3 = ggx.sample_visible(n3, v3, lattice(i, REFLECT_NODES, 2, jitter));
+                        fresnel_inside(v3.dot(wh3).max(0.0), eta)
+                    })
+                    .sum::<f32>()
+                    / REFLECT_NODES as f32;
+                let a = (a1 * a2).powf(0.5);
+                let denom = Vec3::ONE - a * f3;
+                let series = a * (1.0 - f3) * f3 / denom;
+                if series.is_finite() {
+                    p.residual += arriving * series;
+                }
+            }
+        }
+        let r = fresnel_dielectric(cos_om, eta).0;
+        let lobe_sums = [
+            r,
+            p.exits[..TT_EXITS].iter().map(|e| mean(e.weight)).sum(),
+            p.exits[TT_EXITS..].iter().map(|e| mean(e.weight)).sum(),
+            mean(p.residual),
+        ];
+        let total: f32 = lobe_sums.iter().sum();
+        p.lobe_pdf = lobe_sums.map(|s| s / total);
+        for (range, sum) in [
+            (0..TT_EXITS, lobe_sums[TT]),
+            (TT_EXITS..EXITS, lobe_sums[TRT]),
+        ] {
+            for i in range {
+                p.exit_pdf[i] = if sum > 0.0 {
+                    mean(p.exits[i].weight) / sum
+                } else {
+                    0.0
+                };
+            }
+        }
+        p
+    }
+
+    /// The RGB energy of each lobe before the last interface's masking.
+    fn energies(&self, bsdf: &HuangBsdf) -> [Vec3; 4] {
+        if self.cos_om <= 0.0 {
+            return [Vec3::ZERO; 4];
+        }
+        let exits = |r: std::ops::Range<usize>| {
+            self.exits[r]
+                .iter()
+                .map(|e| e.weight * (1.0 - fresnel_inside(e.cos_vn, bsdf.params.eta)))
+                .sum()
+        };
+        [
+            Vec3::splat(fresnel_dielectric(self.cos_om, bsdf.params.eta).0),
+            exits(0..TT_EXITS),
+            exits(TT_EXITS..EXITS),
+            self.residual,
+        ]
+    }
+
+    /// f |wi.z| and pdf toward wi at this offset; `residual` the residual lobe's Mp Np.
+    fn eval(&self, bsdf: &HuangBsdf, wo: Vec3, wi: Vec3, residual: f32) -> (Vec3, f32) {
+        if self.cos_om <= 0.0 {
+            return (Vec3::ZERO, 0.0);
+        }
+        let ggx = &bsdf.ggx;
+        let mut f = Vec3::ZERO;
+        let mut pdf = 0.0;
+        // R: reflection from the visible normals of the mesonormal.
+        if let Some(wh) = (wo + wi).try_normalize() {
+            let pdf_r = self.g1_o * ggx.d(wh.dot(self.m)) / (4.0 * self.cos_om);
+            let cos_im = wi.dot(self.m);
+            if cos_im > 0.0 {
+                let fr = fresnel_dielectric(wo.dot(wh).clamp(0.0, 1.0), bsdf.params.eta).0;
+                f += Vec3::splat(fr * ggx.g2_over_g1(self.cos_om, cos_im) * pdf_r);
+            }
+            pdf += self.lobe_pdf[R] * pdf_r;
+        }
+        for (i, e) in self.exits.iter().enumerate() {
+            if e.cos_vn <= 0.0 {
+                continue;
+            }
+            let (p, t) = refraction_out(ggx, bsdf.params.eta, e, wi);
+            f += e.weight * (t * p);
+            let lobe = if i < TT_EXITS { TT } else { TRT };
+            pdf += self.lobe_pdf[lobe] * self.exit_pdf[i] * p;
+        }
+        f += self.residual * residual;
+        pdf += self.lobe_pdf[RESIDUAL] * residual;
+        (f, pdf)
+    }
+
+    /// A direction from this offset's lobes; None where a refraction out meets total
+    /// internal reflection, or nothing leaves.
+    fn draw(&self, point: &HuangPoint, u: [f32; 3]) -> Option<Vec3> {
+        if self.cos_om <= 0.0 {
+            return None;
+        }
+        let ggx = &point.bsdf.ggx;
+        let (lobe, u0) = pick(&self.lobe_pdf, u[0]);
+        match lobe {
+            R => {
+                let wh = ggx.sample_visible(self.m, point.wo, [u[1], u[2]]);
+                Some(wh * (2.0 * point.wo.dot(wh)) - point.wo)
+            }
+            RESIDUAL => {
+                let (sin_ti, cos_ti) =
+                    point
+                        .bsdf
+                        .residual
+                        .sample(point.sin_to, point.cos_to, [u[1], u[2]]);
+                let (s, c) = (TAU * u0).sin_cos();
+                let a = point.azimuth;
+                Some(Vec3::new(
+                    sin_ti,
+                    cos_ti * (a.x * c - a.y * s),
+                    cos_ti * (a.y * c + a.x * s),
+                ))
+            }
+            _ => {
+                let range = if lobe == TT {
+                    0..TT_EXITS
+                } else {
+                    TT_EXITS..EXITS
+                };
+                let (i, _) = pick(&self.exit_pdf[range.clone()], u0);
+                let e = &self.exits[range.start + i];
+                if e.cos_vn <= 0.0 {
+                    return None;
+                }
+                let wh = ggx.sample_visible(e.n, e.v, [u[1], u[2]]);
+                refract_out(point.bsdf.params.eta, e.v, wh)
+            }
+        }
+    }
+}
+
+/// The light of `v` (inside, away from the surface) refracted out through the microfacet
+/// normal `wh` (on v's side); None under total internal reflection.
+fn refract_out(eta: f32, v: Vec3, wh: Vec3) -> Option<Vec3> {
+    let c = v.dot(wh);
+    let sin2_t = eta * eta * (1.0 - c * c);
+    if c <= 0.0 || sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some(-v * eta + wh * (eta * c - cos_t))
+}
+
+/// At the exit `e`, toward wi outside: the density of a refraction out through a
+/// visible microfacet (`refract_out` of [`Ggx::sample_visible`]) and the fraction of the
+/// light it carries that leaves unmasked, 1 - F times G2 / G1.
+fn refraction_out(ggx: &Ggx, eta: f32, e: &Exit, wi: Vec3) -> (f32, f32) {
+    // The generalised half vector of a refraction from index eta into 1, on v's side.
+    let Some(mut wh) = (-(e.v * eta + wi)).try_normalize() else {
+        return (0.0, 0.0);
+    };
+    if wh.dot(e.n) < 0.0 {
+        wh = -wh;
+    }
+    let cv = e.v.dot(wh);
+    let cw = wi.dot(wh);
+    if cv <= 0.0 || cw >= 0.0 {
+        return (0.0, 0.0);
+    }
+    let denom = eta * cv + cw;
+    let pdf = ggx.visible_pdf(e.n, e.v, wh) * (-cw) / (denom * denom);
+    // A rough refraction may point back across the mesonormal's plane: drawn, but masked.
+    let cos_wn = wi.dot(e.n);
+    let leaves = if cos_wn < 0.0 {
+        (1.0 - fresnel_inside(cv, eta)) * ggx.g2_over_g1(e.cos_vn, cos_wn)
+    } else {
+        0.0
+    };
+    // Not finite only where the half vector degenerates (denom = 0).
+    if pdf.is_finite() {
+        (pdf, leaves)
+    } else {
+        (0.0, 0.0)
+    }
+}

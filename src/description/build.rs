@@ -459,7 +459,8 @@ impl MeshDesc {
             }
         };
         if self.transform != Transform::default() {
-            for p in &mut mesh.positions {
+            let steps = std::iter::once(&mut mesh.positions).chain(&mut mesh.later_positions);
+            for p in steps.flatten() {
                 *p = affine.transform_point3(Vec3::from_array(*p)).to_array();
             }
             // The scale is uniform, so the linear part maps normals to normals.

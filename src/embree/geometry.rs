@@ -13,7 +13,7 @@ use std::ops::Range;
 use std::ptr::NonNull;
 use std::sync::{Arc, OnceLock};
 
-use glam::Vec4;
+use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::order::{centroid, median_split};
@@ -240,12 +240,12 @@ impl RawGeometry {
         unsafe { self.share_range(kind, format, buffer, 0, 0..buffer.len()) }
     }
 
-    /// Binds each of `steps` as the control points of its time step (its slot of the
-    /// vertex buffer), after telling Embree how many there are.
+    /// Binds each of `steps` (elements of `format`) as the vertices of its time step (its
+    /// slot of the vertex buffer), after telling Embree how many there are.
     ///
     /// # Safety
     /// As for [`Self::share`], for every buffer; at most [`MAX_TIME_STEPS`] of them.
-    unsafe fn share_steps(&self, steps: &[SharedBuffer<[f32; 4]>]) {
+    unsafe fn share_steps<T>(&self, format: sys::RTCFormat, steps: &[SharedBuffer<T>]) {
         // SAFETY: live geometry, not yet committed; the count is checked by the caller.
         unsafe { sys::rtcSetGeometryTimeStepCount(self.0.as_ptr(), steps.len() as u32) };
         for (slot, step) in (0u32..).zip(steps) {
@@ -253,7 +253,7 @@ impl RawGeometry {
             unsafe {
                 self.share_range(
                     sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
-                    sys::RTCFormat::RTC_FORMAT_FLOAT4,
+                    format,
                     step,
                     slot,
                     0..step.len(),
@@ -348,6 +348,43 @@ impl CurvePoint {
 
 /// The most time steps of one geometry (Embree's limit).
 pub const MAX_TIME_STEPS: usize = sys::RTC_MAX_TIME_STEP_COUNT as usize;
+
+/// Refuses time steps (each a buffer of `what`) Embree would not take: none, more than
+/// [`MAX_TIME_STEPS`], or steps of other lengths than the first's.
+fn check_steps<T>(steps: &[SharedBuffer<T>], what: &str) -> Result<()> {
+    if !(1..=MAX_TIME_STEPS).contains(&steps.len()) {
+        return Err(invalid_arg!(
+            "{} time steps: Embree takes 1 to {MAX_TIME_STEPS}",
+            steps.len()
+        ));
+    }
+    match steps.iter().position(|s| s.len() != steps[0].len()) {
+        Some(k) => Err(invalid_arg!(
+            "time step {k} has {} {what}, time step 0 {}",
+            steps[k].len(),
+            steps[0].len()
+        )),
+        None => Ok(()),
+    }
+}
+
+/// Element `i` of time steps `steps` (checked by [`check_steps`]) at `time` (a fraction of
+/// the shutter), read by `read`: the blend of the two steps around it
+/// (`math::time_steps`). `None` when `i` is out of range.
+fn at_time<T>(
+    steps: &[SharedBuffer<T>],
+    i: usize,
+    time: f32,
+    read: impl Fn(&T) -> Vec4,
+) -> Option<Vec4> {
+    let (step, f) = time_step(time, steps.len());
+    let a = read(steps[step].as_slice().get(i)?);
+    if f == 0.0 {
+        return Some(a);
+    }
+    let b = read(&steps[step + 1].as_slice()[i]);
+    Some(a + f * (b - a))
+}
 
 /// Geometries of at least this many segments may be cut into parts of at most
 /// [`PART_SEGMENTS`] ([`CurveGeometry::in_parts`]), which a scene builds as one small
@@ -541,19 +578,7 @@ impl CurveGeometry {
         indices: SharedBuffer<u32>,
         mask: u32,
     ) -> Result<Self> {
-        if !(1..=MAX_TIME_STEPS).contains(&steps.len()) {
-            return Err(invalid_arg!(
-                "{} time steps: Embree takes 1 to {MAX_TIME_STEPS}",
-                steps.len()
-            ));
-        }
-        if let Some(k) = steps.iter().position(|s| s.len() != steps[0].len()) {
-            return Err(invalid_arg!(
-                "time step {k} has {} control points, time step 0 {}",
-                steps[k].len(),
-                steps[0].len()
-            ));
-        }
+        check_steps(&steps, "control points")?;
         let span = basis.points_per_segment() as u64;
         let count = steps[0].len() as u64;
         if let Some(i) = indices
@@ -585,7 +610,7 @@ impl CurveGeometry {
         // SAFETY: the buffers move into the returned value next to `raw`, which is dropped
         // before them; the step count is checked above.
         unsafe {
-            raw.share_steps(&steps);
+            raw.share_steps(sys::RTCFormat::RTC_FORMAT_FLOAT4, &steps);
             raw.share(
                 sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
                 sys::RTCFormat::RTC_FORMAT_UINT,
@@ -678,13 +703,7 @@ impl CurveGeometry {
     /// Control point `i` at `time` (a fraction of the shutter, `math::time_steps`): the
     /// blend of its two time steps around it. `None` when `i` is out of range.
     pub fn point_at(&self, i: usize, time: f32) -> Option<Vec4> {
-        let (step, f) = time_step(time, self.steps.len());
-        let a = Vec4::from_array(*self.steps[step].as_slice().get(i)?);
-        if f == 0.0 {
-            return Some(a);
-        }
-        let b = Vec4::from_array(self.steps[step + 1].as_slice()[i]);
-        Some(a + f * (b - a))
+        at_time(&self.steps, i, time, |p| Vec4::from_array(*p))
     }
 
     /// First control point of each segment (primitive).
@@ -754,7 +773,7 @@ impl CurveGeometry {
         // SAFETY: the buffers belong to `self`, which the caller keeps alive for as long as
         // the handle; the range lies inside the index buffer (checked).
         unsafe {
-            raw.share_steps(&self.steps);
+            raw.share_steps(sys::RTCFormat::RTC_FORMAT_FLOAT4, &self.steps);
             raw.share_range(
                 sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
                 sys::RTCFormat::RTC_FORMAT_UINT,
@@ -844,19 +863,25 @@ impl CurveGeometry {
 #[derive(Debug)]
 pub struct TriangleGeometry {
     raw: RawGeometry,
-    vertices: SharedBuffer<[f32; 3]>,
+    /// The vertices at each time step, spread evenly over the shutter: one for a mesh that
+    /// does not deform.
+    steps: Box<[SharedBuffer<[f32; 3]>]>,
     triangles: SharedBuffer<[u32; 3]>,
 }
 
 impl TriangleGeometry {
-    /// Builds and commits a triangle geometry; every index must name a vertex (checked).
-    pub fn new(
+    /// Builds and commits a triangle geometry whose vertices at each of 1 to
+    /// [`MAX_TIME_STEPS`] time steps spread evenly over the shutter (`math::time_steps`;
+    /// one for a mesh that stays put) are `steps`, every step as many; every index must
+    /// name a vertex (checked).
+    pub fn in_motion(
         device: &Device,
-        vertices: SharedBuffer<[f32; 3]>,
+        steps: Vec<SharedBuffer<[f32; 3]>>,
         triangles: SharedBuffer<[u32; 3]>,
         mask: u32,
     ) -> Result<Self> {
-        let count = vertices.len();
+        check_steps(&steps, "vertices")?;
+        let count = steps[0].len();
         if let Some(i) = triangles
             .as_slice()
             .iter()
@@ -868,13 +893,10 @@ impl TriangleGeometry {
             ));
         }
         let raw = RawGeometry::new(device, sys::RTCGeometryType::RTC_GEOMETRY_TYPE_TRIANGLE)?;
-        // SAFETY: both buffers move into the returned value next to `raw`, dropped first.
+        // SAFETY: the buffers move into the returned value next to `raw`, dropped first;
+        // the step count is checked above.
         unsafe {
-            raw.share(
-                sys::RTCBufferType::RTC_BUFFER_TYPE_VERTEX,
-                sys::RTCFormat::RTC_FORMAT_FLOAT3,
-                &vertices,
-            );
+            raw.share_steps(sys::RTCFormat::RTC_FORMAT_FLOAT3, &steps);
             raw.share(
                 sys::RTCBufferType::RTC_BUFFER_TYPE_INDEX,
                 sys::RTCFormat::RTC_FORMAT_UINT3,
@@ -884,13 +906,15 @@ impl TriangleGeometry {
         raw.commit(device, mask)?;
         Ok(TriangleGeometry {
             raw,
-            vertices,
+            steps: steps.into_boxed_slice(),
             triangles,
         })
     }
 
-    pub fn vertices(&self) -> &[[f32; 3]] {
-        self.vertices.as_slice()
+    /// Vertex `i` at `time` (a fraction of the shutter): the blend of its two time steps
+    /// around it. `None` when `i` is out of range.
+    pub fn vertex_at(&self, i: usize, time: f32) -> Option<Vec3> {
+        at_time(&self.steps, i, time, |p| Vec3::from_array(*p).extend(0.0)).map(Vec4::truncate)
     }
 
     pub fn triangles(&self) -> &[[u32; 3]] {
@@ -899,7 +923,8 @@ impl TriangleGeometry {
 
     #[cfg(any(test, feature = "bench-internals"))]
     pub fn heap_bytes(&self) -> usize {
-        self.vertices.heap_bytes() + self.triangles.heap_bytes()
+        let steps: usize = self.steps.iter().map(SharedBuffer::heap_bytes).sum();
+        steps + self.triangles.heap_bytes()
     }
 
     pub(super) fn raw(&self) -> sys::RTCGeometry {
@@ -1439,7 +1464,7 @@ pub(crate) mod tests {
         assert!(err.to_string().contains("segment 1"), "{err}");
         let v = SharedBuffer::new(vec![[0.0; 3]; 3]);
         let t = SharedBuffer::new(vec![[0, 1, 3]]);
-        let err = TriangleGeometry::new(&device, v, t, 1).unwrap_err();
+        let err = TriangleGeometry::in_motion(&device, vec![v], t, 1).unwrap_err();
         assert!(err.to_string().contains("triangle 0"), "{err}");
     }
 

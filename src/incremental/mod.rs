@@ -388,7 +388,9 @@ impl Scene {
             (stages.run(Stage::Read, part, |_| mesh.mesh())).map_err(|e| self.error(name, e))?;
         let mut framing = Framing::default();
         if !matches!(mesh.source, MeshSource::Ground { .. }) {
-            framing.add_mesh(&made.positions);
+            for step in std::iter::once(&made.positions).chain(&made.later_positions) {
+                framing.add_mesh(step);
+            }
         }
         self.add(
             name,

@@ -170,9 +170,10 @@ impl TracerBuilder {
     /// Adds a mesh (mask [`SURFACE_MASK`]) and returns its geometry id.
     pub fn add_mesh(&mut self, mesh: Mesh) -> Result<u32> {
         mesh.validate()?;
-        let geometry = TriangleGeometry::new(
+        let steps = std::iter::once(mesh.positions).chain(mesh.later_positions);
+        let geometry = TriangleGeometry::in_motion(
             self.scene.device(),
-            SharedBuffer::new(mesh.positions),
+            steps.map(SharedBuffer::new).collect(),
             SharedBuffer::new(mesh.triangles),
             SURFACE_MASK,
         )?;
@@ -634,7 +635,8 @@ fn surface_hit(
     normals: Option<&[[f32; 3]]>,
 ) -> Option<SurfaceHit> {
     let tri = geom.triangles().get(hit.prim_id as usize)?;
-    let pos = |i: usize| Vec3::from_array(geom.vertices()[tri[i] as usize]);
+    // A mesh that deforms is where the ray's time puts it.
+    let pos = |i: usize| geom.vertex_at(tri[i] as usize, time).unwrap_or(Vec3::ZERO);
     let ng = (pos(1) - pos(0))
         .cross(pos(2) - pos(0))
         .try_normalize()

@@ -236,7 +236,7 @@ pub(super) fn mesh(
             Mesh {
                 positions,
                 triangles,
-                normals: None,
+                ..Mesh::default()
             }
         }
         "sphere" => {

@@ -1021,6 +1021,10 @@ fn bias(args: &BiasArgs) -> hairtrace::Result<bool> {
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so printing into a closed pipe (`hairtrace lobes | head`) would
+    // panic; a command-line tool ends quietly there instead, as other Unix tools do.
+    // SAFETY: signal() with SIG_DFL has no preconditions, and no other thread runs yet.
+    unsafe { libc::signal(libc::SIGPIPE, libc::SIG_DFL) };
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         // Help and version go to stdout as clap writes them.

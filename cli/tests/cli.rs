@@ -916,3 +916,19 @@ fn info_lists_the_animation_and_render_reads_the_frame() {
         "frame 30 is outside the shot's frames 1 to 24",
     );
 }
+
+/// Output into a closed pipe ends the command quietly, not with a panic.
+#[test]
+fn a_closed_pipe_ends_the_output_quietly() {
+    let o = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "'{}' lobes | head -n 1",
+            env!("CARGO_BIN_EXE_hairtrace")
+        ))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && !err.contains("panicked"), "{err}");
+    assert_eq!(stdout(&o).lines().count(), 1);
+}

@@ -46,8 +46,8 @@ pub struct UsdGrooms {
 }
 
 impl UsdGrooms {
-    /// The time codes strictly between `open` and `close` at which any prim's animated
-    /// attributes have samples.
+    /// How many time codes strictly between `open` and `close` any prim's animated
+    /// attributes have samples at.
     pub fn samples_between(&self, open: f64, close: f64) -> usize {
         let mut times: Vec<f64> = (self.curves.iter())
             .flat_map(|c| c.animation.times.iter().copied())

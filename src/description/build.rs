@@ -393,10 +393,15 @@ fn usd_steps(path: &Path, frame: Option<f64>, (open, close): (f32, f32)) -> Resu
     let clock = still.clock;
     let inside = still.samples_between(clock.time_code(open), clock.time_code(close));
     let count = (inside + 2).min(MAX_TIME_STEPS);
+    let mut still = Some(still);
     (0..count)
         .map(|k| {
             let at = open + (close - open) * k as f64 / (count - 1) as f64;
-            read_usd_file_near(path, Some(at))
+            // A shutter that opens at the frame starts with the read already made.
+            match still.take_if(|_| at == f) {
+                Some(read) => Ok(read),
+                None => read_usd_file_near(path, Some(at)),
+            }
         })
         .collect()
 }

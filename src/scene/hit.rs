@@ -77,7 +77,7 @@ pub struct HairHit {
 impl HairHit {
     /// The major axis of an elliptical fibre's section here, as a (y, z) direction of the
     /// hit's frame: world up (+y) made perpendicular to the tangent, or world +x where the
-    /// tangent is within about 0.06 degrees of vertical. A property of the fibre, not of
+    /// tangent is too near vertical for that ([`MIN_MAJOR_AXIS_SQUARED`]). A property of the fibre, not of
     /// the ray, so that camera and shadow rays see one section (docs/conventions.md,
     /// section 4b); a groom's curve normals are not read yet.
     pub(crate) fn major_axis(&self) -> Vec2 {

@@ -392,9 +392,9 @@ fn points_at(prim: &Prim, at: ReadAt, clock: &Clock) -> Result<Option<Vec<[f32; 
     let Some((lo, hi)) = time::between(&time::sample_times(&points)?, t) else {
         return read(at);
     };
-    let before = read(ReadAt::Code(lo))?.unwrap_or_default();
     let velocities = prim.attribute("velocities");
     if time::sample_times(&velocities)?.contains(&lo) {
+        let before = read(ReadAt::Code(lo))?.unwrap_or_default();
         let at_lo = |name: &str| vec3s(ReadAt::Code(lo).value(&prim.attribute(name))?, name);
         let motion = Motion {
             velocities: at_lo("velocities")?.unwrap_or_default(),
@@ -416,17 +416,20 @@ fn points_at(prim: &Prim, at: ReadAt, clock: &Clock) -> Result<Option<Vec<[f32; 
             motion.moved(&before, (t - lo) / clock.codes_per_second),
         ));
     }
+    // Between samples of different counts USD holds the earlier one, so the value at `t`
+    // has the count of the sample before: a count unlike the sample after's is the change.
+    let points_at_t = read(at)?.unwrap_or_default();
     let after = read(ReadAt::Code(hi))?.unwrap_or_default();
-    if before.len() != after.len() {
+    if points_at_t.len() != after.len() {
         return Err(invalid_arg!(
             "points: the samples at time codes {lo} ({} points) and {hi} ({} points) differ \
              in count and no velocities are authored at {lo}: the points between them are \
              undefined",
-            before.len(),
+            points_at_t.len(),
             after.len()
         ));
     }
-    read(at)
+    Ok(Some(points_at_t))
 }
 
 /// What of the prim at `path` moves.

@@ -74,7 +74,7 @@ pub trait LocalBsdf {
 }
 
 /// Below this |wi.z| the 1/|wi.z| factor is skipped, as pbrt does at exactly zero; the
-/// threshold keeps f finite for every unit wi (the largest lobe value is ~1e7).
+/// threshold keeps f finite for every unit wi (docs/conventions.md, section 2, says why).
 pub(crate) const MIN_COS_WI: f32 = 1e-20;
 /// 1/|wi.z|, or 1 where |wi.z| is below [`MIN_COS_WI`].
 #[inline(always)]

@@ -2,7 +2,6 @@
 //! shutter: one `(n, width)` array (one step), a `(K, n, width)` array, or a list of K
 //! `(n, width)` arrays, each step as many rows as the first; and triangles as integers.
 
-use hairtrace::embree::MAX_TIME_STEPS;
 use numpy::{
     AllowTypeChange, PyArrayDescrMethods, PyArrayLikeDyn, PyUntypedArray, PyUntypedArrayMethods,
 };
@@ -12,12 +11,16 @@ use pyo3::types::{PyList, PyTuple};
 
 use crate::arrays::{Floats, show_shape};
 
-/// The rows of `obj` at each of its time steps, `width` floats a row; `name` names it in
-/// errors, with the step where one is wrong.
+/// The rows of `obj` at each of its time steps, `W` floats a row; `name` names it in
+/// errors, with the step where one is wrong. How many steps Embree takes is the library's
+/// check.
 pub fn time_steps<const W: usize>(
     obj: &Bound<'_, PyAny>,
     name: &'static str,
-) -> PyResult<Vec<Vec<[f32; W]>>> {
+) -> PyResult<Vec<Vec<[f32; W]>>>
+where
+    [f32; W]: bytemuck::Pod,
+{
     let form = format!("({name} is (n, {W}), (K, n, {W}) or a list of K (n, {W}) arrays)");
     let steps = if obj.is_instance_of::<PyList>() || obj.is_instance_of::<PyTuple>() {
         (obj.try_iter()?.enumerate())
@@ -46,13 +49,11 @@ pub fn time_steps<const W: usize>(
             }
         }
     };
-    if !(1..=MAX_TIME_STEPS).contains(&steps.len()) {
+    let Some(n) = steps.first().map(Vec::len) else {
         return Err(PyValueError::new_err(format!(
-            "{name}: {} time steps: must be 1 to {MAX_TIME_STEPS} (Embree's most)",
-            steps.len()
+            "{name}: no time step: give at least one {form}"
         )));
-    }
-    let n = steps[0].len();
+    };
     if let Some(k) = steps.iter().position(|s| s.len() != n) {
         return Err(PyValueError::new_err(format!(
             "{name}[{k}] has {} rows and {name}[0] has {n}: every time step holds the same \

@@ -178,7 +178,7 @@ def test_wrong_arrays_and_frames_are_refused(repo):
         add(grid(0)[:, :3])
     with pytest.raises(ValueError, match=r"points\[1\] has 1596 rows and points\[0\] has 1600"):
         add([grid(0), grid(0)[4:]])
-    with pytest.raises(ValueError, match=r"points: 130 time steps: must be 1 to 129"):
+    with pytest.raises(ValueError, match=r"130 time steps: curves in motion take 1 to 129"):
         add(np.stack([grid(0)] * 130))
     nan = grid(0.1)
     nan[7, 1] = np.nan

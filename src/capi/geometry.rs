@@ -1,5 +1,7 @@
 //! Geometry through the C ABI: curves from host arrays (copied, or float4 xyzr points
-//! shared in place), `.hair` files, and triangle meshes from arrays or files.
+//! shared in place), `.hair` and USD files (as stills, or at a frame over the shutter of
+//! the host's settings), and triangle meshes from arrays or files; curves and meshes at
+//! several time steps move over the shutter.
 
 use super::scene::{HtScene, add_with_id};
 use super::settings::{HtSettings, read_settings};
@@ -367,16 +369,16 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr_motion(
 
 /// The host's arrays (control points or vertices) at the time steps after the first: the
 /// C arguments `later_*` and `later_step_count`.
-struct LaterSteps<'a> {
+struct LaterSteps {
     points: *const *const f32,
     count: usize,
-    /// The C argument `points` is, in messages.
-    name: &'a str,
+    /// The C argument's name, for messages: `later_points` or `later_positions`.
+    name: &'static str,
 }
 
-impl LaterSteps<'_> {
+impl LaterSteps {
     /// No later step: strands or a mesh that stay put.
-    const STILL: LaterSteps<'static> = LaterSteps {
+    const STILL: LaterSteps = LaterSteps {
         points: std::ptr::null(),
         count: 0,
         name: "later_points",
@@ -405,7 +407,7 @@ impl LaterSteps<'_> {
 fn add_curves_xyzr(
     scene: *mut HtScene,
     desc: *const HtCurvesXyzr,
-    later: LaterSteps<'_>,
+    later: LaterSteps,
     material_id: u32,
     geom_id: *mut u32,
     vertices: impl Fn(&[[f32; 4]]) -> std::result::Result<SharedBuffer<[f32; 4]>, Failure>,
@@ -774,17 +776,17 @@ pub unsafe extern "C" fn ht_scene_add_mesh_motion(
 }
 
 /// A C host's mesh vertices: their positions at each time step and their normals.
-struct Vertices<'a> {
+struct Vertices {
     count: usize,
     positions: *const f32,
-    later: LaterSteps<'a>,
+    later: LaterSteps,
     normals: *const f32,
 }
 
 /// The body of `ht_scene_add_mesh` and `ht_scene_add_mesh_motion`.
 fn add_triangles(
     scene: *mut HtScene,
-    vertices: Vertices<'_>,
+    vertices: Vertices,
     triangle_count: usize,
     indices: *const u32,
     material_id: u32,

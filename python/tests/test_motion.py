@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 import hairtrace
+from c_library import f3, render
 
 W, H = 40, 30
 NAMED = dict(width=W, height=H, spp=4, seed=3, threads=2, shutter_open=-0.5, shutter_close=0.5)
@@ -22,11 +23,6 @@ class HtCurvesXyzr(ctypes.Structure):
     _fields_ = [("strand_count", ctypes.c_size_t), ("point_counts", ctypes.c_void_p),
                 ("point_count", ctypes.c_size_t), ("points", ctypes.c_void_p),
                 ("colors", ctypes.c_void_p), ("basis", ctypes.c_uint32), ("shape", ctypes.c_uint32)]
-
-
-class HtHairParams(ctypes.Structure):
-    _fields_ = [("sigma_a", ctypes.c_float * 3), ("eta", ctypes.c_float),
-                ("beta_m", ctypes.c_float), ("beta_n", ctypes.c_float), ("alpha", ctypes.c_float)]
 
 
 def grid(dx):
@@ -54,34 +50,24 @@ def strip(bend):
     return positions.astype(np.float32), triangles.astype(np.uint32)
 
 
-def c_render(clib, fill, camera=False):
-    """The scene `fill(lib, scene, hair, grey)` makes through the C library, under the sky."""
-    lib = ctypes.CDLL(str(clib))
-    lib.ht_hair_params_default.restype = HtHairParams
-    lib.ht_last_error.restype = ctypes.c_char_p
-    f3 = lambda v: (ctypes.c_float * 3)(*v)
-    ok = lambda status: status == 0 or pytest.fail(lib.ht_last_error().decode())
-    device, scene, settings = ctypes.c_void_p(), ctypes.c_void_p(), ctypes.c_void_p()
-    hair, grey = ctypes.c_uint32(), ctypes.c_uint32()
-    ok(lib.ht_device_new(2, ctypes.byref(device)))
-    ok(lib.ht_scene_new(device, ctypes.byref(scene)))
-    params = lib.ht_hair_params_default()
-    ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(hair)))
-    ok(lib.ht_scene_add_diffuse_material(scene, f3([0.6, 0.5, 0.4]), ctypes.byref(grey)))
-    ok(fill(lib, scene, hair, grey))
-    ok(lib.ht_scene_add_environment(scene, f3(SKY)))
-    if camera:
-        ok(lib.ht_scene_set_camera(scene, f3(EYE), f3([0, 0, 0]), f3([0, 1, 0]), ctypes.c_float(40.0)))
-    ok(lib.ht_settings_new(ctypes.byref(settings)))
-    for k, v in NAMED.items():
-        ok(lib.ht_settings_set(settings, k.encode(), str(v).encode()))
-    rgb = np.zeros(W * H * 3, np.float32)
-    ok(lib.ht_render_with(scene, settings, None, None, ctypes.c_void_p(rgb.ctypes.data), ctypes.c_size_t(rgb.size),
-                          None, None, None, ctypes.c_size_t(W * H)))
-    lib.ht_settings_free(settings)
-    lib.ht_scene_free(scene)
-    lib.ht_device_free(device)
-    return rgb.reshape(H, W, 3), list(params.sigma_a)
+def c_render(clib, add, camera=False):
+    """The scene `add(lib, scene, hair, grey)` fills through the C library, with a hair
+    material (the default parameters) and a grey one, under the sky: its pixels, and the
+    hair's absorption."""
+    sigma_a = []
+
+    def fill(lib, scene, ok):
+        hair, grey = ctypes.c_uint32(), ctypes.c_uint32()
+        params = lib.ht_hair_params_default()
+        sigma_a.extend(params.sigma_a)
+        ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(hair)))
+        ok(lib.ht_scene_add_diffuse_material(scene, f3([0.6, 0.5, 0.4]), ctypes.byref(grey)))
+        ok(add(lib, scene, hair, grey))
+        ok(lib.ht_scene_add_environment(scene, f3(SKY)))
+        if camera:
+            ok(lib.ht_scene_set_camera(scene, f3(EYE), f3([0, 0, 0]), f3([0, 1, 0]), ctypes.c_float(40.0)))
+
+    return render(clib, fill, NAMED), sigma_a
 
 
 def pointers(arrays):
@@ -155,9 +141,9 @@ def test_an_animated_groom_at_a_frame_renders_as_the_command_line(cli, repo, tmp
     size = ["--width", str(W), "--height", str(H), "--spp", "4"]
 
     def cli_render(*args):
-        out = tmp_path / "cli.exr"
+        out = tmp_path / "cli.####.exr"
         subprocess.run([cli, "render", scene_file, *size, *args, "-o", out], check=True, capture_output=True)
-        return hairtrace.read_image(out)
+        return hairtrace.read_image(tmp_path / "cli.0006.exr")
 
     still = cli_render("--frame", "6")
     assert np.array_equal(hairtrace.Scene.load(scene_file, frame=6).render(width=W, height=H, spp=4), still)
@@ -184,7 +170,7 @@ def test_wrong_arrays_and_frames_are_refused(repo):
     nan[7, 1] = np.nan
     with pytest.raises(ValueError, match=r"time step 1"):
         add([grid(0), nan])
-    with pytest.raises(ValueError, match=r"basis"):
+    with pytest.raises(ValueError, match=r"unknown variant `cubic`"):
         s.add_curves(grid(0), counts, "hair", basis="cubic")
     flat, triangles = strip(0)
     with pytest.raises(TypeError, match=r"triangles: dtype float32: must be integers"):

@@ -73,11 +73,14 @@ fn c_render(pairs: &[(&str, &str)], steps: &[Vec<[f32; 4]>]) -> Vec<u32> {
             &mut 0,
         );
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        assert_eq!(
-            ht_scene_add_environment(h.scene, SKY.as_ptr()),
-            HtStatus::HT_OK
-        );
     }
+    c_under_the_sky(&h, pairs)
+}
+
+/// The C scene of `h` under the sky, rendered at `SIZE` with `pairs` set, as bits.
+fn c_under_the_sky(h: &Handles, pairs: &[(&str, &str)]) -> Vec<u32> {
+    let sky = unsafe { ht_scene_add_environment(h.scene, SKY.as_ptr()) };
+    assert_eq!(sky, HtStatus::HT_OK);
     let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
     let mut all = vec![("width", w.as_str()), ("height", h_.as_str())];
     all.extend(pairs);
@@ -86,12 +89,30 @@ fn c_render(pairs: &[(&str, &str)], steps: &[Vec<[f32; 4]>]) -> Vec<u32> {
     rgb.iter().map(|v| v.to_bits()).collect()
 }
 
-fn rust_render(steps: &[Vec<[f32; 4]>]) -> Vec<u32> {
+/// A Rust `Scene` of `SIZE` with every setting of `SETTINGS`.
+fn rust_scene() -> Scene {
     let mut scene = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
     (scene.settings.width, scene.settings.height) = SIZE;
     for (k, v) in SETTINGS {
         scene.settings.set(k, v).unwrap();
     }
+    scene
+}
+
+/// `scene` under the sky, rendered, as bits.
+fn under_the_sky(mut scene: Scene) -> Vec<u32> {
+    let sky = LightDesc::Environment {
+        source: EnvironmentSource::Uniform(SKY),
+        rotation_deg: 0.0,
+        scale: 1.0,
+    };
+    scene.add_light(&sky).unwrap();
+    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
+    out.film.rgb().iter().map(|v| v.to_bits()).collect()
+}
+
+fn rust_render(steps: &[Vec<[f32; 4]>]) -> Vec<u32> {
+    let mut scene = rust_scene();
     let hair = HairMaterial {
         color: HairColor::SigmaA(HairParams::default().sigma_a),
         ..HairMaterial::default()
@@ -105,14 +126,7 @@ fn rust_render(steps: &[Vec<[f32; 4]>]) -> Vec<u32> {
         basis: CurveBasis::Linear,
     };
     (scene.add_control_points("grid", points, GroomShape::Round, "hair")).unwrap();
-    let sky = LightDesc::Environment {
-        source: EnvironmentSource::Uniform(SKY),
-        rotation_deg: 0.0,
-        scale: 1.0,
-    };
-    scene.add_light(&sky).unwrap();
-    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
-    out.film.rgb().iter().map(|v| v.to_bits()).collect()
+    under_the_sky(scene)
 }
 
 /// Three time steps from host arrays and the shutter set by name render bit for bit as the
@@ -228,26 +242,13 @@ fn c_mesh_render(
             40.0,
         );
         assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        assert_eq!(
-            ht_scene_add_environment(h.scene, SKY.as_ptr()),
-            HtStatus::HT_OK
-        );
     }
-    let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
-    let mut all = vec![("width", w.as_str()), ("height", h_.as_str())];
-    all.extend(pairs);
-    let (s, rgb) = Named::new(&all).render_rgb(h.scene, (SIZE.0 * SIZE.1) as usize);
-    assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    rgb.iter().map(|v| v.to_bits()).collect()
+    c_under_the_sky(&h, pairs)
 }
 
 /// The same mesh through the Rust `Scene`.
 fn rust_mesh_render(steps: &[Vec<[f32; 3]>], triangles: &[[u32; 3]]) -> Vec<u32> {
-    let mut scene = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
-    (scene.settings.width, scene.settings.height) = SIZE;
-    for (k, v) in SETTINGS {
-        scene.settings.set(k, v).unwrap();
-    }
+    let mut scene = rust_scene();
     let grey = MaterialDesc::Diffuse { albedo: GREY };
     scene.set_material("grey", &grey).unwrap();
     let mesh = Mesh {
@@ -265,14 +266,7 @@ fn rust_mesh_render(steps: &[Vec<[f32; 3]>], triangles: &[[u32; 3]]) -> Vec<u32>
         ..CameraDesc::default()
     };
     scene.set_camera(&view).unwrap();
-    let sky = LightDesc::Environment {
-        source: EnvironmentSource::Uniform(SKY),
-        rotation_deg: 0.0,
-        scale: 1.0,
-    };
-    scene.add_light(&sky).unwrap();
-    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
-    out.film.rgb().iter().map(|v| v.to_bits()).collect()
+    under_the_sky(scene)
 }
 
 /// A mesh deforming over three time steps from host arrays renders bit for bit as the Rust
@@ -534,22 +528,9 @@ fn a_hair_sequence_at_a_frame_from_c_moves_over_the_shutter() {
     let shutter = [("shutter_open", "0"), ("shutter_close", "1")];
     let (h, s) = from_file(1.0, &shutter);
     assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    unsafe {
-        assert_eq!(
-            ht_scene_add_environment(h.scene, SKY.as_ptr()),
-            HtStatus::HT_OK
-        );
-    }
-    let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
-    let mut pairs = vec![("width", w.as_str()), ("height", h_.as_str())];
-    pairs.extend(&SETTINGS[..3]);
+    let mut pairs = SETTINGS[..3].to_vec();
     pairs.extend(shutter);
-    let (s, rgb) = Named::new(&pairs).render_rgb(h.scene, (SIZE.0 * SIZE.1) as usize);
-    assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    let from_sequence: Vec<u32> = rgb.iter().map(|v| v.to_bits()).collect();
-    let mut host = SETTINGS[..3].to_vec();
-    host.extend(shutter);
-    assert_eq!(from_sequence, c_render(&host, &steps));
+    assert_eq!(c_under_the_sky(&h, &pairs), c_render(&pairs, &steps));
 
     fails(
         from_file(3.0, &shutter).1,

@@ -550,10 +550,8 @@ fn a_hair_sequence_at_a_frame_from_c_moves_over_the_shutter() {
     );
     let mut fewer = read_hair_file(&dir.join("grid.0002.hair"), Thickness::Radius).unwrap();
     fewer.counts.pop();
-    (
-        fewer.points.truncate(fewer.points.len() - 4),
-        fewer.radii.truncate(fewer.radii.len() - 4),
-    );
+    fewer.points.truncate(fewer.points.len() - 4);
+    fewer.radii.truncate(fewer.radii.len() - 4);
     write_hair_file(&dir.join("grid.0002.hair"), &fewer, Thickness::Radius).unwrap();
     let (_, s) = from_file(1.0, &shutter);
     fails(

@@ -83,7 +83,7 @@ pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
 
 /// [`inputs::check_u`] with the C ABI's failure.
 #[inline(always)]
-pub(super) fn check_u(u: [f32; 3], name: &str) -> Result<[f32; 3], Failure> {
+pub(super) fn check_u<const N: usize>(u: [f32; N], name: &str) -> Result<[f32; N], Failure> {
     Ok(inputs::check_u(u, name)?)
 }
 

@@ -8,6 +8,9 @@
 pub mod bsdf;
 pub mod frame;
 pub mod prepared;
+// After `prepared`, whose point code it shares, so that the header declares Chiang's
+// point first.
+pub mod huang;
 #[cfg(feature = "render")]
 pub mod scene;
 // Scenes first: the header declares them before the calls that fill them.
@@ -15,6 +18,8 @@ pub mod scene;
 mod edit_tests;
 #[cfg(feature = "render")]
 pub mod geometry;
+#[cfg(all(test, feature = "render"))]
+mod huang_tests;
 #[cfg(feature = "render")]
 pub mod lights;
 #[cfg(feature = "render")]

@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3};
 
 use super::curves::StrandSegment;
 use super::material::HairColor;
+use crate::bsdf::huang::MIN_ACROSS_SQUARED;
 use crate::embree::CurveShape;
 use crate::math::Frame;
 use crate::math::frame::hair_frame_offset;
@@ -77,14 +78,14 @@ pub struct HairHit {
 impl HairHit {
     /// The major axis of an elliptical fibre's section here, as a (y, z) direction of the
     /// hit's frame: world up (+y) made perpendicular to the tangent, or world +x where the
-    /// tangent is too near vertical for that ([`MIN_MAJOR_AXIS_SQUARED`]). A property of the fibre, not of
+    /// tangent is too near vertical for that ([`MIN_ACROSS_SQUARED`]). A property of the fibre, not of
     /// the ray, so that camera and shadow rays see one section (docs/conventions.md,
     /// section 4b); a groom's curve normals are not read yet.
     pub(crate) fn major_axis(&self) -> Vec2 {
         let x = self.frame.x;
         let off = |a: Vec3| a - x * x.dot(a);
         let m = off(Vec3::Y);
-        let m = if m.length_squared() > MIN_MAJOR_AXIS_SQUARED {
+        let m = if m.length_squared() > MIN_ACROSS_SQUARED {
             m
         } else {
             off(Vec3::X)
@@ -92,9 +93,6 @@ impl HairHit {
         Vec2::new(m.dot(self.frame.y), m.dot(self.frame.z))
     }
 }
-
-/// Below this squared length world up is too near the tangent to orient the section.
-const MIN_MAJOR_AXIS_SQUARED: f32 = 1e-6;
 
 /// A hit on a triangle mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]

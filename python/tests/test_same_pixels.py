@@ -37,6 +37,15 @@ class HtHairParams(ctypes.Structure):
                 ("beta_m", ctypes.c_float), ("beta_n", ctypes.c_float), ("alpha", ctypes.c_float)]
 
 
+class HtHuangParams(ctypes.Structure):
+    _fields_ = [("sigma_a", ctypes.c_float * 3), ("eta", ctypes.c_float),
+                ("roughness", ctypes.c_float), ("aspect", ctypes.c_float), ("alpha", ctypes.c_float)]
+
+
+# The Huang material of the tests: elliptical, rough; the rest the defaults.
+HUANG = dict(roughness=0.25, aspect=0.6)
+
+
 class HtCurves(ctypes.Structure):
     _fields_ = [("strand_count", ctypes.c_size_t), ("point_counts", ctypes.c_void_p),
                 ("point_count", ctypes.c_size_t), ("points", ctypes.c_void_p),
@@ -61,17 +70,26 @@ def strands():
     return points, radii, np.full(n, k, np.uint32)
 
 
-def c_render(clib):
+def c_render(clib, model):
+    """The scene through the C library, its hair material of `model`; the image and the
+    material's sigma_a."""
     lib = ctypes.CDLL(str(clib))
     lib.ht_hair_params_default.restype = HtHairParams
+    lib.ht_huang_params_default.restype = HtHuangParams
     f3 = lambda v: (ctypes.c_float * 3)(*v)
     ok = lambda status: status == 0 or pytest.fail(lib.ht_last_error().decode())
     lib.ht_last_error.restype = ctypes.c_char_p
     device, scene, settings, material = ctypes.c_void_p(), ctypes.c_void_p(), ctypes.c_void_p(), ctypes.c_uint32()
     ok(lib.ht_device_new(2, ctypes.byref(device)))
     ok(lib.ht_scene_new(device, ctypes.byref(scene)))
-    params = lib.ht_hair_params_default()
-    ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(material)))
+    if model == "huang":
+        params = lib.ht_huang_params_default()
+        for k, v in HUANG.items():
+            setattr(params, k, v)
+        ok(lib.ht_scene_add_huang_material(scene, ctypes.byref(params), None, ctypes.byref(material)))
+    else:
+        params = lib.ht_hair_params_default()
+        ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(material)))
     points, radii, counts = strands()
     curves = HtCurves(len(counts), counts.ctypes.data, len(radii), points.ctypes.data, radii.ctypes.data,
                       0.0, None, HT_CURVE_BSPLINE, HT_CURVE_AUTO)
@@ -91,11 +109,13 @@ def c_render(clib):
     return rgb.reshape(H, W, 3), list(params.sigma_a)
 
 
-def test_the_same_scene_renders_the_same_through_c_and_python(clib):
-    expected, sigma_a = c_render(clib)
+@pytest.mark.parametrize("model", ["chiang", "huang"])
+def test_the_same_scene_renders_the_same_through_c_and_python(clib, model):
+    expected, sigma_a = c_render(clib, model)
     assert expected.mean() > 0
     s = hairtrace.Scene()
-    s.set_material("hair", type="hair", sigma_a=sigma_a)
+    huang = dict(model="huang", **HUANG) if model == "huang" else {}
+    s.set_material("hair", type="hair", sigma_a=sigma_a, **huang)
     points, radii, counts = strands()
     s.add_strands(points, radii, counts, material="hair", basis="bspline", shape="auto")
     s.add_light(type="environment", radiance=SKY)

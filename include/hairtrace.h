@@ -727,7 +727,7 @@ enum HtStatus ht_huang_prepared_free(struct HtHuangPrepared *prepared);
  * - `tangent`, `ray_org`, `ray_dir`, `axis`, `radius`: as `ht_hair_point_at_hit` takes
  *   and refuses them.
  * - `major[3]`: the section's major axis in world space, any length: finite, and not
- *   along the tangent (within about a thousandth of a radian) nor zero, else
+ *   along the tangent (the sine of its angle to it at most 1e-3) nor zero, else
  *   `HT_ERR_INVALID_ARG`. Its part along the tangent is ignored. A property of the
  *   fibre: pass the same for camera and shadow rays. Any direction serves a round fibre
  *   (aspect 1). The renderer's own choice is world up made perpendicular to the tangent,

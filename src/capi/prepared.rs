@@ -78,8 +78,8 @@ pub(super) trait HostPoint: Sized {
 pub(super) struct Stored<P> {
     /// [`HostPoint::TAG`] once filled.
     tag: u64,
-    pub(super) point: P,
-    pub(super) frame: Frame,
+    point: P,
+    frame: Frame,
 }
 
 impl HostPoint for HtHairPoint {
@@ -101,7 +101,7 @@ const _: () = {
 /// non-NULL and aligned, outputs clear of the inputs and the point, the point filled)
 /// inline and cheaply, anything else through the full checks that name the problem.
 #[inline(always)]
-pub(super) fn checked_point<'a, H: HostPoint>(
+fn checked_point<'a, H: HostPoint>(
     point: *const H,
     inputs: &[Arg],
     outputs: &[Arg],

@@ -116,12 +116,12 @@ int main(int argc, char **argv) {
     } catch (const hairtrace::Error &e) {
         std::printf("throws %s\n", e.what());
     }
-    const hairtrace::HuangMaterial round(hairtrace::default_huang_params());
+    const hairtrace::HuangMaterial circle(hairtrace::default_huang_params());
     hairtrace::HuangPoint unfilled;
     const hairtrace::Frame local(
         HtHairFrame{{1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, 0.0f});
     const float wo[3] = {0.0f, 0.0f, 1.0f}, along[3] = {3.0f, 0.0f, 0.0f};
-    report("major", unfilled.set_world(round, local, wo, along, hairtrace::Jitter{0.5f, 0.5f},
+    report("major", unfilled.set_world(circle, local, wo, along, hairtrace::Jitter{0.5f, 0.5f},
                                        HT_HUANG_NEAR));
     hairtrace::Eval light{};
     report("unfilled", unfilled.eval_world(wo, light));

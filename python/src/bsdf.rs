@@ -4,7 +4,7 @@
 
 use hairtrace::bsdf::{self, inputs};
 use hairtrace::glam::{Vec2, Vec3};
-use hairtrace::{HairBsdf, HairParams, HuangBsdf, HuangParams, HuangPoint};
+use hairtrace::{BsdfSample, HairBsdf, HairParams, HuangBsdf, HuangParams, HuangPoint};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
 use pyo3::exceptions::PyValueError;
@@ -103,11 +103,7 @@ impl PyHairBsdf {
         wo: &Bound<'py, PyAny>,
         wi: &Bound<'py, PyAny>,
     ) -> PyResult<Pair<'py>> {
-        let (h, wo, wi) = (
-            Floats::rows(h, "h", 0)?,
-            Floats::rows(wo, "wo", 3)?,
-            Floats::rows(wi, "wi", 3)?,
-        );
+        let [h, wo, wi] = vertex_rows(h, wo, (wi, "wi"))?;
         let n = same_rows(&[&h, &wo, &wi])?;
         let (h, wo, wi) = (h.values(), wo.vec3s(), wi.vec3s());
         let (f, pdf) = py
@@ -143,26 +139,15 @@ impl PyHairBsdf {
         wo: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<Triple<'py>> {
-        let (h, wo, u) = (
-            Floats::rows(h, "h", 0)?,
-            Floats::rows(wo, "wo", 3)?,
-            Floats::rows(u, "u", 3)?,
-        );
+        let [h, wo, u] = vertex_rows(h, wo, (u, "u"))?;
         let n = same_rows(&[&h, &wo, &u])?;
         let (h, wo, u) = (h.values(), wo.vec3s(), u.vec3s());
         let (wi, f, pdf) = py
             .detach(|| -> hairtrace::Result<_> {
                 check_each(h, wo, |i| inputs::check_u(u[i], "u"))?;
-                let (mut wi, mut f, mut pdf) =
-                    (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
-                for i in 0..n {
-                    if let Some(s) = self.bsdf.sample(h[i], Vec3::from_array(wo[i]), u[i]) {
-                        wi[3 * i..3 * i + 3].copy_from_slice(&s.wi.to_array());
-                        f[3 * i..3 * i + 3].copy_from_slice(&s.f.to_array());
-                        pdf[i] = s.pdf;
-                    }
-                }
-                Ok((wi, f, pdf))
+                samples(n, |i| {
+                    Ok(self.bsdf.sample(h[i], Vec3::from_array(wo[i]), u[i]))
+                })
             })
             .py()?;
         Ok((rows3(py, wi)?, rows3(py, f)?, pdf.into_pyarray(py)))
@@ -245,11 +230,7 @@ impl PyHuangBsdf {
         jitter: Option<&Bound<'py, PyAny>>,
         field: &str,
     ) -> PyResult<Pair<'py>> {
-        let (h, wo, wi) = (
-            Floats::rows(h, "h", 0)?,
-            Floats::rows(wo, "wo", 3)?,
-            Floats::rows(wi, "wi", 3)?,
-        );
+        let [h, wo, wi] = vertex_rows(h, wo, (wi, "wi"))?;
         let args = SectionArgs::read(major, jitter, field)?;
         let n = same_rows(&args.with(&[&h, &wo, &wi]))?;
         let (h, wo, wi, section) = (h.values(), wo.vec3s(), wi.vec3s(), args.section());
@@ -303,11 +284,7 @@ impl PyHuangBsdf {
         jitter: Option<&Bound<'py, PyAny>>,
         field: &str,
     ) -> PyResult<Triple<'py>> {
-        let (h, wo, u) = (
-            Floats::rows(h, "h", 0)?,
-            Floats::rows(wo, "wo", 3)?,
-            Floats::rows(u, "u", 3)?,
-        );
+        let [h, wo, u] = vertex_rows(h, wo, (u, "u"))?;
         let args = SectionArgs::read(major, jitter, field)?;
         let n = same_rows(&args.with(&[&h, &wo, &u]))?;
         let (h, wo, u, section) = (h.values(), wo.vec3s(), u.vec3s(), args.section());
@@ -317,17 +294,9 @@ impl PyHuangBsdf {
                     inputs::check_u(u[i], "u")?;
                     section.at(i)
                 })?;
-                let (mut wi, mut f, mut pdf) =
-                    (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
-                for i in 0..n {
-                    let point = section.point(&self.bsdf, h[i], wo[i], i)?;
-                    if let Some(s) = point.sample(u[i]) {
-                        wi[3 * i..3 * i + 3].copy_from_slice(&s.wi.to_array());
-                        f[3 * i..3 * i + 3].copy_from_slice(&s.f.to_array());
-                        pdf[i] = s.pdf;
-                    }
-                }
-                Ok((wi, f, pdf))
+                samples(n, |i| {
+                    Ok(section.point(&self.bsdf, h[i], wo[i], i)?.sample(u[i]))
+                })
             })
             .py()?;
         Ok((rows3(py, wi)?, rows3(py, f)?, pdf.into_pyarray(py)))
@@ -418,6 +387,35 @@ impl Section<'_> {
             false => bsdf.near(h, wo, major, jitter),
         })
     }
+}
+
+/// h (n,), wo (n, 3) and another (n, 3) array of a call, read and shape-checked.
+fn vertex_rows<'py>(
+    h: &Bound<'py, PyAny>,
+    wo: &Bound<'py, PyAny>,
+    (other, name): (&Bound<'py, PyAny>, &'static str),
+) -> PyResult<[Floats<'py>; 3]> {
+    Ok([
+        Floats::rows(h, "h", 0)?,
+        Floats::rows(wo, "wo", 3)?,
+        Floats::rows(other, name, 3)?,
+    ])
+}
+
+/// wi (3n), f (3n) and pdf (n) of n draws, zeros where `draw(i)` gives no direction.
+fn samples(
+    n: usize,
+    draw: impl Fn(usize) -> hairtrace::Result<Option<BsdfSample>>,
+) -> hairtrace::Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+    let (mut wi, mut f, mut pdf) = (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
+    for i in 0..n {
+        if let Some(s) = draw(i)? {
+            wi[3 * i..3 * i + 3].copy_from_slice(&s.wi.to_array());
+            f[3 * i..3 * i + 3].copy_from_slice(&s.f.to_array());
+            pdf[i] = s.pdf;
+        }
+    }
+    Ok((wi, f, pdf))
 }
 
 /// Checks each element's h and wo, then the rest of it with `rest(i)`, as the C ABI

@@ -62,11 +62,6 @@ impl From<HairParams> for HtHairParams {
     }
 }
 
-/// Copies the host's parameters (NULL: `HT_ERR_NULL_ARG`; misaligned: invalid).
-pub(super) fn read_params(ptr: *const HtHairParams) -> Result<HairParams, Failure> {
-    Ok(host_slice(ptr, 1, "params")?[0].into())
-}
-
 pub(super) use crate::bsdf::inputs::{UNIT_TOLERANCE, is_unit};
 
 /// [`inputs::check_dir`] with the C ABI's failure.

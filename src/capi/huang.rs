@@ -3,12 +3,12 @@
 //! Chiang's (`prepared.rs`; docs/c-abi.md, section 12b). The point is the Rust
 //! `HuangPoint`, near or far field as the host chooses, so it gives the same bits.
 
-use super::bsdf::{check_u, read3, require};
+use super::bsdf::{check_u, read3};
 use super::frame::HtHairFrame;
 use super::prepared::{
-    HostPoint, check_init, eval_world, fill, framed, framed_hit, hit_args, sample_world,
+    HostPoint, check_init, eval_world, fill, framed, framed_hit, hit_args, prepare, sample_world,
 };
-use super::{Failure, HtStatus, boundary, host_slice, host_slice_mut};
+use super::{Failure, HtStatus, boundary, free_handle};
 use crate::bsdf::inputs::check_major;
 use crate::bsdf::{HuangBsdf, HuangParams, HuangPoint};
 use crate::error::invalid_arg;
@@ -138,14 +138,11 @@ pub unsafe extern "C" fn ht_huang_prepare(
     out: *mut *mut HtHuangPrepared,
 ) -> HtStatus {
     boundary(|| {
-        require(&[(params.cast(), "params"), (out.cast_const().cast(), "out")])?;
-        let params = host_slice(params, 1, "params")?[0];
-        let out = host_slice_mut(out, 1, "out")?;
-        let handle = Box::new(HtHuangPrepared {
-            bsdf: HuangBsdf::new(&params.into())?,
-        });
-        out[0] = Box::into_raw(handle);
-        Ok(())
+        prepare(params, out, |p| {
+            Ok(HtHuangPrepared {
+                bsdf: HuangBsdf::new(&p.into())?,
+            })
+        })
     })
 }
 
@@ -158,10 +155,7 @@ pub unsafe extern "C" fn ht_huang_prepare(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_huang_prepared_free(prepared: *mut HtHuangPrepared) -> HtStatus {
     boundary(|| {
-        if !prepared.is_null() {
-            // SAFETY: a live handle from ht_huang_prepare (the caller's promise).
-            drop(unsafe { Box::from_raw(prepared) });
-        }
+        free_handle(prepared);
         Ok(())
     })
 }
@@ -215,15 +209,7 @@ pub unsafe extern "C" fn ht_huang_point_at_hit(
         let (axes, h, wo) = framed_hit(&hit, radius)?;
         // SAFETY: non-NULL, aligned and clear of the inputs (checked); a live handle (the
         // caller's promise).
-        unsafe {
-            fill_huang(
-                point,
-                &(*prepared).bsdf,
-                axes,
-                (h, wo),
-                (major, jitter, field),
-            )
-        }
+        unsafe { fill_huang(point, prepared, (axes, h, wo), (major, jitter, field)) }
     })
 }
 
@@ -257,31 +243,26 @@ pub unsafe extern "C" fn ht_huang_point_init_world(
         check_init(prepared, &inputs, Some(frame), point)?;
         let (axes, h, wo) = framed(frame, wo)?;
         // SAFETY: as in `ht_huang_point_at_hit`.
-        unsafe {
-            fill_huang(
-                point,
-                &(*prepared).bsdf,
-                axes,
-                (h, wo),
-                (major, jitter, field),
-            )
-        }
+        unsafe { fill_huang(point, prepared, (axes, h, wo), (major, jitter, field)) }
     })
 }
 
 /// Checks the section's orientation, the jitter and the field of a point init whose
-/// pointers `check_init` passed, and writes the point of `bsdf` at (h, wo) and `frame`.
+/// pointers `check_init` passed, and writes the point of `prepared` at (h, wo) and
+/// `frame`.
 ///
 /// # Safety
-/// `point` is non-NULL, aligned, writable and not read by anyone meanwhile.
+/// `prepared` is a live handle; `point` is non-NULL, aligned, writable and not read by
+/// anyone meanwhile.
 #[inline(always)]
 unsafe fn fill_huang(
     point: *mut HtHuangPoint,
-    bsdf: &HuangBsdf,
-    frame: Frame,
-    (h, wo): (f32, Vec3),
+    prepared: *const HtHuangPrepared,
+    (frame, h, wo): (Frame, f32, Vec3),
     (major, jitter, field): (*const f32, *const f32, HtHuangField),
 ) -> Result<(), Failure> {
+    // SAFETY: the caller's promise.
+    let bsdf = unsafe { &(*prepared).bsdf };
     let given = read3(major);
     let major = check_major(frame.to_local(given), given, "major")?;
     // SAFETY: non-NULL and aligned (checked by `check_init`), 2 floats (the caller's

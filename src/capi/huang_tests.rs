@@ -8,7 +8,7 @@ use super::huang::{HtHuangParams, ht_huang_params_default};
 use super::lights::*;
 use super::materials::*;
 use super::scene::*;
-use super::scene_tests::{Handles, fails, last_error};
+use super::scene_tests::{Handles, fails, last_error, xyzr_desc};
 use super::settings_tests::Named;
 use crate::Scene;
 use crate::description::{CameraDesc, EnvironmentSource, LightDesc, MaterialDesc};
@@ -71,17 +71,8 @@ fn params() -> (HtHuangParams, HtHairVariation) {
 fn c_render(material: impl Fn(&Handles) -> u32, edit: impl Fn(&Handles, u32)) -> (Vec<u32>, u64) {
     let h = Handles::new();
     let id = material(&h);
-    let points = grid();
-    let counts = vec![4u32; STRANDS];
-    let desc = HtCurvesXyzr {
-        strand_count: STRANDS,
-        point_counts: counts.as_ptr(),
-        point_count: points.len(),
-        points: points.as_ptr().cast(),
-        colors: null(),
-        basis: HT_CURVE_LINEAR,
-        shape: HT_CURVE_ROUND,
-    };
+    let (points, counts) = (grid(), vec![4u32; STRANDS]);
+    let desc = xyzr_desc(&points, &counts);
     let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
     let mut pairs = vec![("width", w.as_str()), ("height", h_.as_str())];
     pairs.extend(SETTINGS);

@@ -337,6 +337,15 @@ pub(crate) fn check_disjoint(outputs: &[Span], inputs: &[Span]) -> Result<(), Fa
     Ok(())
 }
 
+/// Drops a boxed handle; NULL is nothing to free.
+pub(crate) fn free_handle<T>(handle: *mut T) {
+    if !handle.is_null() {
+        // SAFETY: a handle from the matching ht_*_new or ht_*_prepare, freed once (the
+        // host's promise).
+        drop(unsafe { Box::from_raw(handle) });
+    }
+}
+
 /// Reads a `float[3]` that must be finite; the message names the argument.
 pub(crate) fn read_vec3(ptr: *const f32, name: &str) -> Result<Vec3, Failure> {
     let v = Vec3::from_array(host_slice(ptr, 3, name)?.try_into().expect("3 elements"));

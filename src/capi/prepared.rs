@@ -12,12 +12,11 @@
 //! ([`HostPoint`]): the Huang model's point (`huang.rs`) is filled and read by the same
 //! code.
 
-use super::bsdf::{
-    Arg, check_args, check_dir, check_h, check_u, read_params, read3, require, write1, write3,
-};
+use super::bsdf::{Arg, check_args, check_dir, check_h, check_u, read3, require, write1, write3};
 use super::frame::{HtHairFrame, checked_axes, hit_frame};
 use super::{
-    Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
+    Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, free_handle, host_slice,
+    host_slice_mut,
 };
 use crate::bsdf::{HairBsdf, LocalBsdf, OwnedPoint};
 use crate::error::invalid_arg;
@@ -143,15 +142,26 @@ pub unsafe extern "C" fn ht_hair_prepare(
     out: *mut *mut HtHairPrepared,
 ) -> HtStatus {
     boundary(|| {
-        require(&[(params.cast(), "params"), (out.cast_const().cast(), "out")])?;
-        let params = read_params(params)?;
-        let out = host_slice_mut(out, 1, "out")?;
-        let handle = Box::new(HtHairPrepared {
-            bsdf: HairBsdf::new(&params)?,
-        });
-        out[0] = Box::into_raw(handle);
-        Ok(())
+        prepare(params, out, |p| {
+            Ok(HtHairPrepared {
+                bsdf: HairBsdf::new(&p.into())?,
+            })
+        })
     })
+}
+
+/// The body of a `*_prepare` call: the handle `make` builds of the host's `*params`,
+/// written to `*out` (every NULL checked first; `*out` untouched on error).
+pub(super) fn prepare<P: Copy, T>(
+    params: *const P,
+    out: *mut *mut T,
+    make: impl FnOnce(P) -> Result<T, Failure>,
+) -> Result<(), Failure> {
+    require(&[(params.cast(), "params"), (out.cast_const().cast(), "out")])?;
+    let params = host_slice(params, 1, "params")?[0];
+    let out = host_slice_mut(out, 1, "out")?;
+    out[0] = Box::into_raw(Box::new(make(params)?));
+    Ok(())
 }
 
 /// Releases a prepared BSDF (NULL: nothing to do; returns HT_OK). Points filled from it
@@ -163,10 +173,7 @@ pub unsafe extern "C" fn ht_hair_prepare(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_prepared_free(prepared: *mut HtHairPrepared) -> HtStatus {
     boundary(|| {
-        if !prepared.is_null() {
-            // SAFETY: a live handle from ht_hair_prepare (the caller's promise).
-            drop(unsafe { Box::from_raw(prepared) });
-        }
+        free_handle(prepared);
         Ok(())
     })
 }

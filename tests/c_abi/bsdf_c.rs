@@ -6,7 +6,7 @@
 
 use crate::c_examples::build_and_run_file;
 use glam::{Vec2, Vec3};
-use hairtrace::{HairBsdf, HairParams, HuangBsdf, HuangParams};
+use hairtrace::{BsdfSample, HairBsdf, HairParams, HuangBsdf, HuangParams};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::fmt::Write as _;
@@ -63,6 +63,17 @@ fn cases(n: usize) -> Vec<Case> {
         .collect()
 }
 
+/// What a C sample call writes of a Rust sample: wi, f |cos|, the weight f |cos| / pdf and
+/// the pdf (zeros without a direction or a finite weight).
+fn sampled(s: Option<BsdfSample>) -> [f32; 10] {
+    s.map(|s| (s.wi, s.f * s.wi.z.abs(), s.pdf))
+        .filter(|(_, fc, p)| (*fc / *p).is_finite())
+        .map_or([0.0; 10], |(d, fc, p)| {
+            let w = fc / p;
+            [d.x, d.y, d.z, fc.x, fc.y, fc.z, w.x, w.y, w.z, p]
+        })
+}
+
 #[test]
 fn every_c_entry_point_gives_the_rust_bits() {
     let cases = cases(3000);
@@ -102,14 +113,7 @@ fn every_c_entry_point_gives_the_rust_bits() {
         let e = point.eval(wi);
         let cos = e.f * wi.z.abs();
         let eval = [cos.x, cos.y, cos.z, e.pdf];
-        let sample = point
-            .sample(*u)
-            .map(|s| (s.wi, s.f * s.wi.z.abs(), s.pdf))
-            .filter(|(_, fc, p)| (*fc / *p).is_finite())
-            .map_or([0.0; 10], |(d, fc, p)| {
-                let w = fc / p;
-                [d.x, d.y, d.z, fc.x, fc.y, fc.z, w.x, w.y, w.z, p]
-            });
+        let sample = sampled(point.sample(*u));
         let lanes = point.eval_across(wi).expect("the point's lanes");
         let across = (lanes.f.iter().flat_map(|f| (*f * wi.z.abs()).to_array())).chain(lanes.pdf);
         let want: Vec<u32> = (eval.into_iter().chain(sample).chain(across))
@@ -179,14 +183,7 @@ fn the_huang_model_through_cpp_gives_the_rust_bits() {
         };
         let e = point.eval(wi);
         let cos = e.f * wi.z.abs();
-        let sample = point
-            .sample(*u)
-            .map(|s| (s.wi, s.f * s.wi.z.abs(), s.pdf))
-            .filter(|(_, fc, p)| (*fc / *p).is_finite())
-            .map_or([0.0; 10], |(d, fc, p)| {
-                let w = fc / p;
-                [d.x, d.y, d.z, fc.x, fc.y, fc.z, w.x, w.y, w.z, p]
-            });
+        let sample = sampled(point.sample(*u));
         let want: Vec<u32> = ([cos.x, cos.y, cos.z, e.pdf].into_iter().chain(sample))
             .map(f32::to_bits)
             .collect();

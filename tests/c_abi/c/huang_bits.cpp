@@ -1,5 +1,5 @@
 /* The Huang model through hairtrace.hpp and the C calls under it, for inputs the Rust test
- * writes to the file named by argv[1], one case a line as 24 hexadecimal float bit
+ * writes to the file named by argv[1], one case a line as 23 hexadecimal float bit
  * patterns: sigma_a[3], eta, roughness, aspect, alpha, h, wo[3], wi[3], u[3], major[3],
  * jitter[2], field (0 near, 1 far). Each point is filled at the local frame, where world
  * directions are the local ones, three ways: the value form, the noexcept status form into
@@ -59,7 +59,7 @@ int main(int argc, char **argv) {
     for (uint32_t w; std::fscanf(in, "%x", &w) == 1;) v.push_back(from_bits(w));
     std::fclose(in);
     int mismatches = 0;
-    for (std::size_t at = 0; at + 24 <= v.size(); at += 24) {
+    for (std::size_t at = 0; at + 23 <= v.size(); at += 23) {
         const float *c = &v[at];
         HtHuangParams params = hairtrace::default_huang_params();
         std::memcpy(params.sigma_a, c, 3 * sizeof(float));
@@ -72,7 +72,7 @@ int main(int argc, char **argv) {
         const float *wo = c + 8, *wi = c + 11, *major = c + 17;
         const hairtrace::Vec3 u{c[14], c[15], c[16]};
         const hairtrace::Jitter jitter{c[20], c[21]};
-        const HtHuangField field = c[23] > 0.5f ? HT_HUANG_FAR : HT_HUANG_NEAR;
+        const HtHuangField field = c[22] > 0.5f ? HT_HUANG_FAR : HT_HUANG_NEAR;
         const hairtrace::HuangMaterial material(params);
         const hairtrace::HuangPoint point =
             hairtrace::HuangPoint::world(material, frame, wo, major, jitter, field);

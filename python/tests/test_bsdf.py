@@ -149,7 +149,7 @@ def test_huang_eval_and_sample_give_the_c_library_s_bits(clib, field):
     # f |cos| in float32, as the C call forms it.
     assert np.array_equal(f * np.abs(wi[:, 2:3]), c[:, 0:3]) and np.array_equal(pdf, c[:, 3])
     some = ps > 0
-    assert some.mean() > 0.8
+    assert some.mean() > 0.5  # random wo, the back of the fibre included
     assert np.array_equal(ws[some], c[some, 4:7]) and np.array_equal(ps, c[:, 13])
     assert np.array_equal(fs[some] * np.abs(ws[some, 2:3]), c[some, 7:10])
 
@@ -159,7 +159,7 @@ def test_huang_samples_have_eval_s_density_and_the_fields_differ():
     h, wo, wi, u, major, jitter = huang_inputs(300)
     wi_s, f, pdf = bsdf.sample(h, wo, u, major=major, jitter=jitter, field="far")
     ok = pdf > 0
-    assert ok.mean() > 0.8
+    assert ok.mean() > 0.5
     f2, pdf2 = bsdf.eval(h[ok], wo[ok], wi_s[ok], major=major[ok], jitter=jitter[ok], field="far")
     assert np.array_equal(pdf2, pdf[ok]) and np.array_equal(f2, f[ok])
     near = bsdf.eval(h, wo, wi, major=major, jitter=jitter)[1]

@@ -9,7 +9,7 @@
 //! established is not checked again per direction.
 //!
 //! The host's bytes, their checks and the world calls are generic over the model
-//! ([`HostPoint`]): the Huang model's point (`huang.rs`) is filled and read by the same
+//! (`HostPoint`): the Huang model's point (`huang.rs`) is filled and read by the same
 //! code.
 
 use super::bsdf::{Arg, check_args, check_dir, check_h, check_u, read3, require, write1, write3};

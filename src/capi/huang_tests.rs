@@ -5,31 +5,15 @@
 use super::HtStatus;
 use super::geometry::*;
 use super::huang::{HtHuangParams, ht_huang_params_default};
-use super::lights::*;
 use super::materials::*;
-use super::scene::*;
+use super::same_scene_tests::{c_lights, c_pixels, rust_pixels, rust_scene};
 use super::scene_tests::{Handles, fails, last_error, xyzr_desc};
-use super::settings_tests::Named;
-use crate::Scene;
-use crate::description::{CameraDesc, EnvironmentSource, LightDesc, MaterialDesc};
-use crate::embree::{CurveBasis, Device, SharedBuffer};
+use crate::description::MaterialDesc;
+use crate::embree::{CurveBasis, SharedBuffer};
 use crate::incremental::ControlPoints;
-use crate::render::{Aovs, NoProgress};
 use crate::scene::{GroomShape, HairColor, HairMaterial, HairModel};
 use std::ptr::null;
-use std::sync::Arc;
 
-const SIZE: (u32, u32) = (40, 30);
-const SETTINGS: [(&str, &str); 4] = [
-    ("spp", "4"),
-    ("seed", "7"),
-    ("threads", "2"),
-    ("max_depth", "6"),
-];
-const EYE: [f32; 3] = [0.2, 0.5, 3.0];
-const SKY: [f32; 3] = [0.4, 0.45, 0.5];
-const SUN_DIR: [f32; 3] = [-0.5, 1.0, 0.7];
-const SUN: [f32; 3] = [3.0, 2.8, 2.5];
 const STRANDS: usize = 144;
 
 /// Linear strands of 4 control points on a 12 x 12 grid, bent along x: every other one
@@ -66,47 +50,26 @@ fn params() -> (HtHuangParams, HtHairVariation) {
     (params, variation)
 }
 
-/// The grid through the C ABI with the material `material` makes, the sky, the sun and
-/// the camera; the pixels' bits and the scene's builds.
+/// The grid through the C ABI with the material `material` makes, in the lights and
+/// camera of `same_scene_tests`, rendered, edited by `edit`, rendered again: the pixels'
+/// bits and the scene's builds.
 fn c_render(material: impl Fn(&Handles) -> u32, edit: impl Fn(&Handles, u32)) -> (Vec<u32>, u64) {
     let h = Handles::new();
     let id = material(&h);
     let (points, counts) = (grid(), vec![4u32; STRANDS]);
     let desc = xyzr_desc(&points, &counts);
-    let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
-    let mut pairs = vec![("width", w.as_str()), ("height", h_.as_str())];
-    pairs.extend(SETTINGS);
-    let settings = Named::new(&pairs);
-    let pixels = (SIZE.0 * SIZE.1) as usize;
-    unsafe {
-        let s = ht_scene_add_curves_xyzr(h.scene, &desc, id, &mut 0);
-        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        assert_eq!(
-            ht_scene_add_environment(h.scene, SKY.as_ptr()),
-            HtStatus::HT_OK
-        );
-        let s = ht_scene_add_distant_light(h.scene, SUN_DIR.as_ptr(), SUN.as_ptr(), 0.0);
-        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        let (target, up) = ([0.0f32; 3], [0.0f32, 1.0, 0.0]);
-        let s = ht_scene_set_camera(h.scene, EYE.as_ptr(), target.as_ptr(), up.as_ptr(), 40.0);
-        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    }
-    let (s, _) = settings.render_rgb(h.scene, pixels);
-    assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+    let s = unsafe { ht_scene_add_curves_xyzr(h.scene, &desc, id, &mut 0) };
+    assert_eq!(s, HtStatus::HT_OK);
+    c_lights(&h, true);
+    c_pixels(&h);
     edit(&h, id);
-    let (s, rgb) = settings.render_rgb(h.scene, pixels);
-    assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-    let builds = h.scene().scene.builds();
-    (rgb.iter().map(|v| v.to_bits()).collect(), builds)
+    let rgb = c_pixels(&h);
+    (rgb, h.scene().scene.builds())
 }
 
 /// The same scene through the Rust `Scene`, its material the scene file's `model = "huang"`.
 fn rust_render() -> Vec<u32> {
-    let mut scene = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
-    (scene.settings.width, scene.settings.height) = SIZE;
-    for (k, v) in SETTINGS {
-        scene.settings.set(k, v).unwrap();
-    }
+    let mut scene = rust_scene(true);
     let (p, v) = params();
     let hair = HairMaterial {
         color: HairColor::SigmaA(p.sigma_a),
@@ -131,27 +94,7 @@ fn rust_render() -> Vec<u32> {
         basis: CurveBasis::Linear,
     };
     (scene.add_control_points("grid", points, GroomShape::Round, "hair")).unwrap();
-    let view = CameraDesc {
-        eye: Some(EYE),
-        target: Some([0.0; 3]),
-        fov_deg: 40.0,
-        ..CameraDesc::default()
-    };
-    scene.set_camera(&view).unwrap();
-    let sky = LightDesc::Environment {
-        source: EnvironmentSource::Uniform(SKY),
-        rotation_deg: 0.0,
-        scale: 1.0,
-    };
-    scene.add_light(&sky).unwrap();
-    let sun = LightDesc::Distant {
-        direction: SUN_DIR,
-        irradiance: SUN,
-        angular_radius_deg: 0.0,
-    };
-    scene.add_light(&sun).unwrap();
-    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
-    out.film.rgb().iter().map(|v| v.to_bits()).collect()
+    rust_pixels(&mut scene)
 }
 
 fn add_huang(h: &Handles) -> u32 {

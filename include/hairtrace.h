@@ -596,7 +596,235 @@ enum HtStatus ht_hair_point_init_strand(const struct HtHairPrepared *prepared,
 #endif  // __cplusplus
 
 /* ====================================================================================
- * 4. Devices and scenes: geometry, materials, lights
+ * 4. The Huang model of elliptical fibres: parameters, prepared BSDF, path vertices
+ * ==================================================================================== */
+
+/**
+ * Bytes of an `HtHuangPoint`: a far-field point holds the paths of several offsets across
+ * the fibre; the rest leaves room for the model to grow without changing the ABI.
+ */
+#define HT_HUANG_POINT_SIZE 4096
+
+/**
+ * Alignment of an `HtHuangPoint` in bytes.
+ */
+#define HT_HUANG_POINT_ALIGN 16
+
+/**
+ * The Huang model prepared for one parameter set. Create with `ht_huang_prepare`, release
+ * with `ht_huang_prepared_free`. Immutable: any number of threads may use one handle at
+ * once.
+ */
+typedef struct HtHuangPrepared HtHuangPrepared;
+
+/**
+ * Parameters of the Huang et al. 2022 model of elliptical fibres (docs/conventions.md,
+ * section 4b), all checked, never clamped:
+ * - `sigma_a`: absorption per unit major semi-axis (the curve's radius), linear RGB, each
+ *   finite and >= 0 (`ht_hair_sigma_a_*` give it).
+ * - `eta`: index of refraction, in (1, 3].
+ * - `roughness`: GGX roughness of the cuticle, in [0.01, 1].
+ * - `aspect`: minor over major axis of the section, in [0.05, 1] (1 is round); turn the
+ *   section with the major axis the point calls take, not with an aspect above 1.
+ * - `alpha`: cuticle scale tilt in *degrees*, in [-20, 20] (pbrt's sign, as
+ *   `HtHairParams`).
+ */
+typedef struct HtHuangParams {
+    /**
+     * Absorption per unit major semi-axis, linear RGB, finite, >= 0.
+     */
+    float sigma_a[3];
+    /**
+     * Index of refraction of the fiber, (1, 3].
+     */
+    float eta;
+    /**
+     * GGX roughness of the cuticle, [0.01, 1].
+     */
+    float roughness;
+    /**
+     * Minor over major axis, [0.05, 1].
+     */
+    float aspect;
+    /**
+     * Cuticle scale tilt, degrees, [-20, 20].
+     */
+    float alpha;
+} HtHuangParams;
+
+/**
+ * Which part of the fibre a Huang point sees: `HT_HUANG_NEAR` or `HT_HUANG_FAR`.
+ */
+typedef uint32_t HtHuangField;
+
+/**
+ * Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit` or
+ * `ht_huang_point_init_world`, then evaluated and sampled any number of times. The rules
+ * of `HtHairPoint` hold: the host allocates it (`HT_HUANG_POINT_SIZE` bytes aligned to
+ * `HT_HUANG_POINT_ALIGN`, which this type has), the bytes are opaque plain numbers that
+ * may be copied and outlive their `HtHuangPrepared`, an unfilled point (or a Chiang one)
+ * is refused, and filling it while another thread reads it is a data race.
+ */
+typedef struct HT_ALIGNED(16) HtHuangPoint {
+    uint8_t opaque[HT_HUANG_POINT_SIZE];
+} HtHuangPoint;
+
+/**
+ * The near field: the fibre at the hit's h, for a fibre wider than the pixel that sees it.
+ */
+#define HT_HUANG_NEAR 0
+
+/**
+ * The far field: the fibre averaged across its width, stratified from the hit's h, for a
+ * strand no wider than its pixel and at bounces (unbiased when h is uniform over the
+ * width).
+ */
+#define HT_HUANG_FAR 1
+
+#ifdef __cplusplus
+extern "C" {
+#endif // __cplusplus
+
+/**
+ * Brown hair as `ht_hair_params_default` gives it (absorption, eta, tilt), GGX roughness
+ * 0.3, round (aspect 1). Cannot fail; any thread.
+ */
+struct HtHuangParams ht_huang_params_default(void);
+
+/**
+ * Prepares the Huang model for `*params` (see `HtHuangParams` for the ranges) and writes
+ * the new handle to `*out`.
+ *
+ * - `params`, `out`: not NULL (`HT_ERR_NULL_ARG`), aligned for their types. A parameter
+ *   out of range (an `aspect` of 0, above 1 or NaN included): `HT_ERR_INVALID_ARG` naming
+ *   it, and `*out` is left untouched.
+ * - The handle is owned by the host: release it with `ht_huang_prepared_free`. Points
+ *   filled from it keep their own copy and outlive it.
+ *
+ * Any thread.
+ *
+ * # Safety
+ * `params` is NULL or points to an `HtHuangParams`; `out` is NULL or writable.
+ */
+enum HtStatus ht_huang_prepare(const struct HtHuangParams *params, struct HtHuangPrepared **out);
+
+/**
+ * Releases a prepared Huang model (NULL: nothing to do; returns HT_OK). Points filled
+ * from it stay valid. Freeing a handle twice, or while another thread uses it, is
+ * undefined behaviour.
+ *
+ * # Safety
+ * `prepared` is NULL or a live handle from `ht_huang_prepare`, not used after this call.
+ */
+enum HtStatus ht_huang_prepared_free(struct HtHuangPrepared *prepared);
+
+/**
+ * A renderer's hair hit to a ready Huang point, in one call: the hit's frame and h as
+ * `ht_hair_point_at_hit` builds them, and the point of `prepared` there, seen from
+ * wo = -normalize(ray_dir). Equal, bit for bit, to `ht_hair_frame` followed by
+ * `ht_huang_point_init_world` with the same `major`, `jitter` and `field`.
+ *
+ * - `tangent`, `ray_org`, `ray_dir`, `axis`, `radius`: as `ht_hair_point_at_hit` takes
+ *   and refuses them.
+ * - `major[3]`: the section's major axis in world space, any length: finite, and not
+ *   along the tangent (the sine of its angle to it at most 1e-3) nor zero, else
+ *   `HT_ERR_INVALID_ARG`. Its part along the tangent is ignored. A property of the
+ *   fibre: pass the same for camera and shadow rays. Any direction serves a round fibre
+ *   (aspect 1). The renderer's own choice is world up made perpendicular to the tangent,
+ *   or world +x where the tangent is vertical.
+ * - `jitter[2]`: each in [0, 1) (`HT_ERR_INVALID_ARG`): shifts the nodes that integrate
+ *   the first interfaces. Fresh uniform numbers at each hit make a render unbiased for
+ *   the model; a fixed pair gives a deterministic BSDF, whose eval, pdf and sample agree
+ *   exactly either way.
+ * - `field`: `HT_HUANG_NEAR` or `HT_HUANG_FAR`; any other value: `HT_ERR_INVALID_ARG`.
+ * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); the floats 4-byte and `point`
+ *   16-byte aligned; no input may lie inside `*point` (`HT_ERR_INVALID_ARG`). On error
+ *   `*point` is untouched.
+ *
+ * Any thread; `prepared` may be shared, `point` must not be read meanwhile.
+ *
+ * # Safety
+ * `prepared` is NULL or a live handle; each float pointer NULL or 3 floats (`jitter` 2);
+ * `point` NULL or writable storage of `HT_HUANG_POINT_SIZE` bytes.
+ */
+enum HtStatus ht_huang_point_at_hit(const struct HtHuangPrepared *prepared,
+                                    const float *tangent,
+                                    const float *ray_org,
+                                    const float *ray_dir,
+                                    const float *axis,
+                                    float radius,
+                                    const float *major,
+                                    const float *jitter,
+                                    HtHuangField field,
+                                    struct HtHuangPoint *point);
+
+/**
+ * The Huang point of `prepared` at a hit's frame: h is `frame->h`, `wo[3]` is in world
+ * space, as `ht_hair_point_init_world` takes them (and refuses them); `major`, `jitter`
+ * and `field` as `ht_huang_point_at_hit` takes them. With the axes (1,0,0), (0,1,0),
+ * (0,0,1) every direction is its local form, and the major axis a (0, y, z) direction.
+ *
+ * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); `frame` and the floats 4-byte
+ *   and `point` 16-byte aligned; no input may lie inside `*point` (`HT_ERR_INVALID_ARG`).
+ *   On error `*point` is untouched.
+ *
+ * Any thread; `prepared` may be shared, `point` must not be read meanwhile.
+ *
+ * # Safety
+ * `prepared` is NULL or a live handle; `frame` NULL or an `HtHairFrame`; `wo`, `major`
+ * NULL or 3 floats, `jitter` NULL or 2; `point` NULL or writable storage of
+ * `HT_HUANG_POINT_SIZE` bytes.
+ */
+enum HtStatus ht_huang_point_init_world(const struct HtHuangPrepared *prepared,
+                                        const struct HtHairFrame *frame,
+                                        const float *wo,
+                                        const float *major,
+                                        const float *jitter,
+                                        HtHuangField field,
+                                        struct HtHuangPoint *point);
+
+/**
+ * f |cos| and the pdf toward the world `wi[3]` at a filled Huang point, as
+ * `ht_hair_point_eval_world` gives them at a Chiang point (the same checks, statuses and
+ * outputs). The pdf is exact: the density of `ht_huang_point_sample_world` at wi.
+ *
+ * Any thread, concurrently on the same point.
+ *
+ * # Safety
+ * `point` is NULL or `HT_HUANG_POINT_SIZE` readable bytes; `wi`, `f_cos` NULL or 3
+ * floats, `pdf` NULL or 1 float; outputs writable.
+ */
+enum HtStatus ht_huang_point_eval_world(const struct HtHuangPoint *point,
+                                        const float *wi,
+                                        float *f_cos,
+                                        float *pdf);
+
+/**
+ * A sampled direction at a filled Huang point: `wi[3]` (world), `f_cos[3]`, `weight[3]`
+ * = f_cos / pdf and `*pdf`, as `ht_hair_point_sample_world` writes them (the same checks,
+ * statuses and outputs). pdf = 0 (and zeros) means no direction: also where the draw met
+ * total internal reflection on its way out, so the sampled density integrates to less
+ * than 1 by that fraction.
+ *
+ * Any thread, concurrently on the same point.
+ *
+ * # Safety
+ * `point` is NULL or `HT_HUANG_POINT_SIZE` readable bytes; `u`, `wi`, `f_cos`, `weight`
+ * NULL or 3 floats, `pdf` NULL or 1 float; outputs writable.
+ */
+enum HtStatus ht_huang_point_sample_world(const struct HtHuangPoint *point,
+                                          const float *u,
+                                          float *wi,
+                                          float *f_cos,
+                                          float *weight,
+                                          float *pdf);
+
+#ifdef __cplusplus
+}  // extern "C"
+#endif  // __cplusplus
+
+/* ====================================================================================
+ * 5. Devices and scenes: geometry, materials, lights
  * ==================================================================================== */
 
 #if defined(HT_RENDER)
@@ -1277,6 +1505,51 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
                                                 uint32_t *material_id);
 
 /**
+ * Adds a hair material of the Huang model (elliptical fibres: `HtHuangParams`, ranges as
+ * for `ht_huang_prepare`), varied over the groom as `variation` says (NULL: no
+ * variation; `roughness_variation` spreads `roughness`), and writes its id, counted with
+ * the other materials, to `material_id`. It goes on curves as a Chiang hair material
+ * does. The renderer orients each section by world up made perpendicular to the tangent
+ * (world +x where the tangent is vertical), takes the far field at bounces and on strands
+ * no wider than their pixel, and the near field elsewhere (docs/conventions.md, section
+ * 4b). A groom's colours (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s
+ * beta_n, as a scene file's `model = "huang"` material inverts them.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
+ * `HT_ERR_INVALID_ARG` (a parameter or variation out of range, naming it; `material_id`
+ * misaligned). Nothing is added on failure.
+ *
+ * One thread at a time per scene.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `params` and
+ * `variation` are NULL or readable; `material_id` is NULL or points to a writable
+ * `uint32_t`.
+ */
+enum HtStatus ht_scene_add_huang_material(struct HtScene *scene,
+                                          const struct HtHuangParams *params,
+                                          const struct HtHairVariation *variation,
+                                          uint32_t *material_id);
+
+/**
+ * Gives material `material_id` the Huang model with new parameters and variation (as
+ * `ht_scene_add_huang_material` takes them), without a new build: the next render is the
+ * one of a scene built with them. A hair material of either model may change model this
+ * way, or back with `ht_scene_set_hair_material`.
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene` or `params` NULL); `HT_ERR_INVALID_ARG` (as
+ * `ht_scene_set_hair_material`). On failure the material is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `params` and
+ * `variation` are NULL or readable.
+ */
+enum HtStatus ht_scene_set_huang_material(struct HtScene *scene,
+                                          uint32_t material_id,
+                                          const struct HtHuangParams *params,
+                                          const struct HtHairVariation *variation);
+
+/**
  * Gives hair material `material_id` new parameters and variation (as
  * `ht_scene_add_hair_material_varied` takes them), without a new build: the next render
  * is the one of a scene built with them. `variation` may be NULL: no variation.
@@ -1352,7 +1625,7 @@ enum HtStatus ht_shutdown(void);
 #endif  /* HT_RENDER */
 
 /* ====================================================================================
- * 5. Render settings by name
+ * 6. Render settings by name
  * ==================================================================================== */
 
 #if defined(HT_RENDER)
@@ -1436,7 +1709,7 @@ const char *ht_settings_key(size_t index);
 #endif  /* HT_RENDER */
 
 /* ====================================================================================
- * 6. Rendering and images
+ * 7. Rendering and images
  * ==================================================================================== */
 
 #if defined(HT_RENDER)

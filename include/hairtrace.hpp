@@ -1,10 +1,11 @@
 /*
  * hairtrace.hpp: a C++17 layer over the C ABI of hairtrace.h, header-only.
  *
- * - Every handle has an owner that releases it: `Material` (HtHairPrepared), and with the
- *   full library `Device`, `Scene`, `Settings`. `get()` gives the C handle, for the C
- *   calls this layer does not wrap. `Scene` wraps the calls of motion and animation:
- *   strands and meshes at several time steps, files read at a frame.
+ * - Every handle has an owner that releases it: `Material` (HtHairPrepared), `HuangMaterial`
+ *   (HtHuangPrepared), and with the full library `Device`, `Scene`, `Settings`. `get()`
+ *   gives the C handle, for the C calls this layer does not wrap. `Scene` wraps the calls
+ *   of motion and animation: strands and meshes at several time steps, files read at a
+ *   frame.
  * - The host's own vectors go in and out as they are: anything with `x, y, z` members or
  *   an `operator[]` (glm, Eigen, a `float[3]`, a std::array), converted to float.
  * - Two forms of every per-vertex call. The value form throws `hairtrace::Error` (the
@@ -19,7 +20,8 @@
  * its frame), `eval_world` (f |cos| and pdf toward a light), `sample_world` (a direction,
  * f |cos|, the weight f |cos| / pdf and the pdf). `Point` and `Frame` are
  * default-constructible, so a host's vertex struct holds them. They give the bits of the C
- * calls they wrap.
+ * calls they wrap. `HuangPoint` is the same vertex for the Huang model of elliptical
+ * fibres, whose calls also take the section's major axis, the jitter and the field.
  */
 #ifndef HT_HAIRTRACE_HPP
 #define HT_HAIRTRACE_HPP
@@ -104,6 +106,12 @@ struct Sample {
 /** `HtHairParams` with the library's defaults (brown hair); fields as in hairtrace.h. */
 inline HtHairParams default_params() { return ht_hair_params_default(); }
 
+/** `HtHuangParams` with the library's defaults (brown, round); fields as in hairtrace.h. */
+inline HtHuangParams default_huang_params() { return ht_huang_params_default(); }
+
+/** The two numbers that shift a Huang point's nodes, each in [0, 1). */
+using Jitter = std::array<float, 2>;
+
 /** sigma_a for melanin concentrations (`ht_hair_sigma_a_from_melanin`). */
 inline Vec3 sigma_a_from_melanin(float eumelanin, float pheomelanin) {
     Vec3 out;
@@ -161,22 +169,77 @@ private:
     HtHairFrame frame_;
 };
 
+namespace detail {
+/** A model prepared for one parameter set by `Prepare`, released by `Free` with its last
+ * copy. */
+template <class Handle, class Params, HtStatus (*Prepare)(const Params *, Handle **),
+          HtStatus (*Free)(Handle *)>
+class Prepared {
+public:
+    explicit Prepared(const Params &params) {
+        Handle *handle = nullptr;
+        check(Prepare(&params, &handle));
+        handle_.reset(handle, [](Handle *p) { Free(p); });
+    }
+    const Handle *get() const noexcept { return handle_.get(); }
+
+private:
+    std::shared_ptr<Handle> handle_;
+};
+
+/** A model's point `C` in the host's memory, with its world calls `EvalFn` and `SampleFn`:
+ * default-constructed it is unfilled (zero bytes). */
+template <class C, HtStatus (*EvalFn)(const C *, const float *, float *, float *),
+          HtStatus (*SampleFn)(const C *, const float *, float *, float *, float *, float *)>
+class WorldPoint {
+public:
+    WorldPoint() noexcept : point_() {}
+
+    /** f |cos| and pdf toward the world `wi` (`ht_*_point_eval_world`). */
+    template <class V> Eval eval_world(const V &wi) const {
+        Eval e;
+        check(eval_world(wi, e));
+        return e;
+    }
+    /** `eval_world` into `out`, with a status instead of a throw. */
+    template <class V> HtStatus eval_world(const V &wi, Eval &out) const noexcept {
+        const Vec3 w = vec3(wi);
+        return EvalFn(&point_, w.data(), out.f_cos.data(), &out.pdf);
+    }
+    /** A world direction from `u` in [0, 1)^3 (`ht_*_point_sample_world`). */
+    Sample sample_world(const Vec3 &u) const {
+        Sample s;
+        check(sample_world(u, s));
+        return s;
+    }
+    /** `sample_world` into `out`, with a status instead of a throw. */
+    HtStatus sample_world(const Vec3 &u, Sample &out) const noexcept {
+        return SampleFn(&point_, u.data(), out.wi.data(), out.f_cos.data(), out.weight.data(),
+                        &out.pdf);
+    }
+    const C &c() const noexcept { return point_; }
+
+protected:
+    C point_;
+};
+} // namespace detail
+
 /**
  * A hair material: the BSDF prepared for one parameter set (`ht_hair_prepare`). Copies share
  * the one immutable handle, which any number of threads may use at once; the last copy
  * releases it. Made once per material, at set-up: it throws.
  */
-class Material {
+class Material : public detail::Prepared<HtHairPrepared, HtHairParams, ht_hair_prepare,
+                                         ht_hair_prepared_free> {
 public:
-    explicit Material(const HtHairParams &params) {
-        HtHairPrepared *handle = nullptr;
-        check(ht_hair_prepare(&params, &handle));
-        handle_.reset(handle, [](HtHairPrepared *p) { ht_hair_prepared_free(p); });
-    }
-    const HtHairPrepared *get() const noexcept { return handle_.get(); }
+    using Prepared::Prepared;
+};
 
-private:
-    std::shared_ptr<HtHairPrepared> handle_;
+/** A material of the Huang model (`ht_huang_prepare`), shared and released as `Material`. */
+class HuangMaterial : public detail::Prepared<HtHuangPrepared, HtHuangParams, ht_huang_prepare,
+                                              ht_huang_prepared_free> {
+public:
+    using Prepared::Prepared;
 };
 
 /**
@@ -186,9 +249,9 @@ private:
  * Default-constructed it is unfilled (zero bytes): every call on it returns
  * `HT_ERR_INVALID_ARG` (or throws, in the value form) until a `set_*` fills it.
  */
-class Point {
+class Point : public detail::WorldPoint<HtHairPoint, ht_hair_point_eval_world,
+                                        ht_hair_point_sample_world> {
 public:
-    Point() noexcept : point_() {}
 
     /** A renderer's hit to a point, frame included (`ht_hair_point_at_hit`): the curve's
      * tangent, the ray, the axis point at the hit and the radius there; wo is -ray_dir. */
@@ -236,28 +299,6 @@ public:
     }
 #endif
 
-    /** f |cos| and pdf toward the world `wi` (`ht_hair_point_eval_world`). */
-    template <class V> Eval eval_world(const V &wi) const {
-        Eval e;
-        check(eval_world(wi, e));
-        return e;
-    }
-    /** `eval_world` into `out`, with a status instead of a throw. */
-    template <class V> HtStatus eval_world(const V &wi, Eval &out) const noexcept {
-        const Vec3 w = vec3(wi);
-        return ht_hair_point_eval_world(&point_, w.data(), out.f_cos.data(), &out.pdf);
-    }
-    /** A world direction from `u` in [0, 1)^3 (`ht_hair_point_sample_world`). */
-    Sample sample_world(const Vec3 &u) const {
-        Sample s;
-        check(sample_world(u, s));
-        return s;
-    }
-    /** `sample_world` into `out`, with a status instead of a throw. */
-    HtStatus sample_world(const Vec3 &u, Sample &out) const noexcept {
-        return ht_hair_point_sample_world(&point_, u.data(), out.wi.data(), out.f_cos.data(),
-                                          out.weight.data(), &out.pdf);
-    }
     /** f |cos| and pdf toward the world `wi` at `HT_ACROSS` offsets across the fibre, the
      * point's own first (`ht_hair_point_eval_across_world`): next-event estimation weighs a
      * light by the lanes' mean, each lane with its own MIS weight (docs/c-abi.md). */
@@ -280,10 +321,53 @@ public:
         }
         return status;
     }
-    const HtHairPoint &c() const noexcept { return point_; }
+};
 
-private:
-    HtHairPoint point_;
+/**
+ * The Huang model at one path vertex (`HtHuangPoint`): as `Point`, and its fills also take
+ * the section's major axis (world space, any length, across the fibre), the `Jitter` (fresh
+ * uniform numbers per hit for an unbiased render) and the field (`HT_HUANG_NEAR` at the
+ * hit's h, or `HT_HUANG_FAR` across the fibre). Default-constructed it is unfilled.
+ */
+class HuangPoint : public detail::WorldPoint<HtHuangPoint, ht_huang_point_eval_world,
+                                             ht_huang_point_sample_world> {
+public:
+    /** A renderer's hit to a point, frame included (`ht_huang_point_at_hit`). */
+    template <class T, class O, class D, class A, class M>
+    static HuangPoint at_hit(const HuangMaterial &material, const T &tangent, const O &ray_org,
+                             const D &ray_dir, const A &axis, float radius, const M &major,
+                             const Jitter &jitter, HtHuangField field) {
+        HuangPoint p;
+        check(p.set_at_hit(material, tangent, ray_org, ray_dir, axis, radius, major, jitter,
+                           field));
+        return p;
+    }
+    /** `at_hit` into this point, with a status instead of a throw (unchanged on error). */
+    template <class T, class O, class D, class A, class M>
+    HtStatus set_at_hit(const HuangMaterial &material, const T &tangent, const O &ray_org,
+                        const D &ray_dir, const A &axis, float radius, const M &major,
+                        const Jitter &jitter, HtHuangField field) noexcept {
+        const Vec3 t = vec3(tangent), o = vec3(ray_org), d = vec3(ray_dir), a = vec3(axis);
+        const Vec3 m = vec3(major);
+        return ht_huang_point_at_hit(material.get(), t.data(), o.data(), d.data(), a.data(),
+                                     radius, m.data(), jitter.data(), field, &point_);
+    }
+    /** At a frame, `wo` in world space (`ht_huang_point_init_world`). */
+    template <class V, class M>
+    static HuangPoint world(const HuangMaterial &material, const Frame &frame, const V &wo,
+                            const M &major, const Jitter &jitter, HtHuangField field) {
+        HuangPoint p;
+        check(p.set_world(material, frame, wo, major, jitter, field));
+        return p;
+    }
+    /** `world` into this point, with a status instead of a throw (unchanged on error). */
+    template <class V, class M>
+    HtStatus set_world(const HuangMaterial &material, const Frame &frame, const V &wo,
+                       const M &major, const Jitter &jitter, HtHuangField field) noexcept {
+        const Vec3 w = vec3(wo), m = vec3(major);
+        return ht_huang_point_init_world(material.get(), &frame.c(), w.data(), m.data(),
+                                         jitter.data(), field, &point_);
+    }
 };
 
 #if defined(HT_RENDER)

@@ -1,9 +1,10 @@
 """hairtrace: physically based hair and fur rendering from Python.
 
-The Chiang 2016 hair BSDF on numpy arrays (``HairBsdf``, ``sigma_a_from_melanin``,
-``sigma_a_from_color``), and whole renders (``Scene``): from a scene file, a demo, or
-keywords and numpy strands, rendered to a float32 ``Image`` (h, w, 3). docs/python.md
-in the repository says more; every render setting is in ``SETTINGS``.
+The Chiang 2016 hair BSDF and Huang 2022's elliptical fibres on numpy arrays
+(``HairBsdf``, ``HuangBsdf``, ``sigma_a_from_melanin``, ``sigma_a_from_color``), and whole
+renders (``Scene``): from a scene file, a demo, or keywords and numpy strands, rendered to
+a float32 ``Image`` (h, w, 3). docs/python.md in the repository says more; every render
+setting is in ``SETTINGS``.
 
 >>> import hairtrace
 >>> image = hairtrace.Scene.demo("furball").render(spp=4, width=64, height=48)
@@ -17,6 +18,7 @@ from ._native import (
     SETTINGS,
     SIGMA_A_PRESETS,
     HairBsdf,
+    HuangBsdf,
     Scene,
     __version__,
     read_image,
@@ -31,6 +33,7 @@ __all__ = [
     "SETTINGS",
     "SIGMA_A_PRESETS",
     "HairBsdf",
+    "HuangBsdf",
     "Image",
     "Scene",
     "__version__",

@@ -45,6 +45,59 @@ class HairBsdf:
     def sample(self, h: ArrayLike, wo: ArrayLike, u: ArrayLike) -> tuple[F32, F32, F32]:
         """wi (n, 3), f (n, 3), pdf (n,) drawn from u (n, 3) in [0, 1); pdf 0: none."""
 
+class HuangBsdf:
+    """The Huang 2022 model of elliptical fibres; left-out parameters are brown, round hair's."""
+
+    def __init__(
+        self,
+        sigma_a: Optional[Sequence[float]] = None,
+        eta: Optional[float] = None,
+        roughness: Optional[float] = None,
+        aspect: Optional[float] = None,
+        alpha: Optional[float] = None,
+    ) -> None: ...
+    @property
+    def sigma_a(self) -> list[float]: ...
+    @property
+    def eta(self) -> float: ...
+    @property
+    def roughness(self) -> float: ...
+    @property
+    def aspect(self) -> float: ...
+    @property
+    def alpha(self) -> float: ...
+    def eval(
+        self,
+        h: ArrayLike,
+        wo: ArrayLike,
+        wi: ArrayLike,
+        major: Optional[ArrayLike] = None,
+        jitter: Optional[ArrayLike] = None,
+        field: str = "near",
+    ) -> tuple[F32, F32]:
+        """f (n, 3) and pdf (n,); ``major`` (n, 3) across the fibre (None: +y), ``jitter``
+        (n, 2) in [0, 1) (None: 0.5), ``field`` "near" or "far"."""
+    def pdf(
+        self,
+        h: ArrayLike,
+        wo: ArrayLike,
+        wi: ArrayLike,
+        major: Optional[ArrayLike] = None,
+        jitter: Optional[ArrayLike] = None,
+        field: str = "near",
+    ) -> F32:
+        """The density (n,) of ``sample`` at wi."""
+    def sample(
+        self,
+        h: ArrayLike,
+        wo: ArrayLike,
+        u: ArrayLike,
+        major: Optional[ArrayLike] = None,
+        jitter: Optional[ArrayLike] = None,
+        field: str = "near",
+    ) -> tuple[F32, F32, F32]:
+        """wi (n, 3), f (n, 3), pdf (n,) drawn from u (n, 3) in [0, 1); pdf 0: none."""
+
 def sigma_a_from_melanin(eumelanin: ArrayLike, pheomelanin: Optional[ArrayLike] = None) -> F32:
     """sigma_a (..., 3) from melanin concentrations (>= 0)."""
 

@@ -1,10 +1,10 @@
-//! The hair BSDF on numpy arrays: one call evaluates or samples n inputs, every input
-//! checked first as the C ABI checks it (`hairtrace::bsdf::inputs`), the GIL released
-//! while the batch runs. The absorption conversions take arrays too.
+//! The hair BSDFs on numpy arrays, Chiang's and Huang's: one call evaluates or samples n
+//! inputs, every input checked first as the C ABI checks it (`hairtrace::bsdf::inputs`),
+//! the GIL released while the batch runs. The absorption conversions take arrays too.
 
 use hairtrace::bsdf::{self, inputs};
-use hairtrace::glam::Vec3;
-use hairtrace::{HairBsdf, HairParams};
+use hairtrace::glam::{Vec2, Vec3};
+use hairtrace::{BsdfSample, HairBsdf, HairParams, HuangBsdf, HuangParams, HuangPoint};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
 use pyo3::exceptions::PyValueError;
@@ -15,6 +15,7 @@ use crate::errors::IntoPy;
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyHairBsdf>()?;
+    m.add_class::<PyHuangBsdf>()?;
     m.add_function(wrap_pyfunction!(sigma_a_from_melanin, m)?)?;
     m.add_function(wrap_pyfunction!(sigma_a_from_color, m)?)?;
     m.add_function(wrap_pyfunction!(sigma_a_preset, m)?)?;
@@ -102,11 +103,7 @@ impl PyHairBsdf {
         wo: &Bound<'py, PyAny>,
         wi: &Bound<'py, PyAny>,
     ) -> PyResult<Pair<'py>> {
-        let (h, wo, wi) = (
-            Floats::rows(h, "h", 0)?,
-            Floats::rows(wo, "wo", 3)?,
-            Floats::rows(wi, "wi", 3)?,
-        );
+        let [h, wo, wi] = vertex_rows(h, wo, (wi, "wi"))?;
         let n = same_rows(&[&h, &wo, &wi])?;
         let (h, wo, wi) = (h.values(), wo.vec3s(), wi.vec3s());
         let (f, pdf) = py
@@ -142,30 +139,283 @@ impl PyHairBsdf {
         wo: &Bound<'py, PyAny>,
         u: &Bound<'py, PyAny>,
     ) -> PyResult<Triple<'py>> {
-        let (h, wo, u) = (
-            Floats::rows(h, "h", 0)?,
-            Floats::rows(wo, "wo", 3)?,
-            Floats::rows(u, "u", 3)?,
-        );
+        let [h, wo, u] = vertex_rows(h, wo, (u, "u"))?;
         let n = same_rows(&[&h, &wo, &u])?;
         let (h, wo, u) = (h.values(), wo.vec3s(), u.vec3s());
         let (wi, f, pdf) = py
             .detach(|| -> hairtrace::Result<_> {
                 check_each(h, wo, |i| inputs::check_u(u[i], "u"))?;
-                let (mut wi, mut f, mut pdf) =
-                    (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
-                for i in 0..n {
-                    if let Some(s) = self.bsdf.sample(h[i], Vec3::from_array(wo[i]), u[i]) {
-                        wi[3 * i..3 * i + 3].copy_from_slice(&s.wi.to_array());
-                        f[3 * i..3 * i + 3].copy_from_slice(&s.f.to_array());
-                        pdf[i] = s.pdf;
-                    }
-                }
-                Ok((wi, f, pdf))
+                samples(n, |i| {
+                    Ok(self.bsdf.sample(h[i], Vec3::from_array(wo[i]), u[i]))
+                })
             })
             .py()?;
         Ok((rows3(py, wi)?, rows3(py, f)?, pdf.into_pyarray(py)))
     }
+}
+
+/// The Huang 2022 model of elliptical fibres for one parameter set (docs/conventions.md,
+/// section 4b), in the frame and units of `HairBsdf`. Parameters left out take the
+/// defaults of `HuangParams` (brown, round); each is checked (ValueError), never clamped.
+#[pyclass(name = "HuangBsdf", module = "hairtrace", frozen)]
+pub struct PyHuangBsdf {
+    bsdf: HuangBsdf,
+}
+
+#[pymethods]
+impl PyHuangBsdf {
+    #[new]
+    #[pyo3(signature = (sigma_a=None, eta=None, roughness=None, aspect=None, alpha=None))]
+    fn new(
+        sigma_a: Option<[f32; 3]>,
+        eta: Option<f32>,
+        roughness: Option<f32>,
+        aspect: Option<f32>,
+        alpha: Option<f32>,
+    ) -> PyResult<Self> {
+        let d = HuangParams::default();
+        let params = HuangParams {
+            sigma_a: sigma_a.unwrap_or(d.sigma_a),
+            eta: eta.unwrap_or(d.eta),
+            roughness: roughness.unwrap_or(d.roughness),
+            aspect: aspect.unwrap_or(d.aspect),
+            alpha: alpha.unwrap_or(d.alpha),
+        };
+        Ok(PyHuangBsdf {
+            bsdf: HuangBsdf::new(&params).py()?,
+        })
+    }
+
+    #[getter]
+    fn sigma_a(&self) -> [f32; 3] {
+        self.bsdf.params().sigma_a
+    }
+    #[getter]
+    fn eta(&self) -> f32 {
+        self.bsdf.params().eta
+    }
+    #[getter]
+    fn roughness(&self) -> f32 {
+        self.bsdf.params().roughness
+    }
+    #[getter]
+    fn aspect(&self) -> f32 {
+        self.bsdf.params().aspect
+    }
+    #[getter]
+    fn alpha(&self) -> f32 {
+        self.bsdf.params().alpha
+    }
+
+    fn __repr__(&self) -> String {
+        let p = self.bsdf.params();
+        format!(
+            "HuangBsdf(sigma_a={:?}, eta={}, roughness={}, aspect={}, alpha={})",
+            p.sigma_a, p.eta, p.roughness, p.aspect, p.alpha
+        )
+    }
+
+    /// f (n, 3), with its 1/|wi.z|, and pdf (n,) for h (n,) and unit wo, wi (n, 3), the
+    /// section's major axis `major` (n, 3) in the fibre's frame (across the fibre; None:
+    /// +y), `jitter` (n, 2) in [0, 1) (None: 0.5) and `field` "near" or "far".
+    #[pyo3(signature = (h, wo, wi, major=None, jitter=None, field="near"))]
+    #[allow(clippy::too_many_arguments)]
+    fn eval<'py>(
+        &self,
+        py: Python<'py>,
+        h: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        major: Option<&Bound<'py, PyAny>>,
+        jitter: Option<&Bound<'py, PyAny>>,
+        field: &str,
+    ) -> PyResult<Pair<'py>> {
+        let [h, wo, wi] = vertex_rows(h, wo, (wi, "wi"))?;
+        let args = SectionArgs::read(major, jitter, field)?;
+        let n = same_rows(&args.with(&[&h, &wo, &wi]))?;
+        let (h, wo, wi, section) = (h.values(), wo.vec3s(), wi.vec3s(), args.section());
+        let (f, pdf) = py
+            .detach(|| -> hairtrace::Result<_> {
+                check_each(h, wo, |i| {
+                    inputs::check_dir(Vec3::from_array(wi[i]), "wi")?;
+                    section.at(i)
+                })?;
+                let (mut f, mut pdf) = (vec![0.0f32; 3 * n], vec![0.0f32; n]);
+                for i in 0..n {
+                    let e = section.point(&self.bsdf, h[i], wo[i], i)?;
+                    let e = e.eval(Vec3::from_array(wi[i]));
+                    f[3 * i..3 * i + 3].copy_from_slice(&e.f.to_array());
+                    pdf[i] = e.pdf;
+                }
+                Ok((f, pdf))
+            })
+            .py()?;
+        Ok((rows3(py, f)?, pdf.into_pyarray(py)))
+    }
+
+    /// The density (n,) of `sample` at wi: `eval`'s pdf alone.
+    #[pyo3(signature = (h, wo, wi, major=None, jitter=None, field="near"))]
+    #[allow(clippy::too_many_arguments)]
+    fn pdf<'py>(
+        &self,
+        py: Python<'py>,
+        h: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        wi: &Bound<'py, PyAny>,
+        major: Option<&Bound<'py, PyAny>>,
+        jitter: Option<&Bound<'py, PyAny>>,
+        field: &str,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        Ok(self.eval(py, h, wo, wi, major, jitter, field)?.1)
+    }
+
+    /// Directions wi (n, 3) drawn from uniform numbers u (n, 3) in [0, 1), with f (n, 3)
+    /// and pdf (n,) there, the other arguments as `eval`'s; pdf 0 (wi and f zero) where
+    /// there is no direction (total internal reflection on the way out included).
+    #[pyo3(signature = (h, wo, u, major=None, jitter=None, field="near"))]
+    #[allow(clippy::too_many_arguments)]
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        h: &Bound<'py, PyAny>,
+        wo: &Bound<'py, PyAny>,
+        u: &Bound<'py, PyAny>,
+        major: Option<&Bound<'py, PyAny>>,
+        jitter: Option<&Bound<'py, PyAny>>,
+        field: &str,
+    ) -> PyResult<Triple<'py>> {
+        let [h, wo, u] = vertex_rows(h, wo, (u, "u"))?;
+        let args = SectionArgs::read(major, jitter, field)?;
+        let n = same_rows(&args.with(&[&h, &wo, &u]))?;
+        let (h, wo, u, section) = (h.values(), wo.vec3s(), u.vec3s(), args.section());
+        let (wi, f, pdf) = py
+            .detach(|| -> hairtrace::Result<_> {
+                check_each(h, wo, |i| {
+                    inputs::check_u(u[i], "u")?;
+                    section.at(i)
+                })?;
+                samples(n, |i| {
+                    Ok(section.point(&self.bsdf, h[i], wo[i], i)?.sample(u[i]))
+                })
+            })
+            .py()?;
+        Ok((rows3(py, wi)?, rows3(py, f)?, pdf.into_pyarray(py)))
+    }
+}
+
+/// What a Huang point takes besides (h, wo), as given: the major axis (n, 3) and the
+/// jitter (n, 2), each left to its default where None, and the field.
+struct SectionArgs<'py> {
+    major: Option<Floats<'py>>,
+    jitter: Option<Floats<'py>>,
+    far: bool,
+}
+
+impl<'py> SectionArgs<'py> {
+    fn read(
+        major: Option<&Bound<'py, PyAny>>,
+        jitter: Option<&Bound<'py, PyAny>>,
+        field: &str,
+    ) -> PyResult<Self> {
+        let far = match field {
+            "near" => false,
+            "far" => true,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "field = {other:?}: must be \"near\" or \"far\""
+                )));
+            }
+        };
+        Ok(SectionArgs {
+            major: major.map(|m| Floats::rows(m, "major", 3)).transpose()?,
+            jitter: jitter.map(|j| Floats::rows(j, "jitter", 2)).transpose()?,
+            far,
+        })
+    }
+
+    /// `arrays` and the arrays given here, whose rows must agree.
+    fn with<'a>(&'a self, arrays: &[&'a Floats<'py>]) -> Vec<&'a Floats<'py>> {
+        let own = self.major.iter().chain(&self.jitter);
+        arrays.iter().copied().chain(own).collect()
+    }
+
+    /// The values, for the batch that runs without the GIL.
+    fn section(&self) -> Section<'_> {
+        Section {
+            major: self.major.as_ref().map(Floats::vec3s),
+            jitter: self.jitter.as_ref().map(Floats::values),
+            far: self.far,
+        }
+    }
+}
+
+/// [`SectionArgs`]' values.
+struct Section<'a> {
+    major: Option<&'a [[f32; 3]]>,
+    jitter: Option<&'a [f32]>,
+    far: bool,
+}
+
+/// The jitter of an element left without one: the middle of [0, 1).
+const DEFAULT_JITTER: [f32; 2] = [0.5; 2];
+
+impl Section<'_> {
+    /// Element i's major axis as a (y, z) direction and its jitter, checked.
+    fn at(&self, i: usize) -> hairtrace::Result<(Vec2, [f32; 2])> {
+        let major = self.major.map_or(Vec3::Y, |m| Vec3::from_array(m[i]));
+        let jitter = self
+            .jitter
+            .map_or(DEFAULT_JITTER, |j| [j[2 * i], j[2 * i + 1]]);
+        Ok((
+            inputs::check_major(major, major, "major")?,
+            inputs::check_u(jitter, "jitter")?,
+        ))
+    }
+
+    /// The point of element i, whose inputs `at` has passed.
+    fn point(
+        &self,
+        bsdf: &HuangBsdf,
+        h: f32,
+        wo: [f32; 3],
+        i: usize,
+    ) -> hairtrace::Result<HuangPoint> {
+        let (major, jitter) = self.at(i)?;
+        let wo = Vec3::from_array(wo);
+        Ok(match self.far {
+            true => bsdf.far(h, wo, major, jitter),
+            false => bsdf.near(h, wo, major, jitter),
+        })
+    }
+}
+
+/// h (n,), wo (n, 3) and another (n, 3) array of a call, read and shape-checked.
+fn vertex_rows<'py>(
+    h: &Bound<'py, PyAny>,
+    wo: &Bound<'py, PyAny>,
+    (other, name): (&Bound<'py, PyAny>, &'static str),
+) -> PyResult<[Floats<'py>; 3]> {
+    Ok([
+        Floats::rows(h, "h", 0)?,
+        Floats::rows(wo, "wo", 3)?,
+        Floats::rows(other, name, 3)?,
+    ])
+}
+
+/// wi (3n), f (3n) and pdf (n) of n draws, zeros where `draw(i)` gives no direction.
+fn samples(
+    n: usize,
+    draw: impl Fn(usize) -> hairtrace::Result<Option<BsdfSample>>,
+) -> hairtrace::Result<(Vec<f32>, Vec<f32>, Vec<f32>)> {
+    let (mut wi, mut f, mut pdf) = (vec![0.0f32; 3 * n], vec![0.0f32; 3 * n], vec![0.0f32; n]);
+    for i in 0..n {
+        if let Some(s) = draw(i)? {
+            wi[3 * i..3 * i + 3].copy_from_slice(&s.wi.to_array());
+            f[3 * i..3 * i + 3].copy_from_slice(&s.f.to_array());
+            pdf[i] = s.pdf;
+        }
+    }
+    Ok((wi, f, pdf))
 }
 
 /// Checks each element's h and wo, then the rest of it with `rest(i)`, as the C ABI

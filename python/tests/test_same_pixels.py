@@ -5,6 +5,7 @@ import ctypes
 import subprocess
 
 import numpy as np
+import pytest
 
 import hairtrace
 from c_library import f3, render
@@ -32,6 +33,15 @@ def test_a_scene_file_renders_the_same_through_the_command_line_and_python(cli, 
     assert np.array_equal(expected, image)
 
 
+class HtHuangParams(ctypes.Structure):
+    _fields_ = [("sigma_a", ctypes.c_float * 3), ("eta", ctypes.c_float),
+                ("roughness", ctypes.c_float), ("aspect", ctypes.c_float), ("alpha", ctypes.c_float)]
+
+
+# The Huang material of the tests: elliptical, rough; the rest the defaults.
+HUANG = dict(roughness=0.25, aspect=0.6)
+
+
 class HtCurves(ctypes.Structure):
     _fields_ = [("strand_count", ctypes.c_size_t), ("point_counts", ctypes.c_void_p),
                 ("point_count", ctypes.c_size_t), ("points", ctypes.c_void_p),
@@ -56,14 +66,23 @@ def strands():
     return points, radii, np.full(n, k, np.uint32)
 
 
-def c_render(clib):
+def c_render(clib, model):
+    """The scene through the C library, its hair material of `model`; the image and the
+    material's sigma_a."""
     sigma_a = []
 
     def fill(lib, scene, ok):
         material = ctypes.c_uint32()
-        params = lib.ht_hair_params_default()
+        if model == "huang":
+            lib.ht_huang_params_default.restype = HtHuangParams
+            params = lib.ht_huang_params_default()
+            for k, v in HUANG.items():
+                setattr(params, k, v)
+            ok(lib.ht_scene_add_huang_material(scene, ctypes.byref(params), None, ctypes.byref(material)))
+        else:
+            params = lib.ht_hair_params_default()
+            ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(material)))
         sigma_a.extend(params.sigma_a)
-        ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(material)))
         points, radii, counts = strands()
         curves = HtCurves(len(counts), counts.ctypes.data, len(radii), points.ctypes.data, radii.ctypes.data,
                           0.0, None, HT_CURVE_BSPLINE, HT_CURVE_AUTO)
@@ -75,11 +94,13 @@ def c_render(clib):
     return render(clib, fill, NAMED), sigma_a
 
 
-def test_the_same_scene_renders_the_same_through_c_and_python(clib):
-    expected, sigma_a = c_render(clib)
+@pytest.mark.parametrize("model", ["chiang", "huang"])
+def test_the_same_scene_renders_the_same_through_c_and_python(clib, model):
+    expected, sigma_a = c_render(clib, model)
     assert expected.mean() > 0
     s = hairtrace.Scene()
-    s.set_material("hair", type="hair", sigma_a=sigma_a)
+    huang = dict(model="huang", **HUANG) if model == "huang" else {}
+    s.set_material("hair", type="hair", sigma_a=sigma_a, **huang)
     points, radii, counts = strands()
     s.add_strands(points, radii, counts, material="hair", basis="bspline", shape="auto")
     s.add_light(type="environment", radiance=SKY)

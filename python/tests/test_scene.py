@@ -158,6 +158,8 @@ def strands(**changes):
         (lambda s: s.render(aovs=["normal"]), ValueError, "\"normal\": not an AOV"),
         (lambda s: s.set_material("m", type="hair"), ValueError, "materials.m"),
         (lambda s: s.set_material("m", type="hair", melanin=[1, 0], beta_m=7), ValueError, "beta_m"),
+        (lambda s: s.set_material("m", type="hair", melanin=[1, 0], model="huang", aspect=1.5), ValueError, "aspect = 1.5: must be in [0.05, 1]"),
+        (lambda s: s.set_material("m", type="hair", melanin=[1, 0], model="huang", beta_m=0.3), ValueError, "beta_m"),
         (lambda s: s.add_light(type="distant", direction=[0, 1, 0], irradiance=[-1, 1, 1]), ValueError, "irradiance"),
         (lambda s: s.set_camera(eye=[0, 0, 1]), ValueError, "give both `eye` and `target`"),
         (lambda s: s.add_groom(procedural="fur_ball", material="m", params=dict(strands=-3)), ValueError, "strands"),

@@ -555,6 +555,17 @@ impl OwnedPoint {
     }
 }
 
+impl LocalBsdf for OwnedPoint {
+    #[inline]
+    fn eval(&self, wi: Vec3) -> BsdfEval {
+        OwnedPoint::eval(self, wi)
+    }
+
+    fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
+        OwnedPoint::sample(self, u)
+    }
+}
+
 /// What a point keeps of (h, wo).
 #[derive(Clone, Copy)]
 struct Vertex {

@@ -62,11 +62,6 @@ impl From<HairParams> for HtHairParams {
     }
 }
 
-/// Copies the host's parameters (NULL: `HT_ERR_NULL_ARG`; misaligned: invalid).
-pub(super) fn read_params(ptr: *const HtHairParams) -> Result<HairParams, Failure> {
-    Ok(host_slice(ptr, 1, "params")?[0].into())
-}
-
 pub(super) use crate::bsdf::inputs::{UNIT_TOLERANCE, is_unit};
 
 /// [`inputs::check_dir`] with the C ABI's failure.
@@ -83,7 +78,7 @@ pub(super) fn check_h(h: f32) -> Result<f32, Failure> {
 
 /// [`inputs::check_u`] with the C ABI's failure.
 #[inline(always)]
-pub(super) fn check_u(u: [f32; 3], name: &str) -> Result<[f32; 3], Failure> {
+pub(super) fn check_u<const N: usize>(u: [f32; N], name: &str) -> Result<[f32; N], Failure> {
     Ok(inputs::check_u(u, name)?)
 }
 

@@ -1,11 +1,12 @@
-//! Materials through the C ABI: hair from parameters (optionally varied over the groom)
-//! and diffuse surfaces, each returning the id that geometries name; their parameters
-//! can be changed later without a new build.
+//! Materials through the C ABI: hair of either model from parameters (optionally varied
+//! over the groom) and diffuse surfaces, each returning the id that geometries name; their
+//! parameters can be changed later without a new build.
 
 use super::bsdf::HtHairParams;
+use super::huang::HtHuangParams;
 use super::scene::{HtScene, add_with_id, scene_mut};
 use super::{Failure, HtStatus, boundary, read_host, read_vec3};
-use crate::bsdf::HairParams;
+use crate::bsdf::{HairParams, HuangParams};
 use crate::description::MaterialDesc;
 use crate::error::invalid_arg;
 use crate::scene::{HairColor, HairMaterial, HairModel};
@@ -84,9 +85,89 @@ pub unsafe extern "C" fn ht_scene_add_hair_material_varied(
     material_id: *mut u32,
 ) -> HtStatus {
     add_with_id(scene, material_id, "material_id", |scene| {
-        let material = hair_material(params, variation)?;
+        let material = hair_material(params, &read_host(variation, "variation")?)?;
         Ok(scene.add_material(&material)?)
     })
+}
+
+/// Adds a hair material of the Huang model (elliptical fibres: `HtHuangParams`, ranges as
+/// for `ht_huang_prepare`), varied over the groom as `variation` says (NULL: no
+/// variation; `roughness_variation` spreads `roughness`), and writes its id, counted with
+/// the other materials, to `material_id`. It goes on curves as a Chiang hair material
+/// does. The renderer orients each section by world up made perpendicular to the tangent
+/// (world +x where the tangent is vertical), takes the far field at bounces and on strands
+/// no wider than their pixel, and the near field elsewhere (docs/conventions.md, section
+/// 4b). A groom's colours (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s
+/// beta_n, as a scene file's `model = "huang"` material inverts them.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
+/// `HT_ERR_INVALID_ARG` (a parameter or variation out of range, naming it; `material_id`
+/// misaligned). Nothing is added on failure.
+///
+/// One thread at a time per scene.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `params` and
+/// `variation` are NULL or readable; `material_id` is NULL or points to a writable
+/// `uint32_t`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_add_huang_material(
+    scene: *mut HtScene,
+    params: *const HtHuangParams,
+    variation: *const HtHairVariation,
+    material_id: *mut u32,
+) -> HtStatus {
+    add_with_id(scene, material_id, "material_id", |scene| {
+        let material = huang_material(params, variation)?;
+        Ok(scene.add_material(&material)?)
+    })
+}
+
+/// Gives material `material_id` the Huang model with new parameters and variation (as
+/// `ht_scene_add_huang_material` takes them), without a new build: the next render is the
+/// one of a scene built with them. A hair material of either model may change model this
+/// way, or back with `ht_scene_set_hair_material`.
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene` or `params` NULL); `HT_ERR_INVALID_ARG` (as
+/// `ht_scene_set_hair_material`). On failure the material is unchanged.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `params` and
+/// `variation` are NULL or readable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_set_huang_material(
+    scene: *mut HtScene,
+    material_id: u32,
+    params: *const HtHuangParams,
+    variation: *const HtHairVariation,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        let material = huang_material(params, variation)?;
+        Ok(scene.set_material(material_id, &material)?)
+    })
+}
+
+/// The Huang model's hair material of the host's parameters and variation (NULL: none):
+/// the colour inversion's beta_n and the unused beta_m are the defaults, as a scene file
+/// leaves them.
+fn huang_material(
+    params: *const HtHuangParams,
+    variation: *const HtHairVariation,
+) -> std::result::Result<MaterialDesc, Failure> {
+    let p: HuangParams = read_host(params, "params")?.into();
+    let shared = HairParams {
+        sigma_a: p.sigma_a,
+        eta: p.eta,
+        alpha: p.alpha,
+        ..HairParams::default()
+    };
+    let model = HairModel::Huang {
+        roughness: p.roughness,
+        aspect: p.aspect,
+    };
+    let material = varied_material(shared, &variation_or_none(variation)?)?;
+    Ok(MaterialDesc::Hair(HairMaterial { model, ..material }))
 }
 
 /// Gives hair material `material_id` new parameters and variation (as
@@ -111,13 +192,7 @@ pub unsafe extern "C" fn ht_scene_set_hair_material(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        let none = ht_hair_variation_default();
-        let variation = if variation.is_null() {
-            &raw const none
-        } else {
-            variation
-        };
-        let material = hair_material(params, variation)?;
+        let material = hair_material(params, &variation_or_none(variation)?)?;
         Ok(scene.set_material(material_id, &material)?)
     })
 }
@@ -126,11 +201,21 @@ pub unsafe extern "C" fn ht_scene_set_hair_material(
 /// takes it).
 fn hair_material(
     params: *const HtHairParams,
-    variation: *const HtHairVariation,
+    variation: &HtHairVariation,
 ) -> std::result::Result<MaterialDesc, Failure> {
     let p = read_host(params, "params")?;
-    let v = read_host(variation, "variation")?;
-    Ok(MaterialDesc::Hair(varied_material(p.into(), &v)?))
+    Ok(MaterialDesc::Hair(varied_material(p.into(), variation)?))
+}
+
+/// The host's variation; NULL is none.
+fn variation_or_none(
+    variation: *const HtHairVariation,
+) -> std::result::Result<HtHairVariation, Failure> {
+    if variation.is_null() {
+        Ok(ht_hair_variation_default())
+    } else {
+        read_host(variation, "variation")
+    }
 }
 
 /// The hair material of parameters `p` varied as `v` says (`use_vertex_colors` checked;

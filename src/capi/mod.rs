@@ -8,6 +8,9 @@
 pub mod bsdf;
 pub mod frame;
 pub mod prepared;
+// After `prepared`, whose point code it shares, so that the header declares Chiang's
+// point first.
+pub mod huang;
 #[cfg(feature = "render")]
 pub mod scene;
 // Scenes first: the header declares them before the calls that fill them.
@@ -15,6 +18,8 @@ pub mod scene;
 mod edit_tests;
 #[cfg(feature = "render")]
 pub mod geometry;
+#[cfg(all(test, feature = "render"))]
+mod huang_tests;
 #[cfg(feature = "render")]
 pub mod lights;
 #[cfg(feature = "render")]
@@ -330,6 +335,15 @@ pub(crate) fn check_disjoint(outputs: &[Span], inputs: &[Span]) -> Result<(), Fa
         }
     }
     Ok(())
+}
+
+/// Drops a boxed handle; NULL is nothing to free.
+pub(crate) fn free_handle<T>(handle: *mut T) {
+    if !handle.is_null() {
+        // SAFETY: a handle from the matching ht_*_new or ht_*_prepare, freed once (the
+        // host's promise).
+        drop(unsafe { Box::from_raw(handle) });
+    }
 }
 
 /// Reads a `float[3]` that must be finite; the message names the argument.

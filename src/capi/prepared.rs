@@ -7,15 +7,18 @@
 //! it runs the Rust `HairPoint` code, so it gives the same bits. Every call takes and gives
 //! world directions: the frame is checked once, when the point is filled, and what init
 //! established is not checked again per direction.
+//!
+//! The host's bytes, their checks and the world calls are generic over the model
+//! (`HostPoint`): the Huang model's point (`huang.rs`) is filled and read by the same
+//! code.
 
-use super::bsdf::{
-    Arg, check_args, check_dir, check_h, check_u, read_params, read3, require, write1, write3,
-};
+use super::bsdf::{Arg, check_args, check_dir, check_h, check_u, read3, require, write1, write3};
 use super::frame::{HtHairFrame, checked_axes, hit_frame};
 use super::{
-    Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, host_slice, host_slice_mut,
+    Failure, HtHairParams, HtStatus, Span, boundary, check_disjoint, free_handle, host_slice,
+    host_slice_mut,
 };
-use crate::bsdf::{HairBsdf, OwnedPoint};
+use crate::bsdf::{HairBsdf, LocalBsdf, OwnedPoint};
 use crate::error::invalid_arg;
 use crate::math::Frame;
 use glam::Vec3;
@@ -53,55 +56,72 @@ pub struct HtHairPoint {
     pub opaque: [u8; HT_HAIR_POINT_SIZE],
 }
 
-/// What the host's `HtHairPoint` bytes hold: the point and the world axes of its frame.
+/// The host's opaque bytes for one model's point: what they hold once an init filled them.
+pub(super) trait HostPoint: Sized {
+    /// The model's point.
+    type Point: LocalBsdf;
+    /// Marks filled bytes: catches points that were never filled, or another model's.
+    const TAG: u64;
+    /// The calls that fill one, for the message on an unfilled point.
+    const FILLED_BY: &'static str;
+    /// Fails to compile unless the bytes hold a [`Stored`] point at its alignment; every
+    /// generic function that reads or writes them evaluates it.
+    const FITS: () = assert!(
+        size_of::<Stored<Self::Point>>() <= size_of::<Self>()
+            && align_of::<Stored<Self::Point>>() <= align_of::<Self>()
+    );
+}
+
+/// What a host's point bytes hold: the point and the world axes of its frame.
 #[repr(C)]
-struct Stored {
-    /// [`TAG`] once filled: catches points that were never filled.
+pub(super) struct Stored<P> {
+    /// [`HostPoint::TAG`] once filled.
     tag: u64,
-    point: OwnedPoint,
+    point: P,
     frame: Frame,
 }
 
-/// "htpoint" and a layout version (3: every point holds its frame, ABI 7).
-const TAG: u64 = 0x6874_706f_696e_7403;
+impl HostPoint for HtHairPoint {
+    type Point = OwnedPoint;
+    /// "htpoint" and a layout version (3: every point holds its frame, ABI 7).
+    const TAG: u64 = 0x6874_706f_696e_7403;
+    const FILLED_BY: &'static str = "ht_hair_point_at_hit or ht_hair_point_init_world";
+}
 
-// The host's storage must hold a `Stored` at its alignment: checked at compile time.
-const _: () = assert!(
-    size_of::<Stored>() <= HT_HAIR_POINT_SIZE
-        && align_of::<Stored>() <= HT_HAIR_POINT_ALIGN
-        && size_of::<HtHairPoint>() == HT_HAIR_POINT_SIZE
-        && align_of::<HtHairPoint>() == HT_HAIR_POINT_ALIGN
-);
+const _: () = {
+    let () = <HtHairPoint as HostPoint>::FITS;
+    assert!(
+        size_of::<HtHairPoint>() == HT_HAIR_POINT_SIZE
+            && align_of::<HtHairPoint>() == HT_HAIR_POINT_ALIGN
+    );
+};
 
 /// The point of a per-point call, with the call's pointers checked: the common case (all
 /// non-NULL and aligned, outputs clear of the inputs and the point, the point filled)
 /// inline and cheaply, anything else through the full checks that name the problem.
 #[inline(always)]
-fn checked_point<'a>(
-    point: *const HtHairPoint,
+fn checked_point<'a, H: HostPoint>(
+    point: *const H,
     inputs: &[Arg],
     outputs: &[Arg],
-) -> Result<&'a Stored, Failure> {
+) -> Result<&'a Stored<H::Point>, Failure> {
+    let () = H::FITS;
     check_args((point, "point"), inputs, outputs)?;
-    // SAFETY: non-NULL and aligned (checked above); `HtHairPoint` is at least as large and
-    // as aligned as `Stored` (asserted above), whose tag is a plain number valid for any
+    // SAFETY: non-NULL and aligned (checked above); `H` is at least as large and as
+    // aligned as its `Stored` (`H::FITS`), whose tag is a plain number valid for any
     // bytes, and a filled point holds a whole `Stored`.
-    let stored = unsafe { &*point.cast::<Stored>() };
-    if stored.tag == TAG {
+    let stored = unsafe { &*point.cast::<Stored<H::Point>>() };
+    if stored.tag == H::TAG {
         Ok(stored)
     } else {
-        Err(unfilled())
+        Err(unfilled(H::FILLED_BY))
     }
 }
 
 #[cold]
 #[inline(never)]
-fn unfilled() -> Failure {
-    invalid_arg!(
-        "point was not filled by ht_hair_point_at_hit or ht_hair_point_init_world (or was \
-         overwritten)"
-    )
-    .into()
+fn unfilled(filled_by: &str) -> Failure {
+    invalid_arg!("point was not filled by {filled_by} (or was overwritten)").into()
 }
 
 /// Prepares the BSDF for `*params` (see `HtHairParams` for the ranges) and writes the new
@@ -122,15 +142,26 @@ pub unsafe extern "C" fn ht_hair_prepare(
     out: *mut *mut HtHairPrepared,
 ) -> HtStatus {
     boundary(|| {
-        require(&[(params.cast(), "params"), (out.cast_const().cast(), "out")])?;
-        let params = read_params(params)?;
-        let out = host_slice_mut(out, 1, "out")?;
-        let handle = Box::new(HtHairPrepared {
-            bsdf: HairBsdf::new(&params)?,
-        });
-        out[0] = Box::into_raw(handle);
-        Ok(())
+        prepare(params, out, |p| {
+            Ok(HtHairPrepared {
+                bsdf: HairBsdf::new(&p.into())?,
+            })
+        })
     })
+}
+
+/// The body of a `*_prepare` call: the handle `make` builds of the host's `*params`,
+/// written to `*out` (every NULL checked first; `*out` untouched on error).
+pub(super) fn prepare<P: Copy, T>(
+    params: *const P,
+    out: *mut *mut T,
+    make: impl FnOnce(P) -> Result<T, Failure>,
+) -> Result<(), Failure> {
+    require(&[(params.cast(), "params"), (out.cast_const().cast(), "out")])?;
+    let params = host_slice(params, 1, "params")?[0];
+    let out = host_slice_mut(out, 1, "out")?;
+    out[0] = Box::into_raw(Box::new(make(params)?));
+    Ok(())
 }
 
 /// Releases a prepared BSDF (NULL: nothing to do; returns HT_OK). Points filled from it
@@ -142,32 +173,28 @@ pub unsafe extern "C" fn ht_hair_prepare(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn ht_hair_prepared_free(prepared: *mut HtHairPrepared) -> HtStatus {
     boundary(|| {
-        if !prepared.is_null() {
-            // SAFETY: a live handle from ht_hair_prepare (the caller's promise).
-            drop(unsafe { Box::from_raw(prepared) });
-        }
+        free_handle(prepared);
         Ok(())
     })
 }
 
 /// The pointers of a point init, checked inline in the common case, else in the documented
 /// order with messages: every NULL first, then alignment, then an input inside the point.
-/// `inputs` are the float arrays it reads (3 floats each); `frame` the frame it reads, if
-/// any.
+/// `inputs` are the float arrays it reads; `frame` the frame it reads, if any.
 #[inline(always)]
-fn check_init(
-    prepared: *const HtHairPrepared,
-    inputs: &[(*const f32, &'static str)],
+pub(super) fn check_init<P, H>(
+    prepared: *const P,
+    inputs: &[Arg],
     frame: Option<*const HtHairFrame>,
-    point: *mut HtHairPoint,
+    point: *mut H,
 ) -> Result<(), Failure> {
     let start = point as usize;
-    let apart = |p: usize, bytes: usize| p + bytes <= start || start + HT_HAIR_POINT_SIZE <= p;
+    let apart = |p: usize, bytes: usize| p + bytes <= start || start + size_of::<H>() <= p;
     let fast = !prepared.is_null()
         && !point.is_null()
         && point.is_aligned()
-        && inputs.iter().all(|&(p, _)| {
-            !p.is_null() && p.is_aligned() && apart(p as usize, 3 * size_of::<f32>())
+        && inputs.iter().all(|&(p, _, n)| {
+            !p.is_null() && p.is_aligned() && apart(p as usize, n * size_of::<f32>())
         })
         && frame.is_none_or(|f| {
             !f.is_null() && f.is_aligned() && apart(f as usize, size_of::<HtHairFrame>())
@@ -177,14 +204,14 @@ fn check_init(
     }
     let mut all = vec![(prepared.cast(), "prepared")];
     all.extend(frame.map(|f| (f.cast(), "frame")));
-    all.extend(inputs.iter().map(|&(p, name)| (p.cast(), name)));
+    all.extend(inputs.iter().map(|&(p, name, _)| (p.cast(), name)));
     all.push((point.cast_const().cast(), "point"));
     require(&all)?;
     host_slice(point.cast_const(), 1, "point")?;
     let mut spans = Vec::with_capacity(inputs.len() + 1);
-    for &(p, name) in inputs {
-        host_slice(p, 3, name)?;
-        spans.push(Span::of(name, p, 3));
+    for &(p, name, n) in inputs {
+        host_slice(p, n, name)?;
+        spans.push(Span::of(name, p, n));
     }
     if let Some(f) = frame {
         host_slice(f, 1, "frame")?;
@@ -193,21 +220,68 @@ fn check_init(
     check_disjoint(&[Span::of("point", point, 1)], &spans)
 }
 
-/// Writes the point of `bsdf` at (h, wo) and `frame` into the host's storage in place:
-/// built on the stack and copied, the same point cost init a third more (docs/c-abi.md,
-/// "Cost").
+/// Writes the tag, `frame` and, with `write`, the model's point into the host's storage in
+/// place: built on the stack and copied, Chiang's point cost init a third more
+/// (docs/c-abi.md, "Cost").
 ///
 /// # Safety
-/// `point` is non-NULL, aligned, writable and not read by anyone meanwhile.
+/// `point` is non-NULL, aligned, writable and not read by anyone meanwhile; `write`
+/// initialises the whole point it is given.
 #[inline(always)]
-unsafe fn fill(point: *mut HtHairPoint, bsdf: &HairBsdf, frame: Frame, h: f32, wo: Vec3) {
-    let stored = point.cast::<Stored>();
-    // SAFETY: the caller's promise; `HtHairPoint` holds a `Stored` (asserted above), whose
-    // fields are plain numbers valid once written.
+pub(super) unsafe fn fill<H: HostPoint>(
+    point: *mut H,
+    frame: Frame,
+    write: impl FnOnce(*mut H::Point),
+) {
+    let () = H::FITS;
+    let stored = point.cast::<Stored<H::Point>>();
+    // SAFETY: the caller's promise; `H` holds a `Stored` (`H::FITS`), whose fields are
+    // plain numbers valid once written.
     unsafe {
-        (&raw mut (*stored).tag).write(TAG);
+        (&raw mut (*stored).tag).write(H::TAG);
         (&raw mut (*stored).frame).write(frame);
-        OwnedPoint::fill(&mut *(&raw mut (*stored).point).cast(), bsdf, h, wo);
+        write(&raw mut (*stored).point);
+    }
+}
+
+/// The four arrays of a hit, as `check_init` takes them.
+#[inline(always)]
+pub(super) fn hit_args(
+    tangent: *const f32,
+    ray_org: *const f32,
+    ray_dir: *const f32,
+    axis: *const f32,
+) -> [Arg; 4] {
+    [
+        (tangent, "tangent", 3),
+        (ray_org, "ray_org", 3),
+        (ray_dir, "ray_dir", 3),
+        (axis, "axis", 3),
+    ]
+}
+
+/// The frame, h and wo = -normalize(ray_dir) of a hit whose arrays `check_init` passed,
+/// refused as `ht_hair_frame` refuses them.
+#[inline(always)]
+pub(super) fn framed_hit(args: &[Arg; 4], radius: f32) -> Result<(Frame, f32, Vec3), Failure> {
+    let [tangent, org, dir, axis] = args.map(|(p, _, _)| read3(p));
+    let (axes, h) = hit_frame(tangent, org, dir, axis, radius)?;
+    // The frame's z faces the viewer and y is across the ray: wo has y = 0 there.
+    let wo = check_dir(axes.to_local(-dir.normalize()), "wo")?;
+    Ok((axes, h, wo))
+}
+
+/// Writes the Chiang point of `bsdf` at (h, wo) and `frame` into the host's storage.
+///
+/// # Safety
+/// As [`fill`].
+#[inline(always)]
+unsafe fn fill_chiang(point: *mut HtHairPoint, bsdf: &HairBsdf, frame: Frame, h: f32, wo: Vec3) {
+    // SAFETY: the caller's promise; `OwnedPoint::fill` initialises the point.
+    unsafe {
+        fill(point, frame, |p| {
+            OwnedPoint::fill(&mut *p.cast(), bsdf, h, wo)
+        })
     }
 }
 
@@ -240,20 +314,12 @@ pub unsafe extern "C" fn ht_hair_point_at_hit(
     point: *mut HtHairPoint,
 ) -> HtStatus {
     boundary(|| {
-        let inputs = [
-            (tangent, "tangent"),
-            (ray_org, "ray_org"),
-            (ray_dir, "ray_dir"),
-            (axis, "axis"),
-        ];
+        let inputs = hit_args(tangent, ray_org, ray_dir, axis);
         check_init(prepared, &inputs, None, point)?;
-        let [tangent, org, dir, axis] = inputs.map(|(p, _)| read3(p));
-        let (axes, h) = hit_frame(tangent, org, dir, axis, radius)?;
-        // The frame's z faces the viewer and y is across the ray: wo has y = 0 there.
-        let wo = check_dir(axes.to_local(-dir.normalize()), "wo")?;
+        let (axes, h, wo) = framed_hit(&inputs, radius)?;
         // SAFETY: non-NULL, aligned and clear of the inputs (checked); a live handle (the
         // caller's promise).
-        unsafe { fill(point, &(*prepared).bsdf, axes, h, wo) };
+        unsafe { fill_chiang(point, &(*prepared).bsdf, axes, h, wo) };
         Ok(())
     })
 }
@@ -286,17 +352,20 @@ pub unsafe extern "C" fn ht_hair_point_init_world(
     point: *mut HtHairPoint,
 ) -> HtStatus {
     boundary(|| {
-        check_init(prepared, &[(wo, "wo")], Some(frame), point)?;
+        check_init(prepared, &[(wo, "wo", 3)], Some(frame), point)?;
         let (axes, h, wo) = framed(frame, wo)?;
         // SAFETY: as in `ht_hair_point_at_hit`.
-        unsafe { fill(point, &(*prepared).bsdf, axes, h, wo) };
+        unsafe { fill_chiang(point, &(*prepared).bsdf, axes, h, wo) };
         Ok(())
     })
 }
 
 /// The checked axes and h of a frame `check_init` has passed, and the world `wo` in them.
 #[inline(always)]
-fn framed(frame: *const HtHairFrame, wo: *const f32) -> Result<(Frame, f32, Vec3), Failure> {
+pub(super) fn framed(
+    frame: *const HtHairFrame,
+    wo: *const f32,
+) -> Result<(Frame, f32, Vec3), Failure> {
     // SAFETY: non-NULL and aligned (checked by `check_init`), an `HtHairFrame` (the
     // caller's promise).
     let frame = unsafe { frame.read() };
@@ -343,7 +412,7 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
     use crate::scene::material::HairColor;
     boundary(|| {
         require(&[(variation.cast(), "variation")])?;
-        check_init(prepared, &[(wo, "wo")], Some(frame), point)?;
+        check_init(prepared, &[(wo, "wo", 3)], Some(frame), point)?;
         let v = super::read_host(variation, "variation")?;
         let (axes, h, wo) = framed(frame, wo)?;
         if !(0.0..=1.0).contains(&s) {
@@ -364,7 +433,7 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
         material.check_variation()?;
         let bsdf = HairBsdf::new(&material.varied(base, strand, s, groom))?;
         // SAFETY: non-NULL, aligned and clear of the inputs (checked).
-        unsafe { fill(point, &bsdf, axes, h, wo) };
+        unsafe { fill_chiang(point, &bsdf, axes, h, wo) };
         Ok(())
     })
 }
@@ -394,13 +463,22 @@ pub unsafe extern "C" fn ht_hair_point_eval_world(
     f_cos: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| {
-        let (p, wi) = point_and_wi(point, wi, (f_cos, pdf, 1))?;
-        let e = p.point.eval(wi);
-        write3(f_cos, (e.f * wi.z.abs()).to_array());
-        write1(pdf, e.pdf);
-        Ok(())
-    })
+    boundary(|| eval_world(point, wi, f_cos, pdf))
+}
+
+/// The body of a point's `eval_world` call, for every model.
+#[inline(always)]
+pub(super) fn eval_world<H: HostPoint>(
+    point: *const H,
+    wi: *const f32,
+    f_cos: *mut f32,
+    pdf: *mut f32,
+) -> Result<(), Failure> {
+    let (p, wi) = point_and_wi(point, wi, (f_cos, pdf, 1))?;
+    let e = p.point.eval(wi);
+    write3(f_cos, (e.f * wi.z.abs()).to_array());
+    write1(pdf, e.pdf);
+    Ok(())
 }
 
 /// Offsets across the fibre that `ht_hair_point_eval_across_world` evaluates: one lane each.
@@ -481,41 +559,52 @@ pub unsafe extern "C" fn ht_hair_point_sample_world(
     weight: *mut f32,
     pdf: *mut f32,
 ) -> HtStatus {
-    boundary(|| {
-        let outputs = [
-            (wi.cast_const(), "wi", 3),
-            (f_cos.cast_const(), "f_cos", 3),
-            (weight.cast_const(), "weight", 3),
-            (pdf.cast_const(), "pdf", 1),
-        ];
-        let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
-        let s = p.point.sample(check_u(read3(u).to_array(), "u")?);
-        // The weight from f_cos in that order; none when it is not finite (a pdf that
-        // underflowed).
-        let s = s
-            .map(|s| (s, s.f * s.wi.z.abs()))
-            .filter(|(s, fc)| (*fc / s.pdf).is_finite());
-        let zero = ([0.0; 3], [0.0; 3], [0.0; 3], 0.0);
-        let (d, fc, w, density) = s.map_or(zero, |(s, fc)| {
-            let d = p.frame.to_world(s.wi).to_array();
-            (d, fc.to_array(), (fc / s.pdf).to_array(), s.pdf)
-        });
-        write3(wi, d);
-        write3(f_cos, fc);
-        write3(weight, w);
-        write1(pdf, density);
-        Ok(())
-    })
+    boundary(|| sample_world(point, u, [wi, f_cos, weight], pdf))
+}
+
+/// The body of a point's `sample_world` call, for every model: `out` is wi, f_cos and
+/// weight.
+#[inline(always)]
+pub(super) fn sample_world<H: HostPoint>(
+    point: *const H,
+    u: *const f32,
+    out: [*mut f32; 3],
+    pdf: *mut f32,
+) -> Result<(), Failure> {
+    let [wi, f_cos, weight] = out;
+    let outputs = [
+        (wi.cast_const(), "wi", 3),
+        (f_cos.cast_const(), "f_cos", 3),
+        (weight.cast_const(), "weight", 3),
+        (pdf.cast_const(), "pdf", 1),
+    ];
+    let p = checked_point(point, &[(u, "u", 3)], &outputs)?;
+    let s = p.point.sample(check_u(read3(u).to_array(), "u")?);
+    // The weight from f_cos in that order; none when it is not finite (a pdf that
+    // underflowed).
+    let s = s
+        .map(|s| (s, s.f * s.wi.z.abs()))
+        .filter(|(s, fc)| (*fc / s.pdf).is_finite());
+    let zero = ([0.0; 3], [0.0; 3], [0.0; 3], 0.0);
+    let (d, fc, w, density) = s.map_or(zero, |(s, fc)| {
+        let d = p.frame.to_world(s.wi).to_array();
+        (d, fc.to_array(), (fc / s.pdf).to_array(), s.pdf)
+    });
+    write3(wi, d);
+    write3(f_cos, fc);
+    write3(weight, w);
+    write1(pdf, density);
+    Ok(())
 }
 
 /// The checked point of an evaluation into `lanes` values of `f_cos` (3 floats each) and
 /// `pdf`, and the world `wi[3]` in the point's frame.
 #[inline(always)]
-fn point_and_wi<'a>(
-    point: *const HtHairPoint,
+fn point_and_wi<'a, H: HostPoint>(
+    point: *const H,
     wi: *const f32,
     (f_cos, pdf, lanes): (*mut f32, *mut f32, usize),
-) -> Result<(&'a Stored, Vec3), Failure> {
+) -> Result<(&'a Stored<H::Point>, Vec3), Failure> {
     let outputs = [
         (f_cos.cast_const(), "f_cos", 3 * lanes),
         (pdf.cast_const(), "pdf", lanes),

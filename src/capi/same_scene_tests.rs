@@ -82,20 +82,7 @@ fn toml_render(file: &Path, camera: bool) -> Vec<u32> {
 
 /// The same through the Rust API: an empty `Scene` filled by name, settings by field.
 fn rust_render(file: &Path, camera: bool) -> Vec<u32> {
-    let mut scene = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
-    (scene.settings.width, scene.settings.height) = SIZE;
-    for (k, v) in SETTINGS {
-        scene.settings.set(k, v).unwrap();
-    }
-    if camera {
-        let view = CameraDesc {
-            eye: Some(EYE),
-            target: Some([0.0; 3]),
-            fov_deg: 40.0,
-            ..CameraDesc::default()
-        };
-        scene.set_camera(&view).unwrap();
-    }
+    let mut scene = rust_scene(camera);
     let hair = HairMaterial {
         color: HairColor::SigmaA(HairParams::default().sigma_a),
         ..HairMaterial::default()
@@ -114,6 +101,26 @@ fn rust_render(file: &Path, camera: bool) -> Vec<u32> {
         ..GroomDesc::new(source, "hair")
     };
     scene.add_groom("fur", &groom).unwrap();
+    rust_pixels(&mut scene)
+}
+
+/// An empty Rust `Scene` of `SIZE` and `SETTINGS`, lit by the sky and the sun, its camera
+/// at `EYE` if asked (else an automatic one).
+pub(super) fn rust_scene(camera: bool) -> Scene {
+    let mut scene = Scene::new(Arc::new(Device::new(Some(2)).unwrap()));
+    (scene.settings.width, scene.settings.height) = SIZE;
+    for (k, v) in SETTINGS {
+        scene.settings.set(k, v).unwrap();
+    }
+    if camera {
+        let view = CameraDesc {
+            eye: Some(EYE),
+            target: Some([0.0; 3]),
+            fov_deg: 40.0,
+            ..CameraDesc::default()
+        };
+        scene.set_camera(&view).unwrap();
+    }
     let sky = LightDesc::Environment {
         source: EnvironmentSource::Uniform(SKY),
         rotation_deg: 0.0,
@@ -126,6 +133,11 @@ fn rust_render(file: &Path, camera: bool) -> Vec<u32> {
         angular_radius_deg: 0.0,
     };
     scene.add_light(&sun).unwrap();
+    scene
+}
+
+/// The bits of a Rust scene's render.
+pub(super) fn rust_pixels(scene: &mut Scene) -> Vec<u32> {
     let out = scene.render(Aovs::default(), &NoProgress).unwrap();
     out.film.rgb().iter().map(|v| v.to_bits()).collect()
 }
@@ -135,6 +147,12 @@ fn c_render(add: impl FnOnce(&Handles, u32) -> HtStatus, camera: bool) -> Vec<u3
     let h = Handles::new();
     let hair = h.hair_material();
     assert_eq!(add(&h, hair), HtStatus::HT_OK, "{}", last_error());
+    c_lights(&h, camera);
+    c_pixels(&h)
+}
+
+/// `rust_scene`'s sky, sun and camera (if asked) on a C scene.
+pub(super) fn c_lights(h: &Handles, camera: bool) {
     unsafe {
         assert_eq!(
             ht_scene_add_environment(h.scene, SKY.as_ptr()),
@@ -147,13 +165,17 @@ fn c_render(add: impl FnOnce(&Handles, u32) -> HtStatus, camera: bool) -> Vec<u3
             let s = ht_scene_set_camera(h.scene, EYE.as_ptr(), target.as_ptr(), up.as_ptr(), 40.0);
             assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
         }
-        let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
-        let mut pairs = vec![("width", w.as_str()), ("height", h_.as_str())];
-        pairs.extend(SETTINGS);
-        let (s, rgb) = Named::new(&pairs).render_rgb(h.scene, (SIZE.0 * SIZE.1) as usize);
-        assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
-        rgb.iter().map(|v| v.to_bits()).collect()
     }
+}
+
+/// The bits of a C scene's render of `SIZE` and `SETTINGS`, set by name.
+pub(super) fn c_pixels(h: &Handles) -> Vec<u32> {
+    let (w, h_) = (SIZE.0.to_string(), SIZE.1.to_string());
+    let mut pairs = vec![("width", w.as_str()), ("height", h_.as_str())];
+    pairs.extend(SETTINGS);
+    let (s, rgb) = Named::new(&pairs).render_rgb(h.scene, (SIZE.0 * SIZE.1) as usize);
+    assert_eq!(s, HtStatus::HT_OK, "{}", last_error());
+    rgb.iter().map(|v| v.to_bits()).collect()
 }
 
 fn c_hair(file: &Path) -> impl FnOnce(&Handles, u32) -> HtStatus {

@@ -5,7 +5,7 @@
 //! when to build and edits its build: the shell turns C ids into the scene's names
 //! (material `id` is named by its number, geometry ids only count what was added).
 
-use super::{Failure, HtStatus, boundary, non_null_mut, read_path, read_vec3};
+use super::{Failure, HtStatus, boundary, free_handle, non_null_mut, read_path, read_vec3};
 use crate::Scene;
 use crate::description::{CameraDesc, MaterialDesc};
 use crate::embree::{Device, Isa};
@@ -160,14 +160,6 @@ pub(super) fn add_with_id(
         unsafe { out.write(id) };
         Ok(())
     })
-}
-
-/// Drops a boxed handle; NULL is nothing to free.
-fn free_handle<T>(handle: *mut T) {
-    if !handle.is_null() {
-        // SAFETY: a handle from the matching ht_*_new, freed once (the host's promise).
-        drop(unsafe { Box::from_raw(handle) });
-    }
 }
 
 /// Creates a device with `threads` Embree worker threads (0: one per hardware thread),

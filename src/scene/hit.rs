@@ -10,6 +10,7 @@ use glam::{Vec2, Vec3};
 
 use super::curves::StrandSegment;
 use super::material::HairColor;
+use crate::bsdf::huang::MIN_ACROSS_SQUARED;
 use crate::embree::CurveShape;
 use crate::math::Frame;
 use crate::math::frame::hair_frame_offset;
@@ -81,14 +82,14 @@ impl HairHit {
     /// The major axis of an elliptical fibre's section here, as a (y, z) direction of the
     /// hit's frame: the groom's curve normal made perpendicular to the tangent; where the
     /// groom has none, or it runs along the tangent, world up (+y) so made, or world +x
-    /// where the tangent is too near vertical for that ([`MIN_MAJOR_AXIS_SQUARED`] of the
+    /// where the tangent is too near vertical for that ([`MIN_ACROSS_SQUARED`] of the
     /// unit vector). A property of the fibre, not of the ray, so that camera and shadow
     /// rays see one section (docs/conventions.md, section 4b).
     pub(crate) fn major_axis(&self) -> Vec2 {
         let x = self.frame.x;
         let off = |a: Vec3| {
             let a = a.normalize_or_zero();
-            Some(a - x * x.dot(a)).filter(|m| m.length_squared() > MIN_MAJOR_AXIS_SQUARED)
+            Some(a - x * x.dot(a)).filter(|m| m.length_squared() > MIN_ACROSS_SQUARED)
         };
         let m = (self.normal.and_then(off))
             .or_else(|| off(Vec3::Y))
@@ -97,9 +98,6 @@ impl HairHit {
         Vec2::new(m.dot(self.frame.y), m.dot(self.frame.z))
     }
 }
-
-/// Below this squared length a unit direction is too near the tangent to orient the section.
-const MIN_MAJOR_AXIS_SQUARED: f32 = 1e-6;
 
 /// A hit on a triangle mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -1,11 +1,12 @@
 //! The BSDF entry points from C: every bad argument gets its status and message
 //! (`c/bsdf_args.c`), every per-direction entry point gives the Rust API's bits on random
-//! inputs (`c/bsdf_bits.c`), and the benchmark's plain float port agrees with the model
+//! inputs (`c/bsdf_bits.c`), the Huang model's through `hairtrace.hpp` and C too
+//! (`c/huang_bits.cpp`), and the benchmark's plain float port agrees with the model
 //! (`bench/c_bsdf`).
 
 use crate::c_examples::build_and_run_file;
-use glam::Vec3;
-use hairtrace::{HairBsdf, HairParams};
+use glam::{Vec2, Vec3};
+use hairtrace::{BsdfSample, HairBsdf, HairParams, HuangBsdf, HuangParams};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::fmt::Write as _;
@@ -62,6 +63,17 @@ fn cases(n: usize) -> Vec<Case> {
         .collect()
 }
 
+/// What a C sample call writes of a Rust sample: wi, f |cos|, the weight f |cos| / pdf and
+/// the pdf (zeros without a direction or a finite weight).
+fn sampled(s: Option<BsdfSample>) -> [f32; 10] {
+    s.map(|s| (s.wi, s.f * s.wi.z.abs(), s.pdf))
+        .filter(|(_, fc, p)| (*fc / *p).is_finite())
+        .map_or([0.0; 10], |(d, fc, p)| {
+            let w = fc / p;
+            [d.x, d.y, d.z, fc.x, fc.y, fc.z, w.x, w.y, w.z, p]
+        })
+}
+
 #[test]
 fn every_c_entry_point_gives_the_rust_bits() {
     let cases = cases(3000);
@@ -101,14 +113,7 @@ fn every_c_entry_point_gives_the_rust_bits() {
         let e = point.eval(wi);
         let cos = e.f * wi.z.abs();
         let eval = [cos.x, cos.y, cos.z, e.pdf];
-        let sample = point
-            .sample(*u)
-            .map(|s| (s.wi, s.f * s.wi.z.abs(), s.pdf))
-            .filter(|(_, fc, p)| (*fc / *p).is_finite())
-            .map_or([0.0; 10], |(d, fc, p)| {
-                let w = fc / p;
-                [d.x, d.y, d.z, fc.x, fc.y, fc.z, w.x, w.y, w.z, p]
-            });
+        let sample = sampled(point.sample(*u));
         let lanes = point.eval_across(wi).expect("the point's lanes");
         let across = (lanes.f.iter().flat_map(|f| (*f * wi.z.abs()).to_array())).chain(lanes.pdf);
         let want: Vec<u32> = (eval.into_iter().chain(sample).chain(across))
@@ -116,6 +121,88 @@ fn every_c_entry_point_gives_the_rust_bits() {
             .collect();
         assert_eq!(got, want, "case {i}: {p:?} h {h} wo {wo:?} wi {wi} u {u:?}");
     }
+}
+
+/// The Huang model through `hairtrace.hpp` (value and status forms) and the C calls under
+/// it: the three agree bit for bit, and give the bits of the Rust `HuangPoint` near and far
+/// (`c/huang_bits.cpp`); a bad aspect throws, a major axis along the fibre and an unfilled
+/// point get their status and message.
+#[test]
+fn the_huang_model_through_cpp_gives_the_rust_bits() {
+    let mut rng = Pcg64::seed_from_u64(12);
+    let mut input = String::new();
+    let mut cases = Vec::new();
+    for _ in 0..400 {
+        let params = HuangParams {
+            sigma_a: [0; 3].map(|_| rng.random_range(0.0..6.0)),
+            eta: rng.random_range(1.01..3.0),
+            roughness: rng.random_range(0.01..1.0),
+            aspect: rng.random_range(0.05..=1.0),
+            alpha: rng.random_range(-20.0..20.0),
+        };
+        let h: f32 = rng.random_range(-1.0..=1.0);
+        let (wo, wi) = (unit(&mut rng), unit(&mut rng));
+        let u = [0; 3].map(|_| rng.random::<f32>());
+        let major = [0.0, rng.random_range(-1.0..1.0), rng.random_range(0.1..1.0)];
+        let jitter = [0; 2].map(|_| rng.random::<f32>());
+        let far: bool = rng.random();
+        let p = &params;
+        let words = (p.sigma_a.into_iter())
+            .chain([p.eta, p.roughness, p.aspect, p.alpha, h])
+            .chain(wo)
+            .chain(wi)
+            .chain(u)
+            .chain(major)
+            .chain(jitter)
+            .chain([f32::from(u8::from(far))]);
+        for w in words {
+            write!(input, "{:08x} ", w.to_bits()).unwrap();
+        }
+        input.push('\n');
+        cases.push((params, h, wo, wi, u, major, jitter, far));
+    }
+    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("huang_bits_input.txt");
+    std::fs::write(&path, input).unwrap();
+    let out = build_and_run_file(
+        Path::new("tests/c_abi/c/huang_bits.cpp"),
+        "g++",
+        &["-x", "c++", "-std=c++17", "-pedantic"],
+        &[path.as_os_str()],
+    );
+    let lines: Vec<&str> = out.lines().collect();
+    for (i, (p, h, wo, wi, u, major, jitter, far)) in cases.iter().enumerate() {
+        let got: Vec<u32> = (lines[i].split_whitespace())
+            .map(|w| u32::from_str_radix(w, 16).expect("hex"))
+            .collect();
+        let bsdf = HuangBsdf::new(p).unwrap();
+        let (wo, wi) = (Vec3::from_array(*wo), Vec3::from_array(*wi));
+        let yz = Vec2::new(major[1], major[2]);
+        let point = match far {
+            true => bsdf.far(*h, wo, yz, *jitter),
+            false => bsdf.near(*h, wo, yz, *jitter),
+        };
+        let e = point.eval(wi);
+        let cos = e.f * wi.z.abs();
+        let sample = sampled(point.sample(*u));
+        let want: Vec<u32> = ([cos.x, cos.y, cos.z, e.pdf].into_iter().chain(sample))
+            .map(f32::to_bits)
+            .collect();
+        assert_eq!(got, want, "case {i}: {p:?} h {h} wo {wo} wi {wi} u {u:?}");
+    }
+    let rest = &lines[cases.len()..].join("\n");
+    assert!(rest.contains("mismatches 0"), "{rest}");
+    assert!(
+        rest.contains("throws invalid argument: aspect = 1.5: must be in [0.05, 1]"),
+        "{rest}"
+    );
+    assert!(
+        rest.contains("major invalid argument: major = [3, 0, 0]: lies along the fibre"),
+        "{rest}"
+    );
+    assert!(
+        rest.contains("unfilled invalid argument: point was not filled by ht_huang_point_at_hit"),
+        "{rest}"
+    );
 }
 
 #[test]

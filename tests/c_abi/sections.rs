@@ -9,13 +9,17 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The sections in the order a reader meets them, with the `src/capi` files in each.
-const SECTIONS: [(&str, &[&str]); 6] = [
+const SECTIONS: [(&str, &[&str]); 7] = [
     ("Versions, status and errors", &["mod"]),
     (
         "The hair BSDF alone: parameters, frames, eval and sample",
         &["bsdf", "frame"],
     ),
     ("The prepared BSDF and path vertices", &["prepared"]),
+    (
+        "The Huang model of elliptical fibres: parameters, prepared BSDF, path vertices",
+        &["huang"],
+    ),
     (
         "Devices and scenes: geometry, materials, lights",
         &["scene", "geometry", "materials", "lights", "shutdown"],

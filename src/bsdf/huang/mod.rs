@@ -106,5 +106,10 @@ impl HuangBsdf {
     }
 }
 
+/// Below this squared sine of its angle to the fibre a direction is too near the fibre to
+/// orient the section: a renderer's own choice of major axis falls back to another
+/// direction there, and a host's is refused.
+pub(crate) const MIN_ACROSS_SQUARED: f32 = 1e-6;
+
 /// The residual lobe's longitudinal variance per unit of roughness (Cycles' choice).
 const RESIDUAL_VARIANCE_PER_ROUGHNESS: f32 = 4.0;

@@ -250,6 +250,55 @@ int main(void) {
     UNTOUCHED(pa, HT_ACROSS);
     ROW(OK, NULL, ht_hair_point_eval_across_world(&framed, wi_world, fa, pa));
 
+    /* The Huang model: its parameters, a point's section, jitter and field, its points. */
+    HtHuangParams hp = ht_huang_params_default(), flat = hp, oval = hp, nan_aspect = hp;
+    flat.aspect = 0.0f;
+    oval.aspect = 1.5f;
+    nan_aspect.aspect = nan;
+    HtHuangPrepared *huang = NULL, *kept = (HtHuangPrepared *)&store;
+    ROW(NUL, "params is NULL", ht_huang_prepare(NULL, &huang));
+    ROW(NUL, "out is NULL", ht_huang_prepare(&hp, NULL));
+    ROW(BAD, "aspect = 0: must be in [0.05, 1]", ht_huang_prepare(&flat, &kept));
+    ROW(BAD, "aspect = 1.5", ht_huang_prepare(&oval, &kept));
+    ROW(BAD, "aspect = NaN", ht_huang_prepare(&nan_aspect, &kept));
+    if (kept != (HtHuangPrepared *)&store) { ++failed; fprintf(stderr, "FAIL: huang out written\n"); }
+    ROW(OK, NULL, ht_huang_prepared_free(NULL));
+    ROW(OK, NULL, ht_huang_prepare(&hp, &huang));
+    static HtHuangPoint hpt, hzero;
+    float up[3] = {0, 1, 0}, jit[2] = {0.5f, 0.5f}, jit_one[2] = {0.5f, 1.0f};
+    ROW(NUL, "prepared is NULL", ht_huang_point_at_hit(NULL, x, org, d, axis, nan, up, jit, 0, &hpt));
+    ROW(NUL, "major is NULL", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, NULL, jit, 0, &hpt));
+    ROW(NUL, "jitter is NULL", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, NULL, 9, &hpt));
+    ROW(NUL, "point is NULL", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit, 0, NULL));
+    ROW(BAD, "radius = 0", ht_huang_point_at_hit(huang, x, org, d, axis, 0.0f, up, jit, 0, &hpt));
+    ROW(BAD, "2 radii away", ht_huang_point_at_hit(huang, x, far_org, d, axis, 1.0f, up, jit, 0, &hpt));
+    ROW(BAD, "major = [1, 0, 0]: lies along the fibre", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, x, jit, 0, &hpt));
+    ROW(BAD, "major = [0, 0, 0]: lies along", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, zero3, jit, 0, &hpt));
+    ROW(BAD, "major = [NaN, 0, 1]: must be finite", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, nan3, jit, 0, &hpt));
+    ROW(BAD, "jitter[1] = 1: must be in [0, 1)", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit_one, 0, &hpt));
+    ROW(BAD, "field = 2: must be HT_HUANG_NEAR (0) or HT_HUANG_FAR (1)",
+        ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit, 2, &hpt));
+    ROW(BAD, "not aligned to 4", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, odd, jit, 0, &hpt));
+    ROW(BAD, "point and major overlap",
+        ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, (const float *)hpt.opaque, jit, 0, &hpt));
+    ROW(NUL, "frame is NULL", ht_huang_point_init_world(huang, NULL, wo_world, up, jit, 0, &hpt));
+    ROW(BAD, "h = 1.5", ht_huang_point_init_world(huang, &bad_h, wo_world, up, jit, 0, &hpt));
+    ROW(BAD, "wo = [0, 0, 1.01]", ht_huang_point_init_world(huang, &fr, long3, up, jit, 0, &hpt));
+    ROW(BAD, "major = [1, 0, 0]: lies along the fibre", ht_huang_point_init_world(huang, &fr, wo_world, x, jit, 1, &hpt));
+    if (memcmp(&hpt, &hzero, sizeof hpt) != 0) { ++failed; fprintf(stderr, "FAIL: huang point written\n"); }
+    ROW(BAD, "not filled by ht_huang_point_at_hit", ht_huang_point_eval_world(&hzero, wi_world, f, &pdf));
+    ROW(OK, NULL, ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit, HT_HUANG_FAR, &hpt));
+    ROW(OK, NULL, ht_huang_prepared_free(huang)); /* the point keeps its own copy */
+    for (int k = 0; k < 8; ++k) f[k] = 7.0f;
+    ROW(NUL, "wi is NULL", ht_huang_point_eval_world(&hpt, NULL, f, &pdf));
+    ROW(BAD, "wi (in the point's frame) = [0, 0, 0]", ht_huang_point_eval_world(&hpt, zero3, f, &pdf));
+    ROW(BAD, "f_cos and pdf overlap", ht_huang_point_eval_world(&hpt, wi_world, f, f + 1));
+    ROW(BAD, "u[0] = 1", ht_huang_point_sample_world(&hpt, u_one, ws, fc, f, &pdf));
+    ROW(BAD, "wi and f_cos overlap", ht_huang_point_sample_world(&hpt, u, f, f + 2, fc, &pdf));
+    UNTOUCHED(f, 8);
+    ROW(OK, NULL, ht_huang_point_eval_world(&hpt, wi_world, f, &pdf));
+    ROW(OK, NULL, ht_huang_point_sample_world(&hpt, u, ws, fc, f, &pdf));
+
     printf("checks %d failed %d\n", checks, failed);
     return failed ? 1 : 0;
 }

@@ -15,3 +15,4 @@ mod pbrt;
 mod stages;
 mod usd;
 mod usd_crate;
+mod usd_motion;

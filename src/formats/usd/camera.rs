@@ -83,6 +83,9 @@ fn number(value: Option<Value>, what: &str, fallback: f64) -> Result<f64> {
         None => fallback,
         Some(Value::Float(v)) => f64::from(v),
         Some(Value::Double(v)) => v,
+        // A text layer's time samples keep the type their numbers were written in.
+        Some(Value::Int(v)) => f64::from(v),
+        Some(Value::Int64(v)) => v as f64,
         Some(v) => return Err(wrong_type(what, "float", &v)),
     };
     match v.is_finite() {

@@ -687,16 +687,21 @@ impl CameraDesc {
         let steps = usd_steps(path, self.frame, shutter, Prims::Cameras)?;
         let cameras = &steps[0].cameras;
         let index = match &self.prim {
-            Some(prim) => cameras.iter().position(|c| c.path == *prim).ok_or_else(|| {
-                at(invalid_arg!("no Camera prim at {prim}"))
-            })?,
+            Some(prim) => cameras
+                .iter()
+                .position(|c| c.path == *prim)
+                .ok_or_else(|| at(invalid_arg!("no Camera prim at {prim}")))?,
             None if cameras.len() == 1 => 0,
             None => {
                 let paths: Vec<&str> = cameras.iter().map(|c| c.path.as_str()).collect();
                 return Err(at(invalid_arg!(
                     "{} Camera prims ({}): give the one to use as `prim`",
                     cameras.len(),
-                    if paths.is_empty() { "none".into() } else { paths.join(", ") }
+                    if paths.is_empty() {
+                        "none".into()
+                    } else {
+                        paths.join(", ")
+                    }
                 )));
             }
         };

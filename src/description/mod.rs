@@ -336,7 +336,10 @@ pub enum MeshSource {
     /// An `.obj` or `.ply` file.
     File(PathBuf),
     /// Every Mesh prim of a USD stage as one mesh, read at `frame` (None: a still).
-    Usd { path: PathBuf, frame: Option<f64> },
+    Usd {
+        path: PathBuf,
+        frame: Option<f64>,
+    },
     Sphere {
         centre: [f32; 3],
         radius: f32,

@@ -19,8 +19,8 @@ use std::sync::Arc;
 use glam::{Mat3, Quat, Vec2, Vec3};
 
 use crate::Result;
-use crate::error::invalid_arg;
 use crate::embree::MAX_TIME_STEPS;
+use crate::error::invalid_arg;
 use crate::math::sampling::concentric_disk;
 use crate::math::time_steps::time_step;
 use crate::validate::{self, non_negative, positive};
@@ -206,8 +206,7 @@ impl Camera {
     pub fn with_aspect(&self, aspect: f32) -> Result<Self> {
         self.map_poses(|p| {
             let half_width = p.half_extent.y * aspect;
-            if !(aspect.is_finite() && aspect > 0.0 && half_width.is_finite() && half_width > 0.0)
-            {
+            if !(aspect.is_finite() && aspect > 0.0 && half_width.is_finite() && half_width > 0.0) {
                 return Err(invalid_arg!(
                     "camera aspect {aspect} must be finite and > 0"
                 ));
@@ -267,9 +266,8 @@ impl Camera {
     /// camera the smallest over its poses, so that what is thinner than a pixel is so
     /// throughout the shutter.
     pub fn pixel_spread(&self, height: u32) -> f32 {
-        let half_height = (self.later.iter()).fold(self.pose.half_extent.y, |m, p| {
-            m.min(p.half_extent.y)
-        });
+        let half_height =
+            (self.later.iter()).fold(self.pose.half_extent.y, |m, p| m.min(p.half_extent.y));
         2.0 * half_height / height.max(1) as f32
     }
 
@@ -340,7 +338,11 @@ mod tests {
         let q = moving.at(0.25);
         let want = looking(Vec3::new(0.5, 0.0, 0.0), 15.0, 40.0);
         assert!(q.eye().abs_diff_eq(want.eye(), 1e-6));
-        assert!(q.forward().abs_diff_eq(want.forward(), 1e-5), "{}", q.forward());
+        assert!(
+            q.forward().abs_diff_eq(want.forward(), 1e-5),
+            "{}",
+            q.forward()
+        );
         let p = q.pose;
         for (u, v) in [(p.forward, p.right), (p.right, p.up), (p.up, p.forward)] {
             assert!(u.dot(v).abs() < 1e-5 && (u.length() - 1.0).abs() < 1e-5);
@@ -360,7 +362,12 @@ mod tests {
             .collect();
         let moving = Camera::in_motion(steps.clone()).unwrap();
         assert_eq!(moving.at(0.5), steps[1]);
-        assert!(moving.at(0.75).eye().abs_diff_eq(Vec3::new(1.5, 0.0, 0.0), 1e-6));
+        assert!(
+            moving
+                .at(0.75)
+                .eye()
+                .abs_diff_eq(Vec3::new(1.5, 0.0, 0.0), 1e-6)
+        );
     }
 
     #[test]

@@ -155,7 +155,10 @@ fn a_usd_camera_is_the_camera_its_transform_and_lens_describe_and_moves_over_the
         "[camera]\neye = [0, 0, 4]\ntarget = [0, 0, 3]\nfov_deg = {:?}\n{SPHERE}",
         fov(50.0)
     );
-    assert_eq!(camera_of(&at_1).unwrap(), camera_of(&scene(&dir, &toml, "")).unwrap());
+    assert_eq!(
+        camera_of(&at_1).unwrap(),
+        camera_of(&scene(&dir, &toml, "")).unwrap()
+    );
 
     let mut blurred = at_1.clone();
     blurred.render.set("shutter_close", "1").unwrap();
@@ -192,7 +195,10 @@ fn a_usd_cameras_lens_is_in_tenths_of_a_scene_unit_and_its_pose_in_the_stages_ax
     let eye = Vec3::from_array(units.to_world([0.0, 0.0, 500.0]));
     let want = Camera::new(eye, eye - Vec3::Y, -Vec3::Z, fov(50.0) as f32, 1.5)
         .unwrap()
-        .with_thin_lens((50.0 * 0.1 / (2.0 * 2.0) * 0.01) as f32, (300.0 * 0.01) as f32)
+        .with_thin_lens(
+            (50.0 * 0.1 / (2.0 * 2.0) * 0.01) as f32,
+            (300.0 * 0.01) as f32,
+        )
         .unwrap();
     assert_eq!(read.cameras[0].camera(1.5).unwrap(), want);
 }
@@ -204,7 +210,11 @@ fn an_open_shutter_reads_a_usd_mesh_at_its_time_steps() {
     let dir = scratch("mesh-shutter");
     let path = dir.join("anim.usda");
     std::fs::write(&path, animated_mesh()).unwrap();
-    let mut desc = scene(&dir, &format!("{EYE}{}", usd_mesh("anim.usda")), "[animation]\nframe = 1");
+    let mut desc = scene(
+        &dir,
+        &format!("{EYE}{}", usd_mesh("anim.usda")),
+        "[animation]\nframe = 1",
+    );
     desc.render.set("shutter_close", "1").unwrap();
     let blurred = pixels(desc.clone());
     let at = |frame| {
@@ -242,10 +252,28 @@ fn bad_usd_meshes_and_cameras_are_refused_naming_the_prim_the_attribute_and_the_
         }
         error(Scene::from_description(&desc, device()).map(|_| ()))
     };
-    let e = read("range.usda", mesh_stage(" = [4]", " = [0, 1, 2, 4]", quad, " = (0, 0, 0)"), None, false);
-    assert!(e.contains("/World/quad") && e.contains("faceVertexIndices[3] = 4: out of range for 4 points"), "{e}");
-    let e = read("sum.usda", mesh_stage(" = [3, 3]", " = [0, 1, 2, 3]", quad, " = (0, 0, 0)"), None, false);
-    assert!(e.contains("/World/quad") && e.contains("faceVertexCounts add up to 6 but faceVertexIndices has 4"), "{e}");
+    let e = read(
+        "range.usda",
+        mesh_stage(" = [4]", " = [0, 1, 2, 4]", quad, " = (0, 0, 0)"),
+        None,
+        false,
+    );
+    assert!(
+        e.contains("/World/quad")
+            && e.contains("faceVertexIndices[3] = 4: out of range for 4 points"),
+        "{e}"
+    );
+    let e = read(
+        "sum.usda",
+        mesh_stage(" = [3, 3]", " = [0, 1, 2, 3]", quad, " = (0, 0, 0)"),
+        None,
+        false,
+    );
+    assert!(
+        e.contains("/World/quad")
+            && e.contains("faceVertexCounts add up to 6 but faceVertexIndices has 4"),
+        "{e}"
+    );
     let nan = mesh_stage(
         " = [4]",
         " = [0, 1, 2, 3]",
@@ -254,7 +282,10 @@ fn bad_usd_meshes_and_cameras_are_refused_naming_the_prim_the_attribute_and_the_
         " = (0, 0, 0)",
     );
     let e = read("nan.usda", nan, Some(3.0), false);
-    assert!(e.contains("/World/quad at frame 3 (time code 3)") && e.contains("points: point 2"), "{e}");
+    assert!(
+        e.contains("/World/quad at frame 3 (time code 3)") && e.contains("points: point 2"),
+        "{e}"
+    );
     let topology = mesh_stage(
         " = [4]",
         ".timeSamples = { 1: [0, 1, 2, 3], 3: [1, 2, 3, 0] }",
@@ -268,9 +299,7 @@ fn bad_usd_meshes_and_cameras_are_refused_naming_the_prim_the_attribute_and_the_
     );
 
     // Cameras: two and no prim named, a lens with no focus, a prim that is not there.
-    let two = format!(
-        "{HEADER}def Camera \"a\"\n{{\n}}\ndef Camera \"b\"\n{{\n}}\n"
-    );
+    let two = format!("{HEADER}def Camera \"a\"\n{{\n}}\ndef Camera \"b\"\n{{\n}}\n");
     std::fs::write(dir.join("two.usda"), two).unwrap();
     let camera = |body: &str| {
         let desc = scene(&dir, &format!("[camera]\n{body}\n{SPHERE}"), "");

@@ -61,13 +61,19 @@ impl UsdCamera {
             let d = DVec3::from_array(d).normalize_or_zero().as_vec3();
             Vec3::from_array(turn.to_world(d.to_array()))
         };
-        let camera = Camera::new(eye, eye + dir(self.view), dir(self.up), self.fov_y_deg() as f32, aspect)?;
+        let camera = Camera::new(
+            eye,
+            eye + dir(self.view),
+            dir(self.up),
+            self.fov_y_deg() as f32,
+            aspect,
+        )?;
         if self.f_stop == 0.0 {
             return Ok(camera);
         }
         let metres = units.meters_per_unit;
         let radius = self.focal_length * LENS_UNIT / (2.0 * self.f_stop) * metres;
-        if !(self.focus_distance > 0.0) {
+        if self.focus_distance <= 0.0 {
             return Err(invalid_arg!(
                 "focusDistance = {}: fStop {} makes a thin lens, which needs a focus distance > 0",
                 self.focus_distance,
@@ -105,7 +111,8 @@ pub(super) fn read_camera(
         .map_err(|e| invalid_arg!("{e:#}"))?
         .ok_or_else(|| invalid_arg!("not a Camera prim"))?;
     let prim = stage.prim(path.clone());
-    let value = |name: &str, fallback: f64| number(at.value(&prim.attribute(name))?, name, fallback);
+    let value =
+        |name: &str, fallback: f64| number(at.value(&prim.attribute(name))?, name, fallback);
     match at.value(&prim.attribute("projection"))? {
         None => {}
         Some(Value::Token(t)) if t.as_str() == "perspective" => {}
@@ -134,7 +141,7 @@ pub(super) fn read_camera(
         ("verticalAperture", read.vertical_aperture),
         ("horizontalAperture", read.horizontal_aperture),
     ] {
-        if !(v > 0.0) {
+        if v <= 0.0 {
             return Err(invalid_arg!("{what} = {v}: must be > 0"));
         }
     }
@@ -145,10 +152,16 @@ pub(super) fn read_camera(
     // Row vectors, as USD writes them: a point is p M, a direction d M without the
     // translation.
     let apply = |d: [f64; 3], w: f64| -> [f64; 3] {
-        std::array::from_fn(|j| d[0] * m.0[j] + d[1] * m.0[4 + j] + d[2] * m.0[8 + j] + w * m.0[12 + j])
+        std::array::from_fn(|j| {
+            d[0] * m.0[j] + d[1] * m.0[4 + j] + d[2] * m.0[8 + j] + w * m.0[12 + j]
+        })
     };
     let finite = |v: [f64; 3]| v.iter().all(|x| x.is_finite());
-    let (eye, view, up) = (apply([0.0; 3], 1.0), apply([0.0, 0.0, -1.0], 0.0), apply([0.0, 1.0, 0.0], 0.0));
+    let (eye, view, up) = (
+        apply([0.0; 3], 1.0),
+        apply([0.0, 0.0, -1.0], 0.0),
+        apply([0.0, 1.0, 0.0], 0.0),
+    );
     if !(finite(eye) && finite(view) && finite(up)) {
         return Err(invalid_arg!("the camera's world transform is not finite"));
     }

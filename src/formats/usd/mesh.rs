@@ -80,7 +80,8 @@ pub(super) fn read_mesh(
             indices.len()
         ));
     }
-    if let Some(i) = (indices.iter()).position(|&v| !(0..points.len() as i64).contains(&i64::from(v)))
+    if let Some(i) =
+        (indices.iter()).position(|&v| !(0..points.len() as i64).contains(&i64::from(v)))
     {
         return Err(invalid_arg!(
             "faceVertexIndices[{i}] = {}: out of range for {} points",

@@ -382,9 +382,8 @@ fn read_stage(
                 prim::read_basis_curves(stage, p, file_bytes, (units, &clock), at)
                     .map_err(named)?,
             ),
-            ("Mesh", Prims::Meshes) => meshes.push(
-                mesh::read_mesh(stage, p, file_bytes, (units, &clock), at).map_err(named)?,
-            ),
+            ("Mesh", Prims::Meshes) => meshes
+                .push(mesh::read_mesh(stage, p, file_bytes, (units, &clock), at).map_err(named)?),
             ("Camera", Prims::Cameras) => {
                 cameras.push(camera::read_camera(stage, p, units, at).map_err(named)?)
             }

@@ -402,8 +402,7 @@ pub(crate) fn assert_deterministic_through(
     base: RenderSettings,
     what: &str,
 ) {
-    let run =
-        |s: RenderSettings| render(world, camera, &s, Aovs::default(), &NoProgress).unwrap();
+    let run = |s: RenderSettings| render(world, camera, &s, Aovs::default(), &NoProgress).unwrap();
     let one = run(RenderSettings {
         threads: Some(1),
         ..base

@@ -309,16 +309,27 @@ pub unsafe extern "C" fn ht_scene_set_camera(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
+        let [eye, target, up] = read_pose([eye, target, up])?;
         let camera = CameraDesc {
-            eye: Some(read_vec3(eye, "eye")?.to_array()),
-            target: Some(read_vec3(target, "target")?.to_array()),
-            up: read_vec3(up, "up")?.to_array(),
+            eye: Some(eye),
+            target: Some(target),
+            up,
             fov_deg: fov_y_deg,
             shutter_close: None,
             ..scene.scene.camera().clone()
         };
         Ok(scene.scene.set_camera(&camera)?)
     })
+}
+
+/// A host's `eye`, `target` and `up`, each `float[3]`, named in errors.
+fn read_pose(pose: [*const f32; 3]) -> std::result::Result<[[f32; 3]; 3], Failure> {
+    let [eye, target, up] = pose;
+    Ok([
+        read_vec3(eye, "eye")?.to_array(),
+        read_vec3(target, "target")?.to_array(),
+        read_vec3(up, "up")?.to_array(),
+    ])
 }
 
 /// Moves the camera of `ht_scene_set_camera` over the shutter: `eye`, `target`, `up` and
@@ -347,10 +358,11 @@ pub unsafe extern "C" fn ht_scene_set_camera_motion(
 ) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
+        let [eye, target, up] = read_pose([eye, target, up])?;
         let close = PoseDesc {
-            eye: Some(read_vec3(eye, "eye")?.to_array()),
-            target: Some(read_vec3(target, "target")?.to_array()),
-            up: Some(read_vec3(up, "up")?.to_array()),
+            eye: Some(eye),
+            target: Some(target),
+            up: Some(up),
             fov_deg: Some(fov_y_deg),
         };
         if scene.scene.camera().eye.is_none() {

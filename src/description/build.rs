@@ -471,8 +471,8 @@ impl MeshDesc {
         }
     }
 
-    /// The mesh, transformed; a USD stage's deforming over `shutter` (open, close, in
-    /// frames from its frame: [`usd_mesh`]).
+    /// The mesh, transformed; a USD stage's every Mesh prim, deforming over `shutter`
+    /// (open, close, in frames from its frame) where its points move.
     pub fn mesh(&self, shutter: (f32, f32)) -> Result<Mesh> {
         let (affine, _) = self.transform.affine()?;
         let mut mesh = match &self.source {

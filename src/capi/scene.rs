@@ -307,29 +307,35 @@ pub unsafe extern "C" fn ht_scene_set_camera(
     up: *const f32,
     fov_y_deg: f32,
 ) -> HtStatus {
-    boundary(|| {
-        let scene = scene_mut(scene)?;
-        let [eye, target, up] = read_pose([eye, target, up])?;
-        let camera = CameraDesc {
+    place_camera(scene, [eye, target, up], |camera, [eye, target, up]| {
+        Ok(CameraDesc {
             eye: Some(eye),
             target: Some(target),
             up,
             fov_deg: fov_y_deg,
             shutter_close: None,
-            ..scene.scene.camera().clone()
-        };
-        Ok(scene.scene.set_camera(&camera)?)
+            ..camera.clone()
+        })
     })
 }
 
-/// A host's `eye`, `target` and `up`, each `float[3]`, named in errors.
-fn read_pose(pose: [*const f32; 3]) -> std::result::Result<[[f32; 3]; 3], Failure> {
-    let [eye, target, up] = pose;
-    Ok([
-        read_vec3(eye, "eye")?.to_array(),
-        read_vec3(target, "target")?.to_array(),
-        read_vec3(up, "up")?.to_array(),
-    ])
+/// Reads a host's `eye`, `target` and `up` (each `float[3]`, named in errors) and sets the
+/// scene's camera to what `place` makes of its camera with them.
+fn place_camera(
+    scene: *mut HtScene,
+    [eye, target, up]: [*const f32; 3],
+    place: impl FnOnce(&CameraDesc, [[f32; 3]; 3]) -> Result<CameraDesc>,
+) -> HtStatus {
+    boundary(|| {
+        let scene = scene_mut(scene)?;
+        let pose = [
+            read_vec3(eye, "eye")?.to_array(),
+            read_vec3(target, "target")?.to_array(),
+            read_vec3(up, "up")?.to_array(),
+        ];
+        let camera = place(scene.scene.camera(), pose)?;
+        Ok(scene.scene.set_camera(&camera)?)
+    })
 }
 
 /// Moves the camera of `ht_scene_set_camera` over the shutter: `eye`, `target`, `up` and
@@ -356,26 +362,23 @@ pub unsafe extern "C" fn ht_scene_set_camera_motion(
     up: *const f32,
     fov_y_deg: f32,
 ) -> HtStatus {
-    boundary(|| {
-        let scene = scene_mut(scene)?;
-        let [eye, target, up] = read_pose([eye, target, up])?;
+    place_camera(scene, [eye, target, up], |camera, [eye, target, up]| {
+        if camera.eye.is_none() {
+            return Err(invalid_arg!(
+                "no camera to move: set its pose at the shutter's opening with \
+                 ht_scene_set_camera first"
+            ));
+        }
         let close = PoseDesc {
             eye: Some(eye),
             target: Some(target),
             up: Some(up),
             fov_deg: Some(fov_y_deg),
         };
-        if scene.scene.camera().eye.is_none() {
-            return Err(invalid_arg!(
-                "no camera to move: set its pose at the shutter's opening with ht_scene_set_camera first"
-            )
-            .into());
-        }
-        let camera = CameraDesc {
+        Ok(CameraDesc {
             shutter_close: Some(close),
-            ..scene.scene.camera().clone()
-        };
-        Ok(scene.scene.set_camera(&camera)?)
+            ..camera.clone()
+        })
     })
 }
 

@@ -316,3 +316,30 @@ fn bad_usd_meshes_and_cameras_are_refused_naming_the_prim_the_attribute_and_the_
     let e = camera("usd = \"lens.usda\"\neye = [0, 0, 1]");
     assert!(e.contains("no other key but `prim`"), "{e}");
 }
+
+/// A scene file's `[camera.shutter_close]` moves the camera only with the shutter open
+/// (its keys absent keep the opening's), and an automatic camera, which has no pose to
+/// start from, refuses one.
+#[test]
+fn a_scene_files_camera_moves_to_its_shutter_close_pose_with_the_shutter_open() {
+    let dir = scratch("close");
+    let body = format!("{EYE}[camera.shutter_close]\neye = [1, 0, 4]\n{SPHERE}");
+    let mut desc = scene(&dir, &body, "");
+    let still = camera_of(&desc).unwrap();
+    assert!(!still.moves());
+    desc.render.set("shutter_close", "0.5").unwrap();
+    let moving = camera_of(&desc).unwrap();
+    assert!(moving.moves());
+    assert_eq!(moving.at(0.0), still);
+    let close = Camera::new(
+        Vec3::X * 1.0 + Vec3::Z * 4.0,
+        Vec3::ZERO,
+        Vec3::Y,
+        35.0,
+        32.0 / 24.0,
+    );
+    assert_eq!(moving.at(1.0), close.unwrap());
+    let automatic = format!("[camera.shutter_close]\neye = [1, 0, 4]\n{SPHERE}");
+    let e = error(camera_of(&scene(&dir, &automatic, "")));
+    assert!(e.contains("an automatic camera does not move"), "{e}");
+}

@@ -202,6 +202,18 @@ def configure_render(scene, desc, args):
     cycles.pixel_filter_type = "BOX"
     cycles.filter_width = 1.0
 
+    motion = desc.get("motion")
+    render.use_motion_blur = motion is not None
+    if motion:
+        # hairtrace's shutter opens and closes at frames from the frame; Blender's is
+        # centred on the (sub)frame it renders, the shutter's middle.
+        open_, close = motion["shutter"]
+        middle = motion["frame"] + 0.5 * (open_ + close)
+        scene.frame_set(math.floor(middle), subframe=middle - math.floor(middle))
+        render.motion_blur_position = "CENTER"
+        render.motion_blur_shutter = close - open_
+        # Blender's shutter curve is flat by default, as hairtrace's shutter: left as it is.
+
     curves = scene.cycles_curves
     basis = {g.get("basis", "linear") for g in desc.get("grooms", [])}
     if len(basis) > 1:
@@ -246,27 +258,57 @@ def add_camera(bpy, scene, desc):
 
 
 def hair_material(bpy, name, m):
-    """Principled Hair (Chiang) with our parameters: sigma_a per unit radius, roughnesses
-    as given, no coat or randomness, and the cuticle tilt with Cycles' opposite sign."""
+    """Principled Hair with our parameters: the material's model (Chiang or Huang),
+    sigma_a per unit radius, roughnesses as given, no coat or randomness, and the cuticle
+    tilt with Cycles' opposite sign."""
     mat = bpy.data.materials.new(name)
     tree = mat.node_tree
     tree.nodes.clear()
     bsdf = tree.nodes.new("ShaderNodeBsdfHairPrincipled")
-    bsdf.model = "CHIANG"
+    huang = m.get("model", "chiang") == "huang"
+    bsdf.model = "HUANG" if huang else "CHIANG"
     bsdf.parametrization = "ABSORPTION"
     # Keyed lookup misses "Random Color" in Blender 5.0 (it only applies to melanin anyway).
     inputs = {socket.name: socket for socket in bsdf.inputs}
     inputs["Random Color"].default_value = 0.0
     inputs["Absorption Coefficient"].default_value = list(m["sigma_a"])
     inputs["IOR"].default_value = m.get("eta", 1.55)
-    inputs["Roughness"].default_value = m.get("beta_m", 0.3)
-    inputs["Radial Roughness"].default_value = m.get("beta_n", 0.3)
-    inputs["Coat"].default_value = 0.0
     inputs["Offset"].default_value = -math.radians(m.get("alpha_deg", 2.0))
     inputs["Random Roughness"].default_value = 0.0
+    if huang:
+        inputs["Roughness"].default_value = m["roughness"]
+        inputs["Aspect Ratio"].default_value = m["aspect"]
+        for lobe in ("Reflection", "Transmission", "Secondary Reflection"):
+            inputs[lobe].default_value = 1.0
+    else:
+        inputs["Roughness"].default_value = m.get("beta_m", 0.3)
+        inputs["Radial Roughness"].default_value = m.get("beta_n", 0.3)
+        inputs["Coat"].default_value = 0.0
     out = tree.nodes.new("ShaderNodeOutputMaterial")
     tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
     return mat
+
+
+def major_axes(counts, xyz):
+    """hairtrace's default orientation of an elliptical fibre at each point, in Blender's
+    frame: world up made perpendicular to the strand's tangent there, or world +x where
+    the tangent is vertical (`HairHit::major_axis`). The tangent at a point is the chord
+    between its neighbours (one-sided at the ends)."""
+    axes = np.empty_like(xyz)
+    up, side = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    start = 0
+    for n in counts:
+        p = xyz[start:start + n]
+        t = np.empty_like(p)
+        t[1:-1] = p[2:] - p[:-2]
+        t[0], t[-1] = p[1] - p[0], p[-1] - p[-2]
+        t /= np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-30)
+        a = up - t * (t @ up)[:, None]
+        flat = np.einsum("ij,ij->i", a, a) <= 1e-6
+        a[flat] = side - t[flat] * (t[flat] @ side)[:, None]
+        axes[start:start + n] = a / np.linalg.norm(a, axis=1, keepdims=True)
+        start += n
+    return axes
 
 
 def diffuse_material(bpy, name, albedo):
@@ -281,7 +323,32 @@ def diffuse_material(bpy, name, albedo):
     return mat
 
 
+def import_usd_groom(bpy, scene, i, groom):
+    """A moving groom, as Blender imports its animated USD file (its points' time samples
+    through a Mesh Sequence Cache), with the groom's material; Cycles blurs the deforming
+    curves. The stage's up axis and units are Blender's import's, which agree with
+    hairtrace's reading of them (a Z-up stage stays Z-up; a Y-up one turns as
+    `to_blender` turns hairtrace's +y up)."""
+    before = set(bpy.data.objects)
+    bpy.ops.wm.usd_import(filepath=groom["usd"], import_materials=False)
+    imported = [o for o in bpy.data.objects if o not in before]
+    hair = [o for o in imported if o.type == "CURVES"]
+    if not hair:
+        raise ValueError(f"{groom['usd']}: no curves imported")
+    material = hair_material(bpy, f"hair{i}", groom["material"])
+    for o in imported:
+        if o.type == "CURVES":
+            o.data.materials.clear()
+            o.data.materials.append(material)
+            o.cycles.use_motion_blur = True
+            o.cycles.use_deform_motion = True
+        elif o.type not in ("EMPTY",):
+            bpy.data.objects.remove(o)
+
+
 def add_groom(bpy, scene, i, groom, base):
+    if groom.get("usd"):
+        return import_usd_groom(bpy, scene, i, groom)
     counts, xyz, radii = read_hair(os.path.join(base, groom["file"]))
     curves = bpy.data.hair_curves.new(f"groom{i}")
     curves.add_curves(counts.tolist())
@@ -292,6 +359,13 @@ def add_groom(bpy, scene, i, groom, base):
     if basis not in ("linear", "catmull-rom"):
         raise ValueError(f"groom basis {basis!r}: expected linear or catmull-rom")
     curves.set_types(type="POLY" if basis == "linear" else "CATMULL_ROM")
+    if groom["material"].get("model") == "huang":
+        # Normal mode Free: Cycles orients the ellipse's major axis by these normals.
+        mode = curves.attributes.new("normal_mode", "INT8", "CURVE")
+        mode.data.foreach_set("value", np.full(len(counts), 2, dtype=np.int8))
+        normal = curves.attributes.new("custom_normal", "FLOAT_VECTOR", "POINT")
+        normal.data.foreach_set(
+            "vector", major_axes(counts, to_blender(xyz)).astype(np.float32).ravel())
     curves.materials.append(hair_material(bpy, f"hair{i}", groom["material"]))
     obj = bpy.data.objects.new(f"groom{i}", curves)
     scene.collection.objects.link(obj)

@@ -630,6 +630,13 @@ typedef struct HtDevice HtDevice;
 typedef struct HtScene HtScene;
 
 /**
+ * Render settings (every one has a default), read and written by name. Create with
+ * `ht_settings_new`, release with `ht_settings_free`. A handle may be read by any number
+ * of threads at once, but not while one of them sets it.
+ */
+typedef struct HtSettings HtSettings;
+
+/**
  * The basis of a curve geometry: one of the `HT_CURVE_*` basis constants.
  */
 typedef uint32_t HtCurveBasis;
@@ -1022,6 +1029,37 @@ enum HtStatus ht_scene_add_hair_file(struct HtScene *scene,
                                      uint32_t *geom_id);
 
 /**
+ * As `ht_scene_add_hair_file`, read at frame `frame` of an animation: a file whose name
+ * has a run of # (`groom.####.hair`) is a sequence of per-frame files, and the call reads
+ * the file of that frame (`groom.0012.hair` at frame 12; a whole frame >= 0, whose file
+ * must exist); any other file is the same at every frame. With `settings` (NULL: a closed
+ * shutter) whose shutter is open (`shutter_open` < `shutter_close`), a sequence moves over
+ * it: its strands hold time steps read where the shutter opens, where it closes and
+ * evenly between, as many as take in every whole frame inside, a step between two frames
+ * blending their files linearly (docs/formats.md, "Motion blur"), as a scene file with
+ * those `[render]` settings reads it. Render with the same shutter.
+ *
+ * Statuses: those of `ht_scene_add_hair_file`; `HT_ERR_INVALID_ARG` also for a frame that
+ * is not finite or, for a sequence, not a whole number >= 0, a file of the sequence that
+ * does not exist, files the shutter spans that hold different strands or points (the
+ * message names both), and `settings` that do not hold together (as `ht_render_with`
+ * refuses them).
+ *
+ * # Safety
+ * As `ht_scene_add_hair_file`, and `settings` is NULL or a live handle that no other
+ * thread sets during the call.
+ */
+enum HtStatus ht_scene_add_hair_file_at(struct HtScene *scene,
+                                        const char *path,
+                                        double frame,
+                                        const struct HtSettings *settings,
+                                        bool thickness_is_radius,
+                                        HtCurveBasis basis,
+                                        HtCurveShape shape,
+                                        uint32_t material_id,
+                                        uint32_t *geom_id);
+
+/**
  * Adds every BasisCurves prim of a USD stage (.usd, .usda, .usdc or .usdz, read and
  * composed during the call; see docs/formats.md) as its own curve geometry, laid out by the
  * prim's `type`, `basis` and `wrap`, in world space, shaded by the hair material
@@ -1050,6 +1088,35 @@ enum HtStatus ht_scene_add_usd_file(struct HtScene *scene,
                                     uint32_t *geom_count);
 
 /**
+ * As `ht_scene_add_usd_file`, read at frame `frame` of the stage's animation: every
+ * attribute at that frame's time code (frame x `timeCodesPerSecond` / `framesPerSecond`),
+ * interpolated between time samples as USD defines (docs/formats.md, "Animation"); a path
+ * whose file name has a run of # names a sequence of per-frame stages, of which the
+ * frame's is read. With `settings` (NULL: a closed shutter) whose shutter is open
+ * (`shutter_open` < `shutter_close`), an animated stage moves over it: each prim's curves
+ * hold time steps read where the shutter opens, where it closes and evenly between, as
+ * many as take in every time sample inside (docs/formats.md, "Motion blur"), as a scene
+ * file with those `[render]` settings reads it. Render with the same shutter.
+ *
+ * Statuses: those of `ht_scene_add_usd_file`; `HT_ERR_INVALID_ARG` also for a frame that
+ * is not finite or lies outside the stage's animation, a sample the reader refuses (the
+ * message names the prim and the frame), a prim whose counts change inside the shutter,
+ * and `settings` that do not hold together (as `ht_render_with` refuses them).
+ *
+ * # Safety
+ * As `ht_scene_add_usd_file`, and `settings` is NULL or a live handle that no other
+ * thread sets during the call.
+ */
+enum HtStatus ht_scene_add_usd_file_at(struct HtScene *scene,
+                                       const char *path,
+                                       double frame,
+                                       const struct HtSettings *settings,
+                                       HtCurveShape shape,
+                                       uint32_t material_id,
+                                       uint32_t *first_geom_id,
+                                       uint32_t *geom_count);
+
+/**
  * Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
  * `positions` and `normals` hold 3 floats per vertex (`normals` may be NULL: flat
  * shading), `indices` 3 vertex indices per triangle, counter-clockwise seen from the
@@ -1074,6 +1141,36 @@ enum HtStatus ht_scene_add_mesh(struct HtScene *scene,
                                 const uint32_t *indices,
                                 uint32_t material_id,
                                 uint32_t *geom_id);
+
+/**
+ * Adds a triangle mesh that deforms over the shutter (copied), shaded by the diffuse
+ * material `material_id`: `positions` holds its vertices (3 floats each) at the first of
+ * `later_step_count + 1` time steps spread evenly over the shutter (the settings
+ * `shutter_open` and `shutter_close`, as for `ht_scene_add_curves_xyzr_motion`), and
+ * `later_positions[k]` the `3 * vertex_count` floats of the same vertices at step k + 1;
+ * `indices` holds 3 vertex indices per triangle, the same at every step. Between two steps
+ * a vertex moves in a straight line. A deforming mesh has no vertex normals: its geometric
+ * normal at each ray's time shades it. With `later_step_count` 0 (`later_positions` may
+ * then be NULL) this is `ht_scene_add_mesh` without normals. Writes the geometry id.
+ *
+ * Statuses: as `ht_scene_add_mesh`, and `HT_ERR_NULL_ARG` for `later_positions` or one of
+ * its pointers NULL when it is read; `HT_ERR_INVALID_ARG` for more than
+ * `HT_MAX_TIME_STEPS - 1` later steps, or a NaN, infinite or out-of-range value at a step
+ * (the message names the step).
+ *
+ * # Safety
+ * As `ht_scene_add_mesh`, and `later_positions` is NULL or points to `later_step_count`
+ * pointers, each NULL or to `3 * vertex_count` readable floats.
+ */
+enum HtStatus ht_scene_add_mesh_motion(struct HtScene *scene,
+                                       size_t vertex_count,
+                                       const float *positions,
+                                       const float *const *later_positions,
+                                       size_t later_step_count,
+                                       size_t triangle_count,
+                                       const uint32_t *indices,
+                                       uint32_t material_id,
+                                       uint32_t *geom_id);
 
 /**
  * Adds the mesh of an `.obj` or `.ply` file (by extension), shaded by the diffuse
@@ -1284,13 +1381,6 @@ enum HtStatus ht_shutdown(void);
  * ==================================================================================== */
 
 #if defined(HT_RENDER)
-
-/**
- * Render settings (every one has a default), read and written by name. Create with
- * `ht_settings_new`, release with `ht_settings_free`. A handle may be read by any number
- * of threads at once, but not while one of them sets it.
- */
-typedef struct HtSettings HtSettings;
 
 #ifdef __cplusplus
 extern "C" {

@@ -3,7 +3,8 @@
  *
  * - Every handle has an owner that releases it: `Material` (HtHairPrepared), and with the
  *   full library `Device`, `Scene`, `Settings`. `get()` gives the C handle, for the C
- *   calls this layer does not wrap.
+ *   calls this layer does not wrap. `Scene` wraps the calls of motion and animation:
+ *   strands and meshes at several time steps, files read at a frame.
  * - The host's own vectors go in and out as they are: anything with `x, y, z` members or
  *   an `operator[]` (glm, Eigen, a `float[3]`, a std::array), converted to float.
  * - Two forms of every per-vertex call. The value form throws `hairtrace::Error` (the
@@ -32,6 +33,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace hairtrace {
 
@@ -319,19 +321,6 @@ private:
     }
 };
 
-/** A scene on a device (`ht_scene_new`); fill it with the `ht_scene_*` calls on `get()`. */
-class Scene : public detail::Owned<HtScene, ht_scene_free> {
-public:
-    explicit Scene(const Device &device) : Owned(make(device)) {}
-
-private:
-    static HtScene *make(const Device &device) {
-        HtScene *s = nullptr;
-        check(ht_scene_new(device.get(), &s));
-        return s;
-    }
-};
-
 /** Render settings by name (`ht_settings_new`, `ht_settings_set`, `ht_settings_get`). */
 class Settings : public detail::Owned<HtSettings, ht_settings_free> {
 public:
@@ -354,6 +343,87 @@ private:
         HtSettings *s = nullptr;
         check(ht_settings_new(&s));
         return s;
+    }
+};
+
+/**
+ * A scene on a device (`ht_scene_new`). Motion and animation have wrappers here, which
+ * throw `Error`; fill the rest with the `ht_scene_*` calls on `get()`.
+ */
+class Scene : public detail::Owned<HtScene, ht_scene_free> {
+public:
+    explicit Scene(const Device &device) : Owned(make(device)) {}
+
+    /**
+     * Strands of float4 control points moving over the shutter
+     * (`ht_scene_add_curves_xyzr_motion`): `desc.points` at the first time step, `later[k]`
+     * (`4 * desc.point_count` floats each) at step k + 1. Returns the geometry id.
+     */
+    uint32_t add_curves_xyzr_motion(const HtCurvesXyzr &desc,
+                                    const std::vector<const float *> &later,
+                                    uint32_t material_id) {
+        uint32_t id = 0;
+        check(ht_scene_add_curves_xyzr_motion(get(), &desc, later.data(), later.size(),
+                                              material_id, &id));
+        return id;
+    }
+
+    /**
+     * A triangle mesh deforming over the shutter (`ht_scene_add_mesh_motion`):
+     * `positions[k]` holds the `3 * vertex_count` floats of the vertices at time step k (one
+     * pointer: a mesh that stays put), `indices` 3 per triangle. Returns the geometry id.
+     */
+    uint32_t add_mesh_motion(size_t vertex_count, const std::vector<const float *> &positions,
+                             const std::vector<uint32_t> &indices, uint32_t material_id) {
+        uint32_t id = 0;
+        const float *first = positions.empty() ? nullptr : positions[0];
+        size_t later = positions.empty() ? 0 : positions.size() - 1;
+        check(ht_scene_add_mesh_motion(get(), vertex_count, first,
+                                       later ? positions.data() + 1 : nullptr, later,
+                                       indices.size() / 3, indices.data(), material_id, &id));
+        return id;
+    }
+
+    /** The first geometry id of a USD stage's prims, and how many. */
+    struct Geometries {
+        uint32_t first;
+        uint32_t count;
+    };
+
+    /**
+     * A USD stage's BasisCurves read at frame `frame` (`ht_scene_add_usd_file_at`), moving
+     * over the shutter of `settings` where it is open (nullptr: closed).
+     */
+    Geometries add_usd_file_at(const std::string &path, double frame, HtCurveShape shape,
+                               uint32_t material_id, const Settings *settings = nullptr) {
+        Geometries ids{0, 0};
+        check(ht_scene_add_usd_file_at(get(), path.c_str(), frame, settings_of(settings), shape,
+                                       material_id, &ids.first, &ids.count));
+        return ids;
+    }
+
+    /**
+     * A `.hair` file, or the file of frame `frame` of a sequence (`groom.####.hair`), read
+     * by `ht_scene_add_hair_file_at`: a sequence moves over the shutter of `settings` where
+     * it is open (nullptr: closed). Returns the geometry id.
+     */
+    uint32_t add_hair_file_at(const std::string &path, double frame, bool thickness_is_radius,
+                              HtCurveBasis basis, HtCurveShape shape, uint32_t material_id,
+                              const Settings *settings = nullptr) {
+        uint32_t id = 0;
+        check(ht_scene_add_hair_file_at(get(), path.c_str(), frame, settings_of(settings),
+                                        thickness_is_radius, basis, shape, material_id, &id));
+        return id;
+    }
+
+private:
+    static HtScene *make(const Device &device) {
+        HtScene *s = nullptr;
+        check(ht_scene_new(device.get(), &s));
+        return s;
+    }
+    static const HtSettings *settings_of(const Settings *settings) noexcept {
+        return settings ? settings->get() : nullptr;
     }
 };
 #endif

@@ -14,12 +14,14 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use hairtrace::description::{EnvironmentSource, LightDesc, MaterialDesc, SceneDescription};
+use hairtrace::description::{
+    EnvironmentSource, GroomSource, LightDesc, MaterialDesc, SceneDescription, Transform,
+};
 use hairtrace::embree::CurveBasis;
 use hairtrace::formats::hair::{HairTag, Thickness, write_tagged_hair_file};
 use hairtrace::formats::units::StageUnits;
-use hairtrace::formats::usd::Wrap;
-use hairtrace::scene::{GroomShape, Mesh};
+use hairtrace::formats::usd::{Wrap, is_usd_path};
+use hairtrace::scene::{GroomShape, HairModel, Mesh};
 use hairtrace::{Error, Result};
 
 /// An invalid-argument error from a format string.
@@ -37,6 +39,16 @@ struct PeerScene {
     grooms: Vec<PeerGroom>,
     meshes: Vec<PeerMesh>,
     lights: Vec<PeerLight>,
+    /// The frame and the shutter (open, close, in frames from it) when the shutter is open
+    /// on a scene whose grooms move.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    motion: Option<PeerMotion>,
+}
+
+#[derive(Serialize)]
+struct PeerMotion {
+    frame: f64,
+    shutter: [f32; 2],
 }
 
 #[derive(Serialize)]
@@ -50,6 +62,10 @@ struct PeerCamera {
 #[derive(Serialize)]
 struct PeerGroom {
     file: String,
+    /// The animated USD file the groom moves by (absolute), for the peer to import as its
+    /// own tools do: the `.hair` file is its frame, still.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    usd: Option<String>,
     basis: &'static str,
     shape: &'static str,
     material: PeerHair,
@@ -59,9 +75,17 @@ struct PeerGroom {
 struct PeerHair {
     sigma_a: [f32; 3],
     eta: f32,
-    beta_m: f32,
-    beta_n: f32,
     alpha_deg: f32,
+    #[serde(flatten)]
+    model: PeerModel,
+}
+
+/// The hair model and its roughnesses: Cycles' Principled Hair BSDF has both.
+#[derive(Serialize)]
+#[serde(tag = "model", rename_all = "snake_case")]
+enum PeerModel {
+    Chiang { beta_m: f32, beta_n: f32 },
+    Huang { roughness: f32, aspect: f32 },
 }
 
 #[derive(Serialize)]
@@ -110,8 +134,36 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             .get(name)
             .ok_or_else(|| invalid_arg!("{}: no material {name:?}", d.origin))
     };
+    let (open, close) = (d.render.shutter_open, d.render.shutter_close);
+    let mut motion = None;
     let mut grooms = Vec::new();
     for (i, g) in d.grooms.iter().enumerate() {
+        // A USD groom read at a frame, under an open shutter, moves by its time samples.
+        let moving = match &g.source {
+            GroomSource::File {
+                path,
+                frame: Some(frame),
+                ..
+            } if close > open && is_usd_path(path) => Some((path, *frame)),
+            _ => None,
+        };
+        let usd = match moving {
+            Some((path, frame)) => {
+                if g.transform != Transform::default() || g.radius_scale != 1.0 {
+                    return Err(invalid_arg!(
+                        "groom[{i}]: a moving USD groom is exported as its file, which the peer \
+                         imports as it is: give it no transform or radius_scale"
+                    ));
+                }
+                motion = Some(PeerMotion {
+                    frame,
+                    shutter: [open, close],
+                });
+                let path = std::path::absolute(path).map_err(|e| Error::io(path, e))?;
+                Some(path.display().to_string())
+            }
+            None => None,
+        };
         // `auto` is an approximation of round tubes, which the peer traces exactly.
         if g.shape == GroomShape::Flat {
             return Err(invalid_arg!("groom[{i}]: only round curves are exported"));
@@ -164,14 +216,22 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             )?;
             grooms.push(PeerGroom {
                 file,
+                usd: usd.clone(),
                 basis,
                 shape: "round",
                 material: PeerHair {
                     sigma_a: p.sigma_a,
                     eta: p.eta,
-                    beta_m: p.beta_m,
-                    beta_n: p.beta_n,
                     alpha_deg: p.alpha,
+                    model: match hair.model {
+                        HairModel::Chiang => PeerModel::Chiang {
+                            beta_m: p.beta_m,
+                            beta_n: p.beta_n,
+                        },
+                        HairModel::Huang { roughness, aspect } => {
+                            PeerModel::Huang { roughness, aspect }
+                        }
+                    },
                 },
             });
         }
@@ -208,6 +268,7 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
         grooms,
         meshes,
         lights,
+        motion,
     };
     let json = serde_json::to_string_pretty(&scene).map_err(|e| invalid_arg!("scene.json: {e}"))?;
     std::fs::write(dir.join("scene.json"), json).map_err(io)

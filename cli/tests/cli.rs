@@ -788,6 +788,61 @@ fn bench_scenes_export_for_the_peer() {
     assert!(found >= 4, "only {found} bench scenes");
 }
 
+/// The Huang model goes out with its roughness and aspect; a USD groom read at a frame
+/// under an open shutter goes out as its file (for the peer's own USD import) with the frame
+/// and the shutter, and is refused with a transform the import would not apply.
+#[test]
+fn a_huang_material_and_a_moving_usd_groom_go_out_as_the_peer_reads_them() {
+    let bench = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes");
+    let out = tmp("cli_peer_moving");
+    let o = hairtrace(&[
+        "export",
+        &bench.join("swaying_blur.toml").to_string_lossy(),
+        "-o",
+        &out,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let json = scene_json(&out);
+    assert_eq!(json["motion"]["frame"], 6.0);
+    assert_eq!(json["motion"]["shutter"], serde_json::json!([-0.25, 0.25]));
+    let usd = json["grooms"][0]["usd"].as_str().unwrap();
+    assert!(
+        usd.starts_with('/') && usd.ends_with("swaying.usda"),
+        "{usd}"
+    );
+    assert_eq!(json["grooms"][0]["material"]["model"], "chiang");
+
+    let out = tmp("cli_peer_huang");
+    let o = hairtrace(&[
+        "export",
+        &bench.join("huang_oval_fur_ball.toml").to_string_lossy(),
+        "-o",
+        &out,
+    ]);
+    assert!(o.status.success(), "{o:?}");
+    let json = scene_json(&out);
+    let m = &json["grooms"][0]["material"];
+    assert_eq!(
+        (m["model"].as_str(), m["aspect"].as_f64()),
+        (Some("huang"), Some(0.65))
+    );
+    assert_eq!(m["roughness"].as_f64(), Some(0.3));
+    assert!(m.get("beta_m").is_none(), "{m}");
+    // Still: no motion, no file to import.
+    assert!(json.get("motion").is_none() && json["grooms"][0].get("usd").is_none());
+
+    let usd =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/scenes/swaying.usda");
+    let text = format!(
+        "[render]\nshutter_close = 0.5\n[animation]\nframe = 2\n[camera]\neye = [0, 0, 2]\n\
+         target = [0, 0, 0]\n[materials.h]\ntype = \"hair\"\nmelanin = [1, 0]\n\
+         [[groom]]\nfile = {:?}\nmaterial = \"h\"\nscale = 2.0\n",
+        usd.to_string_lossy()
+    );
+    let (o, ..) = export(&text, "cli_peer_moving_placed");
+    assert_one_line_error(&o, "groom[0]: a moving USD groom is exported as its file");
+}
+
 #[test]
 fn a_scene_goes_out_whole() {
     let (o, dir, d) = export(PEER_SCENE, "cli_peer_whole");

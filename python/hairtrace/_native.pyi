@@ -65,7 +65,8 @@ class Scene:
 
     def __init__(self) -> None: ...
     @staticmethod
-    def load(path: Path) -> Scene: ...
+    def load(path: Path, frame: Optional[float] = None) -> Scene:
+        """A scene file, its groom files read at ``frame`` (``render --frame``)."""
     @staticmethod
     def demo(name: str = "furball") -> Scene: ...
     def set(self, **settings: Any) -> None:
@@ -82,8 +83,27 @@ class Scene:
     def add_light(self, **keys: Any) -> None: ...
     def set_lights(self, lights: list[dict[str, Any]]) -> None: ...
     def set_camera(self, **keys: Any) -> None: ...
-    def add_groom(self, **keys: Any) -> None: ...
+    def add_groom(self, frame: Optional[float] = None, **keys: Any) -> None:
+        """A ``[[groom]]``'s keys; a file read at ``frame`` over the scene's shutter."""
     def add_mesh(self, **keys: Any) -> None: ...
+    def add_curves(
+        self,
+        points: Union[ArrayLike, Sequence[ArrayLike]],
+        counts: ArrayLike,
+        material: str,
+        basis: str = "bspline",
+        shape: str = "auto",
+        colors: Optional[ArrayLike] = None,
+    ) -> None:
+        """Float4 control points (n, 4), or at K time steps: (K, n, 4) or K (n, 4) arrays."""
+    def add_triangles(
+        self,
+        positions: Union[ArrayLike, Sequence[ArrayLike]],
+        triangles: ArrayLike,
+        material: str,
+        normals: Optional[ArrayLike] = None,
+    ) -> None:
+        """Vertices (n, 3), or at K time steps: (K, n, 3) or K (n, 3) arrays."""
     def add_strands(
         self,
         points: ArrayLike,

@@ -12,12 +12,12 @@ pub struct Floats<'py> {
     array: PyArrayLikeDyn<'py, f32, AllowTypeChange>,
     /// A C-ordered copy, where the array is not contiguous.
     copy: Option<Vec<f32>>,
-    pub name: &'static str,
+    pub name: String,
 }
 
 impl<'py> Floats<'py> {
     /// `obj` as float32; `name` names it in errors.
-    pub fn new(obj: &Bound<'py, PyAny>, name: &'static str) -> PyResult<Self> {
+    pub fn new(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Self> {
         let array: PyArrayLikeDyn<'py, f32, AllowTypeChange> = obj.extract().map_err(|e| {
             PyTypeError::new_err(format!("{name}: cannot be read as float32 numbers: {e}"))
         })?;
@@ -26,11 +26,15 @@ impl<'py> Floats<'py> {
             true => None,
             false => Some(array.as_array().iter().copied().collect()),
         };
-        Ok(Floats { array, copy, name })
+        Ok(Floats {
+            array,
+            copy,
+            name: name.into(),
+        })
     }
 
     /// `obj` as an array of shape `(n,)` (`width` 0) or `(n, width)`.
-    pub fn rows(obj: &Bound<'py, PyAny>, name: &'static str, width: usize) -> PyResult<Self> {
+    pub fn rows(obj: &Bound<'py, PyAny>, name: &str, width: usize) -> PyResult<Self> {
         let f = Self::new(obj, name)?;
         let shape = f.shape();
         let fits = match width {

@@ -7,9 +7,11 @@
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use hairtrace::description::{GroomSource, demo};
+use hairtrace::description::{GroomSource, MeshDesc, MeshSource, demo};
+use hairtrace::embree::SharedBuffer;
+use hairtrace::incremental::ControlPoints;
 use hairtrace::render::RenderStatus;
-use hairtrace::scene::Strands;
+use hairtrace::scene::{Mesh, Strands};
 use hairtrace::{Aovs, RenderOutput, RenderSettings, Scene, SceneDescription};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::{
@@ -23,6 +25,7 @@ use pyo3::types::{PyBool, PyDict, PyList};
 use crate::arrays::{Floats, same_rows};
 use crate::errors::IntoPy;
 use crate::keys::{self, nest};
+use crate::steps::{self, time_steps};
 use crate::watch::{self, Stop};
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -115,9 +118,16 @@ impl PyScene {
     /// A scene from any file the command line renders: a TOML scene, a pbrt-v4 scene, a
     /// `.hair` groom or a USD stage (a groom file as a quick look: default hair, lights and
     /// camera).
+    /// `frame`: the frame of the shot every groom file is read at (the command line's
+    /// `render --frame F`), over the shutter of the file's `[render]` settings.
     #[staticmethod]
-    fn load(path: PathBuf) -> PyResult<Self> {
-        Self::with(SceneDescription::load(&path).py()?)
+    #[pyo3(signature = (path, frame=None))]
+    fn load(path: PathBuf, frame: Option<f64>) -> PyResult<Self> {
+        let mut desc = SceneDescription::load(&path).py()?;
+        if let Some(f) = frame {
+            desc.at_frame(f).py()?;
+        }
+        Self::with(desc)
     }
 
     /// A built-in demo: "furball", "furnace" or "scalp".
@@ -212,12 +222,100 @@ impl PyScene {
 
     /// Adds a groom by a scene file's `[[groom]]` keys: `file=` (.hair or USD) or
     /// `procedural="fur_ball" | "scalp"` with `params={...}`, then `material`, `basis`,
-    /// `shape`, `translate`, ... The next render builds.
-    #[pyo3(signature = (**keys))]
-    fn add_groom(&mut self, keys: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
-        for groom in Self::entry("groom", keys, "add_groom")?.grooms {
+    /// `shape`, `translate`, ... `frame`: the frame of its animation a file is read at (a
+    /// USD stage's time samples, the file of a `groom.####.hair` sequence), moving over the
+    /// scene's shutter (`set(shutter_open=..., shutter_close=...)` before) where it is open.
+    /// The next render builds.
+    #[pyo3(signature = (frame=None, **keys))]
+    fn add_groom(&mut self, frame: Option<f64>, keys: Option<&Bound<'_, PyDict>>) -> PyResult<()> {
+        for mut groom in Self::entry("groom", keys, "add_groom")?.grooms {
+            if let Some(f) = frame {
+                let GroomSource::File { frame, .. } = &mut groom.source else {
+                    return Err(PyTypeError::new_err(
+                        "add_groom: frame: only a groom file (file=...) is read at a frame",
+                    ));
+                };
+                if !f.is_finite() {
+                    return Err(PyValueError::new_err(format!(
+                        "add_groom: frame = {f}: must be finite"
+                    )));
+                }
+                *frame = Some(f);
+            }
             self.add_groom_desc(&groom)?;
         }
+        Ok(())
+    }
+
+    /// Adds strands of control points laid out for their basis, as float4 (x, y, z,
+    /// radius): `points` (n, 4) for strands that stay put, or at K time steps spread evenly
+    /// over the shutter (the settings `shutter_open` and `shutter_close`: the first step
+    /// where it opens, the last where it closes), as (K, n, 4) or a list of K (n, 4)
+    /// arrays; `counts` (strands,) control points per strand; `colors` (segment ends, 3)
+    /// optional; `material`, `basis` (default "bspline") and `shape` (default "auto") as a
+    /// `[[groom]]` names them. The next render builds.
+    #[pyo3(signature = (points, counts, material, basis="bspline", shape="auto", colors=None))]
+    fn add_curves(
+        &mut self,
+        points: &Bound<'_, PyAny>,
+        counts: &Bound<'_, PyAny>,
+        material: &str,
+        basis: &str,
+        shape: &str,
+        colors: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let mut steps = time_steps::<4>(points, "points")?.into_iter();
+        // Read as a procedural groom's entry, so that the scene reader checks the names.
+        let table = toml::Table::from_iter([
+            ("procedural".to_string(), "fur_ball".into()),
+            ("material".to_string(), material.into()),
+            ("basis".to_string(), basis.into()),
+            ("shape".to_string(), shape.into()),
+        ]);
+        let entry = nest("groom", toml::Value::Array(vec![table.into()]));
+        let groom = keys::read(entry, "add_curves")?.grooms.remove(0);
+        let colors = colors.map(|c| Floats::rows(c, "colors", 3)).transpose()?;
+        let points = ControlPoints {
+            points: steps.next().expect("at least one time step").into(),
+            later_steps: steps.map(SharedBuffer::from).collect(),
+            counts: strand_counts(counts)?,
+            colors: colors.map(|c| c.vec3s().to_vec()),
+            basis: groom.basis.expect("given"),
+        };
+        let name = format!("groom[{}]", self.grooms);
+        (self.scene)
+            .add_control_points(&name, points, groom.shape, &groom.material)
+            .py()?;
+        self.grooms += 1;
+        Ok(())
+    }
+
+    /// Adds a triangle mesh from arrays: `positions` (n, 3), or for a mesh that deforms
+    /// over the shutter its vertices at K time steps spread evenly over it, (K, n, 3) or a
+    /// list of K (n, 3) arrays; `triangles` (t, 3) vertex indices, counter-clockwise seen
+    /// from the front, the same at every step; `normals` (n, 3) optional (none on a mesh
+    /// that deforms: its geometric normal at each ray's time shades it); `material`, a
+    /// diffuse one. The next render builds.
+    #[pyo3(signature = (positions, triangles, material, normals=None))]
+    fn add_triangles(
+        &mut self,
+        positions: &Bound<'_, PyAny>,
+        triangles: &Bound<'_, PyAny>,
+        material: &str,
+        normals: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<()> {
+        let mut steps = time_steps::<3>(positions, "positions")?.into_iter();
+        let normals = normals.map(|n| Floats::rows(n, "normals", 3)).transpose()?;
+        let mesh = Mesh {
+            positions: steps.next().expect("at least one time step"),
+            triangles: steps::triangles(triangles)?,
+            normals: normals.map(|n| n.vec3s().to_vec()),
+            later_positions: steps.collect(),
+        };
+        let desc = MeshDesc::new(MeshSource::Triangles(mesh), material);
+        let name = format!("mesh[{}]", self.meshes);
+        self.scene.add_mesh(&name, &desc).py()?;
+        self.meshes += 1;
         Ok(())
     }
 

@@ -5,9 +5,9 @@ import ctypes
 import subprocess
 
 import numpy as np
-import pytest
 
 import hairtrace
+from c_library import f3, render
 
 SETTINGS = ["--width", "64", "--height", "48", "--spp", "4"]
 
@@ -30,11 +30,6 @@ def test_a_scene_file_renders_the_same_through_the_command_line_and_python(cli, 
     expected = cli_render(cli, tmp_path, path)
     image = hairtrace.Scene.load(path).render(width=64, height=48, spp=4)
     assert np.array_equal(expected, image)
-
-
-class HtHairParams(ctypes.Structure):
-    _fields_ = [("sigma_a", ctypes.c_float * 3), ("eta", ctypes.c_float),
-                ("beta_m", ctypes.c_float), ("beta_n", ctypes.c_float), ("alpha", ctypes.c_float)]
 
 
 class HtCurves(ctypes.Structure):
@@ -62,33 +57,22 @@ def strands():
 
 
 def c_render(clib):
-    lib = ctypes.CDLL(str(clib))
-    lib.ht_hair_params_default.restype = HtHairParams
-    f3 = lambda v: (ctypes.c_float * 3)(*v)
-    ok = lambda status: status == 0 or pytest.fail(lib.ht_last_error().decode())
-    lib.ht_last_error.restype = ctypes.c_char_p
-    device, scene, settings, material = ctypes.c_void_p(), ctypes.c_void_p(), ctypes.c_void_p(), ctypes.c_uint32()
-    ok(lib.ht_device_new(2, ctypes.byref(device)))
-    ok(lib.ht_scene_new(device, ctypes.byref(scene)))
-    params = lib.ht_hair_params_default()
-    ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(material)))
-    points, radii, counts = strands()
-    curves = HtCurves(len(counts), counts.ctypes.data, len(radii), points.ctypes.data, radii.ctypes.data,
-                      0.0, None, HT_CURVE_BSPLINE, HT_CURVE_AUTO)
-    ok(lib.ht_scene_add_curves(scene, ctypes.byref(curves), material, ctypes.byref(ctypes.c_uint32())))
-    ok(lib.ht_scene_add_environment(scene, f3(SKY)))
-    ok(lib.ht_scene_add_distant_light(scene, f3(SUN_DIR), f3(SUN), ctypes.c_float(0.0)))
-    ok(lib.ht_scene_set_camera(scene, f3(EYE), f3([0, 0, 0]), f3([0, 1, 0]), ctypes.c_float(40.0)))
-    ok(lib.ht_settings_new(ctypes.byref(settings)))
-    for k, v in NAMED.items():
-        ok(lib.ht_settings_set(settings, k.encode(), str(v).encode()))
-    rgb = np.zeros(W * H * 3, np.float32)
-    ok(lib.ht_render_with(scene, settings, None, None, ctypes.c_void_p(rgb.ctypes.data), ctypes.c_size_t(rgb.size),
-                          None, None, None, ctypes.c_size_t(W * H)))
-    lib.ht_settings_free(settings)
-    lib.ht_scene_free(scene)
-    lib.ht_device_free(device)
-    return rgb.reshape(H, W, 3), list(params.sigma_a)
+    sigma_a = []
+
+    def fill(lib, scene, ok):
+        material = ctypes.c_uint32()
+        params = lib.ht_hair_params_default()
+        sigma_a.extend(params.sigma_a)
+        ok(lib.ht_scene_add_hair_material(scene, ctypes.byref(params), ctypes.byref(material)))
+        points, radii, counts = strands()
+        curves = HtCurves(len(counts), counts.ctypes.data, len(radii), points.ctypes.data, radii.ctypes.data,
+                          0.0, None, HT_CURVE_BSPLINE, HT_CURVE_AUTO)
+        ok(lib.ht_scene_add_curves(scene, ctypes.byref(curves), material, ctypes.byref(ctypes.c_uint32())))
+        ok(lib.ht_scene_add_environment(scene, f3(SKY)))
+        ok(lib.ht_scene_add_distant_light(scene, f3(SUN_DIR), f3(SUN), ctypes.c_float(0.0)))
+        ok(lib.ht_scene_set_camera(scene, f3(EYE), f3([0, 0, 0]), f3([0, 1, 0]), ctypes.c_float(40.0)))
+
+    return render(clib, fill, NAMED), sigma_a
 
 
 def test_the_same_scene_renders_the_same_through_c_and_python(clib):

@@ -1,13 +1,17 @@
 //! Geometry through the C ABI: curves from host arrays (copied, or float4 xyzr points
-//! shared in place), `.hair` files, and triangle meshes from arrays or files.
+//! shared in place), `.hair` and USD files (as stills, or at a frame over the shutter of
+//! the host's settings), and triangle meshes from arrays or files; curves and meshes at
+//! several time steps move over the shutter.
 
 use super::scene::{HtScene, add_with_id};
+use super::settings::{HtSettings, read_settings};
 use super::{Failure, HtStatus, host_slice, non_null_mut, read_host, read_path};
 use crate::description::{GroomDesc, GroomSource, MeshDesc, MeshSource};
 use crate::embree::{CurveBasis, MAX_TIME_STEPS, SharedBuffer};
 use crate::error::{Result, invalid_arg};
 use crate::formats::hair::Thickness;
 use crate::incremental::ControlPoints;
+use crate::render::settings::RenderSettings;
 use crate::scene::{GroomShape, Mesh, Strands};
 use std::ffi::c_char;
 use std::ptr::NonNull;
@@ -24,6 +28,22 @@ impl HtScene {
         let count = self.scene.add_groom(&name, &groom)?;
         self.added(count)?;
         Ok((first, count as u32))
+    }
+
+    /// [`Self::add_groom`], an animated file's time steps read over the shutter of
+    /// `settings` (None: closed): the scene reads them over its own settings', which a C
+    /// scene otherwise never uses (its builds and renders take settings of their own).
+    fn add_groom_over(
+        &mut self,
+        groom: GroomDesc,
+        material_id: u32,
+        settings: Option<RenderSettings>,
+    ) -> Result<(u32, u32)> {
+        let own = self.scene.settings;
+        self.scene.settings = settings.unwrap_or_default();
+        let added = self.add_groom(groom, material_id);
+        self.scene.settings = own;
+        added
     }
 
     /// Adds the mesh shaded by material `material_id` (diffuse); returns its geometry id.
@@ -255,10 +275,7 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr(
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
-    let still = LaterSteps {
-        points: std::ptr::null(),
-        count: 0,
-    };
+    let still = LaterSteps::STILL;
     add_curves_xyzr(scene, desc, still, material_id, geom_id, |points| {
         Ok(points.to_vec().into())
     })
@@ -291,10 +308,7 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr_shared(
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
-    let still = LaterSteps {
-        points: std::ptr::null(),
-        count: 0,
-    };
+    let still = LaterSteps::STILL;
     add_curves_xyzr(scene, desc, still, material_id, geom_id, |points| {
         if points.as_ptr() as usize % EMBREE_VERTEX_ALIGN != 0 {
             return Err(invalid_arg!(
@@ -346,16 +360,46 @@ pub unsafe extern "C" fn ht_scene_add_curves_xyzr_motion(
     let later = LaterSteps {
         points: later_points,
         count: later_step_count,
+        name: "later_points",
     };
     add_curves_xyzr(scene, desc, later, material_id, geom_id, |points| {
         Ok(points.to_vec().into())
     })
 }
 
-/// The host's control points at the time steps after the first.
+/// The host's arrays (control points or vertices) at the time steps after the first: the
+/// C arguments `later_*` and `later_step_count`.
 struct LaterSteps {
     points: *const *const f32,
     count: usize,
+    /// The C argument's name, for messages: `later_points` or `later_positions`.
+    name: &'static str,
+}
+
+impl LaterSteps {
+    /// No later step: strands or a mesh that stay put.
+    const STILL: LaterSteps = LaterSteps {
+        points: std::ptr::null(),
+        count: 0,
+        name: "later_points",
+    };
+
+    /// The array of each later step, `len` elements of `T`, checked as `host_slice` checks
+    /// (the message names `name[k]`); more than `HT_MAX_TIME_STEPS - 1` are refused.
+    fn arrays<'h, T>(&self, len: usize) -> std::result::Result<Vec<&'h [T]>, Failure> {
+        if self.count >= HT_MAX_TIME_STEPS {
+            return Err(invalid_arg!(
+                "later_step_count = {}: at most {} (HT_MAX_TIME_STEPS - 1)",
+                self.count,
+                HT_MAX_TIME_STEPS - 1
+            )
+            .into());
+        }
+        let steps = host_slice(self.points, self.count, self.name)?;
+        (steps.iter().enumerate())
+            .map(|(k, &p)| host_slice(p.cast(), len, &format!("{}[{k}]", self.name)))
+            .collect()
+    }
 }
 
 /// The body of the `ht_scene_add_curves_xyzr` entry points; `vertices` turns each checked
@@ -390,20 +434,8 @@ fn add_curves_xyzr(
             }
             Some(host_triples(d.colors, ends, "desc->colors")?.to_vec())
         };
-        if later.count >= HT_MAX_TIME_STEPS {
-            return Err(invalid_arg!(
-                "later_step_count = {}: at most {} (HT_MAX_TIME_STEPS - 1)",
-                later.count,
-                HT_MAX_TIME_STEPS - 1
-            )
-            .into());
-        }
-        let later_points = host_slice(later.points, later.count, "later_points")?;
-        let later_steps = (later_points.iter().enumerate())
-            .map(|(k, &p)| {
-                let name = format!("later_points[{k}]");
-                vertices(host_slice(p.cast(), d.point_count, &name)?)
-            })
+        let later_steps = (later.arrays(d.point_count)?.into_iter())
+            .map(&vertices)
             .collect::<std::result::Result<_, Failure>>()?;
         let material = scene.check_material(material_id, true)?;
         let points = ControlPoints {
@@ -444,24 +476,89 @@ pub unsafe extern "C" fn ht_scene_add_hair_file(
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
+    let file = HairFile {
+        thickness_is_radius,
+        basis,
+        shape,
+    };
+    add_hair_file(scene, path, None, file, material_id, geom_id)
+}
+
+/// As `ht_scene_add_hair_file`, read at frame `frame` of an animation: a file whose name
+/// has a run of # (`groom.####.hair`) is a sequence of per-frame files, and the call reads
+/// the file of that frame (`groom.0012.hair` at frame 12; a whole frame >= 0, whose file
+/// must exist); any other file is the same at every frame. With `settings` (NULL: a closed
+/// shutter) whose shutter is open (`shutter_open` < `shutter_close`), a sequence moves over
+/// it: its strands hold time steps read where the shutter opens, where it closes and
+/// evenly between, as many as take in every whole frame inside, a step between two frames
+/// blending their files linearly (docs/formats.md, "Motion blur"), as a scene file with
+/// those `[render]` settings reads it. Render with the same shutter.
+///
+/// Statuses: those of `ht_scene_add_hair_file`; `HT_ERR_INVALID_ARG` also for a frame that
+/// is not finite or, for a sequence, not a whole number >= 0, a file of the sequence that
+/// does not exist, files the shutter spans that hold different strands or points (the
+/// message names both), and `settings` that do not hold together (as `ht_render_with`
+/// refuses them).
+///
+/// # Safety
+/// As `ht_scene_add_hair_file`, and `settings` is NULL or a live handle that no other
+/// thread sets during the call.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)] // the C signature of ht_scene_add_hair_file, and the frame
+pub unsafe extern "C" fn ht_scene_add_hair_file_at(
+    scene: *mut HtScene,
+    path: *const c_char,
+    frame: f64,
+    settings: *const HtSettings,
+    thickness_is_radius: bool,
+    basis: HtCurveBasis,
+    shape: HtCurveShape,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    let file = HairFile {
+        thickness_is_radius,
+        basis,
+        shape,
+    };
+    let at = Some(Frame { frame, settings });
+    add_hair_file(scene, path, at, file, material_id, geom_id)
+}
+
+/// How a C host draws a `.hair` file's strands.
+struct HairFile {
+    thickness_is_radius: bool,
+    basis: HtCurveBasis,
+    shape: HtCurveShape,
+}
+
+/// The body of the `ht_scene_add_hair_file` entry points.
+fn add_hair_file(
+    scene: *mut HtScene,
+    path: *const c_char,
+    at: Option<Frame>,
+    file: HairFile,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
         let path = read_path(path, "path")?;
         scene.check_material(material_id, true)?;
-        let (basis, shape) = (curve_basis(basis)?, curve_shape(shape)?);
-        let thickness = if thickness_is_radius {
+        let (basis, shape) = (curve_basis(file.basis)?, curve_shape(file.shape)?);
+        let thickness = if file.thickness_is_radius {
             Thickness::Radius
         } else {
             Thickness::Diameter
         };
+        let (frame, settings) = read_frame(at)?;
         // Read as a scene file reads it: in the units its header says, if it says them.
         let source = GroomSource::File {
             path,
             thickness,
-            frame: None,
+            frame,
         };
-        Ok(scene
-            .add_groom(groom(source, Some(basis), shape), material_id)?
-            .0)
+        let groom = groom(source, Some(basis), shape);
+        Ok(scene.add_groom_over(groom, material_id, settings)?.0)
     })
 }
 
@@ -493,21 +590,95 @@ pub unsafe extern "C" fn ht_scene_add_usd_file(
     first_geom_id: *mut u32,
     geom_count: *mut u32,
 ) -> HtStatus {
+    let ids = (first_geom_id, geom_count);
+    add_usd_file(scene, path, None, shape, material_id, ids)
+}
+
+/// As `ht_scene_add_usd_file`, read at frame `frame` of the stage's animation: every
+/// attribute at that frame's time code (frame x `timeCodesPerSecond` / `framesPerSecond`),
+/// interpolated between time samples as USD defines (docs/formats.md, "Animation"); a path
+/// whose file name has a run of # names a sequence of per-frame stages, of which the
+/// frame's is read. With `settings` (NULL: a closed shutter) whose shutter is open
+/// (`shutter_open` < `shutter_close`), an animated stage moves over it: each prim's curves
+/// hold time steps read where the shutter opens, where it closes and evenly between, as
+/// many as take in every time sample inside (docs/formats.md, "Motion blur"), as a scene
+/// file with those `[render]` settings reads it. Render with the same shutter.
+///
+/// Statuses: those of `ht_scene_add_usd_file`; `HT_ERR_INVALID_ARG` also for a frame that
+/// is not finite or lies outside the stage's animation, a sample the reader refuses (the
+/// message names the prim and the frame), a prim whose counts change inside the shutter,
+/// and `settings` that do not hold together (as `ht_render_with` refuses them).
+///
+/// # Safety
+/// As `ht_scene_add_usd_file`, and `settings` is NULL or a live handle that no other
+/// thread sets during the call.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)] // the C signature of ht_scene_add_usd_file, and the frame
+pub unsafe extern "C" fn ht_scene_add_usd_file_at(
+    scene: *mut HtScene,
+    path: *const c_char,
+    frame: f64,
+    settings: *const HtSettings,
+    shape: HtCurveShape,
+    material_id: u32,
+    first_geom_id: *mut u32,
+    geom_count: *mut u32,
+) -> HtStatus {
+    let (at, ids) = (Some(Frame { frame, settings }), (first_geom_id, geom_count));
+    add_usd_file(scene, path, at, shape, material_id, ids)
+}
+
+/// The body of the `ht_scene_add_usd_file` entry points; `ids` are the out-parameters
+/// `first_geom_id` and `geom_count`.
+fn add_usd_file(
+    scene: *mut HtScene,
+    path: *const c_char,
+    at: Option<Frame>,
+    shape: HtCurveShape,
+    material_id: u32,
+    (first_geom_id, geom_count): (*mut u32, *mut u32),
+) -> HtStatus {
     add_with_id(scene, first_geom_id, "first_geom_id", |scene| {
         let count_out = non_null_mut(geom_count, "geom_count")?;
         let path = read_path(path, "path")?;
         scene.check_material(material_id, true)?;
         let shape = curve_shape(shape)?;
+        let (frame, settings) = read_frame(at)?;
         let source = GroomSource::File {
             path,
             thickness: Thickness::Diameter,
-            frame: None,
+            frame,
         };
-        let (first, count) = scene.add_groom(groom(source, None, shape), material_id)?;
+        let (first, count) =
+            scene.add_groom_over(groom(source, None, shape), material_id, settings)?;
         // SAFETY: non-NULL (checked), the host's uint32_t.
         unsafe { count_out.write(count) };
         Ok(first)
     })
+}
+
+/// The C arguments `frame` and `settings` of the `_at` entry points.
+struct Frame {
+    frame: f64,
+    settings: *const HtSettings,
+}
+
+/// The frame a C host reads an animated file at (None: as a still, each attribute's
+/// default value, else its first time sample), and the settings whose shutter its time
+/// steps span (None: closed).
+fn read_frame(
+    at: Option<Frame>,
+) -> std::result::Result<(Option<f64>, Option<RenderSettings>), Failure> {
+    let Some(Frame { frame, settings }) = at else {
+        return Ok((None, None));
+    };
+    if !frame.is_finite() {
+        return Err(invalid_arg!("frame = {frame}: must be finite").into());
+    }
+    let settings = (!settings.is_null())
+        .then(|| read_settings(settings))
+        .transpose()?;
+    Ok((Some(frame), settings))
 }
 
 /// Adds a triangle mesh (copied), shaded by the diffuse material `material_id`:
@@ -537,8 +708,93 @@ pub unsafe extern "C" fn ht_scene_add_mesh(
     material_id: u32,
     geom_id: *mut u32,
 ) -> HtStatus {
+    let vertices = Vertices {
+        count: vertex_count,
+        positions,
+        later: LaterSteps::STILL,
+        normals,
+    };
+    add_triangles(
+        scene,
+        vertices,
+        triangle_count,
+        indices,
+        material_id,
+        geom_id,
+    )
+}
+
+/// Adds a triangle mesh that deforms over the shutter (copied), shaded by the diffuse
+/// material `material_id`: `positions` holds its vertices (3 floats each) at the first of
+/// `later_step_count + 1` time steps spread evenly over the shutter (the settings
+/// `shutter_open` and `shutter_close`, as for `ht_scene_add_curves_xyzr_motion`), and
+/// `later_positions[k]` the `3 * vertex_count` floats of the same vertices at step k + 1;
+/// `indices` holds 3 vertex indices per triangle, the same at every step. Between two steps
+/// a vertex moves in a straight line. A deforming mesh has no vertex normals: its geometric
+/// normal at each ray's time shades it. With `later_step_count` 0 (`later_positions` may
+/// then be NULL) this is `ht_scene_add_mesh` without normals. Writes the geometry id.
+///
+/// Statuses: as `ht_scene_add_mesh`, and `HT_ERR_NULL_ARG` for `later_positions` or one of
+/// its pointers NULL when it is read; `HT_ERR_INVALID_ARG` for more than
+/// `HT_MAX_TIME_STEPS - 1` later steps, or a NaN, infinite or out-of-range value at a step
+/// (the message names the step).
+///
+/// # Safety
+/// As `ht_scene_add_mesh`, and `later_positions` is NULL or points to `later_step_count`
+/// pointers, each NULL or to `3 * vertex_count` readable floats.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)] // the C signature: one argument per array
+pub unsafe extern "C" fn ht_scene_add_mesh_motion(
+    scene: *mut HtScene,
+    vertex_count: usize,
+    positions: *const f32,
+    later_positions: *const *const f32,
+    later_step_count: usize,
+    triangle_count: usize,
+    indices: *const u32,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
+    let vertices = Vertices {
+        count: vertex_count,
+        positions,
+        later: LaterSteps {
+            points: later_positions,
+            count: later_step_count,
+            name: "later_positions",
+        },
+        normals: std::ptr::null(),
+    };
+    add_triangles(
+        scene,
+        vertices,
+        triangle_count,
+        indices,
+        material_id,
+        geom_id,
+    )
+}
+
+/// A C host's mesh vertices: their positions at each time step and their normals.
+struct Vertices {
+    count: usize,
+    positions: *const f32,
+    later: LaterSteps,
+    normals: *const f32,
+}
+
+/// The body of `ht_scene_add_mesh` and `ht_scene_add_mesh_motion`.
+fn add_triangles(
+    scene: *mut HtScene,
+    vertices: Vertices,
+    triangle_count: usize,
+    indices: *const u32,
+    material_id: u32,
+    geom_id: *mut u32,
+) -> HtStatus {
     add_with_id(scene, geom_id, "geom_id", |scene| {
         scene.check_material(material_id, false)?;
+        let vertex_count = vertices.count;
         if vertex_count == 0 || triangle_count == 0 {
             return Err(invalid_arg!(
                 "vertex_count = {vertex_count}, triangle_count = {triangle_count}: a mesh needs \
@@ -546,12 +802,19 @@ pub unsafe extern "C" fn ht_scene_add_mesh(
             )
             .into());
         }
-        let positions = host_triples(positions, vertex_count, "positions")?.to_vec();
-        let normals = (!normals.is_null())
-            .then(|| host_triples(normals, vertex_count, "normals").map(<[_]>::to_vec))
+        let positions = host_triples(vertices.positions, vertex_count, "positions")?.to_vec();
+        let normals = (!vertices.normals.is_null())
+            .then(|| host_triples(vertices.normals, vertex_count, "normals").map(<[_]>::to_vec))
             .transpose()?;
+        let later: Vec<&[[f32; 3]]> = vertices.later.arrays(vertex_count)?;
         let triangles: &[[u32; 3]] = host_slice(indices.cast(), triangle_count, "indices")?;
-        let mesh = Mesh::new(positions, triangles.to_vec(), normals)?;
+        let mesh = Mesh {
+            positions,
+            triangles: triangles.to_vec(),
+            normals,
+            later_positions: later.into_iter().map(<[_]>::to_vec).collect(),
+        };
+        mesh.validate()?;
         Ok(scene.add_mesh(MeshSource::Triangles(mesh), material_id)?)
     })
 }

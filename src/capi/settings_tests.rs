@@ -11,7 +11,7 @@ use std::ffi::{CStr, CString, c_char};
 use std::ptr::{null, null_mut};
 
 /// Settings from `ht_settings_new`, freed on drop.
-pub(super) struct Named(*mut HtSettings);
+pub(super) struct Named(pub(super) *mut HtSettings);
 
 impl Named {
     pub(super) fn new(pairs: &[(&str, &str)]) -> Named {

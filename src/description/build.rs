@@ -13,10 +13,11 @@ use super::{
 };
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::CurveBasis;
-use crate::error::{Result, invalid_arg};
+use crate::error::{Error, Result, invalid_arg};
 use crate::render::Aovs;
 use crate::render::renderer::film_bytes_and_uniform;
 use crate::scene::GroomShape;
+use crate::scene::Strands;
 use crate::scene::camera::Camera;
 use crate::scene::curves::{Curves, placed};
 use crate::scene::envmap::Environment;
@@ -31,7 +32,7 @@ use crate::validate::{self, positive};
 
 use crate::embree::MAX_TIME_STEPS;
 use crate::farm::frame_path;
-use crate::formats::hair::{HairTag, read_hair_file, read_hair_tag};
+use crate::formats::hair::{HairTag, Thickness, read_hair_file, read_hair_tag};
 use crate::formats::mesh::read_mesh_file;
 use crate::formats::units::StageUnits;
 use crate::formats::usd::{
@@ -266,14 +267,10 @@ impl GroomDesc {
                 stages.run(Stage::Curves, (i, grooms), |_| {
                     (0..steps[0].curves.len())
                         .map(|prim| {
-                            let mut at = (steps.iter())
+                            let at = (steps.iter())
                                 .map(|s| s.curves[prim].curves(shape, radius_factor, place))
                                 .collect::<Result<Vec<_>>>()?;
-                            if at.len() == 1 {
-                                return Ok(at.remove(0));
-                            }
-                            (Curves::in_motion(at))
-                                .map_err(|e| e.context(&steps[0].curves[prim].path))
+                            in_motion(at).map_err(|e| e.context(&steps[0].curves[prim].path))
                         })
                         .collect()
                 })
@@ -298,21 +295,36 @@ impl GroomDesc {
                 Ok(vec![curves])
             }
             _ => {
-                let read = stages.run(Stage::Read, (i, reads), |_| self.placed_strands())?;
-                // A file that is not USD, or a procedural groom, is one set of strands.
-                let GroomStrands {
-                    strands, curves, ..
-                } = read
-                    .into_iter()
-                    .next()
-                    .ok_or_else(|| invalid_arg!("no strands"))?;
-                framing.add_strands(&strands);
-                let curves = stages.run(Stage::Curves, (i, grooms), |_| match curves {
-                    StrandCurves::Polylines(basis) => Curves::from_strands(&strands, basis, shape),
-                    StrandCurves::Authored(layout) => {
-                        let (control, counts, colors) = layout.control_points(&strands)?;
-                        Curves::from_control_points(control, &counts, colors, layout.basis, shape)
-                    }
+                // A file that is not USD, or a procedural groom, is one set of strands at
+                // each time step (one step but for a `.hair` sequence blurred).
+                let steps = stages.run(Stage::Read, (i, reads), |_| self.placed_steps(shutter))?;
+                for step in &steps {
+                    framing.add_strands(&step.strands);
+                }
+                let curves = stages.run(Stage::Curves, (i, grooms), |_| {
+                    let at = (steps.iter())
+                        .map(
+                            |GroomStrands {
+                                 strands, curves, ..
+                             }| match *curves {
+                                StrandCurves::Polylines(basis) => {
+                                    Curves::from_strands(strands, basis, shape)
+                                }
+                                StrandCurves::Authored(layout) => {
+                                    let (control, counts, colors) =
+                                        layout.control_points(strands)?;
+                                    Curves::from_control_points(
+                                        control,
+                                        &counts,
+                                        colors,
+                                        layout.basis,
+                                        shape,
+                                    )
+                                }
+                            },
+                        )
+                        .collect::<Result<Vec<_>>>()?;
+                    in_motion(at)
                 })?;
                 Ok(vec![curves])
             }
@@ -324,14 +336,7 @@ impl GroomDesc {
     /// groom, one per BasisCurves prim of a USD stage (its points under its own transform,
     /// in the stage's units).
     pub fn authored_strands(&self) -> Result<Vec<GroomStrands>> {
-        let one = |strands, tag: Option<HairTag>| -> Result<Vec<GroomStrands>> {
-            Ok(vec![GroomStrands {
-                prim: None,
-                strands,
-                curves: self.curves_with_tag(tag)?,
-                units: tag.map_or(StageUnits::WORLD, |t| t.units),
-            }])
-        };
+        let one = |strands| Ok(vec![self.strand_set(strands, None)?]);
         match &self.source {
             GroomSource::File { path, frame, .. } if is_usd_path(path) => {
                 let file = read_usd_file_at(&frame_file(path, *frame)?, *frame)?;
@@ -348,14 +353,10 @@ impl GroomDesc {
                 path,
                 thickness,
                 frame,
-            } => {
-                let path = frame_file(path, *frame)?;
-                let tag = read_hair_tag(&path)?;
-                one(read_hair_file(&path, *thickness)?, tag)
-            }
-            GroomSource::FurBall(f) => one(f.build()?, None),
-            GroomSource::Scalp(s) => one(s.build()?, None),
-            GroomSource::Strands(s) => one(s.clone(), None),
+            } => self.hair_steps(path, *thickness, *frame, CLOSED),
+            GroomSource::FurBall(f) => one(f.build()?),
+            GroomSource::Scalp(s) => one(s.build()?),
+            GroomSource::Strands(s) => one(s.clone()),
             GroomSource::ControlPoints { .. } => Err(invalid_arg!(
                 "a groom of control points (from a pbrt file) has no polyline strands"
             )),
@@ -365,10 +366,57 @@ impl GroomDesc {
     /// [`GroomDesc::authored_strands`] in the world: brought from their units, then placed
     /// by the entry's transform, radii scaled.
     pub fn placed_strands(&self) -> Result<Vec<GroomStrands>> {
+        self.placed(self.authored_strands()?)
+    }
+
+    /// [`GroomDesc::placed_strands`] of a groom that is not USD at each time step of
+    /// `shutter` (open, close, in frames from the frame): one set a step, more than one for
+    /// a `.hair` sequence read at a frame with the shutter open ([`hair_sequence_steps`]).
+    fn placed_steps(&self, shutter: (f32, f32)) -> Result<Vec<GroomStrands>> {
+        match &self.source {
+            GroomSource::File {
+                path,
+                thickness,
+                frame,
+            } if !is_usd_path(path) => {
+                self.placed(self.hair_steps(path, *thickness, *frame, shutter)?)
+            }
+            _ => self.placed_strands(),
+        }
+    }
+
+    /// The strands of the `.hair` groom at `path` at each time step of `shutter`, with the
+    /// curve they draw and the units of the frame's file.
+    fn hair_steps(
+        &self,
+        path: &Path,
+        thickness: Thickness,
+        frame: Option<f64>,
+        shutter: (f32, f32),
+    ) -> Result<Vec<GroomStrands>> {
+        let tag = read_hair_tag(&frame_file(path, frame)?)?;
+        (hair_sequence_steps(path, thickness, frame, shutter)?.into_iter())
+            .map(|strands| self.strand_set(strands, tag))
+            .collect()
+    }
+
+    /// `strands` of this groom as one set, with the curve they draw and their units, from
+    /// the tag of the `.hair` file they were read from, if any.
+    fn strand_set(&self, strands: Strands, tag: Option<HairTag>) -> Result<GroomStrands> {
+        Ok(GroomStrands {
+            prim: None,
+            strands,
+            curves: self.curves_with_tag(tag)?,
+            units: tag.map_or(StageUnits::WORLD, |t| t.units),
+        })
+    }
+
+    /// `sets` in the world: brought from their units, then placed by the entry's
+    /// transform, radii scaled.
+    fn placed(&self, mut sets: Vec<GroomStrands>) -> Result<Vec<GroomStrands>> {
         let (affine, scale) = self.transform.affine()?;
         positive("radius_scale", self.radius_scale)?;
         let placed = self.transform != Transform::default();
-        let mut sets = self.authored_strands()?;
         for set in &mut sets {
             let units = std::mem::replace(&mut set.units, StageUnits::WORLD);
             if placed || units != StageUnits::WORLD {
@@ -430,13 +478,111 @@ fn shutter_frame(frame: f64, (open, close): (f32, f32), k: usize, steps: usize) 
     }
 }
 
+/// A closed shutter: one time step, at the frame.
+const CLOSED: (f32, f32) = (0.0, 0.0);
+
+/// Curves made at each time step as one geometry: moving over the shutter when there is
+/// more than one step.
+fn in_motion(mut at: Vec<Curves>) -> Result<Curves> {
+    match at.len() {
+        1 => Ok(at.remove(0)),
+        _ => Curves::in_motion(at),
+    }
+}
+
+/// The strands of the `.hair` file at `path` read at `frame` ([`frame_file`]), or, for a
+/// sequence of per-frame files read at a frame with `shutter` open, at the time steps of
+/// its motion, chosen as [`usd_steps`] chooses a stage's with each file a time sample:
+/// where the shutter opens, where it closes and evenly between, as many as take in every
+/// whole frame inside. A step between two frames blends their files' points and radii
+/// linearly, as USD interpolates its samples (colours are the earlier file's). Every file
+/// a step reads must exist and hold the strands of the frame's file, point for point.
+fn hair_sequence_steps(
+    path: &Path,
+    thickness: Thickness,
+    frame: Option<f64>,
+    (open, close): (f32, f32),
+) -> Result<Vec<Strands>> {
+    let file = frame_file(path, frame)?;
+    let still = read_hair_file(&file, thickness)?;
+    let Some(f) = frame.filter(|_| close > open && is_sequence(path)) else {
+        return Ok(vec![still]);
+    };
+    let (open, close) = (f + f64::from(open), f + f64::from(close));
+    let span = |e: Error| {
+        e.context(format!(
+            "the shutter of frame {f} spans frames {open} to {close}"
+        ))
+    };
+    let inside = (close.ceil() - open.floor() - 1.0).max(0.0) as usize;
+    let count = (inside + 2).min(MAX_TIME_STEPS);
+    // Each file read once: the frame's, then those the steps reach.
+    let mut files = vec![(f, file, still)];
+    type Read = (f64, PathBuf, Strands);
+    let read = |files: &mut Vec<Read>, n: f64| -> Result<usize> {
+        if let Some(i) = files.iter().position(|(m, ..)| *m == n) {
+            return Ok(i);
+        }
+        let file = frame_file(path, Some(n)).map_err(span)?;
+        let strands = read_hair_file(&file, thickness)?;
+        let (first, ours) = (&files[0], &strands);
+        if ours.counts != first.2.counts {
+            return Err(invalid_arg!(
+                "{} ({} strands, {} points) and {} ({} strands, {} points) differ: the files \
+                 a shutter spans hold the same strands, point for point",
+                file.display(),
+                ours.counts.len(),
+                ours.points.len(),
+                first.1.display(),
+                first.2.counts.len(),
+                first.2.points.len()
+            ));
+        }
+        files.push((n, file, strands));
+        Ok(files.len() - 1)
+    };
+    let mut steps = Vec::with_capacity(count);
+    for k in 0..count {
+        let at = open + (close - open) * k as f64 / (count - 1) as f64;
+        let below = at.floor();
+        let earlier = read(&mut files, below)?;
+        let t = (at - below) as f32;
+        if t == 0.0 {
+            steps.push(files[earlier].2.clone());
+            continue;
+        }
+        let later = read(&mut files, below + 1.0)?;
+        steps.push(blend(&files[earlier].2, &files[later].2, t));
+    }
+    Ok(steps)
+}
+
+/// The strands `t` of the way from `a` to `b` (the same strands): points and radii
+/// linearly between, the colours of `a`.
+fn blend(a: &Strands, b: &Strands, t: f32) -> Strands {
+    let lerp = |x: f32, y: f32| x + (y - x) * t;
+    Strands {
+        points: (a.points.iter().zip(&b.points))
+            .map(|(p, q)| [0, 1, 2].map(|i| lerp(p[i], q[i])))
+            .collect(),
+        radii: (a.radii.iter().zip(&b.radii))
+            .map(|(&r, &s)| lerp(r, s))
+            .collect(),
+        counts: a.counts.clone(),
+        colors: a.colors.clone(),
+    }
+}
+
+/// Whether `path` names a sequence of per-frame files: a run of # in its file name.
+fn is_sequence(path: &Path) -> bool {
+    path.file_name()
+        .is_some_and(|n| n.to_string_lossy().contains('#'))
+}
+
 /// The file a groom reads at `frame`: `path` itself, or for a sequence of per-frame files
 /// (a run of # in its file name) the file of that frame, which must exist.
 fn frame_file(path: &Path, frame: Option<f64>) -> Result<PathBuf> {
-    let sequence = path
-        .file_name()
-        .is_some_and(|n| n.to_string_lossy().contains('#'));
-    if !sequence {
+    if !is_sequence(path) {
         return Ok(path.to_path_buf());
     }
     let at = |why: String| invalid_arg!("{}: {why}", path.display());

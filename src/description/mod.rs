@@ -263,7 +263,8 @@ pub enum GroomSource {
         thickness: Thickness,
         /// The frame of its animation the file is read at: a USD stage's time samples
         /// there, the file of that number in a sequence (a run of # in the path's file
-        /// name). None: a still (a stage's default values, else its first samples).
+        /// name); with the shutter open, either moves over it (`GroomDesc::curves`). None:
+        /// a still (a stage's default values, else its first samples).
         frame: Option<f64>,
     },
     FurBall(FurBall),

@@ -313,11 +313,19 @@ pub fn basis_named(name: &str) -> Result<CurveBasis> {
 /// prim's own.
 fn usd_groom(c: &UsdCurves, opts: &ConvertOptions, notes: &mut Vec<String>) -> Result<Groom> {
     let layout = c.layout;
-    if c.melanin.is_some() {
-        notes.push(format!(
-            "{}: primvars:melanin is not written: a .hair file has no melanin",
-            c.path
-        ));
+    for (lost, what) in [
+        (
+            c.melanin.is_some(),
+            "primvars:melanin is not written: a .hair file has no melanin",
+        ),
+        (
+            c.normals.is_some(),
+            "curve normals are not written: a .hair file has none",
+        ),
+    ] {
+        if lost {
+            notes.push(format!("{}: {what}", c.path));
+        }
     }
     let linear = Layout::of_polylines(CurveBasis::Linear);
     let sample = opts.basis == Some(CurveBasis::Linear) && layout != linear;

@@ -26,7 +26,9 @@
 //! segment), the position s along the strand (root 0, tip 1, uniform in the segment
 //! parameter) and the groom's optional absorption: a colour per polyline point,
 //! interpolated linearly, or a melanin pair per strand ([`Curves::with_melanin`]), kept as
-//! given so that the material converts it once, at the hit.
+//! given so that the material converts it once, at the hit; and the groom's optional curve
+//! normals ([`Curves::with_normals`]), a direction per polyline point, which orient an
+//! elliptical fibre's section.
 //!
 //! `Curves::polylines` lays flat linear ribbons over points sampled on other curves (the
 //! level of detail of `lod.rs`); [`TrueCurves`] keeps those curves, so that the ribbons'
@@ -105,6 +107,9 @@ pub struct StrandIndex {
     /// First segment of each strand, plus the total at the end.
     segment_starts: Vec<u32>,
     absorption: Option<GroomAbsorption>,
+    /// The groom's curve normals at each segment end (segments + 1 per strand), strand
+    /// after strand, as given (not unit, not yet perpendicular to the curve).
+    normals: Option<Vec<[f32; 3]>>,
     /// Each strand's number in the groom it came from, when it is not its index here.
     ids: Option<Vec<u32>>,
     /// The strand of every [`COARSE`]-th segment: a lookup narrows to the strands of one
@@ -159,6 +164,7 @@ impl StrandIndex {
         Ok(StrandIndex {
             segment_starts,
             absorption: colors.map(GroomAbsorption::Colors),
+            normals: None,
             ids: None,
             coarse,
         })
@@ -217,15 +223,7 @@ impl StrandIndex {
     /// there (interpolated between the segment's ends) or the strand's melanin.
     pub fn absorption(&self, at: &StrandSegment, u: f32) -> Option<HairColor> {
         match self.absorption.as_ref()? {
-            GroomAbsorption::Colors(colors) => {
-                // Each strand has one more point than segments: skip one per strand before.
-                let k = (at.first_prim + at.strand + at.segment) as usize;
-                let (a, b) = (colors.get(k)?, colors.get(k + 1)?);
-                let u = u.clamp(0.0, 1.0);
-                Some(HairColor::Color(std::array::from_fn(|c| {
-                    a[c] + (b[c] - a[c]) * u
-                })))
-            }
+            GroomAbsorption::Colors(colors) => Some(HairColor::Color(at_knots(colors, at, u)?)),
             GroomAbsorption::Melanin(m) => {
                 let [eumelanin, pheomelanin] = *m.get(at.strand as usize)?;
                 Some(HairColor::Melanin {
@@ -236,9 +234,16 @@ impl StrandIndex {
         }
     }
 
+    /// The groom's curve normal at parameter u of segment `at`, if it gives them:
+    /// interpolated linearly between the segment's ends, as given (not unit).
+    pub fn normal(&self, at: &StrandSegment, u: f32) -> Option<Vec3> {
+        Some(Vec3::from_array(at_knots(self.normals.as_ref()?, at, u)?))
+    }
+
     /// Heap bytes of the table.
     pub fn heap_bytes(&self) -> usize {
         self.segment_starts.capacity() * 4
+            + self.normals.as_ref().map_or(0, |n| n.capacity() * 12)
             + match &self.absorption {
                 Some(GroomAbsorption::Colors(c)) => c.capacity() * 12,
                 Some(GroomAbsorption::Melanin(m)) => m.capacity() * 8,
@@ -247,6 +252,27 @@ impl StrandIndex {
             + self.ids.as_ref().map_or(0, |i| i.capacity() * 4)
             + self.coarse.capacity() * 4
     }
+}
+
+/// A per-segment-end value (segments + 1 per strand) at parameter u of segment `at`,
+/// interpolated linearly between the segment's two ends.
+fn at_knots(values: &[[f32; 3]], at: &StrandSegment, u: f32) -> Option<[f32; 3]> {
+    // Each strand has one more end than segments: skip one per strand before.
+    let k = (at.first_prim + at.strand + at.segment) as usize;
+    let (a, b) = (values.get(k)?, values.get(k + 1)?);
+    let u = u.clamp(0.0, 1.0);
+    Some(std::array::from_fn(|c| a[c] + (b[c] - a[c]) * u))
+}
+
+/// Per-segment-end values (segments + 1 per strand) of the strands `order` names, in that
+/// order, for curves whose strands start at segments `starts`.
+fn gathered_knots(all: &[[f32; 3]], starts: &[u32], order: &[usize]) -> Result<Vec<[f32; 3]>> {
+    let first = |s: usize| starts[s] as usize + s;
+    let sizes = ragged::starts(order.iter().map(|&s| first(s + 1) - first(s)));
+    ragged::filled(&sizes, 0, |i, out| {
+        let s = order[i];
+        out.copy_from_slice(&all[first(s)..first(s + 1)]);
+    })
 }
 
 impl Curves {
@@ -513,18 +539,13 @@ impl Curves {
             })
             .collect::<Result<_>>()?;
         let colors = match &self.strands.absorption {
-            // Segments + 1 colours per strand: s strands' extra ones come before.
-            Some(GroomAbsorption::Colors(all)) => {
-                let first = |s: usize| starts[s] as usize + s;
-                let sizes = ragged::starts(order.iter().map(|&s| first(s + 1) - first(s)));
-                Some(ragged::filled(&sizes, 0, |i, out| {
-                    let s = order[i];
-                    out.copy_from_slice(&all[first(s)..first(s + 1)]);
-                })?)
-            }
+            Some(GroomAbsorption::Colors(all)) => Some(gathered_knots(all, starts, order)?),
             _ => None,
         };
         let mut part = Curves::assembled(vertices.into(), &sizes, colors, self.basis, shape)?;
+        part.strands.normals = (self.strands.normals.as_ref())
+            .map(|all| gathered_knots(all, starts, order))
+            .transpose()?;
         if let Some(GroomAbsorption::Melanin(all)) = &self.strands.absorption {
             part = part.with_melanin(order.iter().map(|&s| all[s]).collect())?;
         }
@@ -577,6 +598,23 @@ impl Curves {
                 .map_err(|e| e.context(format!("strand {i}")))?;
         }
         self.strands.absorption = Some(GroomAbsorption::Melanin(melanin));
+        Ok(self)
+    }
+
+    /// The same curves with the groom's curve normals, one per segment end (segments + 1
+    /// per strand, as colours are given): at a hit, the normal there made perpendicular to
+    /// the curve is the major axis of an elliptical fibre's section (`HairHit::major_axis`).
+    /// Each must be finite; their length does not matter.
+    pub fn with_normals(mut self, normals: Vec<[f32; 3]>) -> Result<Self> {
+        let knots = self.strands.segment_count() + self.strands.strand_count();
+        if normals.len() != knots {
+            return Err(invalid_arg!(
+                "{} normals for {knots} strand points (segments + 1 per strand)",
+                normals.len()
+            ));
+        }
+        validate::positions("normal", &normals)?;
+        self.strands.normals = Some(normals);
         Ok(self)
     }
 
@@ -780,6 +818,11 @@ impl TrueCurves {
     /// The true curve's colour at parameter `u` of segment `at`, if it has colours.
     pub fn absorption(&self, at: &StrandSegment, u: f32) -> Option<HairColor> {
         self.curves.strands.absorption(at, u)
+    }
+
+    /// The true curve's normal at parameter `u` of segment `at`, if it has normals.
+    pub fn normal(&self, at: &StrandSegment, u: f32) -> Option<Vec3> {
+        self.curves.strands.normal(at, u)
     }
 
     pub fn heap_bytes(&self) -> usize {

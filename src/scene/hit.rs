@@ -69,6 +69,9 @@ pub struct HairHit {
     /// The groom's absorption here, when it gives one
     /// ([`super::curves::StrandIndex::absorption`]).
     pub absorption: Option<HairColor>,
+    /// The groom's curve normal here, when it gives them ([`super::curves::StrandIndex::normal`]):
+    /// the direction an elliptical fibre's major axis turns toward.
+    pub normal: Option<Vec3>,
     /// The time of the ray that hit (`Ray::time`), at which the strand was met and is
     /// shaded, and which the rays leaving it keep.
     pub time: f32,
@@ -76,24 +79,26 @@ pub struct HairHit {
 
 impl HairHit {
     /// The major axis of an elliptical fibre's section here, as a (y, z) direction of the
-    /// hit's frame: world up (+y) made perpendicular to the tangent, or world +x where the
-    /// tangent is too near vertical for that ([`MIN_MAJOR_AXIS_SQUARED`]). A property of the fibre, not of
-    /// the ray, so that camera and shadow rays see one section (docs/conventions.md,
-    /// section 4b); a groom's curve normals are not read yet.
+    /// hit's frame: the groom's curve normal made perpendicular to the tangent; where the
+    /// groom has none, or it runs along the tangent, world up (+y) so made, or world +x
+    /// where the tangent is too near vertical for that ([`MIN_MAJOR_AXIS_SQUARED`] of the
+    /// unit vector). A property of the fibre, not of the ray, so that camera and shadow
+    /// rays see one section (docs/conventions.md, section 4b).
     pub(crate) fn major_axis(&self) -> Vec2 {
         let x = self.frame.x;
-        let off = |a: Vec3| a - x * x.dot(a);
-        let m = off(Vec3::Y);
-        let m = if m.length_squared() > MIN_MAJOR_AXIS_SQUARED {
-            m
-        } else {
-            off(Vec3::X)
+        let off = |a: Vec3| {
+            let a = a.normalize_or_zero();
+            Some(a - x * x.dot(a)).filter(|m| m.length_squared() > MIN_MAJOR_AXIS_SQUARED)
         };
+        let m = (self.normal.and_then(off))
+            .or_else(|| off(Vec3::Y))
+            .or_else(|| off(Vec3::X))
+            .unwrap_or(Vec3::ZERO);
         Vec2::new(m.dot(self.frame.y), m.dot(self.frame.z))
     }
 }
 
-/// Below this squared length world up is too near the tangent to orient the section.
+/// Below this squared length a unit direction is too near the tangent to orient the section.
 const MIN_MAJOR_AXIS_SQUARED: f32 = 1e-6;
 
 /// A hit on a triangle mesh.
@@ -200,5 +205,60 @@ mod tests {
         }
         let (_, h) = hair_frame(Vec3::X, -Vec3::Z, Vec3::Y * 5.0, Vec3::ZERO, 1.0);
         assert_eq!(h, 1.0);
+    }
+
+    /// A hit on a strand along `tangent`, seen along -z, with the groom's `normal`.
+    fn hit(tangent: Vec3, normal: Option<Vec3>) -> HairHit {
+        let (frame, h) = hair_frame(tangent, -Vec3::Z, Vec3::Z, Vec3::ZERO, 1.0);
+        HairHit {
+            t: 1.0,
+            p: Vec3::ZERO,
+            ng: frame.z,
+            frame,
+            h,
+            axis: Vec3::ZERO,
+            radius: 1.0,
+            shape: CurveShape::Round,
+            geom_id: 0,
+            prim_id: 0,
+            u: 0.0,
+            v: 0.0,
+            strand: StrandSegment {
+                strand: 0,
+                segment: 0,
+                segments: 1,
+                first_prim: 0,
+                id: 0,
+            },
+            s: 0.0,
+            absorption: None,
+            normal,
+            time: 0.0,
+        }
+    }
+
+    /// The major axis in world space.
+    fn axis(h: &HairHit) -> Vec3 {
+        let m = h.major_axis();
+        h.frame.y * m.x + h.frame.z * m.y
+    }
+
+    /// The groom's normal, made perpendicular to the strand, orients the section whatever
+    /// its length; one along the strand, zero or none falls back to world up so made, and
+    /// a vertical strand to world x.
+    #[test]
+    fn the_major_axis_follows_the_normal_else_the_stated_rule() {
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+        let tilted = Vec3::new(1.0, 0.0, 1.0).normalize();
+        assert!(close(
+            axis(&hit(Vec3::X, Some(Vec3::new(0.0, 0.0, 5.0)))),
+            Vec3::Z
+        ));
+        let n = axis(&hit(tilted, Some(Vec3::new(0.3, 2.0, 0.0))));
+        assert!(n.dot(tilted).abs() < 1e-6 && n.y > 0.9, "{n}");
+        for normal in [None, Some(Vec3::ZERO), Some(3.0 * Vec3::X)] {
+            assert!(close(axis(&hit(Vec3::X, normal)), Vec3::Y), "{normal:?}");
+        }
+        assert!(close(axis(&hit(Vec3::Y, None)).abs(), Vec3::X));
     }
 }

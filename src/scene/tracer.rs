@@ -423,19 +423,21 @@ fn hair_hit(
         (hit.u, geom.interpolate(hit.prim_id, hit.u, time)?)
     };
     let axis = Vec3::from_array(c.p);
-    // A polyline's hit takes the true curve's tangent, position and colour there.
+    // A polyline's hit takes the true curve's tangent, position, colour and normal there.
     let on_curve = truth.and_then(|t| {
         let first = *geom.indices().get(hit.prim_id as usize)?;
         let (seg, cu) = t.locate(at.strand, first, u)?;
-        Some((t.derivative(&seg, cu)?, seg.s(cu), t.absorption(&seg, cu)))
+        let (absorption, normal) = (t.absorption(&seg, cu), t.normal(&seg, cu));
+        Some((t.derivative(&seg, cu)?, seg.s(cu), absorption, normal))
     });
-    let (tangent, s, absorption) = match on_curve {
-        Some((d, s, absorption)) => (
+    let (tangent, s, absorption, normal) = match on_curve {
+        Some((d, s, absorption, normal)) => (
             Some(d)
                 .filter(|d| usable(*d, c.radius))
                 .unwrap_or_else(|| tangent(geom, hit.prim_id, Vec3::ZERO, c.radius, &at, time)),
             s,
             absorption,
+            normal,
         ),
         None => (
             tangent(
@@ -448,6 +450,7 @@ fn hair_hit(
             ),
             at.s(u),
             strands.absorption(&at, u),
+            strands.normal(&at, u),
         ),
     };
     let (frame, h) = hair_frame(tangent, ray.dir, ray.org, axis, c.radius);
@@ -494,6 +497,7 @@ fn hair_hit(
         strand: at,
         s,
         absorption,
+        normal,
         time,
     })
 }

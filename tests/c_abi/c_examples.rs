@@ -305,7 +305,7 @@ pub(crate) fn build_run_check(
 }
 
 const C99: &[&str] = &["-std=c99", "-pedantic", "-D_DEFAULT_SOURCE"];
-const CPP: &[&str] = &["-x", "c++", "-std=c++17"];
+pub(crate) const CPP: &[&str] = &["-x", "c++", "-std=c++17"];
 
 #[test]
 fn every_example_as_c99() {

@@ -6,5 +6,6 @@ mod bsdf_c;
 mod c_examples;
 mod header;
 mod memcheck;
+mod motion_cpp;
 mod quiet;
 mod sections;

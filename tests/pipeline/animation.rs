@@ -320,3 +320,93 @@ fn an_open_shutter_reads_the_stage_at_its_time_steps() {
     let host_pixels: Vec<u32> = out.film.rgb().iter().map(|v| v.to_bits()).collect();
     assert!(host_pixels == blurred);
 }
+
+/// `strands` as float4 control points (a linear `.hair` file's strands are its control
+/// points).
+fn xyzr(strands: &Strands) -> Vec<[f32; 4]> {
+    (strands.points.iter().zip(&strands.radii))
+        .map(|(&[x, y, z], &r)| [x, y, z, r])
+        .collect()
+}
+
+/// With the shutter open, a `.hair` sequence read at a frame moves over it: its time steps
+/// are the files of the frames where the shutter opens and closes, and evenly between,
+/// blended linearly between two files (as USD interpolates its samples), the same bits as a
+/// host's strands given those steps. Files of other strands, or missing, are refused by
+/// name.
+#[test]
+fn an_open_shutter_reads_a_hair_sequence_at_its_time_steps() {
+    let dir = scratch("hair-shutter");
+    for (frame, x) in [(1, 0.0), (2, 0.25), (3, 0.75)] {
+        let path = dir.join(format!("groom.{frame:04}.hair"));
+        write_hair_file(&path, &two_strands(x), Thickness::Diameter).unwrap();
+    }
+    let at = |frame: f64, shutter: (&str, &str)| {
+        let mut desc = scene(
+            &dir,
+            "groom.####.hair",
+            &format!("[animation]\nframe = {frame}"),
+        );
+        desc.render.set("shutter_open", shutter.0).unwrap();
+        desc.render.set("shutter_close", shutter.1).unwrap();
+        desc
+    };
+    let host = |desc: &SceneDescription, steps: &[f32]| {
+        let mut host = desc.clone();
+        host.grooms.clear();
+        let mut scene =
+            Scene::from_description(&host, Arc::new(Device::new(Some(1)).unwrap())).unwrap();
+        let points = ControlPoints {
+            points: xyzr(&two_strands(steps[0])).into(),
+            later_steps: steps[1..]
+                .iter()
+                .map(|&x| xyzr(&two_strands(x)).into())
+                .collect(),
+            counts: vec![2, 2],
+            colors: None,
+            basis: hairtrace::embree::CurveBasis::Linear,
+        };
+        scene
+            .add_control_points("hair", points, GroomShape::Auto, "h")
+            .unwrap();
+        let out = scene.render(Aovs::default(), &NoProgress).unwrap();
+        out.film
+            .rgb()
+            .iter()
+            .map(|v| v.to_bits())
+            .collect::<Vec<u32>>()
+    };
+
+    // Frames 1 and 2: the two files.
+    let blurred = at(1.0, ("0", "1"));
+    let pixels_blurred = pixels(blurred.clone());
+    assert!(
+        pixels_blurred != pixels(at(1.0, ("0", "0"))),
+        "the groom moves"
+    );
+    assert!(pixels_blurred == host(&blurred, &[0.0, 0.25]));
+    // Frames 1.5 to 2.5: halfway between the files, then frame 2's file, then halfway on.
+    let centred = at(2.0, ("-0.5", "0.5"));
+    assert!(pixels(centred.clone()) == host(&centred, &[0.125, 0.25, 0.5]));
+
+    let build = |d: SceneDescription| d.build(Arc::new(Device::new(Some(1)).unwrap())).map(|_| ());
+    let e = error(build(at(3.0, ("0", "1"))));
+    for part in [
+        "groom.0004.hair does not exist",
+        "the shutter of frame 3 spans frames 3 to 4",
+    ] {
+        assert!(e.contains(part), "{part:?} in {e}");
+    }
+    let mut three = two_strands(0.5);
+    three.points.extend([[1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]);
+    three.radii.extend([0.02; 2]);
+    three.counts.push(2);
+    write_hair_file(&dir.join("groom.0003.hair"), &three, Thickness::Diameter).unwrap();
+    let e = error(build(at(2.0, ("0", "1"))));
+    for part in [
+        "groom.0003.hair (3 strands, 6 points)",
+        "groom.0002.hair (2 strands, 4 points)",
+    ] {
+        assert!(e.contains(part), "{part:?} in {e}");
+    }
+}

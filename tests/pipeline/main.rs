@@ -16,3 +16,4 @@ mod stages;
 mod usd;
 mod usd_crate;
 mod usd_motion;
+mod usd_normals;

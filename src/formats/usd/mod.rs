@@ -126,6 +126,9 @@ pub struct UsdCurves {
     pub point_colors: Option<Vec<[f32; 3]>>,
     /// `primvars:melanin`: the eumelanin concentration of each curve, if authored.
     pub melanin: Option<Vec<f32>>,
+    /// The curves' normals at every segment end (segments + 1 per curve), turned by the
+    /// prim's transform, if authored (`read_normals` in `prim.rs` says which names).
+    pub normals: Option<Vec<[f32; 3]>>,
 }
 
 impl UsdCurves {
@@ -153,6 +156,18 @@ impl UsdCurves {
         let curves = match &self.melanin {
             // The primvar is eumelanin alone.
             Some(m) => curves.and_then(|c| c.with_melanin(m.iter().map(|&e| [e, 0.0]).collect())),
+            None => curves,
+        };
+        let curves = match &self.normals {
+            // The placement is affine: its linear part turns a direction.
+            Some(n) => curves.and_then(|c| {
+                let origin = point(units.to_world([0.0; 3]));
+                let turn = |v: [f32; 3]| {
+                    let a = point(units.to_world(v));
+                    std::array::from_fn(|k| a[k] - origin[k])
+                };
+                c.with_normals(n.iter().map(|&v| turn(v)).collect())
+            }),
             None => curves,
         };
         curves.map_err(|e| e.context(&self.path))

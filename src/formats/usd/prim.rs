@@ -159,6 +159,76 @@ fn per_curve<T: Copy>(
     }
 }
 
+/// A vec3 primvar of `interp` at every segment end of the curves (segments + 1 per curve,
+/// as the curve evaluates it between its points), and per authored point unless it is
+/// `varying` (which holds no value per point). `phantom` gives the value at a wrap's extra
+/// point from the one the wrap reflects and the end's own.
+fn segment_end_values(
+    values: &[[f32; 3]],
+    interp: Interpolation,
+    layout: Layout,
+    (counts, segs): (&[usize], &[usize]),
+    phantom: impl Fn([f32; 3], [f32; 3]) -> [f32; 3] + Copy,
+) -> (Vec<[f32; 3]>, Option<Vec<[f32; 3]>>) {
+    let mut ends = Vec::new();
+    let mut points = (interp != Interpolation::Varying).then(Vec::new);
+    let (mut vertex_start, mut varying_start) = (0, 0);
+    for (i, (&n, &s)) in counts.iter().zip(segs).enumerate() {
+        let varying_n = layout.varying_count(s);
+        let v = per_curve(values, interp, i, vertex_start, varying_start, n, varying_n);
+        match interp {
+            Interpolation::Varying => {
+                let v = layout.varying_ends(&v);
+                ends.extend_from_slice(&v);
+                if v.len() == s {
+                    ends.push(v[0]);
+                }
+            }
+            _ => {
+                if let Some(p) = &mut points {
+                    p.extend_from_slice(&v);
+                }
+                let mut ext = Vec::new();
+                layout.extend(&v, &mut ext, phantom);
+                layout.segment_ends(&ext, s, &mut ends);
+            }
+        }
+        vertex_start += n;
+        varying_start += varying_n;
+    }
+    (ends, points)
+}
+
+/// The curves' normals, if authored: USD's `primvars:normals` or `normals`, or Blender's
+/// `primvars:custom_normal` (Blender 5.0 writes a curve's normals, those of its Free
+/// normal mode, under that name and no other). Checked for length and finite values.
+fn read_normals(
+    prim: &Prim,
+    at: ReadAt,
+    layout: Layout,
+    (counts, segs): (&[usize], &[usize]),
+) -> Result<Option<(Vec<[f32; 3]>, Interpolation)>> {
+    for name in ["primvars:normals", "normals", "primvars:custom_normal"] {
+        let attr = prim.attribute(name);
+        let Some(v) = vec3s(at.value(&attr)?, name)? else {
+            continue;
+        };
+        let interp = interpolation(&attr, name, Interpolation::Vertex)?;
+        let want = expected_len(interp, layout, counts, segs)?;
+        if v.len() != want {
+            return Err(invalid_arg!(
+                "{name} has {} values for {interp:?} interpolation: {want} expected",
+                v.len()
+            ));
+        }
+        if let Some(i) = v.iter().position(|n| !n.iter().all(|x| x.is_finite())) {
+            return Err(invalid_arg!("{name}[{i}] = {:?}: must be finite", v[i]));
+        }
+        return Ok(Some((v, interp)));
+    }
+    Ok(None)
+}
+
 /// Reads the BasisCurves prim at `path`. `file_bytes` bounds the counts: no curve table may
 /// ask for more points than the file could hold.
 pub(super) fn read_basis_curves(
@@ -291,9 +361,6 @@ pub(super) fn read_basis_curves(
     let control_total: usize = counts.iter().map(|&n| layout.embree_count(n)).sum();
     let mut control = Vec::with_capacity(control_total);
     let mut control_counts = Vec::with_capacity(counts.len());
-    let mut out_colors = colors.as_ref().map(|_| Vec::new());
-    let mut point_colors =
-        (colors.is_some() && color_interp != Interpolation::Varying).then(Vec::new);
     let (mut vertex_start, mut varying_start) = (0, 0);
     let mut pos = Vec::new();
     let mut radii = Vec::new();
@@ -322,34 +389,6 @@ pub(super) fn read_basis_curves(
                 .map(|(p, r)| [p[0], p[1], p[2], radius_of(r[0])]),
         );
         control_counts.push(pos.len() as u32);
-        if let (Some(c), Some(out)) = (&colors, &mut out_colors) {
-            let v = per_curve(
-                c,
-                color_interp,
-                i,
-                vertex_start,
-                varying_start,
-                n,
-                varying_n,
-            );
-            match color_interp {
-                Interpolation::Varying => {
-                    let v = layout.varying_ends(&v);
-                    out.extend_from_slice(&v);
-                    if v.len() == s {
-                        out.push(v[0]);
-                    }
-                }
-                _ => {
-                    if let Some(p) = &mut point_colors {
-                        p.extend_from_slice(&v);
-                    }
-                    let mut ext = Vec::new();
-                    layout.extend(&v, &mut ext, |c, _| c.map(|x| x.clamp(0.0, 1.0)));
-                    layout.segment_ends(&ext, s, out);
-                }
-            }
-        }
         vertex_start += n;
         varying_start += varying_n;
     }
@@ -362,6 +401,24 @@ pub(super) fn read_basis_curves(
             control[i][3]
         ));
     }
+    let (colors, point_colors) = match &colors {
+        Some(c) => {
+            let clamped = |c: [f32; 3], _| c.map(|x| x.clamp(0.0, 1.0));
+            let (ends, points) =
+                segment_end_values(c, color_interp, layout, (&counts, &segs), clamped);
+            (Some(ends), points)
+        }
+        None => (None, None),
+    };
+    // Normals are directions: the transform's linear part turns them.
+    let turn = |n: [f32; 3]| {
+        let (a, o) = (transform_point(&m, n), transform_point(&m, [0.0; 3]));
+        std::array::from_fn(|k| a[k] - o[k])
+    };
+    let normals = read_normals(&prim, at, layout, (&counts, &segs))?.map(|(v, interp)| {
+        let world: Vec<[f32; 3]> = v.into_iter().map(turn).collect();
+        segment_end_values(&world, interp, layout, (&counts, &segs), |_, end| end).0
+    });
     let animation = animation(stage, path)?;
     Ok(UsdCurves {
         path: path.as_str().to_string(),
@@ -374,8 +431,9 @@ pub(super) fn read_basis_curves(
         radius_range: (lo, hi),
         control,
         control_counts,
-        colors: out_colors,
+        colors,
         point_colors,
+        normals,
         melanin,
     })
 }

@@ -1075,7 +1075,8 @@ enum HtStatus ht_scene_free(struct HtScene *scene);
  * every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
  * giving the image's upward direction (finite, not zero, not parallel to the view), with
  * a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
- * `(target - eye) x up`. Replaces any earlier camera, without a new build unless
+ * `(target - eye) x up`. Replaces any earlier camera, its motion too (the camera is
+ * still until `ht_scene_set_camera_motion`), without a new build unless
  * `HT_CURVE_AUTO` curves need other shapes for it. Without one, renders frame the
  * geometry as added (the hair's points widened by their radii, else the meshes) from the
  * front (+z), a little to the right and above, as a scene file without a camera does.
@@ -1093,6 +1094,30 @@ enum HtStatus ht_scene_set_camera(struct HtScene *scene,
                                   const float *target,
                                   const float *up,
                                   float fov_y_deg);
+
+/**
+ * Moves the camera of `ht_scene_set_camera` over the shutter: `eye`, `target`, `up` and
+ * `fov_y_deg` (as there) are its pose where the shutter closes, the one set there its
+ * pose where it opens. A render with the shutter open (`shutter_open` < `shutter_close`)
+ * takes each ray's pose at the ray's time: the eye and the image plane blended, the view
+ * turned at a constant rate between the two (docs/architecture.md, "Motion"); with it
+ * closed the camera stays where it opens. The thin lens of `ht_scene_set_thin_lens`
+ * holds at both. Replaces any earlier closing pose; `ht_scene_set_camera` removes it.
+ * `HT_CURVE_AUTO` curves seen by a moving camera keep their full detail (round).
+ *
+ * Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
+ * `HT_ERR_INVALID_ARG` (a value out of range as for `ht_scene_set_camera`, or no camera
+ * set with it: a framed camera does not move). On failure the camera is unchanged.
+ *
+ * # Safety
+ * `scene` is NULL or a live handle not in use on another thread; `eye`, `target` and
+ * `up` are NULL or point to 3 readable floats.
+ */
+enum HtStatus ht_scene_set_camera_motion(struct HtScene *scene,
+                                         const float *eye,
+                                         const float *target,
+                                         const float *up,
+                                         float fov_y_deg);
 
 /**
  * Gives the camera a thin lens for depth of field: an aperture of `aperture_radius` (world

@@ -242,7 +242,9 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             return Err(invalid_arg!("mesh[{i}]: its material is not diffuse"));
         };
         let file = format!("mesh{i}.obj");
-        std::fs::write(dir.join(&file), obj_text(&m.mesh()?)).map_err(io)?;
+        // The export is a still: a mesh is written where the shutter would open.
+        let still = m.mesh((0.0, 0.0))?;
+        std::fs::write(dir.join(&file), obj_text(&still)).map_err(io)?;
         meshes.push(PeerMesh {
             file,
             albedo: *albedo,

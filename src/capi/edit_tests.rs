@@ -405,3 +405,56 @@ fn a_render_cannot_repin_its_device() {
     light(&pinned, true);
     assert_eq!(named.render_rgb(pinned.scene, 64).0, HtStatus::HT_OK);
 }
+
+/// `ht_scene_set_camera_motion` gives the camera of `ht_scene_set_camera` its pose at the
+/// shutter's closing: the camera a render places is the one a description with that pose
+/// as `[camera.shutter_close]` places, moving with the shutter open and still with it
+/// closed; `ht_scene_set_camera` makes it still again, and a scene with no camera set, or
+/// a NULL pose, is refused with the camera unchanged.
+#[test]
+fn a_c_host_moves_the_camera_over_the_shutter() {
+    let h = Handles::new();
+    let (eye, target, y) = ([0.0f32, 0.5, 4.0], [0.0f32, 0.0, 0.0], [0.0f32, 1.0, 0.0]);
+    let (eye2, target2) = ([1.0f32, 0.5, 3.5], [0.2f32, 0.0, 0.0]);
+    unsafe {
+        fails(
+            ht_scene_set_camera_motion(h.scene, eye2.as_ptr(), target2.as_ptr(), y.as_ptr(), 30.0),
+            HtStatus::HT_ERR_INVALID_ARG,
+            "ht_scene_set_camera first",
+        );
+        let set = ht_scene_set_camera(h.scene, eye.as_ptr(), target.as_ptr(), y.as_ptr(), 40.0);
+        assert_eq!(set, HtStatus::HT_OK);
+        fails(
+            ht_scene_set_camera_motion(h.scene, eye2.as_ptr(), null(), y.as_ptr(), 30.0),
+            HtStatus::HT_ERR_NULL_ARG,
+            "target",
+        );
+        let moved =
+            ht_scene_set_camera_motion(h.scene, eye2.as_ptr(), target2.as_ptr(), y.as_ptr(), 30.0);
+        assert_eq!(moved, HtStatus::HT_OK);
+    }
+    let mut desc = SceneDescription::default();
+    desc.camera.eye = Some(eye);
+    desc.camera.target = Some(target);
+    desc.camera.fov_deg = 40.0;
+    desc.camera.shutter_close = Some(crate::description::PoseDesc {
+        eye: Some(eye2),
+        target: Some(target2),
+        up: Some(y),
+        fov_deg: Some(30.0),
+    });
+    let device = Arc::new(Device::new(Some(1)).unwrap());
+    let described = crate::Scene::from_description(&desc, device).unwrap();
+    let mut open = RenderSettings::default();
+    open.set("shutter_close", "0.5").unwrap();
+    for settings in [open, RenderSettings::default()] {
+        let placed = h.scene().scene.placed_camera(&settings).unwrap();
+        assert_eq!(placed, described.placed_camera(&settings).unwrap());
+        assert_eq!(placed.moves(), settings.motion_blur());
+    }
+    unsafe {
+        let set = ht_scene_set_camera(h.scene, eye.as_ptr(), target.as_ptr(), y.as_ptr(), 40.0);
+        assert_eq!(set, HtStatus::HT_OK);
+    }
+    assert!(!(h.scene().scene.placed_camera(&open).unwrap()).moves());
+}

@@ -7,7 +7,7 @@
 
 use super::{Failure, HtStatus, boundary, free_handle, non_null_mut, read_path, read_vec3};
 use crate::Scene;
-use crate::description::{CameraDesc, MaterialDesc};
+use crate::description::{CameraDesc, MaterialDesc, PoseDesc};
 use crate::embree::{Device, Isa};
 use crate::error::{Result, invalid_arg};
 use crate::validate::{length, non_negative, positive};
@@ -278,7 +278,8 @@ pub unsafe extern "C" fn ht_scene_free(scene: *mut HtScene) -> HtStatus {
 /// every coordinate finite and within +-1e15: Embree cannot trace rays beyond that), `up`
 /// giving the image's upward direction (finite, not zero, not parallel to the view), with
 /// a vertical field of view of `fov_y_deg` degrees in (0, 180). The image's x runs along
-/// `(target - eye) x up`. Replaces any earlier camera, without a new build unless
+/// `(target - eye) x up`. Replaces any earlier camera, its motion too (the camera is
+/// still until `ht_scene_set_camera_motion`), without a new build unless
 /// `HT_CURVE_AUTO` curves need other shapes for it. Without one, renders frame the
 /// geometry as added (the hair's points widened by their radii, else the meshes) from the
 /// front (+z), a little to the right and above, as a scene file without a camera does.
@@ -298,16 +299,78 @@ pub unsafe extern "C" fn ht_scene_set_camera(
     up: *const f32,
     fov_y_deg: f32,
 ) -> HtStatus {
+    place_camera(scene, [eye, target, up], |camera, [eye, target, up]| {
+        Ok(CameraDesc {
+            eye: Some(eye),
+            target: Some(target),
+            up,
+            fov_deg: fov_y_deg,
+            shutter_close: None,
+            ..camera.clone()
+        })
+    })
+}
+
+/// Reads a host's `eye`, `target` and `up` (each `float[3]`, named in errors) and sets the
+/// scene's camera to what `place` makes of its camera with them.
+fn place_camera(
+    scene: *mut HtScene,
+    [eye, target, up]: [*const f32; 3],
+    place: impl FnOnce(&CameraDesc, [[f32; 3]; 3]) -> Result<CameraDesc>,
+) -> HtStatus {
     boundary(|| {
         let scene = scene_mut(scene)?;
-        let camera = CameraDesc {
-            eye: Some(read_vec3(eye, "eye")?.to_array()),
-            target: Some(read_vec3(target, "target")?.to_array()),
-            up: read_vec3(up, "up")?.to_array(),
-            fov_deg: fov_y_deg,
-            ..scene.scene.camera().clone()
-        };
+        let pose = [
+            read_vec3(eye, "eye")?.to_array(),
+            read_vec3(target, "target")?.to_array(),
+            read_vec3(up, "up")?.to_array(),
+        ];
+        let camera = place(scene.scene.camera(), pose)?;
         Ok(scene.scene.set_camera(&camera)?)
+    })
+}
+
+/// Moves the camera of `ht_scene_set_camera` over the shutter: `eye`, `target`, `up` and
+/// `fov_y_deg` (as there) are its pose where the shutter closes, the one set there its
+/// pose where it opens. A render with the shutter open (`shutter_open` < `shutter_close`)
+/// takes each ray's pose at the ray's time: the eye and the image plane blended, the view
+/// turned at a constant rate between the two (docs/architecture.md, "Motion"); with it
+/// closed the camera stays where it opens. The thin lens of `ht_scene_set_thin_lens`
+/// holds at both. Replaces any earlier closing pose; `ht_scene_set_camera` removes it.
+/// `HT_CURVE_AUTO` curves seen by a moving camera keep their full detail (round).
+///
+/// Statuses: `HT_ERR_NULL_ARG` (`scene`, `eye`, `target` or `up` NULL);
+/// `HT_ERR_INVALID_ARG` (a value out of range as for `ht_scene_set_camera`, or no camera
+/// set with it: a framed camera does not move). On failure the camera is unchanged.
+///
+/// # Safety
+/// `scene` is NULL or a live handle not in use on another thread; `eye`, `target` and
+/// `up` are NULL or point to 3 readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ht_scene_set_camera_motion(
+    scene: *mut HtScene,
+    eye: *const f32,
+    target: *const f32,
+    up: *const f32,
+    fov_y_deg: f32,
+) -> HtStatus {
+    place_camera(scene, [eye, target, up], |camera, [eye, target, up]| {
+        if camera.eye.is_none() {
+            return Err(invalid_arg!(
+                "no camera to move: set its pose at the shutter's opening with \
+                 ht_scene_set_camera first"
+            ));
+        }
+        let close = PoseDesc {
+            eye: Some(eye),
+            target: Some(target),
+            up: Some(up),
+            fov_deg: Some(fov_y_deg),
+        };
+        Ok(CameraDesc {
+            shutter_close: Some(close),
+            ..camera.clone()
+        })
     })
 }
 

@@ -63,7 +63,8 @@ impl Shape {
 }
 
 /// The curves a part is traced with: in spatial order (`Curves::spatially_ordered`) and,
-/// for an `auto` part, shared out for `view`; with `keep`, the ordered curves too, their
+/// for an `auto` part, shared out for `view` (as built, round, for a view that chooses no
+/// detail); with `keep`, the ordered curves too, their
 /// points shared with what is traced (`Curves::shared`).
 fn traced_curves(
     curves: Curves,
@@ -76,7 +77,7 @@ fn traced_curves(
         curves = curves.shared();
     }
     let kept = keep.then(|| curves.clone());
-    let traced = if auto {
+    let traced = if auto && view.chooses() {
         ribbons::share_out(curves, &view.camera, view.height, view.lod_pixels)?
     } else {
         vec![curves]
@@ -193,8 +194,8 @@ impl Assembly {
                         let n = pieces.len();
                         for piece in pieces {
                             sizes.push(CurvesSize::of(&piece, &options));
-                            let added = if auto {
-                                tracer.add_view_curves(piece, *view)
+                            let added = if auto && view.chooses() {
+                                tracer.add_view_curves(piece, view.clone())
                             } else {
                                 tracer.add_curves(piece)
                             };

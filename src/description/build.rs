@@ -9,7 +9,7 @@ use glam::{Affine3A, EulerRot, Quat, Vec3};
 use super::assembly::scene_options;
 use super::{
     CameraDesc, EnvironmentSource, GroomDesc, GroomSource, GroomStrands, LightDesc, MaterialDesc,
-    MeshDesc, MeshSource, SceneDescription, StrandCurves, Transform,
+    MeshDesc, MeshSource, PoseDesc, SceneDescription, StrandCurves, Transform,
 };
 use crate::bsdf::diffuse::Diffuse;
 use crate::embree::CurveBasis;
@@ -36,7 +36,8 @@ use crate::formats::hair::{HairTag, Thickness, read_hair_file, read_hair_tag};
 use crate::formats::mesh::read_mesh_file;
 use crate::formats::units::StageUnits;
 use crate::formats::usd::{
-    Layout, UsdGrooms, Wrap, is_usd_path, read_usd_file_at, read_usd_file_near,
+    Layout, Prims, UsdGrooms, Wrap, is_usd_path, read_usd_file_at, read_usd_prims_at,
+    read_usd_prims_near,
 };
 
 impl SceneDescription {
@@ -62,6 +63,14 @@ impl SceneDescription {
             if let GroomSource::File { frame: f, .. } = &mut g.source {
                 *f = Some(frame);
             }
+        }
+        for m in &mut self.meshes {
+            if let MeshSource::Usd { frame: f, .. } = &mut m.source {
+                *f = Some(frame);
+            }
+        }
+        if self.camera.usd.is_some() {
+            self.camera.frame = Some(frame);
         }
         Ok(())
     }
@@ -250,7 +259,7 @@ impl GroomDesc {
         match &self.source {
             GroomSource::File { path, frame, .. } if is_usd_path(path) => {
                 let steps = stages.run(Stage::Read, (i, reads), |_| {
-                    usd_steps(&frame_file(path, *frame)?, *frame, shutter)
+                    usd_steps(&frame_file(path, *frame)?, *frame, shutter, Prims::Curves)
                 })?;
                 for c in steps.iter().flat_map(|s| &s.curves) {
                     c.frame(framing, radius_factor, place);
@@ -427,31 +436,46 @@ impl GroomDesc {
     }
 }
 
-/// The USD stage at `path` at `frame`, or, with `shutter` open at a frame of an animated
-/// stage, at the time steps of its motion: where the shutter opens, where it closes and
-/// evenly between, as many as take in every time sample inside it (Embree's steps are
-/// even), at most Embree's most. The steps may reach past the animation's first or last
-/// frame, where its values hold.
-fn usd_steps(path: &Path, frame: Option<f64>, (open, close): (f32, f32)) -> Result<Vec<UsdGrooms>> {
-    let still = read_usd_file_at(path, frame)?;
-    let Some(f) = frame.filter(|_| close > open && still.time_range().is_some()) else {
+/// The `prims` of the USD stage at `path` at `frame`, or, with `shutter` open at a frame
+/// of an animated stage, at the time steps of its motion: where the shutter opens, where
+/// it closes and evenly between, as many as take in every time sample inside it (Embree's
+/// steps are even), at most Embree's most. The steps may reach past the animation's first
+/// or last frame, where its values hold.
+fn usd_steps(
+    path: &Path,
+    frame: Option<f64>,
+    shutter: (f32, f32),
+    prims: Prims,
+) -> Result<Vec<UsdGrooms>> {
+    let still = read_usd_prims_at(path, frame, prims)?;
+    let Some(f) = frame.filter(|_| shutter.1 > shutter.0 && still.time_range().is_some()) else {
         return Ok(vec![still]);
     };
-    let (open, close) = (f + f64::from(open), f + f64::from(close));
     let clock = still.clock;
-    let inside = still.samples_between(clock.time_code(open), clock.time_code(close));
+    let code = |k, steps| clock.time_code(shutter_frame(f, shutter, k, steps));
+    let inside = still.samples_between(code(0, 2), code(1, 2));
     let count = (inside + 2).min(MAX_TIME_STEPS);
     let mut still = Some(still);
     (0..count)
         .map(|k| {
-            let at = open + (close - open) * k as f64 / (count - 1) as f64;
+            let at = shutter_frame(f, shutter, k, count);
             // A shutter that opens at the frame starts with the read already made.
             match still.take_if(|_| at == f) {
                 Some(read) => Ok(read),
-                None => read_usd_file_near(path, Some(at)),
+                None => read_usd_prims_near(path, Some(at), prims),
             }
         })
         .collect()
+}
+
+/// The frame of time step `k` of `steps` over `shutter` (open, close, in frames from
+/// `frame`), spread evenly from the opening to the closing.
+fn shutter_frame(frame: f64, (open, close): (f32, f32), k: usize, steps: usize) -> f64 {
+    let (open, close) = (frame + f64::from(open), frame + f64::from(close));
+    match steps {
+        1 => open,
+        _ => open + (close - open) * k as f64 / (steps - 1) as f64,
+    }
 }
 
 /// A closed shutter: one time step, at the frame.
@@ -593,11 +617,13 @@ impl MeshDesc {
         }
     }
 
-    /// The mesh, transformed.
-    pub fn mesh(&self) -> Result<Mesh> {
+    /// The mesh, transformed; a USD stage's every Mesh prim, deforming over `shutter`
+    /// (open, close, in frames from its frame) where its points move.
+    pub fn mesh(&self, shutter: (f32, f32)) -> Result<Mesh> {
         let (affine, _) = self.transform.affine()?;
         let mut mesh = match &self.source {
             MeshSource::File(path) => read_mesh_file(path)?,
+            MeshSource::Usd { path, frame } => usd_mesh(path, *frame, shutter)?,
             MeshSource::Sphere { centre, radius } => shapes::sphere(
                 Vec3::from_array(*centre),
                 *radius,
@@ -624,6 +650,56 @@ impl MeshDesc {
         }
         Ok(mesh)
     }
+}
+
+/// Every Mesh prim of the stage at `path` as one mesh (in the world, before the entry's
+/// transform), read at `frame`, at the time steps of [`usd_steps`] over `shutter`: a mesh
+/// that deforms has its points at each. Refused where a prim's faces or point count
+/// change between two steps, naming the prim, the attribute and the step's frame.
+fn usd_mesh(path: &Path, frame: Option<f64>, shutter: (f32, f32)) -> Result<Mesh> {
+    let steps = usd_steps(path, frame, shutter, Prims::Meshes)?;
+    let first = &steps[0];
+    if first.meshes.is_empty() {
+        return Err(invalid_arg!("{}: no Mesh prims", path.display()));
+    }
+    let at = |e: crate::Error| e.context(path.display());
+    let mut mesh = Mesh::default();
+    for (m, prim) in first.meshes.iter().enumerate() {
+        let base = u32::try_from(mesh.positions.len())
+            .map_err(|_| at(invalid_arg!("more than 2^32 points in all")))?;
+        mesh.positions.extend(prim.world_points(|p| p));
+        (mesh.triangles).extend(prim.triangles.iter().map(|t| t.map(|v| v + base)));
+        for (k, step) in steps.iter().enumerate().skip(1) {
+            let later = &step.meshes[m];
+            let when = || {
+                let f = shutter_frame(frame.unwrap_or(0.0), shutter, k, steps.len());
+                format!("{} at frame {f}", prim.path)
+            };
+            if later.points.len() != prim.points.len() {
+                return Err(at(invalid_arg!(
+                    "{}: points: {} points, {} at the shutter's opening: a mesh's points                      cannot change in number inside the shutter",
+                    when(),
+                    later.points.len(),
+                    prim.points.len()
+                )));
+            }
+            if later.triangles != prim.triangles {
+                return Err(at(invalid_arg!(
+                    "{}: faceVertexCounts or faceVertexIndices differ from the shutter's                      opening: a mesh's faces cannot change inside the shutter",
+                    when()
+                )));
+            }
+            if mesh.later_positions.len() < k {
+                mesh.later_positions.push(Vec::new());
+            }
+            mesh.later_positions[k - 1].extend(later.world_points(|p| p));
+        }
+    }
+    if mesh.later_positions.iter().all(|p| *p == mesh.positions) {
+        mesh.later_positions.clear();
+    }
+    mesh.validate().map_err(at)?;
+    Ok(mesh)
 }
 
 impl LightDesc {
@@ -663,29 +739,64 @@ impl LightDesc {
 }
 
 impl CameraDesc {
-    /// Checks a camera placed by `eye` and `target` (or given one of them alone) before
-    /// there is anything to frame; an automatic camera is checked when the build frames it.
+    /// Checks a camera placed by `eye` and `target` (or given one of them alone), or read
+    /// from a USD stage, before there is anything to frame; an automatic camera is checked
+    /// when the build frames it.
     pub fn validate(&self) -> Result<()> {
-        match (self.eye, self.target) {
-            (None, None) => Ok(()),
-            _ => self.build(&Framing::default(), 1.0).map(|_| ()),
+        match (self.eye, self.target, &self.usd) {
+            (None, None, None) => self.check_placed_if_moving(),
+            _ => self.build(&Framing::default(), 1.0, (0.0, 0.0)).map(|_| ()),
+        }
+    }
+
+    /// An automatic camera does not move.
+    fn check_placed_if_moving(&self) -> Result<()> {
+        match (self.shutter_close, self.eye, self.target) {
+            (Some(_), None, None) => Err(invalid_arg!(
+                "shutter_close: an automatic camera does not move: give `eye` and `target`"
+            )),
+            _ => Ok(()),
         }
     }
 
     /// The camera for an image of `aspect`, framing `framing` when no eye and target are
-    /// given.
-    pub(crate) fn build(&self, framing: &Framing, aspect: f32) -> Result<Camera> {
-        let (camera, target) = match (self.eye, self.target) {
+    /// given, moving over `shutter` (open, close, in frames from the frame) when it is
+    /// open and the camera has a pose at its closing (or a USD camera moves). The pose at
+    /// the closing is checked whether the shutter is open or not.
+    pub(crate) fn build(
+        &self,
+        framing: &Framing,
+        aspect: f32,
+        shutter: (f32, f32),
+    ) -> Result<Camera> {
+        if let Some(path) = &self.usd {
+            return self.usd_camera(path, aspect, shutter);
+        }
+        self.check_placed_if_moving()?;
+        let open = self.pose(framing, aspect, PoseDesc::default())?;
+        let Some(close) = self.shutter_close else {
+            return Ok(open);
+        };
+        let close = (self.pose(framing, aspect, close)).map_err(|e| e.context("shutter_close"))?;
+        match shutter.1 > shutter.0 {
+            true => Camera::in_motion(vec![open, close]),
+            false => Ok(open),
+        }
+    }
+
+    /// The still camera of this table's pose with `over`'s keys in place of its own.
+    fn pose(&self, framing: &Framing, aspect: f32, over: PoseDesc) -> Result<Camera> {
+        let fov = over.fov_deg.unwrap_or(self.fov_deg);
+        let (camera, target) = match (over.eye.or(self.eye), over.target.or(self.target)) {
             (Some(eye), Some(target)) => {
                 let (eye, target) = (Vec3::from_array(eye), Vec3::from_array(target));
-                let up = Vec3::from_array(self.up);
-                (Camera::new(eye, target, up, self.fov_deg, aspect)?, target)
+                let up = Vec3::from_array(over.up.unwrap_or(self.up));
+                (Camera::new(eye, target, up, fov, aspect)?, target)
             }
             (None, None) => {
-                let camera = framing.camera(aspect, self.fov_deg).ok_or_else(|| {
+                let camera = framing.camera(aspect, fov).ok_or_else(|| {
                     invalid_arg!(
-                        "nothing to frame (no groom and no mesh but ground quads): give \
-                         `eye` and `target`"
+                        "nothing to frame (no groom and no mesh but ground quads): give                          `eye` and `target`"
                     )
                 })??;
                 let (lo, hi) = framing.bounds().expect("framed above");
@@ -701,6 +812,55 @@ impl CameraDesc {
             .focus_distance
             .unwrap_or_else(|| camera.eye().distance(target));
         camera.with_thin_lens(self.aperture_radius, focus)
+    }
+
+    /// The UsdGeomCamera of the stage at `path` (the prim `prim`, else the only one), at
+    /// the frame and over the shutter's time steps ([`usd_steps`]).
+    fn usd_camera(&self, path: &Path, aspect: f32, shutter: (f32, f32)) -> Result<Camera> {
+        let defaults = CameraDesc::default();
+        let alone = CameraDesc {
+            usd: None,
+            prim: None,
+            frame: None,
+            ..self.clone()
+        };
+        if alone != defaults {
+            return Err(invalid_arg!(
+                "usd: a camera read from a USD stage takes no other key but `prim`"
+            ));
+        }
+        let at = |e: crate::Error| e.context(path.display());
+        let steps = usd_steps(path, self.frame, shutter, Prims::Cameras)?;
+        let cameras = &steps[0].cameras;
+        let index = match &self.prim {
+            Some(prim) => cameras
+                .iter()
+                .position(|c| c.path == *prim)
+                .ok_or_else(|| at(invalid_arg!("no Camera prim at {prim}")))?,
+            None if cameras.len() == 1 => 0,
+            None => {
+                let paths: Vec<&str> = cameras.iter().map(|c| c.path.as_str()).collect();
+                return Err(at(invalid_arg!(
+                    "{} Camera prims ({}): give the one to use as `prim`",
+                    cameras.len(),
+                    if paths.is_empty() {
+                        "none".into()
+                    } else {
+                        paths.join(", ")
+                    }
+                )));
+            }
+        };
+        let poses = (steps.iter().enumerate())
+            .map(|(k, s)| {
+                let c = &s.cameras[index];
+                c.camera(aspect).map_err(|e| {
+                    let f = shutter_frame(self.frame.unwrap_or(0.0), shutter, k, steps.len());
+                    at(e.context(format!("{} at frame {f}", c.path)))
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        Camera::in_motion(poses).map_err(at)
     }
 }
 

@@ -21,6 +21,11 @@
 //! fov_deg = 35             # vertical field of view
 //! aperture_radius = 0.0    # thin lens; 0 is a pinhole
 //! focus_distance = 5.0     # default: the distance from eye to target
+//! [camera.shutter_close]   # optional: the pose where the shutter closes (any of eye,
+//! eye = [0.5, 1, 5]        # target, up, fov_deg; absent ones keep the pose above, which
+//!                          # is the opening's); moves the camera over an open shutter
+//! # or, instead of all the above: usd = "shot.usda" (its UsdGeomCamera, read at the
+//! # frame and over the shutter) and prim = "/cam" (default: the stage's only camera)
 //!
 //! [materials.brown]
 //! type = "hair"            # exactly one of sigma_a = [r, g, b], melanin = [eu, pheo], color = [r, g, b],
@@ -65,7 +70,8 @@
 //! strands = 20000
 //!
 //! [[mesh]]
-//! shape = "sphere"         # or file = "head.obj" (.obj or .ply)
+//! shape = "sphere"         # or file = "head.obj" (.obj, .ply, or a USD stage: every
+//!                          # UsdGeomMesh, read at the frame and deforming over the shutter)
 //! centre = [0, 0, 0]       # default the origin
 //! radius = 1.0
 //! material = "skin"        # plus translate, scale, rotate or matrix as for grooms
@@ -158,6 +164,28 @@ pub struct CameraDesc {
     pub aperture_radius: f32,
     /// None: focus on the target (the framed box's centre for an automatic camera).
     pub focus_distance: Option<f32>,
+    /// The `[camera.shutter_close]` table: where the camera is when the shutter closes,
+    /// the pose above being where it opens. With the shutter open the camera moves
+    /// between the two; closed, it stays at the opening's.
+    pub shutter_close: Option<PoseDesc>,
+    /// A USD stage whose UsdGeomCamera is the camera, read at the frame (and over an open
+    /// shutter); no other key but `prim` then.
+    pub usd: Option<PathBuf>,
+    /// The camera prim's path in `usd`; None: the stage's only camera.
+    pub prim: Option<String>,
+    /// The frame `usd` is read at ([`SceneDescription::at_frame`]); None: a still.
+    #[serde(skip)]
+    pub frame: Option<f64>,
+}
+
+/// The pose of a `[camera.shutter_close]` table: each key absent keeps the opening's.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PoseDesc {
+    pub eye: Option<[f32; 3]>,
+    pub target: Option<[f32; 3]>,
+    pub up: Option<[f32; 3]>,
+    pub fov_deg: Option<f32>,
 }
 
 impl Default for CameraDesc {
@@ -169,6 +197,10 @@ impl Default for CameraDesc {
             fov_deg: Camera::DEFAULT_FOV_Y_DEG,
             aperture_radius: 0.0,
             focus_distance: None,
+            shutter_close: None,
+            usd: None,
+            prim: None,
+            frame: None,
         }
     }
 }
@@ -304,6 +336,11 @@ pub struct MeshDesc {
 pub enum MeshSource {
     /// An `.obj` or `.ply` file.
     File(PathBuf),
+    /// Every Mesh prim of a USD stage as one mesh, read at `frame` (None: a still).
+    Usd {
+        path: PathBuf,
+        frame: Option<f64>,
+    },
     Sphere {
         centre: [f32; 3],
         radius: f32,

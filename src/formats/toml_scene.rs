@@ -76,10 +76,12 @@ impl SceneDescription {
                 "{origin}: animation.frames = [{first}, {last}]: the first frame is after the last"
             ));
         }
+        let mut camera = raw.camera;
+        camera.usd = camera.usd.map(|p| base_dir.join(p));
         let mut desc = SceneDescription {
             notes: Vec::new(),
             render,
-            camera: raw.camera,
+            camera,
             materials,
             grooms,
             meshes,
@@ -659,7 +661,13 @@ impl RawMesh {
         let source = match (self.file, self.shape) {
             (Some(file), None) => {
                 reject("a mesh file", &[sphere, ground].concat())?;
-                MeshSource::File(base_dir.join(file))
+                match is_usd_path(&file) {
+                    true => MeshSource::Usd {
+                        path: base_dir.join(file),
+                        frame: None,
+                    },
+                    false => MeshSource::File(base_dir.join(file)),
+                }
             }
             (None, Some(MeshShape::Sphere)) => {
                 reject("a sphere", &ground)?;

@@ -136,7 +136,8 @@ impl Scene {
     /// one that frames the geometry.
     pub fn placed_camera(&self, settings: &RenderSettings) -> Result<Camera> {
         let aspect = settings.width as f32 / settings.height as f32;
-        (self.camera.build(&self.framing(), aspect)).map_err(|e| self.error("camera", e))
+        let shutter = (settings.shutter_open, settings.shutter_close);
+        (self.camera.build(&self.framing(), aspect, shutter)).map_err(|e| self.error("camera", e))
     }
 
     fn light_list(&self) -> Vec<crate::scene::light::Light> {

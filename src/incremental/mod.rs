@@ -384,8 +384,9 @@ impl Scene {
         part: (usize, usize),
     ) -> Result<()> {
         self.check_free(name)?;
-        let made =
-            (stages.run(Stage::Read, part, |_| mesh.mesh())).map_err(|e| self.error(name, e))?;
+        let shutter = (self.settings.shutter_open, self.settings.shutter_close);
+        let made = (stages.run(Stage::Read, part, |_| mesh.mesh(shutter)))
+            .map_err(|e| self.error(name, e))?;
         let mut framing = Framing::default();
         if !matches!(mesh.source, MeshSource::Ground { .. }) {
             for step in std::iter::once(&made.positions).chain(&made.later_positions) {

@@ -138,7 +138,7 @@ pub fn film_bytes_and_uniform(
 /// at `settings`' image height and level of detail ([`crate::scene::tracer::Tracer::serves`]).
 pub(crate) fn serves(world: &World, camera: &Camera, settings: &RenderSettings) -> bool {
     (world.tracer).serves(&DetailView::new(
-        *camera,
+        camera.clone(),
         settings.height,
         settings.lod_pixels,
     ))
@@ -261,9 +261,10 @@ pub fn render(
                             sampler.skip();
                             [0.5; 2]
                         };
-                        let (org, dir) = camera.ray(image_point, lens);
+                        let time = if motion_blur { sampler.time() } else { 0.0 };
+                        let (org, dir) = camera.ray_at(image_point, lens, time);
                         let ray = Ray {
-                            time: if motion_blur { sampler.time() } else { 0.0 },
+                            time,
                             ..Ray::new(org, dir)
                         };
                         let (radiance, first, traced) = world.radiance(

@@ -26,7 +26,7 @@ pub const FOOTPRINT_TOLERANCE: f32 = 1e-3;
 
 /// A camera and the height, in pixels, of the image it renders: what the side of a pixel
 /// is at each point.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct DetailView {
     pub camera: Camera,
     pub height: u32,
@@ -44,12 +44,20 @@ impl DetailView {
         }
     }
 
+    /// Whether a build may choose detail for this view: not for a camera that moves, whose
+    /// footprints change over the shutter; its curves keep their full detail, which is
+    /// never wrong, only slower.
+    pub fn chooses(&self) -> bool {
+        !self.camera.moves()
+    }
+
     /// Whether choices made for this view hold for `new` at every one of `points` (x, y,
     /// z, radius; the radius is not used): at each, `new`'s footprint is at least this
     /// view's times 1 - [`FOOTPRINT_TOLERANCE`]. A lens, the aspect and the target play
-    /// no part, and the same eye with pixels no smaller needs no look at the points.
+    /// no part, and the same eye with pixels no smaller needs no look at the points. No
+    /// choice is made for a moving camera ([`DetailView::chooses`]), so none holds for one.
     pub fn holds_for(&self, new: &DetailView, points: &[[f32; 4]]) -> bool {
-        if self.lod_pixels != new.lod_pixels {
+        if self.lod_pixels != new.lod_pixels || !new.chooses() {
             return false;
         }
         let (built, now) = (
@@ -81,7 +89,7 @@ impl ViewDependent {
     /// Refuses a second view: one scene's choices are made for one view.
     pub(crate) fn check(&self, view: &DetailView) -> Result<()> {
         match self.view {
-            Some(v) if v != *view => Err(invalid_arg!(
+            Some(ref v) if v != view => Err(invalid_arg!(
                 "curves shaped for two different views cannot share one scene"
             )),
             _ => Ok(()),
@@ -130,7 +138,7 @@ mod tests {
         // Another level of detail is another build.
         let finer = DetailView {
             lod_pixels: built.lod_pixels / 2.0,
-            ..built
+            ..built.clone()
         };
         assert!(!built.holds_for(&finer, &points));
         // Farther, a wider field of view or fewer pixels: larger footprints.
@@ -140,9 +148,26 @@ mod tests {
         // A lens changes nothing.
         let lens = DetailView {
             camera: built.camera.with_thin_lens(0.1, 3.0).unwrap(),
-            ..built
+            ..built.clone()
         };
         assert!(built.holds_for(&lens, &points));
+        // A moving camera chooses nothing, so no choice holds for it, even one that
+        // starts at the built view.
+        let moving = Camera::in_motion(vec![built.camera.clone(), lens.camera.clone()]);
+        let moving = DetailView {
+            camera: moving.unwrap().at(0.0),
+            ..built.clone()
+        };
+        assert!(moving.chooses() && built.holds_for(&moving, &points));
+        let moving = DetailView {
+            camera: Camera::in_motion(vec![
+                built.camera.clone(),
+                view(Vec3::new(0.0, 0.0, 5.0), 40.0, 100).camera,
+            ])
+            .unwrap(),
+            ..built.clone()
+        };
+        assert!(!moving.chooses() && !built.holds_for(&moving, &points));
         // Nearer, narrower or more pixels: smaller footprints somewhere.
         assert!(!built.holds_for(&view(Vec3::new(0.0, 0.0, 3.9), 40.0, 100), &points));
         assert!(!built.holds_for(&view(Vec3::new(0.0, 0.0, 4.0), 39.0, 100), &points));

@@ -534,7 +534,7 @@ fn transforms_turn_scale_and_move_grooms_and_meshes() {
     // A mesh goes where its groom goes.
     let mesh = |transform: &str| {
         let text = BASE.replace("radius = 1.0", &format!("radius = 1.0\n{transform}"));
-        parse(&text).unwrap().meshes[0].mesh().unwrap()
+        parse(&text).unwrap().meshes[0].mesh((0.0, 0.0)).unwrap()
     };
     let (a, b) = (
         mesh("rotate = [90, 0, 90]\nscale = 2\ntranslate = [1, 2, 3]"),

@@ -15,4 +15,5 @@ mod pbrt;
 mod stages;
 mod usd;
 mod usd_crate;
+mod usd_motion;
 mod usd_normals;

@@ -655,6 +655,7 @@ impl Reader {
             fov_deg: fov_y.to_degrees() as f32,
             aperture_radius: lens as f32,
             focus_distance: (lens > 0.0).then_some(focus as f32),
+            ..CameraDesc::default()
         })
     }
 }

@@ -1,11 +1,15 @@
 //! USD grooms: every `BasisCurves` prim of a composed stage (.usda, .usdc or .usdz, read by
 //! the pure-Rust `openusd` crate), each as its own curve geometry in world space, laid out
 //! for Embree (see [`Layout`] for the basis and wrap conversions), turned and scaled from the
-//! stage's `upAxis` and `metersPerUnit` into hairtrace's +y up metres ([`StageUnits`]). See
-//! docs/formats.md for what is read, the primvar names and what is refused.
+//! stage's `upAxis` and `metersPerUnit` into hairtrace's +y up metres ([`StageUnits`]); and,
+//! read apart ([`Prims`]), its `Mesh` prims ([`UsdMesh`]) and `Camera` prims
+//! ([`UsdCamera`]). See docs/formats.md for what is read, the primvar names and what is
+//! refused.
 
+mod camera;
 mod crate_check;
 mod layout;
+mod mesh;
 mod prim;
 mod resolver;
 mod text_arrays;
@@ -25,7 +29,9 @@ use crate::scene::Strands;
 use crate::scene::curves::{Curves, placed};
 use crate::scene::framing::Framing;
 
+pub use camera::UsdCamera;
 pub use layout::{Interpolation, Layout, Wrap};
+pub use mesh::UsdMesh;
 use time::ReadAt;
 pub use time::{Animation, Clock};
 pub use write::{CurvesToWrite, ROOT_PRIM, write_usd_file};
@@ -33,7 +39,16 @@ pub use write::{CurvesToWrite, ROOT_PRIM, write_usd_file};
 /// Bytes a USD file may have: the reader keeps the whole stage in memory.
 const MAX_FILE_BYTES: u64 = 1 << 32;
 
-/// A stage's grooms and what the reader made of the rest.
+/// Which prims of a stage a read converts; the others it lists as ignored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Prims {
+    Curves,
+    Meshes,
+    Cameras,
+}
+
+/// A stage's grooms (or meshes, or cameras: [`Prims`]) and what the reader made of the
+/// rest.
 #[derive(Debug, Clone, PartialEq)]
 pub struct UsdGrooms {
     /// The stage's `upAxis` and `metersPerUnit` (USD's fallbacks, Y and 0.01, where not
@@ -41,16 +56,25 @@ pub struct UsdGrooms {
     pub units: StageUnits,
     pub clock: Clock,
     pub curves: Vec<UsdCurves>,
-    /// Paths and types of the prims that are not BasisCurves (nor plain Xforms or Scopes).
+    pub meshes: Vec<UsdMesh>,
+    pub cameras: Vec<UsdCamera>,
+    /// Paths and types of the prims that were not read (nor plain Xforms or Scopes).
     pub ignored: Vec<String>,
 }
 
 impl UsdGrooms {
+    /// What of each prim read moves.
+    fn animations(&self) -> impl Iterator<Item = &Animation> {
+        (self.curves.iter().map(|c| &c.animation))
+            .chain(self.meshes.iter().map(|m| &m.animation))
+            .chain(self.cameras.iter().map(|c| &c.animation))
+    }
+
     /// How many time codes strictly between `open` and `close` any prim's animated
     /// attributes have samples at.
     pub fn samples_between(&self, open: f64, close: f64) -> usize {
-        let mut times: Vec<f64> = (self.curves.iter())
-            .flat_map(|c| c.animation.times.iter().copied())
+        let mut times: Vec<f64> = (self.animations())
+            .flat_map(|a| a.times.iter().copied())
             .filter(|&t| open < t && t < close)
             .collect();
         times.sort_by(f64::total_cmp);
@@ -59,10 +83,10 @@ impl UsdGrooms {
     }
 
     /// The animation's time codes: the stage's `startTimeCode` to `endTimeCode` where both
-    /// are authored, else the span of the grooms' samples; None for a still.
+    /// are authored, else the span of the prims' samples; None for a still.
     pub fn time_range(&self) -> Option<(f64, f64)> {
-        let animated = (self.curves.iter()).any(|c| !c.animation.attributes.is_empty());
-        let span = (self.curves.iter().filter_map(|c| c.animation.span))
+        let animated = self.animations().any(|a| !a.attributes.is_empty());
+        let span = (self.animations().filter_map(|a| a.span))
             .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)));
         match self.clock.authored_range {
             Some(range) if animated => Some(range),
@@ -210,7 +234,12 @@ pub fn read_usd_file(path: &Path) -> Result<UsdGrooms> {
 /// when None. A frame outside the animation's time range is refused; any frame of a stage
 /// that has no time samples reads its one still.
 pub fn read_usd_file_at(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> {
-    let grooms = read_usd_file_near(path, frame)?;
+    read_usd_prims_at(path, frame, Prims::Curves)
+}
+
+/// [`read_usd_file_at`] of the prims `prims` names.
+pub fn read_usd_prims_at(path: &Path, frame: Option<f64>, prims: Prims) -> Result<UsdGrooms> {
+    let grooms = read_usd_prims_near(path, frame, prims)?;
     if let (Some(f), Some((start, end))) = (frame, grooms.time_range()) {
         let t = grooms.clock.time_code(f);
         if !(start..=end).contains(&t) {
@@ -230,6 +259,11 @@ pub fn read_usd_file_at(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> {
 /// at its first or last samples: a time step of a shutter that opens before the first
 /// frame or closes after the last.
 pub fn read_usd_file_near(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> {
+    read_usd_prims_near(path, frame, Prims::Curves)
+}
+
+/// [`read_usd_file_near`] of the prims `prims` names.
+pub fn read_usd_prims_near(path: &Path, frame: Option<f64>, prims: Prims) -> Result<UsdGrooms> {
     let at = |e: Error| e.context(path.display());
     let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
     if meta.len() > MAX_FILE_BYTES {
@@ -251,7 +285,7 @@ pub fn read_usd_file_near(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> 
         let fast = if is_text_layer(path) {
             std::panic::catch_unwind(|| {
                 let _quiet = crate::quiet_panic::Quiet::enter();
-                read_lifting(name, meta.len(), frame)
+                read_lifting(name, meta.len(), frame, prims)
             })
             .unwrap_or(Ok(None))?
         } else {
@@ -263,6 +297,7 @@ pub fn read_usd_file_near(path: &Path, frame: Option<f64>) -> Result<UsdGrooms> 
                 &open(name, resolver::CheckingResolver::default())?,
                 meta.len(),
                 frame,
+                prims,
             ),
         }
     });
@@ -296,7 +331,12 @@ fn open(name: &str, resolver: resolver::CheckingResolver) -> Result<Stage> {
 /// The grooms with the numeric arrays of text layers lifted out before openusd parses
 /// them and put back after (see `text_arrays`); `None` when anything went otherwise, an
 /// error for a malformed tuple, which openusd would read without a word.
-fn read_lifting(name: &str, file_bytes: u64, frame: Option<f64>) -> Result<Option<UsdGrooms>> {
+fn read_lifting(
+    name: &str,
+    file_bytes: u64,
+    frame: Option<f64>,
+    prims: Prims,
+) -> Result<Option<UsdGrooms>> {
     let lifted = resolver::Lifted::default();
     let Ok(stage) = open(name, resolver::CheckingResolver::lifting(lifted.clone())) else {
         return Ok(None);
@@ -315,7 +355,7 @@ fn read_lifting(name: &str, file_bytes: u64, frame: Option<f64>) -> Result<Optio
             return Ok(None);
         }
     }
-    let grooms = read_stage(&stage, file_bytes, frame).ok();
+    let grooms = read_stage(&stage, file_bytes, frame, prims).ok();
     // A text layer opened after the arrays were put back would hold placeholders.
     Ok(grooms.filter(|_| resolver::lock(&lifted).is_empty()))
 }
@@ -323,7 +363,12 @@ fn read_lifting(name: &str, file_bytes: u64, frame: Option<f64>) -> Result<Optio
 /// The grooms of a composed stage, at `frame` or as a still. `file_bytes` bounds what any
 /// count may ask for. Composition is lazy: its errors (cycles, missing layers) are known
 /// once every prim has been visited.
-fn read_stage(stage: &Stage, file_bytes: u64, frame: Option<f64>) -> Result<UsdGrooms> {
+fn read_stage(
+    stage: &Stage,
+    file_bytes: u64,
+    frame: Option<f64>,
+    prims: Prims,
+) -> Result<UsdGrooms> {
     let units = stage_units(stage)?;
     let clock = Clock::of(stage)?;
     let (at, when) = match frame {
@@ -337,7 +382,7 @@ fn read_stage(stage: &Stage, file_bytes: u64, frame: Option<f64>) -> Result<UsdG
     stage
         .traverse(PrimPredicate::DEFAULT, |p| paths.push(p.clone()))
         .map_err(|e| invalid_arg!("traversal failed: {e:#}"))?;
-    let mut curves = Vec::new();
+    let (mut curves, mut meshes, mut cameras) = (Vec::new(), Vec::new(), Vec::new());
     let mut ignored = Vec::new();
     for p in &paths {
         let prim = stage.prim(p.clone());
@@ -346,13 +391,19 @@ fn read_stage(stage: &Stage, file_bytes: u64, frame: Option<f64>) -> Result<UsdG
             .map_err(|e| invalid_arg!("{}: {e:#}", p.as_str()))?
             .map(|t| t.as_str().to_string())
             .unwrap_or_default();
-        match kind.as_str() {
-            "BasisCurves" => curves.push(
+        let named = |e: Error| e.context(format!("{}{when}", p.as_str()));
+        match (kind.as_str(), prims) {
+            ("BasisCurves", Prims::Curves) => curves.push(
                 prim::read_basis_curves(stage, p, file_bytes, (units, &clock), at)
-                    .map_err(|e| e.context(format!("{}{when}", p.as_str())))?,
+                    .map_err(named)?,
             ),
-            "" | "Xform" | "Scope" => {}
-            other => ignored.push(format!("{} ({other})", p.as_str())),
+            ("Mesh", Prims::Meshes) => meshes
+                .push(mesh::read_mesh(stage, p, file_bytes, (units, &clock), at).map_err(named)?),
+            ("Camera", Prims::Cameras) => {
+                cameras.push(camera::read_camera(stage, p, units, at).map_err(named)?)
+            }
+            ("" | "Xform" | "Scope", _) => {}
+            (other, _) => ignored.push(format!("{} ({other})", p.as_str())),
         }
     }
     if let Some(e) = stage.composition_errors().first() {
@@ -362,6 +413,8 @@ fn read_stage(stage: &Stage, file_bytes: u64, frame: Option<f64>) -> Result<UsdG
         units,
         clock,
         curves,
+        meshes,
+        cameras,
         ignored,
     })
 }

@@ -13,7 +13,7 @@ use crate::error::{Result, invalid_arg};
 use crate::formats::units::StageUnits;
 use crate::validate;
 
-fn wrong_type(what: &str, expected: &str, v: &Value) -> crate::Error {
+pub(super) fn wrong_type(what: &str, expected: &str, v: &Value) -> crate::Error {
     let actual: &'static str = v.into();
     invalid_arg!("{what}: expected {expected}, found {actual}")
 }
@@ -36,7 +36,7 @@ fn floats(value: Option<Value>, what: &str) -> Result<Option<Vec<f32>>> {
     }
 }
 
-fn vec3s(value: Option<Value>, what: &str) -> Result<Option<Vec<[f32; 3]>>> {
+pub(super) fn vec3s(value: Option<Value>, what: &str) -> Result<Option<Vec<[f32; 3]>>> {
     match value {
         None => Ok(None),
         Some(Value::Vec3fVec(v)) => Ok(Some(v.into_iter().map(Into::into).collect())),
@@ -67,17 +67,17 @@ fn interpolation(attr: &Attribute, what: &str, fallback: Interpolation) -> Resul
 
 /// The prim's local-to-world matrix (row vectors, as USD writes them): its own xformOps
 /// and every ancestor's, stopping at a `!resetXformStack!`.
-fn world_transform(
+pub(super) fn world_transform(
     stage: &Stage,
     path: &sdf::Path,
-    curves: &BasisCurves,
+    prim: &impl Xformable,
     when: ReadAt,
 ) -> Result<Matrix4d> {
     let err = failed;
-    let mut m = curves
+    let mut m = prim
         .local_to_parent_transform(when.transform_time())
         .map_err(|e| err(path, e))?;
-    let mut reset = curves.resets_xform_stack().map_err(|e| err(path, e))?;
+    let mut reset = prim.resets_xform_stack().map_err(|e| err(path, e))?;
     let mut at = path.parent();
     while let Some(p) = at.filter(|p| *p != sdf::Path::abs_root() && !reset) {
         let ancestor = stage.prim(p.clone());
@@ -110,7 +110,7 @@ fn uniform_scale(m: &Matrix4d) -> Result<f64> {
     validate::uniform_scale("the world transform", [row(0), row(1), row(2)])
 }
 
-fn transform_point(m: &Matrix4d, p: [f32; 3]) -> [f32; 3] {
+pub(super) fn transform_point(m: &Matrix4d, p: [f32; 3]) -> [f32; 3] {
     let p = p.map(f64::from);
     std::array::from_fn(|j| {
         (p[0] * m.0[j] + p[1] * m.0[4 + j] + p[2] * m.0[8 + j] + m.0[12 + j]) as f32
@@ -441,7 +441,7 @@ pub(super) fn read_basis_curves(
 /// The prim's points at `at`: moved by their velocities from the sample before, where
 /// those are authored there (UsdGeomPointBased's rule), else as [`ReadAt::value`] gives
 /// them; refused between two samples of different counts with no velocities.
-fn points_at(prim: &Prim, at: ReadAt, clock: &Clock) -> Result<Option<Vec<[f32; 3]>>> {
+pub(super) fn points_at(prim: &Prim, at: ReadAt, clock: &Clock) -> Result<Option<Vec<[f32; 3]>>> {
     let points = prim.attribute("points");
     let read = |t: ReadAt| vec3s(t.value(&points)?, "points");
     let ReadAt::Code(t) = at else {
@@ -491,7 +491,7 @@ fn points_at(prim: &Prim, at: ReadAt, clock: &Clock) -> Result<Option<Vec<[f32; 
 }
 
 /// What of the prim at `path` moves.
-fn animation(stage: &Stage, path: &sdf::Path) -> Result<Animation> {
+pub(super) fn animation(stage: &Stage, path: &sdf::Path) -> Result<Animation> {
     let mut a = Animation::default();
     let mut at = Some(path.clone());
     while let Some(p) = at.filter(|p| *p != sdf::Path::abs_root()) {

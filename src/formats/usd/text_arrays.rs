@@ -463,7 +463,7 @@ fn before(text: &[u8], i: usize) -> Option<u8> {
 mod tests {
     use std::path::{Path, PathBuf};
 
-    use super::super::{open, read_lifting, read_stage, read_usd_file, resolver};
+    use super::super::{Prims, open, read_lifting, read_stage, read_usd_file, resolver};
     use super::*;
 
     fn lifted(text: &str) -> String {
@@ -476,7 +476,7 @@ mod tests {
         let name = path.to_str().unwrap();
         let bytes = std::fs::metadata(path).unwrap().len();
         let read = open(name, resolver::CheckingResolver::default())
-            .and_then(|stage| read_stage(&stage, bytes, None))
+            .and_then(|stage| read_stage(&stage, bytes, None, Prims::Curves))
             .map_err(|e| e.context(path.display()));
         format!("{read:?}")
     }
@@ -534,7 +534,7 @@ mod tests {
             let text = std::fs::read(&path).unwrap();
             assert!(lift(text).is_ok(), "{}", path.display());
             let bytes = std::fs::metadata(&path).unwrap().len();
-            let fast = read_lifting(path.to_str().unwrap(), bytes, None)
+            let fast = read_lifting(path.to_str().unwrap(), bytes, None, Prims::Curves)
                 .unwrap()
                 .unwrap_or_else(|| panic!("{}: the fast path gave up", path.display()));
             assert_eq!(

@@ -13,14 +13,14 @@ use crate::scene::envmap::Environment;
 use crate::scene::light::Light;
 use crate::scene::material::{HairMaterial, Material};
 use crate::scene::tracer::TracerBuilder;
-use crate::scene::{FurBall, Mesh, Strands};
+use crate::scene::{Camera, FurBall, Mesh, Strands};
 use glam::Vec3;
 use std::sync::Arc;
 
 /// How far the groom moves over the shutter: a third of the ball's width, many pixels.
 const TRAVEL: Vec3 = Vec3::new(0.9, 0.3, 0.0);
 
-fn ball() -> Strands {
+pub(super) fn ball() -> Strands {
     FurBall {
         strands: 1500,
         segments: 8,
@@ -43,7 +43,7 @@ fn moved(strands: &Strands, by: Vec3) -> Strands {
 
 /// The ball under a sky and a sun, its curves at `steps` time steps (for each step, where
 /// the groom is), `basis` and `shape`.
-fn world(steps: &[Strands], basis: CurveBasis, shape: CurveShape) -> World {
+pub(super) fn world(steps: &[Strands], basis: CurveBasis, shape: CurveShape) -> World {
     let device = Arc::new(Device::new(Some(2)).unwrap());
     let mut b = TracerBuilder::new(device, SceneOptions::default()).unwrap();
     let curves = (steps.iter())
@@ -65,7 +65,7 @@ fn world(steps: &[Strands], basis: CurveBasis, shape: CurveShape) -> World {
     .unwrap()
 }
 
-fn settings(spp: u32, seed: u64, blur: bool) -> RenderSettings {
+pub(super) fn settings(spp: u32, seed: u64, blur: bool) -> RenderSettings {
     RenderSettings {
         width: 40,
         height: 30,
@@ -79,20 +79,24 @@ fn settings(spp: u32, seed: u64, blur: bool) -> RenderSettings {
 }
 
 fn image(world: &World, settings: &RenderSettings) -> Vec<f64> {
-    let out = render(world, &camera(), settings, Aovs::default(), &NoProgress).unwrap();
+    image_through(world, &camera(), settings)
+}
+
+pub(super) fn image_through(world: &World, camera: &Camera, settings: &RenderSettings) -> Vec<f64> {
+    let out = render(world, camera, settings, Aovs::default(), &NoProgress).unwrap();
     out.film.rgb().iter().map(|&v| f64::from(v)).collect()
 }
 
-fn mean_square_difference(a: &[f64], b: &[f64]) -> f64 {
+pub(super) fn mean_square_difference(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| (x - y).powi(2)).sum::<f64>() / a.len() as f64
 }
 
 /// Static renders at this many stratified times across the shutter make the reference.
-const STATIC_TIMES: u32 = 16;
+pub(super) const STATIC_TIMES: u32 = 16;
 
 /// How far above the mean square difference that noise alone makes (measured from two
 /// seeds a side) a render's difference from its reference may be and still count as noise.
-const NOISE_BOUND: f64 = 1.3;
+pub(super) const NOISE_BOUND: f64 = 1.3;
 
 /// The mean of [`STATIC_TIMES`] static renders of the ball moved to the middles of equal
 /// slices of its path, each at `spp` / [`STATIC_TIMES`] samples.

@@ -392,8 +392,17 @@ fn renders_are_deterministic_across_threads_and_crops() {
 /// `world` rendered with `base` (a 40 x 30 frame) gives the same bits on one thread and on
 /// two, and its [`CROP`] those pixels of the full frame.
 pub(crate) fn assert_deterministic(world: &World, base: RenderSettings, what: &str) {
-    let run =
-        |s: RenderSettings| render(world, &camera(), &s, Aovs::default(), &NoProgress).unwrap();
+    assert_deterministic_through(world, &camera(), base, what);
+}
+
+/// [`assert_deterministic`] through `camera`.
+pub(crate) fn assert_deterministic_through(
+    world: &World,
+    camera: &Camera,
+    base: RenderSettings,
+    what: &str,
+) {
+    let run = |s: RenderSettings| render(world, camera, &s, Aovs::default(), &NoProgress).unwrap();
     let one = run(RenderSettings {
         threads: Some(1),
         ..base

@@ -353,8 +353,8 @@ settings! {
         /// outweighs the slower rays: docs/large-grooms.md), on or off.
         curve_parts: CurveParts = CurveParts::Auto, Range::Any, Build;
         /// When the shutter opens, in frames from the frame's time (negative: before it).
-        /// Curves in motion hold their time steps spread evenly from the opening to the
-        /// closing, and each camera sample, with every ray of its path, is traced at a time
+        /// Curves, meshes and the camera in motion hold their time steps spread evenly from
+        /// the opening to the closing, and each camera sample, with every ray of its path, is traced at a time
         /// of its own in between (motion blur); equal to shutter_close: no blur, every ray
         /// at the opening.
         shutter_open: f32 = 0.0, Range::Any, Render;

@@ -6,8 +6,10 @@
 //!
 //! Only what both renderers can express is exported: an explicit camera, hair materials
 //! without per-strand variation, round linear or Catmull-Rom curves (Cycles' thick curves
-//! are Catmull-Rom splines), pinhole cameras. Anything else is an error naming it, never
-//! a silently different scene.
+//! are Catmull-Rom splines), pinhole cameras that stay put, meshes that do not deform.
+//! Anything else is an error naming it, never a silently different scene. A USD groom
+//! read at a frame under an open shutter goes out as its file too, for the peer to import
+//! with its own USD reader and blur (bench/README.md).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -15,7 +17,7 @@ use std::path::Path;
 use serde::Serialize;
 
 use hairtrace::description::{
-    EnvironmentSource, GroomSource, LightDesc, MaterialDesc, SceneDescription, Transform,
+    EnvironmentSource, GroomSource, LightDesc, MaterialDesc, SceneDescription, Shutter, Transform,
 };
 use hairtrace::embree::CurveBasis;
 use hairtrace::formats::hair::{HairTag, Thickness, write_tagged_hair_file};
@@ -134,7 +136,14 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             .get(name)
             .ok_or_else(|| invalid_arg!("{}: no material {name:?}", d.origin))
     };
-    let (open, close) = (d.render.shutter_open, d.render.shutter_close);
+    let shutter = Shutter::of(&d.render);
+    let (open, close) = (shutter.open, shutter.close);
+    if close > open && d.camera.shutter_close.is_some() {
+        return Err(invalid_arg!(
+            "{}: the camera moves over the shutter: a moving camera is not exported",
+            d.origin
+        ));
+    }
     let mut motion = None;
     let mut grooms = Vec::new();
     for (i, g) in d.grooms.iter().enumerate() {
@@ -183,6 +192,11 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             .placed_strands()
             .map_err(|e| e.context(format_args!("groom[{i}]")))?;
         let many = sets.len() > 1;
+        // A moving USD groom goes out once, as its file: the peer imports all its prims.
+        let sets = match usd {
+            Some(_) => &sets[..sets.len().min(1)],
+            None => &sets[..],
+        };
         for (k, set) in sets.iter().enumerate() {
             let layout = set.curves.layout();
             let basis = match (layout.basis, layout.wrap) {
@@ -242,9 +256,13 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
             return Err(invalid_arg!("mesh[{i}]: its material is not diffuse"));
         };
         let file = format!("mesh{i}.obj");
-        // The export is a still: a mesh is written where the shutter would open.
-        let still = m.mesh((0.0, 0.0))?;
-        std::fs::write(dir.join(&file), obj_text(&still)).map_err(io)?;
+        let mesh = m.mesh(shutter)?;
+        if !mesh.later_positions.is_empty() {
+            return Err(invalid_arg!(
+                "mesh[{i}]: it deforms over the shutter: a moving mesh is not exported"
+            ));
+        }
+        std::fs::write(dir.join(&file), obj_text(&mesh)).map_err(io)?;
         meshes.push(PeerMesh {
             file,
             albedo: *albedo,

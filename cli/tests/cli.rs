@@ -841,6 +841,10 @@ fn a_huang_material_and_a_moving_usd_groom_go_out_as_the_peer_reads_them() {
     );
     let (o, ..) = export(&text, "cli_peer_moving_placed");
     assert_one_line_error(&o, "groom[0]: a moving USD groom is exported as its file");
+    // A camera that moves over the shutter has no still pose to export.
+    let text = text.replace("scale = 2.0\n", "") + "[camera.shutter_close]\neye = [0, 0, 3]\n";
+    let (o, ..) = export(&text, "cli_peer_moving_camera");
+    assert_one_line_error(&o, "a moving camera is not exported");
 }
 
 #[test]

@@ -16,6 +16,7 @@ use crate::embree::CurveBasis;
 use crate::error::{Error, Result, invalid_arg};
 use crate::render::Aovs;
 use crate::render::renderer::film_bytes_and_uniform;
+use crate::render::settings::RenderSettings;
 use crate::scene::GroomShape;
 use crate::scene::Strands;
 use crate::scene::camera::Camera;
@@ -249,7 +250,7 @@ impl GroomDesc {
         stages: &mut StageRunner,
         (i, grooms, reads): (usize, usize, usize),
         framing: &mut Framing,
-        shutter: (f32, f32),
+        shutter: Shutter,
     ) -> Result<Vec<Curves>> {
         let (affine, scale) = self.transform.affine()?;
         positive("radius_scale", self.radius_scale)?;
@@ -353,7 +354,7 @@ impl GroomDesc {
                 path,
                 thickness,
                 frame,
-            } => self.hair_steps(path, *thickness, *frame, CLOSED),
+            } => self.hair_steps(path, *thickness, *frame, Shutter::CLOSED),
             GroomSource::FurBall(f) => one(f.build()?),
             GroomSource::Scalp(s) => one(s.build()?),
             GroomSource::Strands(s) => one(s.clone()),
@@ -372,7 +373,7 @@ impl GroomDesc {
     /// [`GroomDesc::placed_strands`] of a groom that is not USD at each time step of
     /// `shutter` (open, close, in frames from the frame): one set a step, more than one for
     /// a `.hair` sequence read at a frame with the shutter open ([`hair_sequence_steps`]).
-    fn placed_steps(&self, shutter: (f32, f32)) -> Result<Vec<GroomStrands>> {
+    fn placed_steps(&self, shutter: Shutter) -> Result<Vec<GroomStrands>> {
         match &self.source {
             GroomSource::File {
                 path,
@@ -392,7 +393,7 @@ impl GroomDesc {
         path: &Path,
         thickness: Thickness,
         frame: Option<f64>,
-        shutter: (f32, f32),
+        shutter: Shutter,
     ) -> Result<Vec<GroomStrands>> {
         let tag = read_hair_tag(&frame_file(path, frame)?)?;
         (hair_sequence_steps(path, thickness, frame, shutter)?.into_iter())
@@ -444,17 +445,16 @@ impl GroomDesc {
 fn usd_steps(
     path: &Path,
     frame: Option<f64>,
-    shutter: (f32, f32),
+    shutter: Shutter,
     prims: Prims,
 ) -> Result<Vec<UsdGrooms>> {
     let still = read_usd_prims_at(path, frame, prims)?;
-    let Some(f) = frame.filter(|_| shutter.1 > shutter.0 && still.time_range().is_some()) else {
+    let Some(f) = frame.filter(|_| shutter.is_open() && still.time_range().is_some()) else {
         return Ok(vec![still]);
     };
     let clock = still.clock;
     let code = |k, steps| clock.time_code(shutter_frame(f, shutter, k, steps));
-    let inside = still.samples_between(code(0, 2), code(1, 2));
-    let count = (inside + 2).min(MAX_TIME_STEPS);
+    let count = shutter.steps(still.samples_between(code(0, 2), code(1, 2)));
     let mut still = Some(still);
     (0..count)
         .map(|k| {
@@ -470,7 +470,7 @@ fn usd_steps(
 
 /// The frame of time step `k` of `steps` over `shutter` (open, close, in frames from
 /// `frame`), spread evenly from the opening to the closing.
-fn shutter_frame(frame: f64, (open, close): (f32, f32), k: usize, steps: usize) -> f64 {
+fn shutter_frame(frame: f64, Shutter { open, close, .. }: Shutter, k: usize, steps: usize) -> f64 {
     let (open, close) = (frame + f64::from(open), frame + f64::from(close));
     match steps {
         1 => open,
@@ -478,8 +478,44 @@ fn shutter_frame(frame: f64, (open, close): (f32, f32), k: usize, steps: usize) 
     }
 }
 
-/// A closed shutter: one time step, at the frame.
-const CLOSED: (f32, f32) = (0.0, 0.0);
+/// The shutter a scene is read over: when it opens and closes, in frames from the frame,
+/// and the fewest time steps an animated file gives a geometry over it when it is open
+/// (the settings `shutter_open`, `shutter_close` and `motion_steps`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Shutter {
+    pub open: f32,
+    pub close: f32,
+    pub least_steps: usize,
+}
+
+impl Shutter {
+    /// A closed shutter: one time step, at the frame.
+    pub const CLOSED: Shutter = Shutter {
+        open: 0.0,
+        close: 0.0,
+        least_steps: 0,
+    };
+
+    /// The shutter of a render with `settings`.
+    pub fn of(settings: &RenderSettings) -> Shutter {
+        Shutter {
+            open: settings.shutter_open,
+            close: settings.shutter_close,
+            least_steps: settings.motion_steps as usize,
+        }
+    }
+
+    fn is_open(self) -> bool {
+        self.close > self.open
+    }
+
+    /// Time steps over the open shutter for a file with `inside` time samples (or whole
+    /// frames) inside it: one at each end and evenly between, enough to take in every
+    /// sample (Embree's steps are even), at least `least_steps`, at most Embree's most.
+    fn steps(self, inside: usize) -> usize {
+        (inside + 2).max(self.least_steps).min(MAX_TIME_STEPS)
+    }
+}
 
 /// Curves made at each time step as one geometry: moving over the shutter when there is
 /// more than one step.
@@ -501,21 +537,20 @@ fn hair_sequence_steps(
     path: &Path,
     thickness: Thickness,
     frame: Option<f64>,
-    (open, close): (f32, f32),
+    shutter: Shutter,
 ) -> Result<Vec<Strands>> {
     let file = frame_file(path, frame)?;
     let still = read_hair_file(&file, thickness)?;
-    let Some(f) = frame.filter(|_| close > open && is_sequence(path)) else {
+    let Some(f) = frame.filter(|_| shutter.is_open() && is_sequence(path)) else {
         return Ok(vec![still]);
     };
-    let (open, close) = (f + f64::from(open), f + f64::from(close));
+    let (open, close) = (f + f64::from(shutter.open), f + f64::from(shutter.close));
     let span = |e: Error| {
         e.context(format!(
             "the shutter of frame {f} spans frames {open} to {close}"
         ))
     };
-    let inside = (close.ceil() - open.floor() - 1.0).max(0.0) as usize;
-    let count = (inside + 2).min(MAX_TIME_STEPS);
+    let count = shutter.steps((close.ceil() - open.floor() - 1.0).max(0.0) as usize);
     // Each file read once: the frame's, then those the steps reach.
     let mut files = vec![(f, file, still)];
     type Read = (f64, PathBuf, Strands);
@@ -619,7 +654,7 @@ impl MeshDesc {
 
     /// The mesh, transformed; a USD stage's every Mesh prim, deforming over `shutter`
     /// (open, close, in frames from its frame) where its points move.
-    pub fn mesh(&self, shutter: (f32, f32)) -> Result<Mesh> {
+    pub fn mesh(&self, shutter: Shutter) -> Result<Mesh> {
         let (affine, _) = self.transform.affine()?;
         let mut mesh = match &self.source {
             MeshSource::File(path) => read_mesh_file(path)?,
@@ -656,7 +691,7 @@ impl MeshDesc {
 /// transform), read at `frame`, at the time steps of [`usd_steps`] over `shutter`: a mesh
 /// that deforms has its points at each. Refused where a prim's faces or point count
 /// change between two steps, naming the prim, the attribute and the step's frame.
-fn usd_mesh(path: &Path, frame: Option<f64>, shutter: (f32, f32)) -> Result<Mesh> {
+fn usd_mesh(path: &Path, frame: Option<f64>, shutter: Shutter) -> Result<Mesh> {
     let steps = usd_steps(path, frame, shutter, Prims::Meshes)?;
     let first = &steps[0];
     if first.meshes.is_empty() {
@@ -745,7 +780,9 @@ impl CameraDesc {
     pub fn validate(&self) -> Result<()> {
         match (self.eye, self.target, &self.usd) {
             (None, None, None) => self.check_placed_if_moving(),
-            _ => self.build(&Framing::default(), 1.0, (0.0, 0.0)).map(|_| ()),
+            _ => self
+                .build(&Framing::default(), 1.0, Shutter::CLOSED)
+                .map(|_| ()),
         }
     }
 
@@ -763,12 +800,7 @@ impl CameraDesc {
     /// given, moving over `shutter` (open, close, in frames from the frame) when it is
     /// open and the camera has a pose at its closing (or a USD camera moves). The pose at
     /// the closing is checked whether the shutter is open or not.
-    pub(crate) fn build(
-        &self,
-        framing: &Framing,
-        aspect: f32,
-        shutter: (f32, f32),
-    ) -> Result<Camera> {
+    pub(crate) fn build(&self, framing: &Framing, aspect: f32, shutter: Shutter) -> Result<Camera> {
         if let Some(path) = &self.usd {
             return self.usd_camera(path, aspect, shutter);
         }
@@ -778,7 +810,7 @@ impl CameraDesc {
             return Ok(open);
         };
         let close = (self.pose(framing, aspect, close)).map_err(|e| e.context("shutter_close"))?;
-        match shutter.1 > shutter.0 {
+        match shutter.is_open() {
             true => Camera::in_motion(vec![open, close]),
             false => Ok(open),
         }
@@ -816,7 +848,7 @@ impl CameraDesc {
 
     /// The UsdGeomCamera of the stage at `path` (the prim `prim`, else the only one), at
     /// the frame and over the shutter's time steps ([`usd_steps`]).
-    fn usd_camera(&self, path: &Path, aspect: f32, shutter: (f32, f32)) -> Result<Camera> {
+    fn usd_camera(&self, path: &Path, aspect: f32, shutter: Shutter) -> Result<Camera> {
         let defaults = CameraDesc::default();
         let alone = CameraDesc {
             usd: None,

@@ -2,6 +2,7 @@
 //! use the last build.
 
 use super::{Built, Scene};
+use crate::description::Shutter;
 use crate::description::assembly::Assembly;
 use crate::error::{Result, invalid_arg};
 use crate::render::renderer::{self, RenderOutput};
@@ -136,7 +137,7 @@ impl Scene {
     /// one that frames the geometry.
     pub fn placed_camera(&self, settings: &RenderSettings) -> Result<Camera> {
         let aspect = settings.width as f32 / settings.height as f32;
-        let shutter = (settings.shutter_open, settings.shutter_close);
+        let shutter = Shutter::of(settings);
         (self.camera.build(&self.framing(), aspect, shutter)).map_err(|e| self.error("camera", e))
     }
 

@@ -18,7 +18,9 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use crate::description::assembly::Shape;
-use crate::description::{CameraDesc, GroomDesc, LightDesc, MaterialDesc, MeshDesc, MeshSource};
+use crate::description::{
+    CameraDesc, GroomDesc, LightDesc, MaterialDesc, MeshDesc, MeshSource, Shutter,
+};
 use crate::embree::{CurveBasis, Device, SharedBuffer};
 use crate::error::{Error, Result, invalid_arg};
 use crate::render::integrator::World;
@@ -322,7 +324,7 @@ impl Scene {
     ) -> Result<usize> {
         self.check_free(name)?;
         let mut framing = Framing::default();
-        let shutter = (self.settings.shutter_open, self.settings.shutter_close);
+        let shutter = Shutter::of(&self.settings);
         let curves =
             (groom.curves(stages, part, &mut framing, shutter)).map_err(|e| self.error(name, e))?;
         let n = curves.len();
@@ -384,7 +386,7 @@ impl Scene {
         part: (usize, usize),
     ) -> Result<()> {
         self.check_free(name)?;
-        let shutter = (self.settings.shutter_open, self.settings.shutter_close);
+        let shutter = Shutter::of(&self.settings);
         let made = (stages.run(Stage::Read, part, |_| mesh.mesh(shutter)))
             .map_err(|e| self.error(name, e))?;
         let mut framing = Framing::default();

@@ -10,7 +10,7 @@
 use std::fmt;
 
 use super::film::PixelFilter;
-use crate::embree::{Device, Isa};
+use crate::embree::{Device, Isa, MAX_TIME_STEPS};
 use crate::error::{Error, Result, invalid_arg};
 use crate::scene::lod::DEFAULT_LOD_PIXELS;
 
@@ -360,6 +360,11 @@ settings! {
         shutter_open: f32 = 0.0, Range::Any, Render;
         /// When the shutter closes, in frames from the frame's time: at least shutter_open.
         shutter_close: f32 = 0.0, Range::Any, Render;
+        /// The fewest time steps an animated file (USD, a `.hair` sequence) gives a groom, a
+        /// mesh or the camera over an open shutter: 0, as many as take in every time sample
+        /// inside it; more follow motion that curves between samples (velocities,
+        /// accelerations, a fast turn) more closely, each step read from the file.
+        motion_steps: u32 = 0, Range::Closed(0.0, MAX_TIME_STEPS as f64), Render;
     }
 
     /// How paths are traced and ended, and the hair BSDF's fidelity knobs.

@@ -321,6 +321,55 @@ fn an_open_shutter_reads_the_stage_at_its_time_steps() {
     assert!(host_pixels == blurred);
 }
 
+/// `motion_steps` asks for more time steps than the samples inside the shutter give: the
+/// stage is read at that many, evenly from the opening to the closing, bit for bit the
+/// host's strands given those steps; past Embree's most it is refused.
+#[test]
+fn motion_steps_reads_the_stage_at_that_many_steps() {
+    let dir = scratch("motion-steps");
+    let path = dir.join("anim.usda");
+    std::fs::write(&path, animated()).unwrap();
+    let mut desc = scene(&dir, "anim.usda", "[animation]\nframe = 1");
+    desc.render.set("shutter_close", "1").unwrap();
+    desc.render.set("motion_steps", "3").unwrap();
+    let blurred = pixels(desc.clone());
+
+    let at = |frame| {
+        read_usd_file_at(&path, Some(frame))
+            .unwrap()
+            .curves
+            .remove(0)
+    };
+    let (open, middle, close) = (at(1.0), at(1.5), at(2.0));
+    let mut host = desc.clone();
+    host.grooms.clear();
+    let mut scene =
+        Scene::from_description(&host, Arc::new(Device::new(Some(1)).unwrap())).unwrap();
+    let points = ControlPoints {
+        points: open.control.into(),
+        later_steps: vec![middle.control.into(), close.control.into()],
+        counts: open.control_counts,
+        colors: None,
+        basis: open.layout.basis,
+    };
+    scene
+        .add_control_points("hair", points, GroomShape::Auto, "h")
+        .unwrap();
+    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
+    let host_pixels: Vec<u32> = out.film.rgb().iter().map(|v| v.to_bits()).collect();
+    assert!(
+        host_pixels == blurred,
+        "three steps are not the stage at 1, 1.5 and 2"
+    );
+
+    let refused = desc
+        .render
+        .set("motion_steps", "130")
+        .unwrap_err()
+        .to_string();
+    assert!(refused.contains("motion_steps"), "{refused}");
+}
+
 /// `strands` as float4 control points (a linear `.hair` file's strands are its control
 /// points).
 fn xyzr(strands: &Strands) -> Vec<[f32; 4]> {

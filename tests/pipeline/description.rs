@@ -8,7 +8,8 @@ use glam::Vec3;
 use hairtrace::Error;
 use hairtrace::bsdf::SIGMA_A_PRESETS;
 use hairtrace::description::{
-    DEMOS, GroomSource, LightDesc, MaterialDesc, SceneDescription, Transform, demo, quick_look,
+    DEMOS, GroomSource, LightDesc, MaterialDesc, SceneDescription, Shutter, Transform, demo,
+    quick_look,
 };
 use hairtrace::embree::{CurveBasis, Device};
 use hairtrace::formats::hair::{Thickness, write_hair_file};
@@ -534,7 +535,9 @@ fn transforms_turn_scale_and_move_grooms_and_meshes() {
     // A mesh goes where its groom goes.
     let mesh = |transform: &str| {
         let text = BASE.replace("radius = 1.0", &format!("radius = 1.0\n{transform}"));
-        parse(&text).unwrap().meshes[0].mesh((0.0, 0.0)).unwrap()
+        parse(&text).unwrap().meshes[0]
+            .mesh(Shutter::CLOSED)
+            .unwrap()
     };
     let (a, b) = (
         mesh("rotate = [90, 0, 90]\nscale = 2\ntranslate = [1, 2, 3]"),

@@ -354,7 +354,7 @@ impl GroomDesc {
                 path,
                 thickness,
                 frame,
-            } => self.hair_steps(path, *thickness, *frame, Shutter::CLOSED),
+            } => self.hair_steps(path, *thickness, *frame, Shutter::default()),
             GroomSource::FurBall(f) => one(f.build()?),
             GroomSource::Scalp(s) => one(s.build()?),
             GroomSource::Strands(s) => one(s.clone()),
@@ -480,8 +480,9 @@ fn shutter_frame(frame: f64, Shutter { open, close, .. }: Shutter, k: usize, ste
 
 /// The shutter a scene is read over: when it opens and closes, in frames from the frame,
 /// and the fewest time steps an animated file gives a geometry over it when it is open
-/// (the settings `shutter_open`, `shutter_close` and `motion_steps`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// (the settings `shutter_open`, `shutter_close` and `motion_steps`). The default is closed:
+/// one time step, at the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Shutter {
     pub open: f32,
     pub close: f32,
@@ -489,13 +490,6 @@ pub struct Shutter {
 }
 
 impl Shutter {
-    /// A closed shutter: one time step, at the frame.
-    pub const CLOSED: Shutter = Shutter {
-        open: 0.0,
-        close: 0.0,
-        least_steps: 0,
-    };
-
     /// The shutter of a render with `settings`.
     pub fn of(settings: &RenderSettings) -> Shutter {
         Shutter {
@@ -781,7 +775,7 @@ impl CameraDesc {
         match (self.eye, self.target, &self.usd) {
             (None, None, None) => self.check_placed_if_moving(),
             _ => self
-                .build(&Framing::default(), 1.0, Shutter::CLOSED)
+                .build(&Framing::default(), 1.0, Shutter::default())
                 .map(|_| ()),
         }
     }

@@ -536,7 +536,7 @@ fn transforms_turn_scale_and_move_grooms_and_meshes() {
     let mesh = |transform: &str| {
         let text = BASE.replace("radius = 1.0", &format!("radius = 1.0\n{transform}"));
         parse(&text).unwrap().meshes[0]
-            .mesh(Shutter::CLOSED)
+            .mesh(Shutter::default())
             .unwrap()
     };
     let (a, b) = (

@@ -74,12 +74,11 @@ def main():
     hair.CreateBasisAttr(UsdGeom.Tokens.catmullRom)
     hair.CreateWrapAttr(UsdGeom.Tokens.pinned)
     hair.CreateCurveVertexCountsAttr(Vt.IntArray.FromNumpy(counts.astype(np.int32)))
-    widths_attr = hair.CreateWidthsAttr(Vt.FloatArray.FromNumpy(widths.astype(np.float32)))
+    hair.CreateWidthsAttr(Vt.FloatArray.FromNumpy(widths.astype(np.float32)))
     hair.SetWidthsInterpolation(UsdGeom.Tokens.vertex)
     points = hair.CreatePointsAttr()
     points.Set(Vt.Vec3fArray.FromNumpy(xyz.astype(np.float32)), 1.0)
     points.Set(Vt.Vec3fArray.FromNumpy(swung.astype(np.float32)), 2.0)
-    del widths_attr
     stage.GetRootLayer().Save()
     del stage
     # Appears only when complete.

@@ -10,7 +10,8 @@ along +x, each point by SWAY times the square of its place along its strand (roo
 that a shutter open over part of the frame blurs the tips most. One time code per frame
 (24 and 24), metres, +y up, widths per point (diameters), `pinned` Catmull-Rom: what hairtrace
 and Blender both read as the same curves. Default OUT: target/bench-motion/scalp_1m_sway.usdc
-(about 0.4 GB, made on demand, never in git).
+(made on demand, never in git; its size is in docs/measurements.md, "Against Cycles'
+motion blur").
 """
 
 import importlib.util

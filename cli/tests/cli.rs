@@ -793,16 +793,16 @@ fn bench_scenes_export_for_the_peer() {
 /// and the shutter, and is refused with a transform the import would not apply.
 #[test]
 fn a_huang_material_and_a_moving_usd_groom_go_out_as_the_peer_reads_them() {
-    let bench = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes");
-    let out = tmp("cli_peer_moving");
-    let o = hairtrace(&[
-        "export",
-        &bench.join("swaying_blur.toml").to_string_lossy(),
-        "-o",
-        &out,
-    ]);
-    assert!(o.status.success(), "{o:?}");
-    let json = scene_json(&out);
+    // The bench scene `name`'s export.
+    let exported = |name: &str| {
+        let bench = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench/scenes");
+        let out = tmp(&format!("cli_peer_read_{name}"));
+        let scene = bench.join(format!("{name}.toml"));
+        let o = hairtrace(&["export", &scene.to_string_lossy(), "-o", &out]);
+        assert!(o.status.success(), "{o:?}");
+        scene_json(&out)
+    };
+    let json = exported("swaying_blur");
     assert_eq!(json["motion"]["frame"], 6.0);
     assert_eq!(json["motion"]["shutter"], serde_json::json!([-0.25, 0.25]));
     let usd = json["grooms"][0]["usd"].as_str().unwrap();
@@ -812,15 +812,7 @@ fn a_huang_material_and_a_moving_usd_groom_go_out_as_the_peer_reads_them() {
     );
     assert_eq!(json["grooms"][0]["material"]["model"], "chiang");
 
-    let out = tmp("cli_peer_huang");
-    let o = hairtrace(&[
-        "export",
-        &bench.join("huang_oval_fur_ball.toml").to_string_lossy(),
-        "-o",
-        &out,
-    ]);
-    assert!(o.status.success(), "{o:?}");
-    let json = scene_json(&out);
+    let json = exported("huang_oval_fur_ball");
     let m = &json["grooms"][0]["material"];
     assert_eq!(
         (m["model"].as_str(), m["aspect"].as_f64()),

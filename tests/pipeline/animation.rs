@@ -294,31 +294,32 @@ fn an_open_shutter_reads_the_stage_at_its_time_steps() {
 
     // The same strands from host buffers at frames 1 and 2, where the shutter opens and
     // closes (no sample lies between).
-    let at = |frame| {
-        read_usd_file_at(&path, Some(frame))
-            .unwrap()
-            .curves
-            .remove(0)
-    };
-    let (open, close) = (at(1.0), at(2.0));
+    desc.render.set("shutter_close", "1").unwrap();
+    assert!(host_steps(&desc, &path, &[1.0, 2.0]) == blurred);
+}
+
+/// The pixels of `desc` with its grooms replaced by the strands of the stage at `path`
+/// read at each of `frames`, handed over as a host's time steps.
+fn host_steps(desc: &SceneDescription, path: &Path, frames: &[f64]) -> Vec<u32> {
+    let mut steps =
+        (frames.iter()).map(|&f| read_usd_file_at(path, Some(f)).unwrap().curves.remove(0));
+    let first = steps.next().unwrap();
     let mut host = desc.clone();
     host.grooms.clear();
-    host.render.set("shutter_close", "1").unwrap();
     let mut scene =
         Scene::from_description(&host, Arc::new(Device::new(Some(1)).unwrap())).unwrap();
     let points = ControlPoints {
-        points: open.control.into(),
-        later_steps: vec![close.control.into()],
-        counts: open.control_counts,
+        points: first.control.into(),
+        later_steps: steps.map(|s| s.control.into()).collect(),
+        counts: first.control_counts,
         colors: None,
-        basis: open.layout.basis,
+        basis: first.layout.basis,
     };
     scene
         .add_control_points("hair", points, GroomShape::Auto, "h")
         .unwrap();
     let out = scene.render(Aovs::default(), &NoProgress).unwrap();
-    let host_pixels: Vec<u32> = out.film.rgb().iter().map(|v| v.to_bits()).collect();
-    assert!(host_pixels == blurred);
+    out.film.rgb().iter().map(|v| v.to_bits()).collect()
 }
 
 /// `motion_steps` asks for more time steps than the samples inside the shutter give: the
@@ -333,32 +334,8 @@ fn motion_steps_reads_the_stage_at_that_many_steps() {
     desc.render.set("shutter_close", "1").unwrap();
     desc.render.set("motion_steps", "3").unwrap();
     let blurred = pixels(desc.clone());
-
-    let at = |frame| {
-        read_usd_file_at(&path, Some(frame))
-            .unwrap()
-            .curves
-            .remove(0)
-    };
-    let (open, middle, close) = (at(1.0), at(1.5), at(2.0));
-    let mut host = desc.clone();
-    host.grooms.clear();
-    let mut scene =
-        Scene::from_description(&host, Arc::new(Device::new(Some(1)).unwrap())).unwrap();
-    let points = ControlPoints {
-        points: open.control.into(),
-        later_steps: vec![middle.control.into(), close.control.into()],
-        counts: open.control_counts,
-        colors: None,
-        basis: open.layout.basis,
-    };
-    scene
-        .add_control_points("hair", points, GroomShape::Auto, "h")
-        .unwrap();
-    let out = scene.render(Aovs::default(), &NoProgress).unwrap();
-    let host_pixels: Vec<u32> = out.film.rgb().iter().map(|v| v.to_bits()).collect();
     assert!(
-        host_pixels == blurred,
+        host_steps(&desc, &path, &[1.0, 1.5, 2.0]) == blurred,
         "three steps are not the stage at 1, 1.5 and 2"
     );
 

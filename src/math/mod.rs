@@ -22,6 +22,12 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
+/// Two numbers in [0, 1) from a hash: its top 24 bits and the 24 below them.
+pub(crate) fn unit_pair(z: u64) -> [f32; 2] {
+    let unit = |bits: u64| (bits >> 40) as f32 / (1u64 << 24) as f32;
+    [unit(z), unit(z << 24)]
+}
+
 /// Rec. 709 luminance of linear RGB: the weight of a colour for importance sampling.
 pub fn luminance(rgb: glam::Vec3) -> f32 {
     rgb.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722))

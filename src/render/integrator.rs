@@ -18,7 +18,7 @@ use crate::bsdf::{
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
-use crate::math::{Frame, luminance, mix64};
+use crate::math::{Frame, luminance, mix64, unit_pair};
 use crate::scene::hit::{HairHit, Hit, SurfaceHit};
 use crate::scene::light::{Light, LightEval};
 use crate::scene::material::Material;
@@ -225,7 +225,11 @@ impl World {
                     // averaged across the fibre serves.
                     let thin = events > 0 || 2.0 * h.radius <= pixel_spread * h.t;
                     if let Some(b) = m.huang_at(h.strand.id, h.s, h.absorption) {
-                        Shading::huang(h, &b, wo_world, thin, jitter(u_rr, u_lobe, events))
+                        // Huang's far field at camera hits alone: a bounce's h is already
+                        // uniform across the fibre, and averaging offsets there costs more
+                        // than the noise it saves (docs/measurements.md, "The Huang model").
+                        let far = events == 0 && thin;
+                        Shading::huang(h, &b, wo_world, far, jitter(u_rr, u_lobe, events))
                     } else {
                         varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
                         let across = settings.light_offsets == LightOffsets::Across && thin;
@@ -453,9 +457,9 @@ enum Point<'a> {
 /// bounce's own, so that the pixel sampler's sequence keeps its layout for every model.
 fn jitter(u_rr: f32, u_lobe: f32, events: u32) -> [f32; 2] {
     let key = (u64::from(u_rr.to_bits()) << 32) | u64::from(u_lobe.to_bits());
-    let z = mix64(key ^ u64::from(events).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-    let unit = |bits: u64| (bits >> 40) as f32 / (1u64 << 24) as f32;
-    [unit(z), unit(z << 24)]
+    unit_pair(mix64(
+        key ^ u64::from(events).wrapping_mul(0x9e37_79b9_7f4a_7c15),
+    ))
 }
 
 impl<'a> Shading<'a> {

@@ -6,32 +6,44 @@ use super::{Ggx, HuangBsdf};
 use crate::bsdf::fresnel::{fresnel_dielectric, fresnel_inside};
 use crate::bsdf::pick::{U_MIN, pick};
 use crate::bsdf::{BsdfEval, BsdfSample, LocalBsdf, inv_cos};
-use crate::math::cos_from_sin;
 use crate::math::sampling::ONE_MINUS_EPSILON;
+use crate::math::{cos_from_sin, mix64, unit_pair};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, TAU};
 
-/// Microfacet normals of the first interface that each point follows into the fibre.
-const ENTRY_NODES: usize = 5;
-/// Internal reflections at the second interface followed from each of them (TRT).
-const REFLECT_NODES: usize = 3;
-const TT_EXITS: usize = ENTRY_NODES;
-const EXITS: usize = ENTRY_NODES * (1 + REFLECT_NODES);
 /// Offsets a far-field point averages.
 pub(super) const FAR_SHIFTS: usize = 4;
 /// Below this (y, z) length an internal direction runs along the fibre and never meets
 /// the far side: its path is dropped.
 const MIN_CROSSING: f32 = 1e-6;
+/// Visible normals whose Fresnel the residual averages for the interfaces past TRT.
+const ESCAPE_NODES: usize = 3;
+/// The least share of the residual's light an interface lets out: a fibre that reflects it
+/// totally at every normal keeps its light until absorbed, and none at all would divide
+/// zero by zero in the series of a clear fibre.
+const MIN_ESCAPE: f32 = 1e-5;
 
-/// Node k of a rank-1 lattice of `n` points in [0, 1)^2 with generator `g` (spread evenly
-/// in both coordinates), shifted by `jitter` modulo 1.
-fn lattice(k: usize, n: usize, g: usize, jitter: [f32; 2]) -> [f32; 2] {
-    let n = n as f32;
+/// Node `k` of the rank-1 lattice of `ESCAPE_NODES` points (generator 2) shifted by `u`,
+/// modulo 1.
+fn stratum(k: usize, u: [f32; 2]) -> [f32; 2] {
+    let n = ESCAPE_NODES as f32;
     let wrap = |x: f32| (x - x.floor()).min(ONE_MINUS_EPSILON);
-    [
-        wrap(k as f32 / n + jitter[0]),
-        wrap((k * g) as f32 / n + jitter[1]),
-    ]
+    [wrap(u[0] + k as f32 / n), wrap(u[1] + (2 * k) as f32 / n)]
+}
+
+/// Spreads the keys of an offset's interfaces apart before hashing (2^64 over phi).
+const KEY_STEP: u64 = 0x9e37_79b9_7f4a_7c15;
+
+/// The numbers offset `k` draws its three visible normals from: the entry's, the internal
+/// reflection's and the third interface's. Offset 0's entry takes `jitter` (in [0, 1))
+/// itself; every other pair is hashed from it, so that each interface draws independently
+/// of the others: pairs tied to one another would average to another integral, a bias.
+fn numbers(jitter: [f32; 2], k: usize) -> [[f32; 2]; 3] {
+    let key = (u64::from(jitter[0].to_bits()) << 32) | u64::from(jitter[1].to_bits());
+    std::array::from_fn(|i| match 3 * k + i {
+        0 => jitter,
+        n => unit_pair(mix64(key ^ (n as u64).wrapping_mul(KEY_STEP))),
+    })
 }
 
 /// Where a path meets its last interface from inside: the internal direction reversed
@@ -45,13 +57,15 @@ struct Exit {
     weight: Vec3,
 }
 
-/// The lobes, in the order of a point's sampling weights.
+/// The lobes, in the order of a point's sampling weights; TT and TRT also index an
+/// offset's exits from 1.
 const R: usize = 0;
 const TT: usize = 1;
 const TRT: usize = 2;
 const RESIDUAL: usize = 3;
 
-/// One offset's paths.
+/// One offset's paths: one visible microfacet normal at each interface, drawn from the
+/// point's numbers (module doc of `huang`).
 #[derive(Debug, Clone, Copy)]
 struct Paths {
     /// The entry's mesonormal.
@@ -59,10 +73,8 @@ struct Paths {
     /// dot(wo, m); the point sends nothing where it is <= 0.
     cos_om: f32,
     g1_o: f32,
-    /// TT's exits, then TRT's.
-    exits: [Exit; EXITS],
-    /// Each exit's probability within its lobe.
-    exit_pdf: [f32; EXITS],
+    /// TT's exit and TRT's; a path that ends early leaves `cos_vn` 0.
+    exits: [Exit; 2],
     /// The residual lobe's RGB energy.
     residual: Vec3,
     /// Probability of sampling R, TT, TRT, the residual.
@@ -94,7 +106,10 @@ impl HuangPoint {
         shifts: usize,
     ) -> Self {
         let h = if h.is_nan() { 0.0 } else { h.clamp(-1.0, 1.0) };
-        let jitter = jitter.map(|x| if x.is_finite() { x } else { 0.0 });
+        let jitter = jitter.map(|x| {
+            let x = if x.is_finite() { x } else { 0.0 };
+            (x - x.floor()).min(ONE_MINUS_EPSILON)
+        });
         let major = major.try_normalize().unwrap_or(Vec2::X);
         let section = Section::new(bsdf.params.aspect, major);
         let azimuth = Vec2::new(wo.y, wo.z).try_normalize().unwrap_or(Vec2::X);
@@ -103,7 +118,7 @@ impl HuangPoint {
         for (k, p) in paths.iter_mut().enumerate().take(shifts) {
             let x = h + 2.0 * k as f32 / shifts as f32;
             let x = if x > 1.0 { x - 2.0 } else { x };
-            *p = Paths::new(bsdf, &section, x, wo, azimuth, jitter);
+            *p = Paths::new(bsdf, &section, x, wo, azimuth, numbers(jitter, k));
         }
         Self {
             bsdf: *bsdf,
@@ -225,8 +240,7 @@ impl Paths {
             n: Vec3::Z,
             cos_vn: 0.0,
             weight: Vec3::ZERO,
-        }; EXITS],
-        exit_pdf: [0.0; EXITS],
+        }; 2],
         residual: Vec3::ZERO,
         lobe_pdf: [0.0; 4],
     };
@@ -237,7 +251,7 @@ impl Paths {
         h: f32,
         wo: Vec3,
         view: Vec2,
-        jitter: [f32; 2],
+        u: [[f32; 2]; 3],
     ) -> Self {
         let q1 = section.entry(view, h);
         let m = mesonormal(bsdf, section.normal(q1));
@@ -248,103 +262,96 @@ impl Paths {
         }
         p.m = m;
         p.cos_om = cos_om;
-        let ggx = &bsdf.ggx;
-        p.g1_o = ggx.g1(cos_om);
-        let eta = bsdf.params.eta;
-        for k in 0..ENTRY_NODES {
-            let wh = ggx.sample_visible(m, wo, lattice(k, ENTRY_NODES, 2, jitter));
-            let c = wo.dot(wh);
-            if c <= 0.0 {
-                continue;
-            }
-            // Refraction in: wt travels into the fibre.
-            let (_, t) = fresnel_dielectric(c, eta);
-            let cos_t = cos_from_sin((1.0 - c * c).max(0.0).sqrt() / eta);
-            let wt = -wo / eta + wh * (c / eta - cos_t);
-            let cos_tm = wt.dot(m);
-            if cos_tm >= 0.0 {
-                continue;
-            }
-            let w_in = t * ggx.g2_over_g1(cos_om, cos_tm) / ENTRY_NODES as f32;
-            let Some((q2, n2, a1)) = cross(bsdf, section, q1, wt) else {
-                continue;
-            };
-            let v = -wt;
-            let cos_vn = v.dot(n2);
-            let weight = a1 * w_in;
-            p.exits[k] = Exit {
-                v,
-                n: n2,
-                cos_vn,
-                weight,
-            };
-            for j in 0..REFLECT_NODES {
-                let wh2 =
-                    ggx.sample_visible(n2, v, lattice(j, REFLECT_NODES, 2, [jitter[1], jitter[0]]));
-                let c2 = v.dot(wh2);
-                if c2 <= 0.0 {
-                    continue;
-                }
-                let wr = wh2 * (2.0 * c2) - v;
-                let cos_rn = wr.dot(n2);
-                if cos_rn <= 0.0 {
-                    continue;
-                }
-                let w_r =
-                    fresnel_inside(c2, eta) * ggx.g2_over_g1(cos_vn, cos_rn) / REFLECT_NODES as f32;
-                let Some((_, n3, a2)) = cross(bsdf, section, q2, wr) else {
-                    continue;
-                };
-                let v3 = -wr;
-                let cos_v3 = v3.dot(n3);
-                let arriving = weight * w_r * a2;
-                p.exits[TT_EXITS + k * REFLECT_NODES + j] = Exit {
-                    v: v3,
-                    n: n3,
-                    cos_vn: cos_v3,
-                    weight: arriving,
-                };
-                // Past TRT: the light the third interface reflects (its Fresnel, total
-                // internal reflection included, at the same nodes of its visible normals)
-                // crosses again and again, each crossing absorbed as the mean of the two
-                // before, each interface letting out 1 - F: a geometric series.
-                let f3 = (0..REFLECT_NODES)
-                    .map(|i| {
-                        let wh3 = ggx.sample_visible(n3, v3, lattice(i, REFLECT_NODES, 2, jitter));
-                        fresnel_inside(v3.dot(wh3).max(0.0), eta)
-                    })
-                    .sum::<f32>()
-                    / REFLECT_NODES as f32;
-                let a = (a1 * a2).powf(0.5);
-                let denom = Vec3::ONE - a * f3;
-                let series = a * (1.0 - f3) * f3 / denom;
-                if series.is_finite() {
-                    p.residual += arriving * series;
-                }
-            }
-        }
-        let r = fresnel_dielectric(cos_om, eta).0;
+        p.g1_o = bsdf.ggx.g1(cos_om);
+        // A path that ends early leaves the later exits and the residual dark.
+        let _ = p.follow(bsdf, section, q1, wo, u);
         let lobe_sums = [
-            r,
-            p.exits[..TT_EXITS].iter().map(|e| mean(e.weight)).sum(),
-            p.exits[TT_EXITS..].iter().map(|e| mean(e.weight)).sum(),
+            fresnel_dielectric(cos_om, bsdf.params.eta).0,
+            mean(p.exits[0].weight),
+            mean(p.exits[1].weight),
             mean(p.residual),
         ];
         let total: f32 = lobe_sums.iter().sum();
         p.lobe_pdf = lobe_sums.map(|s| s / total);
-        for (range, sum) in [
-            (0..TT_EXITS, lobe_sums[TT]),
-            (TT_EXITS..EXITS, lobe_sums[TRT]),
-        ] {
-            for i in range {
-                p.exit_pdf[i] = if sum > 0.0 {
-                    mean(p.exits[i].weight) / sum
-                } else {
-                    0.0
-                };
-            }
-        }
         p
+    }
+
+    /// Follows the light refracted in at `q1` through the visible normal of `u[0]` across
+    /// the section (TT's exit), reflected there through `u[1]` on to the third interface
+    /// (TRT's), and what that interface reflects through `u[2]` (the residual).
+    fn follow(
+        &mut self,
+        bsdf: &HuangBsdf,
+        section: &Section,
+        q1: Vec2,
+        wo: Vec3,
+        u: [[f32; 2]; 3],
+    ) -> Option<()> {
+        let ggx = &bsdf.ggx;
+        let eta = bsdf.params.eta;
+        let wh = ggx.sample_visible(self.m, wo, u[0]);
+        let c = wo.dot(wh);
+        if c <= 0.0 {
+            return None;
+        }
+        // Refraction in: wt travels into the fibre.
+        let (_, t) = fresnel_dielectric(c, eta);
+        let cos_t = cos_from_sin((1.0 - c * c).max(0.0).sqrt() / eta);
+        let wt = -wo / eta + wh * (c / eta - cos_t);
+        let cos_tm = wt.dot(self.m);
+        if cos_tm >= 0.0 {
+            return None;
+        }
+        let (q2, n2, a1) = cross(bsdf, section, q1, wt)?;
+        let v = -wt;
+        let cos_vn = v.dot(n2);
+        let weight = a1 * (t * ggx.g2_over_g1(self.cos_om, cos_tm));
+        self.exits[0] = Exit {
+            v,
+            n: n2,
+            cos_vn,
+            weight,
+        };
+        let wh2 = ggx.sample_visible(n2, v, u[1]);
+        let c2 = v.dot(wh2);
+        if c2 <= 0.0 {
+            return None;
+        }
+        let wr = wh2 * (2.0 * c2) - v;
+        let cos_rn = wr.dot(n2);
+        if cos_rn <= 0.0 {
+            return None;
+        }
+        let (_, n3, a2) = cross(bsdf, section, q2, wr)?;
+        let v3 = -wr;
+        let arriving = weight * (fresnel_inside(c2, eta) * ggx.g2_over_g1(cos_vn, cos_rn)) * a2;
+        self.exits[1] = Exit {
+            v: v3,
+            n: n3,
+            cos_vn: v3.dot(n3),
+            weight: arriving,
+        };
+        // Past TRT: the third interface reflects the light at one visible normal (its
+        // Fresnel, total internal reflection included). That light crosses again and
+        // again, each crossing absorbed as the mean of the two before, each interface
+        // letting out 1 - F with F averaged over visible normals (a few, stratified from
+        // the first): a geometric series. One normal's F would trap all of it wherever
+        // that normal reflects totally, and later interfaces meet other normals.
+        let fresnel_at =
+            |u: [f32; 2]| fresnel_inside(v3.dot(ggx.sample_visible(n3, v3, u)).max(0.0), eta);
+        let f3 = fresnel_at(u[2]);
+        let f_mean = (1..ESCAPE_NODES)
+            .map(|k| fresnel_at(stratum(k, u[2])))
+            .sum::<f32>()
+            + f3;
+        let out = (1.0 - f_mean / ESCAPE_NODES as f32).max(MIN_ESCAPE);
+        let a = (a1 * a2).powf(0.5);
+        // 1 - a (1 - out), written so that a clear fibre's (a = 1) keeps out's digits.
+        let series = a * (out * f3) / (Vec3::ONE - a + a * out);
+        if series.is_finite() {
+            self.residual = arriving * series;
+        }
+        Some(())
     }
 
     /// The RGB energy of each lobe before the last interface's masking.
@@ -352,16 +359,11 @@ impl Paths {
         if self.cos_om <= 0.0 {
             return [Vec3::ZERO; 4];
         }
-        let exits = |r: std::ops::Range<usize>| {
-            self.exits[r]
-                .iter()
-                .map(|e| e.weight * (1.0 - fresnel_inside(e.cos_vn, bsdf.params.eta)))
-                .sum()
-        };
+        let leaving = |e: &Exit| e.weight * (1.0 - fresnel_inside(e.cos_vn, bsdf.params.eta));
         [
             Vec3::splat(fresnel_dielectric(self.cos_om, bsdf.params.eta).0),
-            exits(0..TT_EXITS),
-            exits(TT_EXITS..EXITS),
+            leaving(&self.exits[0]),
+            leaving(&self.exits[1]),
             self.residual,
         ]
     }
@@ -384,14 +386,13 @@ impl Paths {
             }
             pdf += self.lobe_pdf[R] * pdf_r;
         }
-        for (i, e) in self.exits.iter().enumerate() {
+        for (e, lobe) in self.exits.iter().zip([TT, TRT]) {
             if e.cos_vn <= 0.0 {
                 continue;
             }
             let (p, t) = refraction_out(ggx, bsdf.params.eta, e, wi);
             f += e.weight * (t * p);
-            let lobe = if i < TT_EXITS { TT } else { TRT };
-            pdf += self.lobe_pdf[lobe] * self.exit_pdf[i] * p;
+            pdf += self.lobe_pdf[lobe] * p;
         }
         f += self.residual * residual;
         pdf += self.lobe_pdf[RESIDUAL] * residual;
@@ -426,13 +427,7 @@ impl Paths {
                 ))
             }
             _ => {
-                let range = if lobe == TT {
-                    0..TT_EXITS
-                } else {
-                    TT_EXITS..EXITS
-                };
-                let (i, _) = pick(&self.exit_pdf[range.clone()], u0);
-                let e = &self.exits[range.start + i];
+                let e = &self.exits[lobe - TT];
                 if e.cos_vn <= 0.0 {
                     return None;
                 }

@@ -2,7 +2,7 @@
 //! (docs/conventions.md, section 4b) rather than from the crate's code: the section as a
 //! parametric ellipse with its quadratics solved directly (the crate maps it to a unit
 //! circle), Fresnel from Snell's cosines, and every vector in f64. It takes the same
-//! nodes (the visible-normal lattice and the jitter), so the two agree up to rounding; the
+//! numbers (the jitter and those the description hashes from it), so the two agree up to rounding; the
 //! test gives the f32 evaluation's largest error against it.
 
 use super::{huang, point};
@@ -151,7 +151,7 @@ impl Model {
     }
 
     /// f |wi.z| and pdf at the offset h: the model of section 4b, term by term.
-    fn eval(&self, h: f64, wo: V3, wi: V3, jitter: [f64; 2], residual_mp: f64) -> (V3, f64) {
+    fn eval(&self, h: f64, wo: V3, wi: V3, u: [[f64; 2]; 3], residual_mp: f64) -> (V3, f64) {
         let vl = (wo[1] * wo[1] + wo[2] * wo[2]).sqrt();
         let view = if vl > 0.0 {
             [wo[1] / vl, wo[2] / vl]
@@ -176,71 +176,68 @@ impl Model {
             return ([0.0; 3], 0.0);
         }
         let eta = self.eta;
-        let wrap = |x: f64| x - x.floor();
         let mut exits: Vec<(V3, V3, V3, bool)> = Vec::new();
         let mut residual = [0.0; 3];
-        for k in 0..5 {
-            let u = [
-                wrap(k as f64 / 5.0 + jitter[0]),
-                wrap((2 * k) as f64 / 5.0 + jitter[1]),
-            ];
-            let wh = self.visible(m, wo, u);
+        // One visible normal per interface, each from its own numbers; a path that ends
+        // leaves the later lobes dark.
+        'path: {
+            let wh = self.visible(m, wo, u[0]);
             let c = dot(wo, wh);
             if c <= 0.0 {
-                continue;
+                break 'path;
             }
             let t1 = 1.0 - Self::fresnel(c, 1.0, eta);
             let cos_t = (1.0 - (1.0 - c * c) / (eta * eta)).sqrt();
             let wt = add(mul(wo, -1.0 / eta), mul(wh, c / eta - cos_t));
             let ctm = dot(wt, m);
             if ctm >= 0.0 {
-                continue;
+                break 'path;
             }
-            let w_in = t1 * self.g2_g1(com, ctm.abs()) / 5.0;
+            let w_in = t1 * self.g2_g1(com, ctm.abs());
             let Some((p2, n2, a1)) = self.cross(p1, wt) else {
-                continue;
+                break 'path;
             };
             let v = mul(wt, -1.0);
             let w = mul(a1, w_in);
             exits.push((v, n2, w, true));
-            for j in 0..3 {
-                let u = [
-                    wrap(j as f64 / 3.0 + jitter[1]),
-                    wrap((2 * j) as f64 / 3.0 + jitter[0]),
-                ];
-                let wh2 = self.visible(n2, v, u);
-                let c2 = dot(v, wh2);
-                if c2 <= 0.0 {
-                    continue;
-                }
-                let wr = add(mul(wh2, 2.0 * c2), mul(v, -1.0));
-                let crn = dot(wr, n2);
-                if crn <= 0.0 {
-                    continue;
-                }
-                let w_r = Self::fresnel(c2, eta, 1.0) * self.g2_g1(dot(v, n2), crn) / 3.0;
-                let Some((_, n3, a2)) = self.cross(p2, wr) else {
-                    continue;
-                };
-                let v3 = mul(wr, -1.0);
-                let arriving: V3 = std::array::from_fn(|c| w[c] * w_r * a2[c]);
-                exits.push((v3, n3, arriving, false));
-                let f3 = (0..3)
-                    .map(|i| {
-                        let u = [
-                            wrap(i as f64 / 3.0 + jitter[0]),
-                            wrap((2 * i) as f64 / 3.0 + jitter[1]),
-                        ];
-                        Self::fresnel(dot(v3, self.visible(n3, v3, u)).max(0.0), eta, 1.0)
-                    })
-                    .sum::<f64>()
-                    / 3.0;
-                for c in 0..3 {
-                    let a = (a1[c] * a2[c]).sqrt();
-                    let s = a * (1.0 - f3) * f3 / (1.0 - a * f3);
-                    if s.is_finite() {
-                        residual[c] += arriving[c] * s;
-                    }
+            let wh2 = self.visible(n2, v, u[1]);
+            let c2 = dot(v, wh2);
+            if c2 <= 0.0 {
+                break 'path;
+            }
+            let wr = add(mul(wh2, 2.0 * c2), mul(v, -1.0));
+            let crn = dot(wr, n2);
+            if crn <= 0.0 {
+                break 'path;
+            }
+            let w_r = Self::fresnel(c2, eta, 1.0) * self.g2_g1(dot(v, n2), crn);
+            let Some((_, n3, a2)) = self.cross(p2, wr) else {
+                break 'path;
+            };
+            let v3 = mul(wr, -1.0);
+            let arriving: V3 = std::array::from_fn(|c| w[c] * w_r * a2[c]);
+            exits.push((v3, n3, arriving, false));
+            // The third interface reflects at u[2]'s normal; later ones let out 1 - F, F
+            // averaged over three normals: u[2] and the two lattice points past it.
+            let wrap = |x: f64| x - x.floor();
+            let fresnel_at =
+                |u: [f64; 2]| Self::fresnel(dot(v3, self.visible(n3, v3, u)).max(0.0), eta, 1.0);
+            let f3 = fresnel_at(u[2]);
+            let f_mean = (0..3)
+                .map(|k| {
+                    fresnel_at([
+                        wrap(u[2][0] + k as f64 / 3.0),
+                        wrap(u[2][1] + (2 * k) as f64 / 3.0),
+                    ])
+                })
+                .sum::<f64>()
+                / 3.0;
+            let out = (1.0 - f_mean).max(1e-5);
+            for c in 0..3 {
+                let a = (a1[c] * a2[c]).sqrt();
+                let s = a * out * f3 / (1.0 - a + a * out);
+                if s.is_finite() {
+                    residual[c] += arriving[c] * s;
                 }
             }
         }
@@ -283,6 +280,27 @@ impl Model {
         pdf += sums[3] / total * residual_mp;
         (f, pdf)
     }
+}
+
+/// The numbers of offset `k`'s three interfaces (section 4b): the jitter for offset 0's
+/// entry, and for the others the two 24-bit halves of SplitMix64's finaliser of the
+/// jitter's bits (first << 32 | second) xor (3k + interface) x 0x9e3779b97f4a7c15.
+fn numbers(jitter: [f32; 2], k: usize) -> [[f64; 2]; 3] {
+    let key = (u64::from(jitter[0].to_bits()) << 32) | u64::from(jitter[1].to_bits());
+    std::array::from_fn(|i| {
+        let n = (3 * k + i) as u64;
+        if n == 0 {
+            return jitter.map(f64::from);
+        }
+        let mut z = key ^ n.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        [
+            (z >> 40) as f64 / 16777216.0,
+            ((z << 24) >> 40) as f64 / 16777216.0,
+        ]
+    })
 }
 
 /// Chiang's longitudinal lobe (d'Eon's Mp) of variance v, untilted, in f64.
@@ -370,8 +388,7 @@ fn huang_f32_against_f64_reference() {
             for k in 0..shifts {
                 let x = f64::from(h + 2.0 * k as f32 / shifts as f32);
                 let x = if x > 1.0 { x - 2.0 } else { x };
-                let j = jitter.map(f64::from);
-                let (f, pdf) = model.eval(x, d3(wo), d3(wi), j, res);
+                let (f, pdf) = model.eval(x, d3(wo), d3(wi), numbers(jitter, k), res);
                 for c in 0..3 {
                     rf[c] += f[c] / shifts as f64;
                 }

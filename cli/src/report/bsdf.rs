@@ -1,7 +1,8 @@
 //! BSDF section: nanoseconds per call of each way the library evaluates and samples the
-//! hair BSDF, against its accuracy relative to the f64 reference model of the BSDF tests
-//! (tests/bsdf/common/reference.rs, compiled in here so that both judge by the same
-//! formulas), over hard cases and over random in-range inputs.
+//! Chiang hair BSDF, against its accuracy relative to the f64 reference model of the BSDF
+//! tests (tests/bsdf/common/reference.rs, compiled in here so that both judge by the same
+//! formulas), over hard cases and over random in-range inputs; then the Huang model's
+//! points beside Chiang's ([`huang`], judged by tests/bsdf/common/huang_reference.rs).
 
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
@@ -13,6 +14,10 @@ use rand_pcg::Pcg64;
 use std::hint::black_box;
 use std::time::Instant;
 
+mod huang;
+
+#[path = "../../../tests/bsdf/common/huang_reference.rs"]
+mod huang_reference;
 #[path = "../../../tests/bsdf/common/pbrt_f32.rs"]
 mod pbrt_f32;
 #[allow(dead_code)] // the tests use more of it than the report does
@@ -222,30 +227,23 @@ fn accumulate(acc: &mut Errors, s: &Set, x: &Input, wi: Vec3, got: BsdfEval) {
         (got.f.z as f64, want.f[2], cos),
         (got.pdf as f64, want.pdf, 1.0),
     ];
+    let at = || {
+        let p = s.bsdf.params();
+        format!(
+            "h = {}, wo = {:?}, wi = {:?}, sigma_a = {:?}, eta {}, beta_m {}, beta_n {}, \
+             alpha {}",
+            x.h,
+            x.wo.to_array(),
+            wi.to_array(),
+            p.sigma_a,
+            p.eta,
+            p.beta_m,
+            p.beta_n,
+            p.alpha
+        )
+    };
     for (what, (g, w, scale)) in ["f red", "f green", "f blue", "pdf"].iter().zip(pairs) {
-        let err = (g - w).abs();
-        if err * scale <= ABS_FLOOR {
-            continue;
-        }
-        let rel = err / w.abs().max(1e-300);
-        if rel > acc.max {
-            let p = s.bsdf.params();
-            acc.worst = format!(
-                "{what} {g:.4e} against {w:.4e} at h = {}, wo = {:?}, wi = {:?}, sigma_a = \
-                 {:?}, eta {}, beta_m {}, beta_n {}, alpha {}",
-                x.h,
-                x.wo.to_array(),
-                wi.to_array(),
-                p.sigma_a,
-                p.eta,
-                p.beta_m,
-                p.beta_n,
-                p.alpha
-            );
-            acc.max = rel;
-        }
-        acc.sum_sq += rel * rel;
-        acc.n += 1;
+        acc.add(what, g, w, scale, &at);
     }
 }
 
@@ -260,6 +258,22 @@ struct Errors {
 }
 
 impl Errors {
+    /// Adds the relative error of `got` (what it is: `what`) against `want`, unless the
+    /// error times `scale` is below [`ABS_FLOOR`]; `at` says where, for the worst.
+    fn add(&mut self, what: &str, got: f64, want: f64, scale: f64, at: impl Fn() -> String) {
+        let err = (got - want).abs();
+        if err * scale <= ABS_FLOOR {
+            return;
+        }
+        let rel = err / want.abs().max(1e-300);
+        if rel > self.max {
+            self.worst = format!("{what} {got:.4e} against {want:.4e} at {}", at());
+            self.max = rel;
+        }
+        self.sum_sq += rel * rel;
+        self.n += 1;
+    }
+
     fn rms(&self) -> f64 {
         (self.sum_sq / self.n.max(1) as f64).sqrt()
     }
@@ -501,7 +515,7 @@ fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> Optio
 }
 
 pub fn steps(_: &Context) -> u64 {
-    VARIANTS.len() as u64 + 1
+    VARIANTS.len() as u64 + 1 + huang::STEPS
 }
 
 pub fn section(ctx: &Context) -> Result<String> {
@@ -533,6 +547,7 @@ pub fn section(ctx: &Context) -> Result<String> {
             worst.push(format!("The worst hard case of `{}`: {}.", v.name, e.worst));
         }
         rows.push(vec![
+            "Chiang".to_owned(),
             format!("`{}`", v.name),
             num(ns, 3),
             num(hard_max, 2),
@@ -562,7 +577,7 @@ pub fn section(ctx: &Context) -> Result<String> {
     log_log(
         &ctx.path(file),
         &Labels {
-            title: "Hair BSDF: ns per call against relative error",
+            title: "Chiang hair BSDF: ns per call against relative error",
             x: "ns per call",
             y: "relative error against the f64 reference",
             caption: &caption,
@@ -570,8 +585,8 @@ pub fn section(ctx: &Context) -> Result<String> {
         &series,
     )?;
     Ok(format!(
-        "Each way of calling the hair BSDF, timed with `std::time::Instant` on one thread \
-         (ns per call: the median of {reps} rounds, each over every random input), and its \
+        "Each way of calling the Chiang hair BSDF (`HairBsdf`, round fibres: every row of \
+         the first table), timed with `std::time::Instant` on one thread (ns per call: the median of {reps} rounds, each over every random input), and its \
          relative error in f (each channel) and pdf against the f64 reference model of the \
          BSDF tests. Sampling is judged by the f and pdf it returns against the reference \
          at the direction it drew. Values whose error in f |cos| or pdf is below 1e-30 \
@@ -592,10 +607,11 @@ pub fn section(ctx: &Context) -> Result<String> {
          (`math::fast`); the port row is pbrt-v3's evaluation in plain f32 with libm's exp, \
          log and Bessel series (the accuracy tests' yardstick, \
          tests/bsdf/common/pbrt_f32.rs), eval only: it has no hard-case RMS, since it \
-         gives no finite value at h = +-1 without absorption.\n\n{}\n{}\n\n{}",
+         gives no finite value at h = +-1 without absorption.\n\n{}\n{}\n\n{}{}",
         random.len(),
         table(
             &[
+                "model",
                 "variant",
                 "ns per call",
                 "max rel. error (hard)",
@@ -607,5 +623,6 @@ pub fn section(ctx: &Context) -> Result<String> {
         ),
         worst.join(" "),
         figure(file, "BSDF Pareto plot", &caption),
+        huang::part(ctx, reps)?,
     ))
 }

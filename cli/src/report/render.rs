@@ -74,9 +74,7 @@ fn set(v: &mut Variant, key: &str, value: &str) -> Result<()> {
 /// offsets across the fibre): on a scene whose hair is all Huang it would change nothing.
 fn set_chiang(v: &mut Variant, key: &str, value: &str) -> Result<()> {
     if !hair_models(&v.desc).contains(&HairModel::Chiang) {
-        return Err(Error::InvalidArg(format!(
-            "the Huang model does not read `{key}`"
-        )));
+        return Err(Error::InvalidArg("the Huang model does not read it".into()));
     }
     set(v, key, value)
 }

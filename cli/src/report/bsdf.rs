@@ -172,34 +172,55 @@ fn hard_sets(quick: bool, g: &mut Pcg64) -> Result<Vec<Set>> {
 /// Random parameter sets over the valid ranges (roughness log-uniform, eta away from the
 /// ill-conditioned 1.0001, absorption none or log-uniform) with uniform h, wo and wi.
 fn random_sets(sets: usize, per_set: usize, g: &mut Pcg64) -> Result<Vec<Set>> {
-    let beta = |g: &mut Pcg64| 10f32.powf(g.random_range(-2.0..=0.0)).clamp(0.01, 1.0);
     (0..sets)
         .map(|_| {
-            let sigma = |g: &mut Pcg64| {
-                if g.random_range(0..5) == 0 {
-                    0.0
-                } else {
-                    10f32.powf(g.random_range(-2.0..1.0))
-                }
-            };
             let params = HairParams {
-                sigma_a: [sigma(g), sigma(g), sigma(g)],
-                eta: g.random_range(1.05..=3.0),
-                beta_m: beta(g),
-                beta_n: beta(g),
-                alpha: g.random_range(-20.0..=20.0),
+                sigma_a: random_sigma_a(g),
+                eta: random_eta(g),
+                beta_m: random_roughness(g),
+                beta_n: random_roughness(g),
+                alpha: random_tilt(g),
             };
-            let inputs = (0..per_set)
-                .map(|_| Input {
-                    h: g.random_range(-1.0..=1.0),
-                    wo: v3(uniform_sphere(g)),
-                    wi: v3(uniform_sphere(g)),
-                    u: [g.random(), g.random(), g.random()],
-                })
-                .collect();
+            let inputs = (0..per_set).map(|_| random_input(g)).collect();
             set(params, inputs)
         })
         .collect()
+}
+
+/// Absorption per channel: none one time in five, else log-uniform over [0.01, 10].
+fn random_sigma_a(g: &mut Pcg64) -> [f32; 3] {
+    std::array::from_fn(|_| {
+        if g.random_range(0..5) == 0 {
+            0.0
+        } else {
+            10f32.powf(g.random_range(-2.0..1.0))
+        }
+    })
+}
+
+/// eta over [1.05, 3], away from the ill-conditioned 1.0001.
+fn random_eta(g: &mut Pcg64) -> f32 {
+    g.random_range(1.05..=3.0)
+}
+
+/// A roughness, log-uniform over its valid [0.01, 1].
+fn random_roughness(g: &mut Pcg64) -> f32 {
+    10f32.powf(g.random_range(-2.0..=0.0)).clamp(0.01, 1.0)
+}
+
+/// A cuticle tilt in degrees over its valid [-20, 20].
+fn random_tilt(g: &mut Pcg64) -> f32 {
+    g.random_range(-20.0..=20.0)
+}
+
+/// Uniform h, wo and wi and random numbers to sample with.
+fn random_input(g: &mut Pcg64) -> Input {
+    Input {
+        h: g.random_range(-1.0..=1.0),
+        wo: v3(uniform_sphere(g)),
+        wi: v3(uniform_sphere(g)),
+        u: [g.random(), g.random(), g.random()],
+    }
 }
 
 /// Relative errors below this absolute size of f |wi.z| (or pdf) are f32 underflow, not
@@ -514,6 +535,17 @@ fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> Optio
     Some(acc)
 }
 
+/// A plot of ns per call against relative error, one bar a call.
+fn pareto(ctx: &Context, file: &str, title: &str, caption: &str, series: &[Series]) -> Result<()> {
+    let labels = Labels {
+        title,
+        x: "ns per call",
+        y: "relative error against the f64 reference",
+        caption,
+    };
+    log_log(&ctx.path(file), &labels, series)
+}
+
 pub fn steps(_: &Context) -> u64 {
     VARIANTS.len() as u64 + 1 + huang::STEPS
 }
@@ -574,21 +606,18 @@ pub fn section(ctx: &Context) -> Result<String> {
         ),
     );
     let file = "bsdf_pareto.png";
-    log_log(
-        &ctx.path(file),
-        &Labels {
-            title: "Chiang hair BSDF: ns per call against relative error",
-            x: "ns per call",
-            y: "relative error against the f64 reference",
-            caption: &caption,
-        },
+    pareto(
+        ctx,
+        file,
+        "Chiang hair BSDF: ns per call against relative error",
+        &caption,
         &series,
     )?;
     Ok(format!(
         "Each way of calling the Chiang hair BSDF (`HairBsdf`, round fibres: every row of \
-         the first table), timed with `std::time::Instant` on one thread (ns per call: the median of {reps} rounds, each over every random input), and its \
-         relative error in f (each channel) and pdf against the f64 reference model of the \
-         BSDF tests. Sampling is judged by the f and pdf it returns against the reference \
+         the first table), timed with `std::time::Instant` on one thread (ns per call: the \
+         median of {reps} rounds, each over every random input), and its relative error in \
+         f (each channel) and pdf against the f64 reference model of the BSDF tests. Sampling is judged by the f and pdf it returns against the reference \
          at the direction it drew. Values whose error in f |cos| or pdf is below 1e-30 \
          (f32 underflow) and directions exactly along the fibre (no azimuth) are left \
          out. Hard cases: roughness 0.01 to 1, no, brown and huge absorption, tilt 0 to 20 \

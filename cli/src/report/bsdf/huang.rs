@@ -5,12 +5,13 @@
 //! compare as a ratio.
 
 use super::super::markdown::{figure, num, table};
-use super::super::plots::{Labels, Series, log_log};
+use super::super::plots::Series;
 use super::super::{Context, median};
 use super::huang_reference::RefHuang;
 use super::reference::RefHair;
-use super::sphere::uniform_sphere;
-use super::{Errors, v3};
+use super::{
+    Errors, pareto, random_eta, random_input, random_roughness, random_sigma_a, random_tilt,
+};
 use glam::{Vec2, Vec3};
 use hairtrace::{BsdfEval, HairBsdf, HairParams, HuangBsdf, HuangParams, LocalBsdf, Result};
 use rand::{Rng, SeedableRng};
@@ -18,13 +19,10 @@ use rand_pcg::Pcg64;
 use std::hint::black_box;
 use std::time::Instant;
 
-/// One input: the point (h, wo, the section's major axis, the nodes' jitter), a direction
-/// to evaluate at and numbers to sample with.
+/// One input: the Chiang table's (h, wo, wi, numbers to sample with), and the section's
+/// major axis and the nodes' jitter.
 struct Input {
-    h: f32,
-    wo: Vec3,
-    wi: Vec3,
-    u: [f32; 3],
+    at: super::Input,
     major: Vec2,
     jitter: [f32; 2],
 }
@@ -45,19 +43,12 @@ struct Set {
 fn random_sets(sets: usize, per_set: usize, g: &mut Pcg64) -> Result<Vec<Set>> {
     (0..sets)
         .map(|_| {
-            let sigma = |g: &mut Pcg64| {
-                if g.random_range(0..5) == 0 {
-                    0.0
-                } else {
-                    10f32.powf(g.random_range(-2.0..1.0))
-                }
-            };
             let p = HuangParams {
-                sigma_a: [sigma(g), sigma(g), sigma(g)],
-                eta: g.random_range(1.05..=3.0),
-                roughness: 10f32.powf(g.random_range(-2.0..=0.0)).clamp(0.01, 1.0),
+                sigma_a: random_sigma_a(g),
+                eta: random_eta(g),
+                roughness: random_roughness(g),
                 aspect: g.random_range(0.05..=1.0),
-                alpha: g.random_range(-20.0..=20.0),
+                alpha: random_tilt(g),
             };
             let chiang = HairParams {
                 sigma_a: p.sigma_a,
@@ -69,10 +60,7 @@ fn random_sets(sets: usize, per_set: usize, g: &mut Pcg64) -> Result<Vec<Set>> {
             let f = f64::from;
             let inputs = (0..per_set)
                 .map(|_| Input {
-                    h: g.random_range(-1.0..=1.0),
-                    wo: v3(uniform_sphere(g)),
-                    wi: v3(uniform_sphere(g)),
-                    u: [g.random(), g.random(), g.random()],
+                    at: random_input(g),
                     major: Vec2::from_angle(g.random_range(0.0..std::f32::consts::TAU)),
                     jitter: [g.random(), g.random()],
                 })
@@ -116,7 +104,7 @@ const CHIANG: Model = Model {
     name: "Chiang",
     calls: ["HairBsdf::at", "HairPoint::eval", "HairPoint::sample"],
     reference: |s, x, wi| {
-        let want = s.chiang_reference.eval(x.h.into(), d3(x.wo), d3(wi));
+        let want = s.chiang_reference.eval(x.at.h.into(), d3(x.at.wo), d3(wi));
         let cos = f64::from(wi.z.abs());
         (want.f.map(|f| f * cos), want.pdf)
     },
@@ -137,7 +125,7 @@ const FAR: Model = Model {
 fn huang_reference(s: &Set, x: &Input, wi: Vec3, far: bool) -> ([f64; 3], f64) {
     let major = x.major.to_array().map(f64::from);
     let jitter = x.jitter.map(f64::from);
-    (s.reference).eval(far, x.h, d3(x.wo), d3(wi), major, jitter)
+    (s.reference).eval(far, x.at.h, d3(x.at.wo), d3(wi), major, jitter)
 }
 
 /// One model's figures: ns per point built, per eval and per sample, and the relative
@@ -203,12 +191,12 @@ fn measure<'s, P: LocalBsdf>(
         .collect();
     let eval_ns = timed(reps, || {
         per_point(sets, &points, |p, x, k| {
-            p.eval(if k % 2 == 0 { x.wi } else { -x.wi })
+            p.eval(if k % 2 == 0 { x.at.wi } else { -x.at.wi })
         })
     });
     let sample_ns = timed(reps, || {
         per_point(sets, &points, |p, x, k| {
-            p.sample(x.u.map(|u| (u + k as f32 * 0.125).fract()))
+            p.sample(x.at.u.map(|u| (u + k as f32 * 0.125).fract()))
         })
     });
     let mut m = Measured {
@@ -218,8 +206,8 @@ fn measure<'s, P: LocalBsdf>(
     };
     for (s, ps) in sets.iter().zip(&points) {
         for (x, p) in s.inputs.iter().zip(ps) {
-            add(&mut m.eval, &model, s, x, x.wi, p.eval(x.wi));
-            if let Some(r) = p.sample(x.u) {
+            add(&mut m.eval, &model, s, x, x.at.wi, p.eval(x.at.wi));
+            if let Some(r) = p.sample(x.at.u) {
                 let e = BsdfEval { f: r.f, pdf: r.pdf };
                 add(&mut m.sample, &model, s, x, r.wi, e);
             }
@@ -235,8 +223,8 @@ fn add(acc: &mut [Errors; 2], model: &Model, s: &Set, x: &Input, wi: Vec3, got: 
     let at = || {
         format!(
             "h = {}, wo = {:?}, wi = {:?}, major axis {:?}, jitter {:?}, {:?}",
-            x.h,
-            x.wo.to_array(),
+            x.at.h,
+            x.at.wo.to_array(),
             wi.to_array(),
             x.major.to_array(),
             x.jitter,
@@ -276,12 +264,14 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
     };
     ctx.done();
     let measured = [
-        measure(ctx, &sets, reps, CHIANG, |s, x| s.chiang.at(x.h, x.wo)),
+        measure(ctx, &sets, reps, CHIANG, |s, x| {
+            s.chiang.at(x.at.h, x.at.wo)
+        }),
         measure(ctx, &sets, reps, NEAR, |s, x| {
-            s.huang.near(x.h, x.wo, x.major, x.jitter)
+            s.huang.near(x.at.h, x.at.wo, x.major, x.jitter)
         }),
         measure(ctx, &sets, reps, FAR, |s, x| {
-            s.huang.far(x.h, x.wo, x.major, x.jitter)
+            s.huang.far(x.at.h, x.at.wo, x.major, x.jitter)
         }),
     ];
     let mut rows = Vec::new();
@@ -333,16 +323,8 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
         ),
     );
     let file = "bsdf_huang.png";
-    log_log(
-        &ctx.path(file),
-        &Labels {
-            title: "Huang and Chiang points: ns per call against relative error",
-            x: "ns per call",
-            y: "relative error against the f64 reference",
-            caption: &caption,
-        },
-        &series,
-    )?;
+    let title = "Huang and Chiang points: ns per call against relative error";
+    pareto(ctx, file, title, &caption, &series)?;
     Ok(format!(
         "### The Huang model beside Chiang\n\n\
          The Huang model's points (elliptical fibres, docs/conventions.md, section 4b), \

@@ -339,7 +339,9 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
          samples call it. Errors are relative, per channel of f |wi.z| and of the pdf, \
          against the f64 reference of each model's BSDF tests (the Huang one: \
          tests/bsdf/common/huang_reference.rs, the same nodes in f64), values below \
-         1e-30 left out; a sample is judged at the direction it drew.\n\n\
+         1e-30 left out; a sample is judged at the direction it drew. A Huang sample \
+         evaluates the point at the direction it drew, but a draw lost to total internal \
+         reflection returns before that, so a sample can cost less than an eval.\n\n\
          Here a Huang point's eval costs {}x a Chiang point's (near field) and {}x (far \
          field); its sample {}x and {}x Chiang's sample; building a near point costs as \
          much as {} Chiang point evals, a far one {}.\n\n{}\n{}\n\n{}",

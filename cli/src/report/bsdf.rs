@@ -264,7 +264,7 @@ fn accumulate(acc: &mut Errors, s: &Set, x: &Input, wi: Vec3, got: BsdfEval) {
         )
     };
     for (what, (g, w, scale)) in ["f red", "f green", "f blue", "pdf"].iter().zip(pairs) {
-        acc.add(what, g, w, scale, &at);
+        acc.add(what, g, w, scale, at);
     }
 }
 
@@ -505,10 +505,15 @@ const VARIANTS: [Variant; 12] = [
 
 /// Median ns per call of `v` over `reps` rounds of every set.
 fn time_variant(v: &Variant, sets: &mut [Set], reps: usize) -> f64 {
+    timed(reps, || sets.iter_mut().map(|s| (v.time)(s)).sum())
+}
+
+/// Median ns per call of `round` (which returns the calls it made) over `reps` rounds.
+fn timed(reps: usize, mut round: impl FnMut() -> usize) -> f64 {
     let rounds = (0..reps)
         .map(|_| {
             let start = Instant::now();
-            let calls: usize = sets.iter_mut().map(|s| (v.time)(s)).sum();
+            let calls = round();
             start.elapsed().as_secs_f64() * 1e9 / calls as f64
         })
         .collect();

@@ -4,20 +4,19 @@
 //! point timed and judged the same way on the same inputs, so that the two models' costs
 //! compare as a ratio.
 
+use super::super::Context;
 use super::super::markdown::{figure, num, table};
 use super::super::plots::Series;
-use super::super::{Context, median};
 use super::huang_reference::RefHuang;
 use super::reference::RefHair;
 use super::{
-    Errors, pareto, random_eta, random_input, random_roughness, random_sigma_a, random_tilt,
+    Errors, pareto, random_eta, random_input, random_roughness, random_sigma_a, random_tilt, timed,
 };
 use glam::{Vec2, Vec3};
 use hairtrace::{BsdfEval, HairBsdf, HairParams, HuangBsdf, HuangParams, LocalBsdf, Result};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use std::hint::black_box;
-use std::time::Instant;
 
 /// One input: the Chiang table's (h, wo, wi, numbers to sample with), and the section's
 /// major axis and the nodes' jitter.
@@ -92,8 +91,8 @@ fn d3(w: Vec3) -> [f64; 3] {
     w.to_array().map(f64::from)
 }
 
-/// A model as the rows call it: its name, its calls' names, how a point is built and the
-/// reference's f |wi.z| and pdf.
+/// A model as the rows call it: its name, its calls' names and the reference's f |wi.z|
+/// and pdf (its points are built by the closure [`measure`] takes).
 struct Model {
     name: &'static str,
     calls: [&'static str; 3],
@@ -136,18 +135,6 @@ struct Measured {
     sample: [Errors; 2],
 }
 
-/// Median ns per call of `round` (which returns the calls it made) over `reps` rounds.
-fn timed(reps: usize, round: impl Fn() -> usize) -> f64 {
-    let rounds = (0..reps)
-        .map(|_| {
-            let start = Instant::now();
-            let calls = round();
-            start.elapsed().as_secs_f64() * 1e9 / calls as f64
-        })
-        .collect();
-    median(rounds)
-}
-
 /// Calls `call` 8 times on each input's prepared point (with the call's index), as a
 /// renderer does over its light and BSDF samples; returns the calls made.
 fn per_point<P, R>(
@@ -177,14 +164,14 @@ fn measure<'s, P: LocalBsdf>(
 ) -> (Model, Measured) {
     ctx.step(format!("BSDF: {}", model.name));
     let build_ns = timed(reps, || {
-        sets.iter()
-            .map(|s| {
-                s.inputs
-                    .iter()
-                    .map(|x| black_box(build(s, black_box(x))))
-                    .count()
-            })
-            .sum()
+        let mut calls = 0;
+        for s in sets {
+            for x in &s.inputs {
+                black_box(build(s, black_box(x)));
+            }
+            calls += s.inputs.len();
+        }
+        calls
     });
     let points: Vec<Vec<P>> = (sets.iter())
         .map(|s| s.inputs.iter().map(|x| build(s, x)).collect())
@@ -234,15 +221,10 @@ fn add(acc: &mut [Errors; 2], model: &Model, s: &Set, x: &Input, wi: Vec3, got: 
     let cos = f64::from(wi.z.abs());
     let what = format!("{}: f |wi.z|", model.name);
     for (c, want) in f.into_iter().enumerate() {
-        acc[0].add(&what, f64::from(got.f[c]) * cos, want, 1.0, &at);
+        acc[0].add(&what, f64::from(got.f[c]) * cos, want, 1.0, at);
     }
-    acc[1].add(
-        &format!("{}: pdf", model.name),
-        got.pdf.into(),
-        pdf,
-        1.0,
-        &at,
-    );
+    let what = format!("{}: pdf", model.name);
+    acc[1].add(&what, got.pdf.into(), pdf, 1.0, at);
 }
 
 /// RMS and max relative error over f and pdf together (the plot's bar).

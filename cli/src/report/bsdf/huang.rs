@@ -233,6 +233,7 @@ fn pooled([f, pdf]: &[Errors; 2]) -> (f64, f64) {
     (((f.sum_sq + pdf.sum_sq) / n).sqrt(), f.max.max(pdf.max))
 }
 
+/// Progress steps of [`part`]: the inputs, then each model.
 pub const STEPS: u64 = 4;
 
 /// The Huang part's text, table and plot; `reps` rounds of timing as the Chiang table's.

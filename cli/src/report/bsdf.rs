@@ -1,7 +1,8 @@
 //! BSDF section: nanoseconds per call of each way the library evaluates and samples the
-//! hair BSDF, against its accuracy relative to the f64 reference model of the BSDF tests
-//! (tests/bsdf/common/reference.rs, compiled in here so that both judge by the same
-//! formulas), over hard cases and over random in-range inputs.
+//! Chiang hair BSDF, against its accuracy relative to the f64 reference model of the BSDF
+//! tests (tests/bsdf/common/reference.rs, compiled in here so that both judge by the same
+//! formulas), over hard cases and over random in-range inputs; then the Huang model's
+//! points beside Chiang's ([`huang`], judged by tests/bsdf/common/huang_reference.rs).
 
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
@@ -13,6 +14,10 @@ use rand_pcg::Pcg64;
 use std::hint::black_box;
 use std::time::Instant;
 
+mod huang;
+
+#[path = "../../../tests/bsdf/common/huang_reference.rs"]
+mod huang_reference;
 #[path = "../../../tests/bsdf/common/pbrt_f32.rs"]
 mod pbrt_f32;
 #[allow(dead_code)] // the tests use more of it than the report does
@@ -167,34 +172,55 @@ fn hard_sets(quick: bool, g: &mut Pcg64) -> Result<Vec<Set>> {
 /// Random parameter sets over the valid ranges (roughness log-uniform, eta away from the
 /// ill-conditioned 1.0001, absorption none or log-uniform) with uniform h, wo and wi.
 fn random_sets(sets: usize, per_set: usize, g: &mut Pcg64) -> Result<Vec<Set>> {
-    let beta = |g: &mut Pcg64| 10f32.powf(g.random_range(-2.0..=0.0)).clamp(0.01, 1.0);
     (0..sets)
         .map(|_| {
-            let sigma = |g: &mut Pcg64| {
-                if g.random_range(0..5) == 0 {
-                    0.0
-                } else {
-                    10f32.powf(g.random_range(-2.0..1.0))
-                }
-            };
             let params = HairParams {
-                sigma_a: [sigma(g), sigma(g), sigma(g)],
-                eta: g.random_range(1.05..=3.0),
-                beta_m: beta(g),
-                beta_n: beta(g),
-                alpha: g.random_range(-20.0..=20.0),
+                sigma_a: random_sigma_a(g),
+                eta: random_eta(g),
+                beta_m: random_roughness(g),
+                beta_n: random_roughness(g),
+                alpha: random_tilt(g),
             };
-            let inputs = (0..per_set)
-                .map(|_| Input {
-                    h: g.random_range(-1.0..=1.0),
-                    wo: v3(uniform_sphere(g)),
-                    wi: v3(uniform_sphere(g)),
-                    u: [g.random(), g.random(), g.random()],
-                })
-                .collect();
+            let inputs = (0..per_set).map(|_| random_input(g)).collect();
             set(params, inputs)
         })
         .collect()
+}
+
+/// Absorption per channel: none one time in five, else log-uniform over [0.01, 10].
+fn random_sigma_a(g: &mut Pcg64) -> [f32; 3] {
+    std::array::from_fn(|_| {
+        if g.random_range(0..5) == 0 {
+            0.0
+        } else {
+            10f32.powf(g.random_range(-2.0..1.0))
+        }
+    })
+}
+
+/// eta over [1.05, 3], away from the ill-conditioned 1.0001.
+fn random_eta(g: &mut Pcg64) -> f32 {
+    g.random_range(1.05..=3.0)
+}
+
+/// A roughness, log-uniform over its valid [0.01, 1].
+fn random_roughness(g: &mut Pcg64) -> f32 {
+    10f32.powf(g.random_range(-2.0..=0.0)).clamp(0.01, 1.0)
+}
+
+/// A cuticle tilt in degrees over its valid [-20, 20].
+fn random_tilt(g: &mut Pcg64) -> f32 {
+    g.random_range(-20.0..=20.0)
+}
+
+/// Uniform h, wo and wi and random numbers to sample with.
+fn random_input(g: &mut Pcg64) -> Input {
+    Input {
+        h: g.random_range(-1.0..=1.0),
+        wo: v3(uniform_sphere(g)),
+        wi: v3(uniform_sphere(g)),
+        u: [g.random(), g.random(), g.random()],
+    }
 }
 
 /// Relative errors below this absolute size of f |wi.z| (or pdf) are f32 underflow, not
@@ -222,30 +248,23 @@ fn accumulate(acc: &mut Errors, s: &Set, x: &Input, wi: Vec3, got: BsdfEval) {
         (got.f.z as f64, want.f[2], cos),
         (got.pdf as f64, want.pdf, 1.0),
     ];
+    let at = || {
+        let p = s.bsdf.params();
+        format!(
+            "h = {}, wo = {:?}, wi = {:?}, sigma_a = {:?}, eta {}, beta_m {}, beta_n {}, \
+             alpha {}",
+            x.h,
+            x.wo.to_array(),
+            wi.to_array(),
+            p.sigma_a,
+            p.eta,
+            p.beta_m,
+            p.beta_n,
+            p.alpha
+        )
+    };
     for (what, (g, w, scale)) in ["f red", "f green", "f blue", "pdf"].iter().zip(pairs) {
-        let err = (g - w).abs();
-        if err * scale <= ABS_FLOOR {
-            continue;
-        }
-        let rel = err / w.abs().max(1e-300);
-        if rel > acc.max {
-            let p = s.bsdf.params();
-            acc.worst = format!(
-                "{what} {g:.4e} against {w:.4e} at h = {}, wo = {:?}, wi = {:?}, sigma_a = \
-                 {:?}, eta {}, beta_m {}, beta_n {}, alpha {}",
-                x.h,
-                x.wo.to_array(),
-                wi.to_array(),
-                p.sigma_a,
-                p.eta,
-                p.beta_m,
-                p.beta_n,
-                p.alpha
-            );
-            acc.max = rel;
-        }
-        acc.sum_sq += rel * rel;
-        acc.n += 1;
+        acc.add(what, g, w, scale, at);
     }
 }
 
@@ -260,6 +279,22 @@ struct Errors {
 }
 
 impl Errors {
+    /// Adds the relative error of `got` (what it is: `what`) against `want`, unless the
+    /// error times `scale` is below [`ABS_FLOOR`]; `at` says where, for the worst.
+    fn add(&mut self, what: &str, got: f64, want: f64, scale: f64, at: impl Fn() -> String) {
+        let err = (got - want).abs();
+        if err * scale <= ABS_FLOOR {
+            return;
+        }
+        let rel = err / want.abs().max(1e-300);
+        if rel > self.max {
+            self.worst = format!("{what} {got:.4e} against {want:.4e} at {}", at());
+            self.max = rel;
+        }
+        self.sum_sq += rel * rel;
+        self.n += 1;
+    }
+
     fn rms(&self) -> f64 {
         (self.sum_sq / self.n.max(1) as f64).sqrt()
     }
@@ -470,10 +505,15 @@ const VARIANTS: [Variant; 12] = [
 
 /// Median ns per call of `v` over `reps` rounds of every set.
 fn time_variant(v: &Variant, sets: &mut [Set], reps: usize) -> f64 {
+    timed(reps, || sets.iter_mut().map(|s| (v.time)(s)).sum())
+}
+
+/// Median ns per call of `round` (which returns the calls it made) over `reps` rounds.
+fn timed(reps: usize, mut round: impl FnMut() -> usize) -> f64 {
     let rounds = (0..reps)
         .map(|_| {
             let start = Instant::now();
-            let calls: usize = sets.iter_mut().map(|s| (v.time)(s)).sum();
+            let calls = round();
             start.elapsed().as_secs_f64() * 1e9 / calls as f64
         })
         .collect();
@@ -500,8 +540,19 @@ fn accuracy(outputs: Option<fn(&mut Set) -> Outputs>, sets: &mut [Set]) -> Optio
     Some(acc)
 }
 
+/// A plot of ns per call against relative error, one bar a call.
+fn pareto(ctx: &Context, file: &str, title: &str, caption: &str, series: &[Series]) -> Result<()> {
+    let labels = Labels {
+        title,
+        x: "ns per call",
+        y: "relative error against the f64 reference",
+        caption,
+    };
+    log_log(&ctx.path(file), &labels, series)
+}
+
 pub fn steps(_: &Context) -> u64 {
-    VARIANTS.len() as u64 + 1
+    VARIANTS.len() as u64 + 1 + huang::STEPS
 }
 
 pub fn section(ctx: &Context) -> Result<String> {
@@ -533,6 +584,7 @@ pub fn section(ctx: &Context) -> Result<String> {
             worst.push(format!("The worst hard case of `{}`: {}.", v.name, e.worst));
         }
         rows.push(vec![
+            "Chiang".to_owned(),
             format!("`{}`", v.name),
             num(ns, 3),
             num(hard_max, 2),
@@ -559,21 +611,18 @@ pub fn section(ctx: &Context) -> Result<String> {
         ),
     );
     let file = "bsdf_pareto.png";
-    log_log(
-        &ctx.path(file),
-        &Labels {
-            title: "Hair BSDF: ns per call against relative error",
-            x: "ns per call",
-            y: "relative error against the f64 reference",
-            caption: &caption,
-        },
+    pareto(
+        ctx,
+        file,
+        "Chiang hair BSDF: ns per call against relative error",
+        &caption,
         &series,
     )?;
     Ok(format!(
-        "Each way of calling the hair BSDF, timed with `std::time::Instant` on one thread \
-         (ns per call: the median of {reps} rounds, each over every random input), and its \
-         relative error in f (each channel) and pdf against the f64 reference model of the \
-         BSDF tests. Sampling is judged by the f and pdf it returns against the reference \
+        "Each way of calling the Chiang hair BSDF (`HairBsdf`, round fibres: every row of \
+         the first table), timed with `std::time::Instant` on one thread (ns per call: the \
+         median of {reps} rounds, each over every random input), and its relative error in \
+         f (each channel) and pdf against the f64 reference model of the BSDF tests. Sampling is judged by the f and pdf it returns against the reference \
          at the direction it drew. Values whose error in f |cos| or pdf is below 1e-30 \
          (f32 underflow) and directions exactly along the fibre (no azimuth) are left \
          out. Hard cases: roughness 0.01 to 1, no, brown and huge absorption, tilt 0 to 20 \
@@ -592,10 +641,11 @@ pub fn section(ctx: &Context) -> Result<String> {
          (`math::fast`); the port row is pbrt-v3's evaluation in plain f32 with libm's exp, \
          log and Bessel series (the accuracy tests' yardstick, \
          tests/bsdf/common/pbrt_f32.rs), eval only: it has no hard-case RMS, since it \
-         gives no finite value at h = +-1 without absorption.\n\n{}\n{}\n\n{}",
+         gives no finite value at h = +-1 without absorption.\n\n{}\n{}\n\n{}{}",
         random.len(),
         table(
             &[
+                "model",
                 "variant",
                 "ns per call",
                 "max rel. error (hard)",
@@ -607,5 +657,6 @@ pub fn section(ctx: &Context) -> Result<String> {
         ),
         worst.join(" "),
         figure(file, "BSDF Pareto plot", &caption),
+        huang::part(ctx, reps)?,
     ))
 }

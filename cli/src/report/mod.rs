@@ -199,12 +199,10 @@ pub fn bench_scene(ctx: &Context, name: &str) -> Result<hairtrace::SceneDescript
 
 /// Refuses a scenes folder without the files the sections read, before minutes of work.
 fn check_scenes(dir: &Path) -> Result<()> {
-    let needed = [
-        scene_path(dir, "fur_ball"),
-        scene_path(dir, "hdr_fur_ball"),
-        scene_path(dir, "demo_fur_ball"),
-        scale::scalp_path(dir),
-    ];
+    let needed: Vec<PathBuf> = (render::QUICK_SCENES.iter().chain(&["demo_fur_ball"]))
+        .map(|name| scene_path(dir, name))
+        .chain([scale::scalp_path(dir)])
+        .collect();
     match needed.iter().find(|p| !p.is_file()) {
         Some(missing) => Err(Error::InvalidArg(format!(
             "{} not found: run from the repository's root or pass --scenes with the \

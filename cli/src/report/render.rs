@@ -5,12 +5,12 @@
 use super::markdown::{figure, num, table};
 use super::plots::{Labels, Series, log_log};
 use super::{Context, all_scene_names, bench_scene, median};
-use hairtrace::description::{GroomSource, SceneDescription};
+use hairtrace::description::{GroomSource, MaterialDesc, SceneDescription};
 use hairtrace::embree::CurveBasis;
 use hairtrace::image::{Image, compare};
 use hairtrace::render::settings::Filter;
-use hairtrace::scene::GroomShape;
-use hairtrace::{Aovs, NoProgress, Result};
+use hairtrace::scene::{GroomShape, HairModel};
+use hairtrace::{Aovs, Error, NoProgress, Result};
 use std::sync::Arc;
 
 /// What a knob changes: the scene description.
@@ -46,13 +46,21 @@ const KNOBS: &[Knob] = &[
     knob("max_depth 16", |v| set(v, "max_depth", "16")),
     knob("max_depth 4", |v| set(v, "max_depth", "4")),
     knob("filter tent", |v| set(v, "filter", "tent")),
-    knob("deep_bounce_depth 1", |v| set(v, "deep_bounce_depth", "1")),
-    knob("deep_bounce_depth 2", |v| set(v, "deep_bounce_depth", "2")),
-    knob("deep_bounce_depth 4", |v| set(v, "deep_bounce_depth", "4")),
-    knob("lobe_cull 0.01", |v| set(v, "lobe_cull", "0.01")),
-    knob("lobe_cull 0.1", |v| set(v, "lobe_cull", "0.1")),
+    knob("deep_bounce_depth 1", |v| {
+        set_chiang(v, "deep_bounce_depth", "1")
+    }),
+    knob("deep_bounce_depth 2", |v| {
+        set_chiang(v, "deep_bounce_depth", "2")
+    }),
+    knob("deep_bounce_depth 4", |v| {
+        set_chiang(v, "deep_bounce_depth", "4")
+    }),
+    knob("lobe_cull 0.01", |v| set_chiang(v, "lobe_cull", "0.01")),
+    knob("lobe_cull 0.1", |v| set_chiang(v, "lobe_cull", "0.1")),
     knob("light_threshold 0", |v| set(v, "light_threshold", "0")),
-    knob("light_offsets hit", |v| set(v, "light_offsets", "hit")),
+    knob("light_offsets hit", |v| {
+        set_chiang(v, "light_offsets", "hit")
+    }),
     knob("allocation uniform", |v| set(v, "allocation", "uniform")),
     knob("noise_target 0.05", |v| set(v, "noise_target", "0.05")),
 ];
@@ -60,6 +68,40 @@ const KNOBS: &[Knob] = &[
 /// A render setting, by name.
 fn set(v: &mut Variant, key: &str, value: &str) -> Result<()> {
     v.desc.render.set(key, value)
+}
+
+/// A render setting only the Chiang model reads (lobe culling, the merged lobe, light
+/// offsets across the fibre): on a scene whose hair is all Huang it would change nothing.
+fn set_chiang(v: &mut Variant, key: &str, value: &str) -> Result<()> {
+    if !hair_models(&v.desc).contains(&HairModel::Chiang) {
+        return Err(Error::InvalidArg("the Huang model does not read it".into()));
+    }
+    set(v, key, value)
+}
+
+/// The hair models of a scene's materials, each once.
+fn hair_models(desc: &SceneDescription) -> Vec<HairModel> {
+    let mut models = Vec::new();
+    for m in desc.materials.values() {
+        match m {
+            MaterialDesc::Hair(h) if !models.contains(&h.model) => models.push(h.model),
+            _ => {}
+        }
+    }
+    models
+}
+
+/// What a scene's heading says of its hair: "Chiang model", "Huang model, aspect 0.65".
+fn model_names(desc: &SceneDescription) -> String {
+    let names: Vec<String> = (hair_models(desc).into_iter())
+        .map(|m| match m {
+            HairModel::Chiang => "Chiang model".to_owned(),
+            HairModel::Huang { roughness, aspect } => {
+                format!("Huang model, roughness {roughness}, aspect {aspect}")
+            }
+        })
+        .collect();
+    names.join("; ")
 }
 
 fn set_shape(v: &mut Variant, shape: GroomShape) -> Result<()> {
@@ -96,17 +138,25 @@ fn plan(ctx: &Context, desc: &SceneDescription) -> Plan {
 }
 
 /// The bench scenes: every `*.toml` of the scenes folder (quick: the fur ball under a
-/// uniform sky, and the one under an HDR map and a small key light, where next-event
-/// estimation matters).
+/// uniform sky, the one under an HDR map and a small key light, where next-event
+/// estimation matters, and the fur ball in the Huang model, round and elliptical).
 pub fn scene_names(ctx: &Context) -> Result<Vec<String>> {
     if ctx.quick {
-        return Ok(vec!["fur_ball".into(), "hdr_fur_ball".into()]);
+        return Ok(QUICK_SCENES.map(String::from).to_vec());
     }
     let mut names = all_scene_names(ctx)?;
     // The real grooms (made on demand by bench/real_grooms.py) have a section of their own.
     names.retain(|name| !name.starts_with("real_"));
     Ok(names)
 }
+
+/// The scenes of a quick run.
+pub const QUICK_SCENES: [&str; 4] = [
+    "fur_ball",
+    "hdr_fur_ball",
+    "huang_fur_ball",
+    "huang_oval_fur_ball",
+];
 
 /// A bench scene with the reference settings; quick: a tenth of the strands at a quarter
 /// of the size.
@@ -220,7 +270,10 @@ pub fn section(ctx: &Context) -> Result<String> {
          below; one that only changes noise moves \
          its curve sideways. The tent filter's floor is partly the blur it adds by design, \
          not error. Efficiency is 1 / (RMSE^2 x seconds) at the scene's spp, relative to \
-         the reference settings'.\n\n",
+         the reference settings'. Each scene names its hair model (Chiang's round fibres, \
+         or Huang's elliptical ones: the `huang_` scenes); the Huang model reads neither \
+         `deep_bounce_depth`, `lobe_cull` nor `light_offsets`, so those knobs are not \
+         measured on its scenes.\n\n",
         rounds(ctx)
     );
     for name in scene_names(ctx)? {
@@ -351,7 +404,8 @@ fn scene_section(ctx: &Context, name: &str) -> Result<String> {
         "efficiency vs reference settings",
     ]);
     let mut text = format!(
-        "### {name}\n\nReference: {} spp in {} s.\n\n{}\n",
+        "### {name}\n\nHair: {}. Reference: {} spp in {} s.\n\n{}\n",
+        model_names(&base.desc),
         plan.reference_spp,
         num(reference_seconds, 3),
         table(&header, &rows)

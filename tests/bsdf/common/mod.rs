@@ -1,8 +1,10 @@
-//! Shared helpers of the BSDF integration tests: an independent f64 reference of the hair
-//! model ([`reference`]), quadrature ([`quad`]), the chi-square harness ([`chi2`]) and
-//! direction helpers ([`sphere`]), plus the glue between them and the crate's f32 API.
+//! Shared helpers of the BSDF integration tests: independent f64 references of the hair
+//! model ([`reference`]) and of the Huang model ([`huang_reference`]), quadrature
+//! ([`quad`]), the chi-square harness ([`chi2`]) and direction helpers ([`sphere`]), plus
+//! the glue between them and the crate's f32 API.
 
 pub mod chi2;
+pub mod huang_reference;
 pub mod pbrt_f32;
 pub mod quad;
 pub mod reference;

@@ -109,7 +109,7 @@ inline HtHairParams default_params() { return ht_hair_params_default(); }
 /** `HtHuangParams` with the library's defaults (brown, round); fields as in hairtrace.h. */
 inline HtHuangParams default_huang_params() { return ht_huang_params_default(); }
 
-/** The two numbers that shift a Huang point's nodes, each in [0, 1). */
+/** The two numbers a Huang point draws its microfacet normals from, each in [0, 1). */
 using Jitter = std::array<float, 2>;
 
 /** sigma_a for melanin concentrations (`ht_hair_sigma_a_from_melanin`). */

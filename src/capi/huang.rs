@@ -173,8 +173,8 @@ pub unsafe extern "C" fn ht_huang_prepared_free(prepared: *mut HtHuangPrepared) 
 ///   fibre: pass the same for camera and shadow rays. Any direction serves a round fibre
 ///   (aspect 1). The renderer's own choice is world up made perpendicular to the tangent,
 ///   or world +x where the tangent is vertical.
-/// - `jitter[2]`: each in [0, 1) (`HT_ERR_INVALID_ARG`): shifts the nodes that integrate
-///   the first interfaces. Fresh uniform numbers at each hit make a render unbiased for
+/// - `jitter[2]`: each in [0, 1) (`HT_ERR_INVALID_ARG`): the numbers the point draws its
+///   microfacet normals from (docs/conventions.md, section 4b). Fresh uniform numbers at each hit make a render unbiased for
 ///   the model; a fixed pair gives a deterministic BSDF, whose eval, pdf and sample agree
 ///   exactly either way.
 /// - `field`: `HT_HUANG_NEAR` or `HT_HUANG_FAR`; any other value: `HT_ERR_INVALID_ARG`.

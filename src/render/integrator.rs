@@ -448,7 +448,7 @@ struct Shading<'a> {
 /// and BSDF sampling.
 enum Point<'a> {
     Hair(HairPoint<'a>),
-    /// Boxed: a far-field point holds the paths of four offsets.
+    /// Boxed: a far-field point holds the paths of two offsets.
     Huang(Box<HuangPoint>),
     Diffuse(DiffusePoint),
 }

@@ -12,21 +12,21 @@
 //! How it is computed, staged by what it depends on (docs/conventions.md, section 4b):
 //! - [`HuangBsdf::new`]: parameters alone.
 //! - the point (h, wo): the entry on the section and its tilted normal (the mesonormal);
-//!   a set of microfacet normals visible from wo (`ENTRY_NODES`, drawn from the
-//!   distribution of visible normals at a lattice of numbers, shifted by the point's
-//!   jitter) for the refractions in, each
-//!   followed across the section to the second interface; there, a fixed set of internal
-//!   reflections (`REFLECT_NODES`) followed to the third. Every path ends at an *exit*: an
-//!   internal direction, the inner normal there and the path's RGB weight (Fresnel,
-//!   masking, absorption and the node's share).
+//!   one microfacet normal visible from wo for the refraction in, followed across the
+//!   section to the second interface; there, one internal reflection followed to the
+//!   third. Each is drawn from the distribution of visible normals at its own pair of
+//!   numbers (the point's jitter, and pairs hashed from it). Every path ends at an *exit*:
+//!   an internal direction, the inner normal there and the path's RGB weight (Fresnel,
+//!   masking, absorption).
 //! - wi: R's microfacet reflection, and at each exit the exact density of a GGX
 //!   refraction out toward wi. The last interface of TT and TRT is thus integrated
-//!   exactly and the earlier ones by the fixed nodes.
+//!   exactly, and the earlier ones by the draws, which a renderer's fresh jitter at each
+//!   hit averages.
 //!
-//! Sampling draws from the same terms: a lobe, then an exit by its weight, then a visible
-//! microfacet normal there; its density over wi is the sum the evaluation already forms,
-//! so `pdf` is exact and `sample` agrees with it (a draw that meets total internal
-//! reflection at the exit is lost: the density integrates to less than 1 by that much).
+//! Sampling draws from the same terms: a lobe, then a visible microfacet normal at its
+//! exit; its density over wi is the sum the evaluation already forms, so `pdf` is exact
+//! and `sample` agrees with it (a draw that meets total internal reflection at the exit
+//! is lost: the density integrates to less than 1 by that much).
 //!
 //! The far field averages the point over the fibre's width: the same point at
 //! `FAR_SHIFTS` offsets h + 2k / `FAR_SHIFTS` (wrapped), an unbiased stratified estimate of
@@ -90,9 +90,9 @@ impl HuangBsdf {
 
     /// The near field: the fibre seen at the offset h (in [-1, 1], clamped; NaN is 0) from
     /// wo, its section's major axis along the (y, z) direction `major` (normalised here; a
-    /// direction of zero or non-finite length is taken as y), the fixed nodes shifted by
-    /// `jitter` (modulo 1; not finite is 0). A renderer passes fresh uniform numbers as
-    /// `jitter` at each hit, so that the nodes average to the model's integral over the
+    /// direction of zero or non-finite length is taken as y), its microfacet normals drawn
+    /// from `jitter` (modulo 1; not finite is 0). A renderer passes fresh uniform numbers
+    /// as `jitter` at each hit, so that the draws average to the model's integral over the
     /// first interfaces; any fixed jitter gives a deterministic model. The rules are those
     /// of docs/conventions.md, section 4b.
     pub fn near(&self, h: f32, wo: Vec3, major: Vec2, jitter: [f32; 2]) -> HuangPoint {

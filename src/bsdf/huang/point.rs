@@ -12,7 +12,7 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, TAU};
 
 /// Offsets a far-field point averages.
-pub(super) const FAR_SHIFTS: usize = 4;
+pub(super) const FAR_SHIFTS: usize = 2;
 /// Below this (y, z) length an internal direction runs along the fibre and never meets
 /// the far side: its path is dropped.
 const MIN_CROSSING: f32 = 1e-6;

@@ -311,7 +311,7 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
         "### The Huang model beside Chiang\n\n\
          The Huang model's points (elliptical fibres, docs/conventions.md, section 4b), \
          near field (`HuangBsdf::near`, the fibre at one offset h) and far field \
-         (`HuangBsdf::far`, averaged over four offsets across it), and a Chiang point \
+         (`HuangBsdf::far`, averaged over two offsets across it), and a Chiang point \
          (`HairBsdf::at`) on the same inputs: {} random parameter sets over the valid \
          ranges (roughness 0.01 to 1 log-uniform, both Chiang roughnesses the Huang one; \
          aspect 0.05 to 1; eta 1.05 to 3; tilt up to 20 degrees; no or log-uniform \

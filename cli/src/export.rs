@@ -359,7 +359,11 @@ fn peer_light(i: usize, light: &LightDesc) -> Result<PeerLight> {
 /// per point of its `.hair` file, in the same order (as it is exported, one per segment end),
 /// so that the peer orients an elliptical fibre as hairtrace does (`HairHit::major_axis`).
 fn write_normals(dir: &Path, file: &str, normals: &[[f32; 3]]) -> Result<String> {
-    let bytes: Vec<u8> = normals.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+    let bytes: Vec<u8> = normals
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
     let path = dir.join(file);
     std::fs::write(&path, bytes).map_err(|e| Error::io(&path, e))?;
     Ok(file.to_owned())

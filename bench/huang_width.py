@@ -90,8 +90,10 @@ def predict(round_dir, oval_dir):
     a2 = np.load(os.path.join(oval_dir, "alpha.npy"))[..., None]
     h = read_exr(os.path.join(oval_dir, "reference-hairtrace.exr"))[..., :3]
     c = read_exr(os.path.join(oval_dir, "reference-Cycles.exr"))[..., :3]
-    sky = json.load(open(os.path.join(oval_dir, "peer", "scene.json")))["lights"][0]["radiance"]
-    sky = np.asarray(sky, dtype=np.float32)
+    lights = json.load(open(os.path.join(oval_dir, "peer", "scene.json")))["lights"]
+    if [light["type"] for light in lights] != ["environment"]:
+        sys.exit(f"{oval_dir}: the prediction needs a uniform sky as the only light")
+    sky = np.asarray(lights[0]["radiance"], dtype=np.float32)
     hair = a1 > 1e-3
     radiance = np.where(hair, (h - (1 - a1) * sky) / np.where(hair, a1, 1), sky)
     p = h + (a1 - a2) * (sky - radiance)

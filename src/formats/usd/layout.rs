@@ -309,7 +309,7 @@ impl Layout {
 
     /// The value at each segment end (segments + 1 per curve) of a curve whose Embree control
     /// values are `c`: the basis evaluated at the segment's start, and at the last one's end.
-    /// Signed: a colour's caller clamps ([`clamp_colors`]), a normal's keeps its sign.
+    /// Signed: a colour's caller clamps (`clamp_colors`), a normal's keeps its sign.
     pub fn segment_ends(self, c: &[[f32; 3]], segments: usize, out: &mut Vec<[f32; 3]>) {
         let stride = self.basis.segment_stride();
         // The segment's start is its Bezier form's first point; the last segment end is the

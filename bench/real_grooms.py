@@ -317,7 +317,7 @@ def style_long(groups, seed, density):
              Above_Surface=0.0, Smoothing_Steps=0)
     modifier(hair, groups, "Set Hair Curve Profile", Radius=40e-6, Shape=0.15,
              Factor_Min=0.3, Factor_Max=1.0)
-    # The flat side of each (elliptical) strand faces away from the scalp at its root.
+    # Each (elliptical) section stands with its major axis along the scalp's normal at the root.
     surface_normals(hair)
     return surface, hair
 

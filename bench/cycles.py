@@ -311,6 +311,29 @@ def major_axes(counts, xyz):
     return axes
 
 
+def groom_normals(groom, base, counts, xyz):
+    """The major axis at each point in Blender's frame: the groom's own curve normals
+    where the export gives them (`normals`: 3 little-endian float32 per point of the .hair
+    file), else hairtrace's default orientation (`major_axes`)."""
+    if "normals" not in groom:
+        return major_axes(counts, to_blender(xyz))
+    normals = np.fromfile(os.path.join(base, groom["normals"]), dtype="<f4").reshape(-1, 3)
+    if len(normals) != len(xyz):
+        raise ValueError(f"{groom['normals']}: {len(normals)} normals for {len(xyz)} points")
+    return to_blender(normals)
+
+
+def orient(curves, counts, axes):
+    """Normal mode Free with `axes` as the normals: Cycles' Huang takes the curve normal,
+    made perpendicular to the tangent, as the ellipse's major axis. (Blender 5.0.1's USD
+    importer brings `custom_normal` back but not the Free mode, so an imported groom would
+    be drawn with minimum-twist normals.)"""
+    mode = curves.attributes.new("normal_mode", "INT8", "CURVE")
+    mode.data.foreach_set("value", np.full(len(counts), 2, dtype=np.int8))
+    normal = curves.attributes.new("custom_normal", "FLOAT_VECTOR", "POINT")
+    normal.data.foreach_set("vector", np.asarray(axes, dtype=np.float32).ravel())
+
+
 def diffuse_material(bpy, name, albedo):
     mat = bpy.data.materials.new(name)
     tree = mat.node_tree
@@ -329,6 +352,10 @@ def import_usd_groom(bpy, scene, i, groom):
     curves. The stage's up axis and units are Blender's import's, which agree with
     hairtrace's reading of them (a Z-up stage stays Z-up; a Y-up one turns as
     `to_blender` turns hairtrace's +y up)."""
+    if groom["material"].get("model") == "huang":
+        # The import keeps `custom_normal` but not the Free mode (`orient`), and nothing
+        # here hands it hairtrace's orientation yet: refused rather than drawn otherwise.
+        raise ValueError(f"{groom['usd']}: a moving groom in the Huang model is not supported")
     before = set(bpy.data.objects)
     bpy.ops.wm.usd_import(filepath=groom["usd"], import_materials=False)
     imported = [o for o in bpy.data.objects if o not in before]
@@ -360,12 +387,7 @@ def add_groom(bpy, scene, i, groom, base):
         raise ValueError(f"groom basis {basis!r}: expected linear or catmull-rom")
     curves.set_types(type="POLY" if basis == "linear" else "CATMULL_ROM")
     if groom["material"].get("model") == "huang":
-        # Normal mode Free: Cycles orients the ellipse's major axis by these normals.
-        mode = curves.attributes.new("normal_mode", "INT8", "CURVE")
-        mode.data.foreach_set("value", np.full(len(counts), 2, dtype=np.int8))
-        normal = curves.attributes.new("custom_normal", "FLOAT_VECTOR", "POINT")
-        normal.data.foreach_set(
-            "vector", major_axes(counts, to_blender(xyz)).astype(np.float32).ravel())
+        orient(curves, counts, groom_normals(groom, base, counts, xyz))
     curves.materials.append(hair_material(bpy, f"hair{i}", groom["material"]))
     obj = bpy.data.objects.new(f"groom{i}", curves)
     scene.collection.objects.link(obj)

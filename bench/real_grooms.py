@@ -13,7 +13,8 @@ of Geometry Nodes modifiers, each one of those assets:
   Generate Hair Curves (guides: ~290 on a head, ~3900 on the body) -> combing (Displace Hair
   Curves reading a combing field painted on the surface, Trim, Shrinkwrap, Smooth) ->
   Interpolate Hair Curves (the children, at a real density) -> Clump, Curl, Frizz, Hair
-  Curves Noise, Shrinkwrap -> Set Hair Curve Profile (tapered radii).
+  Curves Noise, Shrinkwrap -> Set Hair Curve Profile (tapered radii) -> for `long`, Set
+  Curve Normal (Free: the sections' major axes from the scalp's normal).
 
 The curves stay Blender's hair curves: Catmull-Rom, per-point `radius`. Everything is in
 metres (hair radii 30-40 micrometres at the root, an ellipsoid head of semi-axes 0.078,
@@ -21,7 +22,9 @@ metres (hair radii 30-40 micrometres at the root, an ellipsoid head of semi-axes
 
 - `groom.usdc`: Blender's own USD exporter (`bpy.ops.wm.usd_export`) at its defaults:
   modifiers evaluated at render settings, Z-up, metersPerUnit 1; the curves (a
-  BasisCurves prim) and the surface mesh.
+  BasisCurves prim) and the surface mesh. `long` also orients its strands' sections (a
+  Set Curve Normal node in Free mode, the scalp's normal at each root), which the exporter
+  writes as `primvars:custom_normal`.
 - `head.obj`: the surface mesh alone, Blender's OBJ exporter at its defaults (Y-up, -Z
   forward: Blender's (x, y, z) is written (x, z, -y), as hairtrace turns a Z-up stage).
 - `groom.blend` with `--blend`: the Blender file itself, to open and inspect (the
@@ -189,6 +192,29 @@ def modifier(obj, groups, group, **inputs):
     return mod
 
 
+def surface_normals(obj, attribute="surface_normal"):
+    """Orients the strands' elliptical sections: a Geometry Nodes modifier with a Set Curve
+    Normal node in Free mode whose normal is the named attribute, `surface_normal` (the
+    surface's normal at each root, which Generate and Interpolate Hair Curves leave on the
+    curves). Blender stores the result as `custom_normal`, which its USD exporter writes as
+    `primvars:custom_normal`; a renderer takes it, made perpendicular to the strand, as the
+    major axis (docs/conventions.md, section 4b)."""
+    tree = bpy.data.node_groups.new("Hair Normals from Surface", "GeometryNodeTree")
+    tree.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    tree.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    nodes, links = tree.nodes, tree.links
+    source, sink = nodes.new("NodeGroupInput"), nodes.new("NodeGroupOutput")
+    named = nodes.new("GeometryNodeInputNamedAttribute")
+    named.data_type = "FLOAT_VECTOR"
+    named.inputs["Name"].default_value = attribute
+    normal = nodes.new("GeometryNodeSetCurveNormal")
+    normal.inputs["Mode"].default_value = "Free"
+    links.new(source.outputs["Geometry"], normal.inputs["Curve"])
+    links.new(named.outputs["Attribute"], normal.inputs["Normal"])
+    links.new(normal.outputs["Curve"], sink.inputs["Geometry"])
+    obj.modifiers.new("Hair Normals from Surface", "NODES").node_group = tree
+
+
 def hair_material(name, melanin):
     """Principled Hair by melanin: for the preview and the .blend (the bench scenes give
     their own materials)."""
@@ -291,6 +317,8 @@ def style_long(groups, seed, density):
              Above_Surface=0.0, Smoothing_Steps=0)
     modifier(hair, groups, "Set Hair Curve Profile", Radius=40e-6, Shape=0.15,
              Factor_Min=0.3, Factor_Max=1.0)
+    # Each (elliptical) section stands with its major axis along the scalp's normal at the root.
+    surface_normals(hair)
     return surface, hair
 
 
@@ -422,7 +450,9 @@ def usd_stats(path):
             "bounds": (points.min(axis=0).tolist(), points.max(axis=0).tolist()),
             "identity": xf == xf.GetIdentity() if hasattr(xf, "GetIdentity") else None,
             "transform": [list(r) for r in xf],
-            "normals": c.GetNormalsAttr().HasAuthoredValue(),
+            # The names a renderer reads curve normals from (hairtrace: all three).
+            "normals": [name for name in ("normals", "primvars:normals", "primvars:custom_normal")
+                        if prim.HasAttribute(name) and prim.GetAttribute(name).HasAuthoredValue()],
             "primvars": sorted(p.GetPrimvarName() for p in
                                UsdGeom.PrimvarsAPI(prim).GetPrimvarsWithAuthoredValues()),
         })
@@ -511,7 +541,7 @@ def main():
                   f"({lo}-{hi} per curve), {c['type']} {c['basis']} {c['wrap']}, widths "
                   f"{c['widths_interpolation']} {c['width_range'][0] * 1e6:.1f}-"
                   f"{c['width_range'][1] * 1e6:.1f} um, normals "
-                  f"{'yes' if c['normals'] else 'no'}, primvars {c['primvars']}, bounds "
+                  f"{', '.join(c['normals']) or 'none'}, primvars {c['primvars']}, bounds "
                   + " .. ".join("(" + ", ".join(f"{v:.3f}" for v in b) + ")"
                                 for b in c["bounds"]), flush=True)
         if args.preview:

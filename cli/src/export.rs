@@ -1,7 +1,7 @@
 //! A scene written out for another renderer: what the peer benchmark (`bench/peer`)
 //! hands to Blender Cycles so that both render the same strands, meshes, lights and
-//! camera. Grooms go out as world-space `.hair` files (thickness = diameter), meshes as
-//! OBJ with their shading normals, the rest as one JSON file (`scene.json`); the format
+//! camera. Grooms go out as world-space `.hair` files (thickness = diameter), with their
+//! curve normals beside them where they have some, meshes as OBJ with their shading normals, the rest as one JSON file (`scene.json`); the format
 //! is documented in `bench/README.md`.
 //!
 //! Only what both renderers can express is exported: an explicit camera, hair materials
@@ -68,6 +68,9 @@ struct PeerGroom {
     /// own tools do: the `.hair` file is its frame, still.
     #[serde(skip_serializing_if = "Option::is_none")]
     usd: Option<String>,
+    /// The groom's curve normals, where it has them (`write_normals`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    normals: Option<String>,
     basis: &'static str,
     shape: &'static str,
     material: PeerHair,
@@ -214,10 +217,11 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
                     ));
                 }
             };
-            let file = match many {
-                true => format!("groom{i}_{k}.hair"),
-                false => format!("groom{i}.hair"),
+            let stem = match many {
+                true => format!("groom{i}_{k}"),
+                false => format!("groom{i}"),
             };
+            let file = format!("{stem}.hair");
             let tag = HairTag {
                 layout,
                 units: StageUnits::WORLD,
@@ -228,9 +232,21 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
                 Thickness::Diameter,
                 Some(&tag),
             )?;
+            let normals = match &set.normals {
+                Some(n) if n.len() != set.strands.point_count() => {
+                    return Err(invalid_arg!(
+                        "groom[{i}]: {} curve normals for {} points",
+                        n.len(),
+                        set.strands.point_count()
+                    ));
+                }
+                Some(n) => Some(write_normals(dir, &format!("{stem}.normals"), n)?),
+                None => None,
+            };
             grooms.push(PeerGroom {
                 file,
                 usd: usd.clone(),
+                normals,
                 basis,
                 shape: "round",
                 material: PeerHair {
@@ -337,6 +353,20 @@ fn peer_light(i: usize, light: &LightDesc) -> Result<PeerLight> {
             ));
         }
     })
+}
+
+/// Writes a groom's curve normals into `dir/file` and returns `file`: 3 little-endian f32
+/// per point of its `.hair` file, in the same order (as it is exported, one per segment end),
+/// so that the peer orients an elliptical fibre as hairtrace does (`HairHit::major_axis`).
+fn write_normals(dir: &Path, file: &str, normals: &[[f32; 3]]) -> Result<String> {
+    let bytes: Vec<u8> = normals
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let path = dir.join(file);
+    std::fs::write(&path, bytes).map_err(|e| Error::io(&path, e))?;
+    Ok(file.to_owned())
 }
 
 /// A mesh as OBJ text: positions, normals when it has them, 1-based faces.

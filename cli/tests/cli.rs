@@ -839,6 +839,38 @@ fn a_huang_material_and_a_moving_usd_groom_go_out_as_the_peer_reads_them() {
     assert_one_line_error(&o, "a moving camera is not exported");
 }
 
+/// A USD groom's curve normals go out beside its `.hair` file, one per point, in the world
+/// as hairtrace reads them: the Z-up stage turned, the entry's scale applied, signs kept.
+#[test]
+fn curve_normals_go_out_in_the_world() {
+    let usd = tmp("cli_peer_normals.usda");
+    std::fs::write(
+        &usd,
+        "#usda 1.0\n(\n    upAxis = \"Z\"\n    metersPerUnit = 1\n)\n\
+         def BasisCurves \"c\"\n{\nint[] curveVertexCounts = [2, 2]\n\
+         point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0)]\n\
+         float[] widths = [0.1] (interpolation = \"constant\")\n\
+         uniform token type = \"linear\"\n\
+         float3[] primvars:custom_normal = [(0, -1, 0), (0, 0, 1), (0.6, 0, -0.8), (-1, 0, 0)] \
+         (interpolation = \"vertex\")\n}\n",
+    )
+    .unwrap();
+    let text = format!(
+        "[camera]\neye = [0, 0, 4]\ntarget = [0, 0, 0]\n[materials.h]\ntype = \"hair\"\n\
+         melanin = [1, 0]\n[[groom]]\nfile = {usd:?}\nmaterial = \"h\"\nscale = 2.0\n"
+    );
+    let (o, dir, _) = export(&text, "cli_peer_normals");
+    assert!(o.status.success(), "{o:?}");
+    assert_eq!(scene_json(&dir)["grooms"][0]["normals"], "groom0.normals");
+    let bytes = std::fs::read(format!("{dir}/groom0.normals")).unwrap();
+    let normals: Vec<f32> = (bytes.chunks_exact(4))
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
+    // A Z-up stage's (x, y, z) is the world's (x, z, -y); then twice as long.
+    let want = [0.0, 0.0, 2.0, 0.0, 2.0, 0.0, 1.2, -1.6, 0.0, -2.0, 0.0, 0.0];
+    assert_eq!(normals, want);
+}
+
 #[test]
 fn a_scene_goes_out_whole() {
     let (o, dir, d) = export(PEER_SCENE, "cli_peer_whole");
@@ -848,6 +880,10 @@ fn a_scene_goes_out_whole() {
     assert_eq!(json["camera"]["fov_y_deg"], 30.0);
     let groom = &json["grooms"][0];
     assert_eq!(groom["basis"], "linear");
+    assert!(
+        groom.get("normals").is_none(),
+        "a procedural groom has no normals"
+    );
     let sigma_a = hairtrace::bsdf::sigma_a_from_melanin(1.3, 0.0).unwrap();
     let exported = groom["material"]["sigma_a"][1].as_f64().unwrap() as f32;
     assert_eq!(exported, sigma_a[1], "f32 values survive the text exactly");

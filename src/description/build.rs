@@ -347,6 +347,7 @@ impl GroomDesc {
                         strands: c.authored(),
                         curves: StrandCurves::Authored(c.layout),
                         units: file.units,
+                        normals: c.normals.clone(),
                     })
                     .collect())
             }
@@ -409,6 +410,7 @@ impl GroomDesc {
             strands,
             curves: self.curves_with_tag(tag)?,
             units: tag.map_or(StageUnits::WORLD, |t| t.units),
+            normals: None,
         })
     }
 
@@ -424,6 +426,11 @@ impl GroomDesc {
                 for p in &mut set.strands.points {
                     let world = Vec3::from_array(units.to_world(*p));
                     *p = affine.transform_point3(world).to_array();
+                }
+                // The turn and the placement are linear on directions.
+                for n in set.normals.iter_mut().flatten() {
+                    let world = Vec3::from_array(units.to_world(*n));
+                    *n = affine.transform_vector3(world).to_array();
                 }
             }
             let radius_factor = scale * self.radius_scale * units.scale();

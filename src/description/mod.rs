@@ -323,6 +323,9 @@ pub struct GroomStrands {
     pub strands: Strands,
     pub curves: StrandCurves,
     pub units: StageUnits,
+    /// The curves' normals at each segment end (segments + 1 per strand), where a USD
+    /// groom authors them: in the same frame as the points, not unit.
+    pub normals: Option<Vec<[f32; 3]>>,
 }
 
 /// A `[[mesh]]` entry.

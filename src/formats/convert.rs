@@ -346,6 +346,7 @@ fn usd_groom(c: &UsdCurves, opts: &ConvertOptions, notes: &mut Vec<String>) -> R
             strands,
             curves,
             units: c.units,
+            normals: None,
         },
     };
     if !sample {

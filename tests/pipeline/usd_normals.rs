@@ -84,6 +84,7 @@ fn curve_normals_orient_the_fibres_by_every_name_and_transform() {
     write("plain.usda", strands(""));
     write("up.usda", strands(&vertex("normals", "(0, 1, 0)")));
     write("z.usda", strands(&vertex("normals", "(0, 0, 1)")));
+    write("minus_z.usda", strands(&vertex("normals", "(0, 0, -1)")));
     write(
         "z_primvar.usda",
         strands(&format!(
@@ -119,6 +120,15 @@ fn curve_normals_orient_the_fibres_by_every_name_and_transform() {
     assert!(
         differing > z.len() / 20,
         "{differing} of {} values differ",
+        z.len()
+    );
+    // The ellipse is the same turned half a turn; a normal's negative parts were once
+    // clamped to 0, which left (0, 0, -1) no direction and the default's image.
+    let minus_z = image("minus_z.usda");
+    let differing = minus_z.iter().zip(&plain).filter(|(a, b)| a != b).count();
+    assert!(
+        differing > z.len() / 20,
+        "normals along -z: {differing} of {} values differ from the default's",
         z.len()
     );
     assert!(

@@ -155,7 +155,9 @@ impl Layout {
             if let (Some(c), Some(out)) = (&strands.colors, &mut colors) {
                 ext.clear();
                 self.extend(&c[points], &mut ext, |c, _| c.map(|x| x.max(0.0)));
+                let first = out.len();
                 self.segment_ends(&ext, segments, out);
+                clamp_colors(&mut out[first..]);
             }
         }
         Ok((control, counts, colors))
@@ -307,6 +309,7 @@ impl Layout {
 
     /// The value at each segment end (segments + 1 per curve) of a curve whose Embree control
     /// values are `c`: the basis evaluated at the segment's start, and at the last one's end.
+    /// Signed: a colour's caller clamps (`clamp_colors`), a normal's keeps its sign.
     pub fn segment_ends(self, c: &[[f32; 3]], segments: usize, out: &mut Vec<[f32; 3]>) {
         let stride = self.basis.segment_stride();
         // The segment's start is its Bezier form's first point; the last segment end is the
@@ -316,10 +319,17 @@ impl Layout {
             let [start, ..] = self
                 .basis
                 .bezier_form::<Vec3, f32>([p(0), p(1), p(2), p(3)]);
-            // A B-spline's weighted sum of colours >= 0 may round below 0.
-            start.max(Vec3::ZERO).to_array()
+            start.to_array()
         };
         out.extend((0..=segments).map(|s| at(s * stride)));
+    }
+}
+
+/// Colours at segment ends made >= 0: a B-spline's weighted sum of colours >= 0 may round
+/// below 0.
+pub(crate) fn clamp_colors(colors: &mut [[f32; 3]]) {
+    for c in colors {
+        *c = c.map(|x| x.max(0.0));
     }
 }
 

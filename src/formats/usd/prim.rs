@@ -7,7 +7,7 @@ use openusd::sdf::{self, Value};
 use openusd::usd::{Attribute, Prim, Stage};
 
 use super::UsdCurves;
-use super::layout::{Interpolation, Layout};
+use super::layout::{Interpolation, Layout, clamp_colors};
 use super::time::{self, Animation, Clock, Motion, ReadAt, failed};
 use crate::error::{Result, invalid_arg};
 use crate::formats::units::StageUnits;
@@ -404,8 +404,9 @@ pub(super) fn read_basis_curves(
     let (colors, point_colors) = match &colors {
         Some(c) => {
             let clamped = |c: [f32; 3], _| c.map(|x| x.clamp(0.0, 1.0));
-            let (ends, points) =
+            let (mut ends, points) =
                 segment_end_values(c, color_interp, layout, (&counts, &segs), clamped);
+            clamp_colors(&mut ends);
             (Some(ends), points)
         }
         None => (None, None),

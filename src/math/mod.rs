@@ -22,8 +22,11 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
     z ^ (z >> 31)
 }
 
-/// Two numbers in [0, 1) from a hash: its top 24 bits and the 24 below them.
-pub(crate) fn unit_pair(z: u64) -> [f32; 2] {
+/// Two numbers in [0, 1), unrelated to `u` and to other `n`'s: the top 24 bits and the 24
+/// below them of `mix64` of u's bits (first << 32 | second) xor n x 2^64 over phi.
+pub(crate) fn hashed_pair(u: [f32; 2], n: u64) -> [f32; 2] {
+    let key = (u64::from(u[0].to_bits()) << 32) | u64::from(u[1].to_bits());
+    let z = mix64(key ^ n.wrapping_mul(0x9e37_79b9_7f4a_7c15));
     let unit = |bits: u64| (bits >> 40) as f32 / (1u64 << 24) as f32;
     [unit(z), unit(z << 24)]
 }

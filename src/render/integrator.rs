@@ -18,7 +18,7 @@ use crate::bsdf::{
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
 use crate::math::sampling::{Distribution1D, power_heuristic};
-use crate::math::{Frame, luminance, mix64, unit_pair};
+use crate::math::{Frame, hashed_pair, luminance};
 use crate::scene::hit::{HairHit, Hit, SurfaceHit};
 use crate::scene::light::{Light, LightEval};
 use crate::scene::material::Material;
@@ -453,13 +453,10 @@ enum Point<'a> {
     Diffuse(DiffusePoint),
 }
 
-/// The Huang model's node jitter at a hit (`HuangBsdf::near`): two numbers hashed from the
+/// The Huang model's jitter at a hit (`HuangBsdf::near`): two numbers hashed from the
 /// bounce's own, so that the pixel sampler's sequence keeps its layout for every model.
 fn jitter(u_rr: f32, u_lobe: f32, events: u32) -> [f32; 2] {
-    let key = (u64::from(u_rr.to_bits()) << 32) | u64::from(u_lobe.to_bits());
-    unit_pair(mix64(
-        key ^ u64::from(events).wrapping_mul(0x9e37_79b9_7f4a_7c15),
-    ))
+    hashed_pair([u_rr, u_lobe], u64::from(events))
 }
 
 impl<'a> Shading<'a> {

@@ -7,7 +7,7 @@ use crate::bsdf::fresnel::{fresnel_dielectric, fresnel_inside};
 use crate::bsdf::pick::{U_MIN, pick};
 use crate::bsdf::{BsdfEval, BsdfSample, LocalBsdf, inv_cos};
 use crate::math::sampling::ONE_MINUS_EPSILON;
-use crate::math::{cos_from_sin, mix64, unit_pair};
+use crate::math::{cos_from_sin, hashed_pair};
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, TAU};
 
@@ -31,18 +31,14 @@ fn stratum(k: usize, u: [f32; 2]) -> [f32; 2] {
     [wrap(u[0] + k as f32 / n), wrap(u[1] + (2 * k) as f32 / n)]
 }
 
-/// Spreads the keys of an offset's interfaces apart before hashing (2^64 over phi).
-const KEY_STEP: u64 = 0x9e37_79b9_7f4a_7c15;
-
 /// The numbers offset `k` draws its three visible normals from: the entry's, the internal
 /// reflection's and the third interface's. Offset 0's entry takes `jitter` (in [0, 1))
 /// itself; every other pair is hashed from it, so that each interface draws independently
 /// of the others: pairs tied to one another would average to another integral, a bias.
 fn numbers(jitter: [f32; 2], k: usize) -> [[f32; 2]; 3] {
-    let key = (u64::from(jitter[0].to_bits()) << 32) | u64::from(jitter[1].to_bits());
     std::array::from_fn(|i| match 3 * k + i {
         0 => jitter,
-        n => unit_pair(mix64(key ^ (n as u64).wrapping_mul(KEY_STEP))),
+        n => hashed_pair(jitter, n as u64),
     })
 }
 

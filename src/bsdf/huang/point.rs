@@ -27,8 +27,15 @@ const MIN_ESCAPE: f32 = 1e-5;
 /// modulo 1.
 fn stratum(k: usize, u: [f32; 2]) -> [f32; 2] {
     let n = ESCAPE_NODES as f32;
-    let wrap = |x: f32| (x - x.floor()).min(ONE_MINUS_EPSILON);
-    [wrap(u[0] + k as f32 / n), wrap(u[1] + (2 * k) as f32 / n)]
+    [
+        modulo_one(u[0] + k as f32 / n),
+        modulo_one(u[1] + (2 * k) as f32 / n),
+    ]
+}
+
+/// x modulo 1, in [0, 1) even where the subtraction rounds up to 1.
+fn modulo_one(x: f32) -> f32 {
+    (x - x.floor()).min(ONE_MINUS_EPSILON)
 }
 
 /// The numbers offset `k` draws its three visible normals from: the entry's, the internal
@@ -102,10 +109,7 @@ impl HuangPoint {
         shifts: usize,
     ) -> Self {
         let h = if h.is_nan() { 0.0 } else { h.clamp(-1.0, 1.0) };
-        let jitter = jitter.map(|x| {
-            let x = if x.is_finite() { x } else { 0.0 };
-            (x - x.floor()).min(ONE_MINUS_EPSILON)
-        });
+        let jitter = jitter.map(|x| if x.is_finite() { modulo_one(x) } else { 0.0 });
         let major = major.try_normalize().unwrap_or(Vec2::X);
         let section = Section::new(bsdf.params.aspect, major);
         let azimuth = Vec2::new(wo.y, wo.z).try_normalize().unwrap_or(Vec2::X);

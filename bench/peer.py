@@ -42,6 +42,7 @@ import json
 import math
 import os
 import platform
+import shutil
 import statistics
 import subprocess
 import sys
@@ -49,7 +50,10 @@ import time
 import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-HAIRTRACE = os.path.join(ROOT, "target", "release", "hairtrace")
+# The binary measured: $HT_HAIRTRACE (`hairtrace report` passes its own) or the release
+# build. main() copies it into the work folder first and runs the copy, so that a build
+# during a run (hours, for the real grooms) cannot change the renderer under it.
+HAIRTRACE = os.environ.get("HT_HAIRTRACE") or os.path.join(ROOT, "target", "release", "hairtrace")
 CYCLES = os.path.join(ROOT, "bench", "cycles.py")
 SCENES = os.path.join(ROOT, "bench", "scenes")
 # Grooms made by Blender's hair node assets (bench/real_grooms.py), on demand, never committed.
@@ -370,6 +374,13 @@ def main():
                         help="also render hairtrace with this allocation")
     args = parser.parse_args()
     names = select_scenes(args.scenes, args.exclude)
+    global HAIRTRACE
+    os.makedirs(args.work, exist_ok=True)
+    own = os.path.join(args.work, "hairtrace")
+    if os.path.abspath(HAIRTRACE) != own:
+        shutil.copy2(HAIRTRACE, own + ".part")
+        os.replace(own + ".part", own)
+    HAIRTRACE = own
 
     def log(message):
         print(message, file=sys.stderr, flush=True)

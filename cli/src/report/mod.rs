@@ -42,6 +42,9 @@ pub struct Context {
     pub scenes: PathBuf,
     pub peers: Option<PathBuf>,
     pub machine: Machine,
+    /// The report's own copy of this binary, which sections that render in a process of
+    /// their own run (`OwnBinary`).
+    pub hairtrace: PathBuf,
     bar: ProgressBar,
 }
 
@@ -112,12 +115,14 @@ pub fn run(options: &ReportOptions) -> Result<()> {
     std::fs::create_dir_all(&options.output).map_err(|e| Error::io(&options.output, e))?;
     plots::load_font()?;
     let start = Instant::now();
+    let binary = OwnBinary::copy()?;
     let mut ctx = Context {
         quick: options.quick,
         output: options.output.clone(),
         scenes: options.scenes.clone(),
         peers: options.peers.clone(),
         machine: Machine::this(),
+        hairtrace: binary.0.clone(),
         bar: ProgressBar::hidden(),
     };
     let total: u64 = SECTIONS.iter().map(|s| (s.steps)(&ctx)).sum();
@@ -166,6 +171,32 @@ pub fn run(options: &ReportOptions) -> Result<()> {
     crate::files::write_file(&path, report)?;
     eprintln!("{}", path.display());
     Ok(())
+}
+
+/// A copy of the running binary in a folder of its own, removed when dropped. A full report
+/// takes most of an hour, and a build in that time replaces target/release/hairtrace: a
+/// section that started the new binary would measure another renderer, or fail where
+/// the file was being written (as one run did).
+struct OwnBinary(PathBuf);
+
+impl OwnBinary {
+    fn copy() -> Result<Self> {
+        let exe =
+            std::env::current_exe().map_err(|e| Error::io(Path::new("current executable"), e))?;
+        let dir = std::env::temp_dir().join(format!("hairtrace-report-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
+        let own = dir.join("hairtrace");
+        std::fs::copy(&exe, &own).map_err(|e| Error::io(&own, e))?;
+        Ok(OwnBinary(own))
+    }
+}
+
+impl Drop for OwnBinary {
+    fn drop(&mut self) {
+        if let Some(dir) = self.0.parent() {
+            let _ = std::fs::remove_dir_all(dir);
+        }
+    }
 }
 
 /// The median of a non-empty list.

@@ -87,7 +87,8 @@ fn run_peer(ctx: &Context, python: &Path) -> Result<String> {
     let json = ctx.path("peers.json");
     let shim = bench.join("../target/bench-peer/count_rays.so");
     let mut cmd = Command::new(python);
-    cmd.arg(&script)
+    cmd.env("HT_HAIRTRACE", &ctx.hairtrace)
+        .arg(&script)
         .args(["--quick", "--repeats", "1", "--scenes"])
         .arg(scene_names(ctx)?.join(","))
         .arg("--threads")

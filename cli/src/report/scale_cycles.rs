@@ -84,8 +84,7 @@ fn compare(ctx: &Context, python: &Path, dir: &Path) -> Result<Vec<Vec<String>>>
     std::fs::create_dir_all(dir).map_err(io)?;
     let path = scene_path(ctx);
     let source = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-    let hairtrace =
-        std::env::current_exe().map_err(|e| Error::io(Path::new("current executable"), e))?;
+    let hairtrace = &ctx.hairtrace;
     let cycles = ctx.scenes.join("../cycles.py");
     let threads = ctx.machine.threads.to_string();
     let mut rows = Vec::new();
@@ -96,7 +95,7 @@ fn compare(ctx: &Context, python: &Path, dir: &Path) -> Result<Vec<Vec<String>>>
         let scene = dir.join(format!("scalp_{strands}.toml"));
         std::fs::write(&scene, with_strands(&source, strands)?).map_err(io)?;
         let ht_stats = dir.join("hairtrace.json");
-        let mut render = Command::new(&hairtrace);
+        let mut render = Command::new(hairtrace);
         render
             .arg("render")
             .arg(&scene)

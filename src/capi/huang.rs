@@ -93,12 +93,13 @@ pub const HT_HUANG_POINT_SIZE: usize = 4096;
 /// Alignment of an `HtHuangPoint` in bytes.
 pub const HT_HUANG_POINT_ALIGN: usize = 16;
 
-/// Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit` or
-/// `ht_huang_point_init_world`, then evaluated and sampled any number of times. The rules
-/// of `HtHairPoint` hold: the host allocates it (`HT_HUANG_POINT_SIZE` bytes aligned to
-/// `HT_HUANG_POINT_ALIGN`, which this type has), the bytes are opaque plain numbers that
-/// may be copied and outlive their `HtHuangPrepared`, an unfilled point (or a Chiang one)
-/// is refused, and filling it while another thread reads it is a data race.
+/// Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit`,
+/// `ht_huang_point_init_world` or `ht_huang_point_init_strand`, then evaluated and sampled
+/// any number of times. The rules of `HtHairPoint` hold: the host allocates it
+/// (`HT_HUANG_POINT_SIZE` bytes aligned to `HT_HUANG_POINT_ALIGN`, which this type has),
+/// the bytes are opaque plain numbers that may be copied and outlive their
+/// `HtHuangPrepared`, an unfilled point (or a Chiang one) is refused, and filling it while
+/// another thread reads it is a data race.
 #[repr(C, align(16))]
 pub struct HtHuangPoint {
     pub opaque: [u8; HT_HUANG_POINT_SIZE],

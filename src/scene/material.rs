@@ -308,7 +308,10 @@ impl PreparedHair {
             return Some(b);
         }
         // Valid by construction: the base was checked, the variation is clamped into range.
-        let p = (self.material.huang_varied(self.base, strand, s, groom)).ok()??;
+        let p = self
+            .material
+            .huang_varied(self.base, strand, s, groom)
+            .ok()??;
         HuangBsdf::new(&p).ok()
     }
 }

@@ -658,12 +658,13 @@ typedef struct HtHuangParams {
 typedef uint32_t HtHuangField;
 
 /**
- * Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit` or
- * `ht_huang_point_init_world`, then evaluated and sampled any number of times. The rules
- * of `HtHairPoint` hold: the host allocates it (`HT_HUANG_POINT_SIZE` bytes aligned to
- * `HT_HUANG_POINT_ALIGN`, which this type has), the bytes are opaque plain numbers that
- * may be copied and outlive their `HtHuangPrepared`, an unfilled point (or a Chiang one)
- * is refused, and filling it while another thread reads it is a data race.
+ * Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit`,
+ * `ht_huang_point_init_world` or `ht_huang_point_init_strand`, then evaluated and sampled
+ * any number of times. The rules of `HtHairPoint` hold: the host allocates it
+ * (`HT_HUANG_POINT_SIZE` bytes aligned to `HT_HUANG_POINT_ALIGN`, which this type has),
+ * the bytes are opaque plain numbers that may be copied and outlive their
+ * `HtHuangPrepared`, an unfilled point (or a Chiang one) is refused, and filling it while
+ * another thread reads it is a data race.
  */
 typedef struct HT_ALIGNED(16) HtHuangPoint {
     uint8_t opaque[HT_HUANG_POINT_SIZE];
@@ -818,6 +819,49 @@ enum HtStatus ht_huang_point_sample_world(const struct HtHuangPoint *point,
                                           float *f_cos,
                                           float *weight,
                                           float *pdf);
+
+#if defined(HT_RENDER)
+
+/**
+ * `ht_huang_point_init_world` for one strand of a groom whose parameters vary as a scene's
+ * Huang material varies them (`ht_scene_add_huang_material`): the parameters of
+ * `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
+ * (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
+ * `variation->use_vertex_colors` is 1 (NULL: none), as `ht_hair_point_init_strand` varies
+ * Chiang's: the absorption spread per strand and toward the tip (or the strand's colour,
+ * inverted at `ht_hair_params_default`'s beta_n), and `roughness` spread per strand by
+ * `roughness_variation`. No handle per parameter set and no allocation: the varied model
+ * is built inside the point, and the point equals, bit for bit, the one the renderer
+ * shades that strand's hit with at the same `major`, `jitter` and `field`.
+ *
+ * - `strand`, `s`, `color`, the variation's ranges: as `ht_hair_point_init_strand` takes
+ *   and refuses them; `frame`, `wo`, `major`, `jitter`, `field` as
+ *   `ht_huang_point_init_world`. Else `HT_ERR_INVALID_ARG`.
+ * - Pointers: `prepared`, `variation`, `frame`, `wo`, `major`, `jitter`, `point` not NULL
+ *   (`HT_ERR_NULL_ARG`, checked first); others as `ht_huang_point_init_world`. On error
+ *   `*point` is untouched.
+ * - Cost: an init plus the preparation of the varied parameters.
+ *
+ * Any thread; `prepared` and `variation` may be shared, `point` must not be read
+ * meanwhile. Not in the BSDF-only library.
+ *
+ * # Safety
+ * As `ht_huang_point_init_world`; `variation` NULL or an `HtHairVariation`; `color` NULL
+ * or 3 floats.
+ */
+enum HtStatus ht_huang_point_init_strand(const struct HtHuangPrepared *prepared,
+                                         const struct HtHairVariation *variation,
+                                         uint32_t strand,
+                                         float s,
+                                         const float *color,
+                                         const struct HtHairFrame *frame,
+                                         const float *wo,
+                                         const float *major,
+                                         const float *jitter,
+                                         HtHuangField field,
+                                         struct HtHuangPoint *point);
+
+#endif
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -368,6 +368,24 @@ public:
         return ht_huang_point_init_world(material.get(), &frame.c(), w.data(), m.data(),
                                          jitter.data(), field, &point_);
     }
+
+#if defined(HT_RENDER)
+    /** At strand `strand`, position `s`, of a groom varied as `variation` says, with the
+     * strand's colour `color` (NULL: none), at a frame with `wo` in world space:
+     * `ht_huang_point_init_strand`. */
+    template <class V, class M>
+    static HuangPoint strand(const HuangMaterial &material, const HtHairVariation &variation,
+                             uint32_t strand, float s, const float *color, const Frame &frame,
+                             const V &wo, const M &major, const Jitter &jitter,
+                             HtHuangField field) {
+        const Vec3 w = vec3(wo), m = vec3(major);
+        HuangPoint p;
+        check(ht_huang_point_init_strand(material.get(), &variation, strand, s, color,
+                                         &frame.c(), w.data(), m.data(), jitter.data(), field,
+                                         &p.point_));
+        return p;
+    }
+#endif
 };
 
 #if defined(HT_RENDER)

@@ -93,12 +93,13 @@ pub const HT_HUANG_POINT_SIZE: usize = 4096;
 /// Alignment of an `HtHuangPoint` in bytes.
 pub const HT_HUANG_POINT_ALIGN: usize = 16;
 
-/// Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit` or
-/// `ht_huang_point_init_world`, then evaluated and sampled any number of times. The rules
-/// of `HtHairPoint` hold: the host allocates it (`HT_HUANG_POINT_SIZE` bytes aligned to
-/// `HT_HUANG_POINT_ALIGN`, which this type has), the bytes are opaque plain numbers that
-/// may be copied and outlive their `HtHuangPrepared`, an unfilled point (or a Chiang one)
-/// is refused, and filling it while another thread reads it is a data race.
+/// Storage for the Huang model at one shading point, filled by `ht_huang_point_at_hit`,
+/// `ht_huang_point_init_world` or `ht_huang_point_init_strand`, then evaluated and sampled
+/// any number of times. The rules of `HtHairPoint` hold: the host allocates it
+/// (`HT_HUANG_POINT_SIZE` bytes aligned to `HT_HUANG_POINT_ALIGN`, which this type has),
+/// the bytes are opaque plain numbers that may be copied and outlive their
+/// `HtHuangPrepared`, an unfilled point (or a Chiang one) is refused, and filling it while
+/// another thread reads it is a data race.
 #[repr(C, align(16))]
 pub struct HtHuangPoint {
     pub opaque: [u8; HT_HUANG_POINT_SIZE],
@@ -209,7 +210,9 @@ pub unsafe extern "C" fn ht_huang_point_at_hit(
         let (axes, h, wo) = framed_hit(&hit, radius)?;
         // SAFETY: non-NULL, aligned and clear of the inputs (checked); a live handle (the
         // caller's promise).
-        unsafe { fill_huang(point, prepared, (axes, h, wo), (major, jitter, field)) }
+        let bsdf = unsafe { &(*prepared).bsdf };
+        // SAFETY: as above.
+        unsafe { fill_huang(point, bsdf, (axes, h, wo), (major, jitter, field)) }
     })
 }
 
@@ -243,26 +246,84 @@ pub unsafe extern "C" fn ht_huang_point_init_world(
         check_init(prepared, &inputs, Some(frame), point)?;
         let (axes, h, wo) = framed(frame, wo)?;
         // SAFETY: as in `ht_huang_point_at_hit`.
-        unsafe { fill_huang(point, prepared, (axes, h, wo), (major, jitter, field)) }
+        let bsdf = unsafe { &(*prepared).bsdf };
+        // SAFETY: as in `ht_huang_point_at_hit`.
+        unsafe { fill_huang(point, bsdf, (axes, h, wo), (major, jitter, field)) }
+    })
+}
+
+/// `ht_huang_point_init_world` for one strand of a groom whose parameters vary as a scene's
+/// Huang material varies them (`ht_scene_add_huang_material`): the parameters of
+/// `prepared`, varied by `*variation` for strand number `strand` at position `s` along it
+/// (root 0, tip 1), with the strand's own reflectance colour `color[3]` when
+/// `variation->use_vertex_colors` is 1 (NULL: none), as `ht_hair_point_init_strand` varies
+/// Chiang's: the absorption spread per strand and toward the tip (or the strand's colour,
+/// inverted at `ht_hair_params_default`'s beta_n), and `roughness` spread per strand by
+/// `roughness_variation`. No handle per parameter set and no allocation: the varied model
+/// is built inside the point, and the point equals, bit for bit, the one the renderer
+/// shades that strand's hit with at the same `major`, `jitter` and `field`.
+///
+/// - `strand`, `s`, `color`, the variation's ranges: as `ht_hair_point_init_strand` takes
+///   and refuses them; `frame`, `wo`, `major`, `jitter`, `field` as
+///   `ht_huang_point_init_world`. Else `HT_ERR_INVALID_ARG`.
+/// - Pointers: `prepared`, `variation`, `frame`, `wo`, `major`, `jitter`, `point` not NULL
+///   (`HT_ERR_NULL_ARG`, checked first); others as `ht_huang_point_init_world`. On error
+///   `*point` is untouched.
+/// - Cost: an init plus the preparation of the varied parameters.
+///
+/// Any thread; `prepared` and `variation` may be shared, `point` must not be read
+/// meanwhile. Not in the BSDF-only library.
+///
+/// # Safety
+/// As `ht_huang_point_init_world`; `variation` NULL or an `HtHairVariation`; `color` NULL
+/// or 3 floats.
+#[cfg(feature = "render")]
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn ht_huang_point_init_strand(
+    prepared: *const HtHuangPrepared,
+    variation: *const super::materials::HtHairVariation,
+    strand: u32,
+    s: f32,
+    color: *const f32,
+    frame: *const HtHairFrame,
+    wo: *const f32,
+    major: *const f32,
+    jitter: *const f32,
+    field: HtHuangField,
+    point: *mut HtHuangPoint,
+) -> HtStatus {
+    boundary(|| {
+        let inputs = [(wo, "wo", 3), (major, "major", 3), (jitter, "jitter", 2)];
+        let (v, framed, groom) =
+            super::prepared::strand_init(prepared, variation, &inputs, frame, point, (s, color))?;
+        // SAFETY: non-NULL (checked), a live handle (the caller's promise).
+        let given = *unsafe { &(*prepared).bsdf }.params();
+        let material = super::materials::huang_varied_material(given, &v)?;
+        material.check_variation()?;
+        let base = material.base_params()?;
+        let Some(params) = material.huang_varied(base, strand, s, groom)? else {
+            unreachable!("a material of the Huang model")
+        };
+        let bsdf = HuangBsdf::new(&params)?;
+        // SAFETY: non-NULL, aligned and clear of the inputs (checked).
+        unsafe { fill_huang(point, &bsdf, framed, (major, jitter, field)) }
     })
 }
 
 /// Checks the section's orientation, the jitter and the field of a point init whose
-/// pointers `check_init` passed, and writes the point of `prepared` at (h, wo) and
-/// `frame`.
+/// pointers `check_init` passed, and writes the point of `bsdf` at (h, wo) and `frame`.
 ///
 /// # Safety
-/// `prepared` is a live handle; `point` is non-NULL, aligned, writable and not read by
-/// anyone meanwhile.
+/// `point` is non-NULL, aligned, writable and not read by anyone meanwhile; `major` and
+/// `jitter` are non-NULL, aligned and hold 3 and 2 floats.
 #[inline(always)]
 unsafe fn fill_huang(
     point: *mut HtHuangPoint,
-    prepared: *const HtHuangPrepared,
+    bsdf: &HuangBsdf,
     (frame, h, wo): (Frame, f32, Vec3),
     (major, jitter, field): (*const f32, *const f32, HtHuangField),
 ) -> Result<(), Failure> {
-    // SAFETY: the caller's promise.
-    let bsdf = unsafe { &(*prepared).bsdf };
     let given = read3(major);
     let major = check_major(frame.to_local(given), given, "major")?;
     // SAFETY: non-NULL and aligned (checked by `check_init`), 2 floats (the caller's
@@ -333,6 +394,7 @@ mod tests {
     use super::super::prepared::{HT_HAIR_POINT_SIZE, HtHairPoint};
     use super::*;
     use glam::Vec2;
+    use std::collections::BTreeSet;
     use std::ptr::{null, null_mut};
 
     fn point() -> HtHuangPoint {
@@ -741,6 +803,358 @@ mod tests {
             "wi (in the point's frame)",
         );
         fails(sample(&pt, [0.5, 1.0, 0.5]).0, INVALID, "u[1] = 1");
+        unsafe { ht_huang_prepared_free(handle) };
+    }
+
+    /// A Huang material that varies over the groom, as the host gives it.
+    #[cfg(feature = "render")]
+    fn varied() -> (HtHuangParams, super::super::materials::HtHairVariation) {
+        let params = HtHuangParams {
+            roughness: 0.35,
+            aspect: 0.6,
+            alpha: 2.5,
+            ..ht_huang_params_default()
+        };
+        let variation = super::super::materials::HtHairVariation {
+            absorption_variation: 0.5,
+            roughness_variation: 0.6,
+            tip_absorption: 0.3,
+            use_vertex_colors: 1,
+            seed: 42,
+        };
+        (params, variation)
+    }
+
+    /// One strand's point init at the local frame of offset `h`, seen from `wo`, with the
+    /// major axis (0, 1, 0.3).
+    #[cfg(feature = "render")]
+    #[allow(clippy::too_many_arguments)]
+    fn init_strand(
+        handle: *const HtHuangPrepared,
+        variation: *const super::super::materials::HtHairVariation,
+        (strand, s, color): (u32, f32, *const f32),
+        h: f32,
+        wo: Vec3,
+        jitter: [f32; 2],
+        field: HtHuangField,
+        pt: *mut HtHuangPoint,
+    ) -> HtStatus {
+        let (wo, major) = (wo.to_array(), [0.0f32, 1.0, 0.3]);
+        unsafe {
+            ht_huang_point_init_strand(
+                handle,
+                variation,
+                strand,
+                s,
+                color,
+                &local(h),
+                wo.as_ptr(),
+                major.as_ptr(),
+                jitter.as_ptr(),
+                field,
+                pt,
+            )
+        }
+    }
+
+    /// A strand's point is the model the renderer shades that strand's hits with (the
+    /// scene material's `huang_at`, of the material `ht_scene_add_huang_material` makes of
+    /// the same parameters and variation), bit for bit, near and far, with and without the
+    /// strand's colour; strands differ in absorption and roughness.
+    #[cfg(feature = "render")]
+    #[test]
+    fn strand_points_are_the_scene_materials_model() {
+        use super::super::materials::huang_varied_material;
+        use crate::scene::material::HairColor;
+        let (params, variation) = varied();
+        let handle = prepare(&params);
+        let Ok(material) = huang_varied_material(params.into(), &variation) else {
+            panic!("a valid variation")
+        };
+        let scene = material.prepare().unwrap();
+        let (mut absorptions, mut roughnesses) = (BTreeSet::new(), BTreeSet::new());
+        let axes = Frame {
+            x: Vec3::X,
+            y: Vec3::Y,
+            z: Vec3::Z,
+        };
+        let wo = Vec3::new(0.3, 0.2, 0.9).normalize();
+        for k in 0..120u32 {
+            let (strand, s) = (k * 7 % 53, (k % 11) as f32 / 10.0);
+            let color = [0.3 + 0.005 * k as f32, 0.2, 0.1];
+            let groom = (k % 2 == 0).then_some(color);
+            let color_ptr = groom.as_ref().map_or(null(), |c| c.as_ptr());
+            let h = 0.9 * (0.3 * k as f32).sin();
+            let jitter = [(0.17 * k as f32).fract(), (0.29 * k as f32).fract()];
+            let far = k % 3 == 0;
+            let field = if far { HT_HUANG_FAR } else { HT_HUANG_NEAR };
+            let mut pt = point();
+            let st = init_strand(
+                handle,
+                &variation,
+                (strand, s, color_ptr),
+                h,
+                wo,
+                jitter,
+                field,
+                &mut pt,
+            );
+            assert_eq!(st, HtStatus::HT_OK, "{}", last_error());
+            let Some(bsdf) = scene.huang_at(strand, s, groom.map(HairColor::Color)) else {
+                panic!("a Huang material")
+            };
+            absorptions.insert(bsdf.params().sigma_a.map(f32::to_bits));
+            roughnesses.insert(bsdf.params().roughness.to_bits());
+            let major = Vec2::new(1.0, 0.3);
+            let rust = match far {
+                true => bsdf.far(h, wo, major, jitter),
+                false => bsdf.near(h, wo, major, jitter),
+            };
+            let wi = Vec3::new(-0.2, 0.7, 0.5).normalize();
+            let u = [0.61, 0.27, 0.83];
+            let (we, ws) = want(&rust, &axes, wi, u);
+            let (ge, gs) = got(&pt, wi, u);
+            assert_eq!(
+                (bits(ge), bits(gs)),
+                (bits(we), bits(ws)),
+                "strand {strand} s {s}"
+            );
+        }
+        assert!(
+            absorptions.len() > 100,
+            "absorptions: {}",
+            absorptions.len()
+        );
+        assert!(roughnesses.len() > 40, "roughnesses: {}", roughnesses.len());
+        unsafe { ht_huang_prepared_free(handle) };
+    }
+
+    /// Without variation (any seed, a groom's colours asked for but none given) a strand's
+    /// point is `ht_huang_point_init_world`'s, bit for bit; with it, strands at the same
+    /// position, offset and directions scatter differently.
+    #[cfg(feature = "render")]
+    #[test]
+    fn strand_points_vary_only_with_a_variation() {
+        use super::super::materials::ht_hair_variation_default;
+        let (params, variation) = varied();
+        let handle = prepare(&params);
+        let none = [
+            ht_hair_variation_default(),
+            super::super::materials::HtHairVariation {
+                seed: 77,
+                use_vertex_colors: 1,
+                ..ht_hair_variation_default()
+            },
+        ];
+        let wo = Vec3::new(-0.4, 0.1, 0.8).normalize();
+        let wi = Vec3::new(0.3, -0.6, 0.5).normalize();
+        let u = [0.2, 0.55, 0.4];
+        let mut distinct = BTreeSet::new();
+        for k in 0..40u32 {
+            let (s, h, jitter) = ((k % 5) as f32 / 4.0, 0.3, [0.25, 0.75]);
+            let field = if k % 2 == 0 {
+                HT_HUANG_NEAR
+            } else {
+                HT_HUANG_FAR
+            };
+            let mut world = point();
+            let st = unsafe {
+                let (wo, major) = (wo.to_array(), [0.0f32, 1.0, 0.3]);
+                let j = jitter.as_ptr();
+                ht_huang_point_init_world(
+                    handle,
+                    &local(h),
+                    wo.as_ptr(),
+                    major.as_ptr(),
+                    j,
+                    field,
+                    &mut world,
+                )
+            };
+            assert_eq!(st, HtStatus::HT_OK, "{}", last_error());
+            let plain = got(&world, wi, u);
+            for v in &none {
+                let mut pt = point();
+                let st = init_strand(handle, v, (k, s, null()), h, wo, jitter, field, &mut pt);
+                assert_eq!(st, HtStatus::HT_OK, "{}", last_error());
+                let (e, smp) = got(&pt, wi, u);
+                assert_eq!(
+                    (bits(e), bits(smp)),
+                    (bits(plain.0), bits(plain.1)),
+                    "strand {k}"
+                );
+            }
+            let mut pt = point();
+            let st = init_strand(
+                handle,
+                &variation,
+                (k, 0.5, null()),
+                h,
+                wo,
+                jitter,
+                HT_HUANG_NEAR,
+                &mut pt,
+            );
+            assert_eq!(st, HtStatus::HT_OK, "{}", last_error());
+            distinct.insert(bits(got(&pt, wi, u).0));
+        }
+        assert_eq!(distinct.len(), 40, "40 strands scatter alike");
+        unsafe { ht_huang_prepared_free(handle) };
+    }
+
+    /// A strand's point refuses what `ht_hair_point_init_strand` and
+    /// `ht_huang_point_init_world` refuse, with their statuses and messages, NULLs first,
+    /// and writes nothing.
+    #[cfg(feature = "render")]
+    #[test]
+    fn bad_strand_input_is_refused_with_named_messages() {
+        use super::super::materials::HtHairVariation;
+        use HtStatus::{HT_ERR_INVALID_ARG as INVALID, HT_ERR_NULL_ARG as NULL};
+        let fails = |status: HtStatus, want: HtStatus, words: &str| {
+            assert_eq!(status, want, "{words}: {}", last_error());
+            assert!(last_error().contains(words), "{words}: {}", last_error());
+        };
+        let (params, v) = varied();
+        let handle = prepare(&params);
+        let wo = Vec3::Z;
+        let mut pt = point();
+        let init = |v: *const HtHairVariation, s: f32, color: *const f32, pt: *mut HtHuangPoint| {
+            init_strand(
+                handle,
+                v,
+                (3, s, color),
+                0.2,
+                wo,
+                [0.5; 2],
+                HT_HUANG_NEAR,
+                pt,
+            )
+        };
+        let grey = [0.5f32; 3];
+        fails(
+            init(null(), 0.5, null(), &mut pt),
+            NULL,
+            "variation is NULL",
+        );
+        fails(init(&v, 0.5, null(), null_mut()), NULL, "point is NULL");
+        fails(
+            init(null(), f32::NAN, null(), null_mut()),
+            NULL,
+            "variation is NULL",
+        );
+        let st = init_strand(null(), &v, (3, 0.5, null()), 0.2, wo, [0.5; 2], 0, &mut pt);
+        fails(st, NULL, "prepared is NULL");
+        let mut words = [0u64; 8];
+        let odd = unsafe { words.as_mut_ptr().cast::<u8>().add(4) }.cast::<HtHairVariation>();
+        fails(init(odd, 0.5, null(), &mut pt), INVALID, "variation = ");
+        fails(
+            init(&v, 1.5, null(), &mut pt),
+            INVALID,
+            "s = 1.5: must be in [0, 1]",
+        );
+        fails(
+            init(&v, -0.25, null(), &mut pt),
+            INVALID,
+            "s = -0.25: must be in [0, 1]",
+        );
+        fails(
+            init(&v, f32::NAN, null(), &mut pt),
+            INVALID,
+            "s = NaN: must be in [0, 1]",
+        );
+        let bright = [0.5f32, 2.0, 0.5];
+        fails(
+            init(&v, 0.5, bright.as_ptr(), &mut pt),
+            INVALID,
+            "color[1] = 2: must be in [0, 1]",
+        );
+        let nan = [0.5f32, 0.5, f32::NAN];
+        fails(
+            init(&v, 0.5, nan.as_ptr(), &mut pt),
+            INVALID,
+            "color = [0.5, 0.5, NaN]: must be finite",
+        );
+        for (bad, words) in [
+            (
+                HtHairVariation {
+                    absorption_variation: 1.5,
+                    ..v
+                },
+                "absorption_variation = 1.5: must be in [0, 1]",
+            ),
+            (
+                HtHairVariation {
+                    roughness_variation: -0.1,
+                    ..v
+                },
+                "roughness_variation = -0.1: must be in [0, 1]",
+            ),
+            (
+                HtHairVariation {
+                    roughness_variation: f32::NAN,
+                    ..v
+                },
+                "roughness_variation = NaN",
+            ),
+            (
+                HtHairVariation {
+                    tip_absorption: 0.0,
+                    ..v
+                },
+                "tip_absorption = 0: must be finite and > 0",
+            ),
+            (
+                HtHairVariation {
+                    use_vertex_colors: 2,
+                    ..v
+                },
+                "variation->use_vertex_colors = 2: must be 0 or 1",
+            ),
+        ] {
+            fails(init(&bad, 0.5, grey.as_ptr(), &mut pt), INVALID, words);
+        }
+        // The frame's and the Huang point's own checks.
+        let st = init_strand(handle, &v, (3, 0.5, null()), 1.5, wo, [0.5; 2], 0, &mut pt);
+        fails(st, INVALID, "h = 1.5");
+        let st = init_strand(
+            handle,
+            &v,
+            (3, 0.5, null()),
+            0.2,
+            wo,
+            [0.5, 1.0],
+            0,
+            &mut pt,
+        );
+        fails(st, INVALID, "jitter[1] = 1: must be in [0, 1)");
+        let st = init_strand(handle, &v, (3, 0.5, null()), 0.2, wo, [0.5; 2], 2, &mut pt);
+        fails(st, INVALID, "field = 2");
+        let along = [1.0f32, 0.0, 0.0];
+        let st = unsafe {
+            let w = wo.to_array();
+            let j = [0.5f32; 2];
+            ht_huang_point_init_strand(
+                handle,
+                &v,
+                3,
+                0.5,
+                null(),
+                &local(0.0),
+                w.as_ptr(),
+                along.as_ptr(),
+                j.as_ptr(),
+                0,
+                &mut pt,
+            )
+        };
+        fails(st, INVALID, "major = [1, 0, 0]: lies along the fibre");
+        assert_eq!(pt.opaque, [0; HT_HUANG_POINT_SIZE], "a refused init wrote");
+        assert_eq!(
+            init(&v, 1.0, grey.as_ptr(), &mut pt),
+            HtStatus::HT_OK,
+            "{}",
+            last_error()
+        );
         unsafe { ht_huang_prepared_free(handle) };
     }
 }

@@ -148,14 +148,24 @@ pub unsafe extern "C" fn ht_scene_set_huang_material(
     })
 }
 
-/// The Huang model's hair material of the host's parameters and variation (NULL: none):
-/// the colour inversion's beta_n and the unused beta_m are the defaults, as a scene file
-/// leaves them.
+/// The Huang model's hair material of the host's parameters and variation (NULL: none).
 fn huang_material(
     params: *const HtHuangParams,
     variation: *const HtHairVariation,
 ) -> std::result::Result<MaterialDesc, Failure> {
-    let p: HuangParams = read_host(params, "params")?.into();
+    let p = read_host(params, "params")?.into();
+    let material = huang_varied_material(p, &variation_or_none(variation)?)?;
+    Ok(MaterialDesc::Hair(material))
+}
+
+/// The Huang model's hair material of parameters `p` varied as `v` says, as a scene takes
+/// it (`use_vertex_colors` checked; the other ranges by `HairMaterial::prepare` or
+/// `check_variation`): the colour inversion's beta_n and the unused beta_m are the
+/// defaults, as a scene file leaves them.
+pub(super) fn huang_varied_material(
+    p: HuangParams,
+    v: &HtHairVariation,
+) -> std::result::Result<HairMaterial, Failure> {
     let shared = HairParams {
         sigma_a: p.sigma_a,
         eta: p.eta,
@@ -166,8 +176,10 @@ fn huang_material(
         roughness: p.roughness,
         aspect: p.aspect,
     };
-    let material = varied_material(shared, &variation_or_none(variation)?)?;
-    Ok(MaterialDesc::Hair(HairMaterial { model, ..material }))
+    Ok(HairMaterial {
+        model,
+        ..varied_material(shared, v)?
+    })
 }
 
 /// Gives hair material `material_id` new parameters and variation (as

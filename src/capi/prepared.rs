@@ -409,24 +409,10 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
     wo: *const f32,
     point: *mut HtHairPoint,
 ) -> HtStatus {
-    use crate::scene::material::HairColor;
     boundary(|| {
-        require(&[(variation.cast(), "variation")])?;
-        check_init(prepared, &[(wo, "wo", 3)], Some(frame), point)?;
-        let v = super::read_host(variation, "variation")?;
-        let (axes, h, wo) = framed(frame, wo)?;
-        if !(0.0..=1.0).contains(&s) {
-            return Err(invalid_arg!("s = {s}: must be in [0, 1]").into());
-        }
-        let groom = if color.is_null() {
-            None
-        } else {
-            let c = super::read_vec3(color, "color")?.to_array();
-            if let Some(bad) = c.iter().position(|x| !(0.0..=1.0).contains(x)) {
-                return Err(invalid_arg!("color[{bad}] = {}: must be in [0, 1]", c[bad]).into());
-            }
-            Some(HairColor::Color(c))
-        };
+        let inputs = [(wo, "wo", 3)];
+        let (v, (axes, h, wo), groom) =
+            strand_init(prepared, variation, &inputs, frame, point, (s, color))?;
         // SAFETY: non-NULL (checked), a live handle (the caller's promise).
         let base = *unsafe { &(*prepared).bsdf }.params();
         let material = super::materials::varied_material(base, &v)?;
@@ -437,6 +423,48 @@ pub unsafe extern "C" fn ht_hair_point_init_strand(
         Ok(())
     })
 }
+
+/// The checks and reads a strand's point init of either model shares, in the documented
+/// order (every NULL, then alignment and overlap, then the values): the host's variation,
+/// the frame's axes and h with the world wo in them, and the strand's colour as the
+/// renderer takes a groom's (NULL: none). `inputs` are the float arrays the init reads,
+/// `wo` first.
+#[cfg(feature = "render")]
+pub(super) fn strand_init<P, H>(
+    prepared: *const P,
+    variation: *const super::materials::HtHairVariation,
+    inputs: &[Arg],
+    frame: *const HtHairFrame,
+    point: *mut H,
+    (s, color): (f32, *const f32),
+) -> Result<StrandInputs, Failure> {
+    use crate::scene::material::HairColor;
+    require(&[(variation.cast(), "variation")])?;
+    check_init(prepared, inputs, Some(frame), point)?;
+    let v = super::read_host(variation, "variation")?;
+    let framed = framed(frame, inputs[0].0)?;
+    if !(0.0..=1.0).contains(&s) {
+        return Err(invalid_arg!("s = {s}: must be in [0, 1]").into());
+    }
+    let groom = if color.is_null() {
+        None
+    } else {
+        let c = super::read_vec3(color, "color")?.to_array();
+        if let Some(bad) = c.iter().position(|x| !(0.0..=1.0).contains(x)) {
+            return Err(invalid_arg!("color[{bad}] = {}: must be in [0, 1]", c[bad]).into());
+        }
+        Some(HairColor::Color(c))
+    };
+    Ok((v, framed, groom))
+}
+
+/// What [`strand_init`] gives: the variation, (frame, h, wo) and the strand's colour.
+#[cfg(feature = "render")]
+pub(super) type StrandInputs = (
+    super::materials::HtHairVariation,
+    (Frame, f32, Vec3),
+    Option<crate::scene::material::HairColor>,
+);
 
 /// f |cos| and the pdf toward the world `wi[3]` at a filled point, for a light's
 /// contribution and its MIS weight: writes `f_cos[3]` = f * |cos| (f the BSDF, RGB per

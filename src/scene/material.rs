@@ -132,7 +132,9 @@ pub struct PreparedHair {
 }
 
 impl HairMaterial {
-    fn base_params(&self) -> Result<HairParams> {
+    /// The parameters every strand starts from ([`Self::varied`]'s `base`): the colour's
+    /// absorption with the material's other values. Checked.
+    pub(crate) fn base_params(&self) -> Result<HairParams> {
         let params = HairParams {
             sigma_a: self.color.sigma_a(self.beta_n)?,
             eta: self.eta,
@@ -239,6 +241,23 @@ impl HairMaterial {
         p
     }
 
+    /// The Huang model's parameters at position s (root 0, tip 1) of `strand`: `base` (this
+    /// material's valid parameters, [`Self::base_params`]) varied as [`Self::varied`] varies
+    /// them, the strand's roughness factor applied to the model's roughness. None for the
+    /// Chiang model. The renderer's hits ([`PreparedHair::huang_at`]) and the C ABI's
+    /// strand points both take their parameters from here.
+    pub(crate) fn huang_varied(
+        &self,
+        base: HairParams,
+        strand: u32,
+        s: f32,
+        groom: Option<HairColor>,
+    ) -> Result<Option<HuangParams>> {
+        let varied = self.varied(base, strand, s, groom);
+        let [_, ur] = strand_uniforms(self.seed, strand);
+        self.huang_params(varied, self.roughness_factor(ur))
+    }
+
     /// The factor a strand's roughnesses are scaled by, from its uniform number `ur`.
     fn roughness_factor(&self, ur: f32) -> f32 {
         1.0 + self.roughness_variation * (2.0 * ur - 1.0)
@@ -288,11 +307,11 @@ impl PreparedHair {
         if let Some(b) = self.uniform_huang {
             return Some(b);
         }
-        let varied = self.params_at(strand, s, groom);
-        let [_, ur] = strand_uniforms(self.material.seed, strand);
-        let factor = self.material.roughness_factor(ur);
         // Valid by construction: the base was checked, the variation is clamped into range.
-        let p = self.material.huang_params(varied, factor).ok()??;
+        let p = self
+            .material
+            .huang_varied(self.base, strand, s, groom)
+            .ok()??;
         HuangBsdf::new(&p).ok()
     }
 }

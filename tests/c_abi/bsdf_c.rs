@@ -124,9 +124,10 @@ fn every_c_entry_point_gives_the_rust_bits() {
 }
 
 /// The Huang model through `hairtrace.hpp` (value and status forms) and the C calls under
-/// it: the three agree bit for bit, and give the bits of the Rust `HuangPoint` near and far
-/// (`c/huang_bits.cpp`); a bad aspect throws, a major axis along the fibre and an unfilled
-/// point get their status and message.
+/// it, and a strand's point without variation: the four agree bit for bit, and give the
+/// bits of the Rust `HuangPoint` near and far (`c/huang_bits.cpp`); a bad aspect and a
+/// strand's point at s = 1.5 throw, a major axis along the fibre and an unfilled point get
+/// their status and message.
 #[test]
 fn the_huang_model_through_cpp_gives_the_rust_bits() {
     let mut rng = Pcg64::seed_from_u64(12);
@@ -201,6 +202,10 @@ fn the_huang_model_through_cpp_gives_the_rust_bits() {
     );
     assert!(
         rest.contains("unfilled invalid argument: point was not filled by ht_huang_point_at_hit"),
+        "{rest}"
+    );
+    assert!(
+        rest.contains("strand throws invalid argument: s = 1.5: must be in [0, 1]"),
         "{rest}"
     );
 }

@@ -2,11 +2,13 @@
  * writes to the file named by argv[1], one case a line as 23 hexadecimal float bit
  * patterns: sigma_a[3], eta, roughness, aspect, alpha, h, wo[3], wi[3], u[3], major[3],
  * jitter[2], field (0 near, 1 far). Each point is filled at the local frame, where world
- * directions are the local ones, three ways: the value form, the noexcept status form into
- * a default-constructed point, and the C calls; they must agree bit for bit. Prints one
- * line a case with the bit patterns of eval (f_cos, pdf) and sample (wi, f_cos, weight,
- * pdf), then "mismatches M" and the refusals: "throws STATUS: MESSAGE" for a bad aspect,
- * "major STATUS: MESSAGE" for a major axis along the fibre, "unfilled STATUS: MESSAGE". */
+ * directions are the local ones, four ways: the value form, the noexcept status form into
+ * a default-constructed point, the C calls, and a strand's point without variation
+ * (`HuangPoint::strand`); they must agree bit for bit. Prints one line a case with the bit
+ * patterns of eval (f_cos, pdf) and sample (wi, f_cos, weight, pdf), then "mismatches M"
+ * and the refusals: "throws STATUS: MESSAGE" for a bad aspect, "major STATUS: MESSAGE" for
+ * a major axis along the fibre, "unfilled STATUS: MESSAGE", "strand throws STATUS:
+ * MESSAGE" for a strand's point at s = 1.5. */
 #include "hairtrace.hpp"
 
 #include <cstdint>
@@ -95,7 +97,13 @@ int main(int argc, char **argv) {
             ht_huang_point_eval_world(&c_point, wi, e3.f_cos.data(), &e3.pdf) == HT_OK &&
             ht_huang_point_sample_world(&c_point, u.data(), s3.wi.data(), s3.f_cos.data(),
                                         s3.weight.data(), &s3.pdf) == HT_OK;
-        if (!status_ok || !c_ok || !same(e, e2) || !same(e, e3) || !same(s, s2) || !same(s, s3)) {
+        const hairtrace::HuangPoint strand_point = hairtrace::HuangPoint::strand(
+            material, ht_hair_variation_default(), static_cast<uint32_t>(at / 23), 0.5f, nullptr,
+            frame, wo, major, jitter, field);
+        const hairtrace::Eval e4 = strand_point.eval_world(wi);
+        const hairtrace::Sample s4 = strand_point.sample_world(u);
+        if (!status_ok || !c_ok || !same(e, e2) || !same(e, e3) || !same(s, s2) || !same(s, s3) ||
+            !same(e, e4) || !same(s, s4)) {
             ++mismatches;
         }
         put(e.f_cos.data(), 3);
@@ -125,5 +133,16 @@ int main(int argc, char **argv) {
                                        HT_HUANG_NEAR));
     hairtrace::Eval light{};
     report("unfilled", unfilled.eval_world(wo, light));
+    try {
+        const float across[3] = {0.0f, 1.0f, 0.0f};
+        const hairtrace::HuangPoint refused =
+            hairtrace::HuangPoint::strand(circle, ht_hair_variation_default(), 0, 1.5f, nullptr,
+                                          local, wo, across, hairtrace::Jitter{0.5f, 0.5f},
+                                          HT_HUANG_NEAR);
+        static_cast<void>(refused);
+        std::printf("strand throws nothing\n");
+    } catch (const hairtrace::Error &e) {
+        std::printf("strand throws %s\n", e.what());
+    }
     return 0;
 }

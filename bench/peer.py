@@ -51,7 +51,7 @@ import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # The binary measured: $HT_HAIRTRACE (`hairtrace report` passes its own) or the release
-# build. main() copies it into the work folder first and runs the copy, so that a build
+# build. main() links or copies it into the work folder first and runs that, so that a build
 # during a run (hours, for the real grooms) cannot change the renderer under it.
 HAIRTRACE = os.environ.get("HT_HAIRTRACE") or os.path.join(ROOT, "target", "release", "hairtrace")
 CYCLES = os.path.join(ROOT, "bench", "cycles.py")
@@ -378,7 +378,11 @@ def main():
     os.makedirs(args.work, exist_ok=True)
     own = os.path.join(args.work, "hairtrace")
     if os.path.abspath(HAIRTRACE) != own:
-        shutil.copy2(HAIRTRACE, own + ".part")
+        # A hard link keeps the file a build unlinks (the linker writes a new one).
+        try:
+            os.link(HAIRTRACE, own + ".part")
+        except OSError:
+            shutil.copy2(HAIRTRACE, own + ".part")
         os.replace(own + ".part", own)
     HAIRTRACE = own
 

@@ -653,7 +653,8 @@ typedef struct HtHuangParams {
 } HtHuangParams;
 
 /**
- * Which part of the fibre a Huang point sees: `HT_HUANG_NEAR` or `HT_HUANG_FAR`.
+ * Which part of the fibre a Huang point sees: `HT_HUANG_NEAR`, `HT_HUANG_FAR` or
+ * `HT_HUANG_FAR_LIT`.
  */
 typedef uint32_t HtHuangField;
 
@@ -681,6 +682,13 @@ typedef struct HT_ALIGNED(16) HtHuangPoint {
  * width).
  */
 #define HT_HUANG_FAR 1
+
+/**
+ * The far field at more offsets across the fibre, for a point that also weighs sampled
+ * lights (next-event estimation): its values toward the lights are less noisy, as the
+ * renderer's own points where it samples lights (docs/conventions.md, section 4b).
+ */
+#define HT_HUANG_FAR_LIT 2
 
 #ifdef __cplusplus
 extern "C" {
@@ -737,7 +745,8 @@ enum HtStatus ht_huang_prepared_free(struct HtHuangPrepared *prepared);
  *   microfacet normals from (docs/conventions.md, section 4b). Fresh uniform numbers at each hit make a render unbiased for
  *   the model; a fixed pair gives a deterministic BSDF, whose eval, pdf and sample agree
  *   exactly either way.
- * - `field`: `HT_HUANG_NEAR` or `HT_HUANG_FAR`; any other value: `HT_ERR_INVALID_ARG`.
+ * - `field`: `HT_HUANG_NEAR`, `HT_HUANG_FAR` or `HT_HUANG_FAR_LIT`; any other value:
+ *   `HT_ERR_INVALID_ARG`.
  * - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); the floats 4-byte and `point`
  *   16-byte aligned; no input may lie inside `*point` (`HT_ERR_INVALID_ARG`). On error
  *   `*point` is untouched.

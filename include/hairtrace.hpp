@@ -327,7 +327,8 @@ public:
  * The Huang model at one path vertex (`HtHuangPoint`): as `Point`, and its fills also take
  * the section's major axis (world space, any length, across the fibre), the `Jitter` (fresh
  * uniform numbers per hit for an unbiased render) and the field (`HT_HUANG_NEAR` at the
- * hit's h, or `HT_HUANG_FAR` across the fibre). Default-constructed it is unfilled.
+ * hit's h, `HT_HUANG_FAR` across the fibre, or `HT_HUANG_FAR_LIT` across it at more offsets
+ * for a vertex that also samples lights). Default-constructed it is unfilled.
  */
 class HuangPoint : public detail::WorldPoint<HtHuangPoint, ht_huang_point_eval_world,
                                              ht_huang_point_sample_world> {

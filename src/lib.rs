@@ -86,7 +86,7 @@ mod validate;
 
 pub use bsdf::{
     ACROSS, AcrossEval, BsdfEval, BsdfSample, HairBsdf, HairParams, HairPoint, HuangBsdf,
-    HuangParams, HuangPoint, Lobes, LocalBsdf,
+    HuangField, HuangParams, HuangPoint, Lobes, LocalBsdf,
 };
 #[cfg(feature = "render")]
 pub use description::SceneDescription;

@@ -147,6 +147,14 @@ fn quick_report_has_the_huang_bsdf_rows() {
             "Huang far",
             ["HuangBsdf::far", "HuangPoint::eval", "HuangPoint::sample"],
         ),
+        (
+            "Huang far, lit",
+            [
+                "HuangBsdf::far_lit",
+                "HuangPoint::eval",
+                "HuangPoint::sample",
+            ],
+        ),
     ] {
         let cells = |call: &str| row(text, from, &format!("| {model} | `{call}`"));
         assert!(finite(cells(build)[3]) > 0.0);
@@ -164,7 +172,7 @@ fn quick_report_has_the_huang_bsdf_rows() {
         .split("a Huang point's eval costs ")
         .nth(1)
         .expect("the cost ratio to Chiang");
-    for r in ratios.split("x").take(2) {
+    for r in ratios.split("x").take(3) {
         let r = r.rsplit(' ').next().unwrap();
         assert!(finite(r) > 0.0, "{ratios}");
     }

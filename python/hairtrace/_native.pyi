@@ -76,7 +76,7 @@ class HuangBsdf:
         field: str = "near",
     ) -> tuple[F32, F32]:
         """f (n, 3) and pdf (n,); ``major`` (n, 3) across the fibre (None: +y), ``jitter``
-        (n, 2) in [0, 1) (None: 0.5), ``field`` "near" or "far"."""
+        (n, 2) in [0, 1) (None: 0.5), ``field`` "near", "far" or "far_lit"."""
     def pdf(
         self,
         h: ArrayLike,

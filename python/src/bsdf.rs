@@ -4,7 +4,7 @@
 
 use hairtrace::bsdf::{self, inputs};
 use hairtrace::glam::{Vec2, Vec3};
-use hairtrace::{BsdfSample, HairBsdf, HairParams, HuangBsdf, HuangParams, HuangPoint};
+use hairtrace::{BsdfSample, HairBsdf, HairParams, HuangBsdf, HuangField, HuangParams, HuangPoint};
 use numpy::ndarray::{Array, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
 use pyo3::exceptions::PyValueError;
@@ -217,7 +217,7 @@ impl PyHuangBsdf {
 
     /// f (n, 3), with its 1/|wi.z|, and pdf (n,) for h (n,) and unit wo, wi (n, 3), the
     /// section's major axis `major` (n, 3) in the fibre's frame (across the fibre; None:
-    /// +y), `jitter` (n, 2) in [0, 1) (None: 0.5) and `field` "near" or "far".
+    /// +y), `jitter` (n, 2) in [0, 1) (None: 0.5) and `field` "near", "far" or "far_lit".
     #[pyo3(signature = (h, wo, wi, major=None, jitter=None, field="near"))]
     #[allow(clippy::too_many_arguments)]
     fn eval<'py>(
@@ -308,7 +308,7 @@ impl PyHuangBsdf {
 struct SectionArgs<'py> {
     major: Option<Floats<'py>>,
     jitter: Option<Floats<'py>>,
-    far: bool,
+    field: HuangField,
 }
 
 impl<'py> SectionArgs<'py> {
@@ -317,19 +317,20 @@ impl<'py> SectionArgs<'py> {
         jitter: Option<&Bound<'py, PyAny>>,
         field: &str,
     ) -> PyResult<Self> {
-        let far = match field {
-            "near" => false,
-            "far" => true,
+        let field: HuangField = match field {
+            "near" => HuangBsdf::near,
+            "far" => HuangBsdf::far,
+            "far_lit" => HuangBsdf::far_lit,
             other => {
                 return Err(PyValueError::new_err(format!(
-                    "field = {other:?}: must be \"near\" or \"far\""
+                    "field = {other:?}: must be \"near\", \"far\" or \"far_lit\""
                 )));
             }
         };
         Ok(SectionArgs {
             major: major.map(|m| Floats::rows(m, "major", 3)).transpose()?,
             jitter: jitter.map(|j| Floats::rows(j, "jitter", 2)).transpose()?,
-            far,
+            field,
         })
     }
 
@@ -344,7 +345,7 @@ impl<'py> SectionArgs<'py> {
         Section {
             major: self.major.as_ref().map(Floats::vec3s),
             jitter: self.jitter.as_ref().map(Floats::values),
-            far: self.far,
+            field: self.field,
         }
     }
 }
@@ -353,7 +354,7 @@ impl<'py> SectionArgs<'py> {
 struct Section<'a> {
     major: Option<&'a [[f32; 3]]>,
     jitter: Option<&'a [f32]>,
-    far: bool,
+    field: HuangField,
 }
 
 /// The jitter of an element left without one: the middle of [0, 1).
@@ -382,10 +383,7 @@ impl Section<'_> {
     ) -> hairtrace::Result<HuangPoint> {
         let (major, jitter) = self.at(i)?;
         let wo = Vec3::from_array(wo);
-        Ok(match self.far {
-            true => bsdf.far(h, wo, major, jitter),
-            false => bsdf.near(h, wo, major, jitter),
-        })
+        Ok((self.field)(bsdf, h, wo, major, jitter))
     }
 }
 

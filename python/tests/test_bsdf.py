@@ -113,7 +113,7 @@ class HtHairFrame(ctypes.Structure):
                 ("h", ctypes.c_float)]
 
 
-def c_huang(clib, params, h, wo, wi, u, major, jitter, far):
+def c_huang(clib, params, h, wo, wi, u, major, jitter, field):
     """Each element through the C library's Huang point at the local frame: f |cos| and
     pdf toward wi, and a sample's wi, f |cos| and pdf."""
     lib = ctypes.CDLL(str(clib))
@@ -128,7 +128,7 @@ def c_huang(clib, params, h, wo, wi, u, major, jitter, far):
     for i in range(len(h)):
         frame = HtHairFrame(f3([1, 0, 0]), f3([0, 1, 0]), f3([0, 0, 1]), float(h[i]))
         ok(lib.ht_huang_point_init_world(prepared, ctypes.byref(frame), f3(wo[i]), f3(major[i]),
-                                         (ctypes.c_float * 2)(*jitter[i]), ctypes.c_uint32(int(far)), at))
+                                         (ctypes.c_float * 2)(*jitter[i]), ctypes.c_uint32(field), at))
         row = out[i].ctypes.data
         pointer = lambda k: ctypes.c_void_p(row + 4 * k)
         ok(lib.ht_huang_point_eval_world(at, f3(wi[i]), pointer(0), pointer(3)))
@@ -137,7 +137,7 @@ def c_huang(clib, params, h, wo, wi, u, major, jitter, far):
     return out
 
 
-@pytest.mark.parametrize("field", ["near", "far"])
+@pytest.mark.parametrize("field", ["near", "far", "far_lit"])
 def test_huang_eval_and_sample_give_the_c_library_s_bits(clib, field):
     params = dict(sigma_a=[0.8, 1.1, 2.0], eta=1.6, roughness=0.2, aspect=0.55, alpha=-2.5)
     bsdf = hairtrace.HuangBsdf(**params)
@@ -145,7 +145,7 @@ def test_huang_eval_and_sample_give_the_c_library_s_bits(clib, field):
     f, pdf = bsdf.eval(h, wo, wi, major=major, jitter=jitter, field=field)
     ws, fs, ps = bsdf.sample(h, wo, u, major=major, jitter=jitter, field=field)
     c = c_huang(clib, HtHuangParams((ctypes.c_float * 3)(*params["sigma_a"]), 1.6, 0.2, 0.55, -2.5),
-                h, wo, wi, u, major, jitter, field == "far")
+                h, wo, wi, u, major, jitter, ["near", "far", "far_lit"].index(field))
     # f |cos| in float32, as the C call forms it.
     assert np.array_equal(f * np.abs(wi[:, 2:3]), c[:, 0:3]) and np.array_equal(pdf, c[:, 3])
     some = ps > 0
@@ -185,7 +185,7 @@ def test_huang_samples_have_eval_s_density_and_the_fields_differ():
         (lambda b, h, wo, wi, m, j: b.eval(h, wo, wi, jitter=j[:7]), ValueError, "jitter has 7 rows and h has 8"),
         (lambda b, h, wo, wi, m, j: b.eval(h, wo, wi, jitter=j.reshape(4, 4)), ValueError, "jitter: shape (4, 4): must be (n, 2)"),
         (lambda b, h, wo, wi, m, j: b.sample(h, wo, wi * 0 + 0.5, jitter=np.ones((8, 2))), ValueError, "element 0: jitter[0] = 1: must be in [0, 1)"),
-        (lambda b, h, wo, wi, m, j: b.eval(h, wo, wi, field="mid"), ValueError, 'field = "mid": must be "near" or "far"'),
+        (lambda b, h, wo, wi, m, j: b.eval(h, wo, wi, field="mid"), ValueError, 'field = "mid": must be "near", "far" or "far_lit"'),
         (lambda b, h, wo, wi, m, j: b.eval(h + 2, wo, wi), ValueError, "element 0: h = "),
         (lambda b, h, wo, wi, m, j: b.eval(h, wo, 2 * wi), ValueError, "must be a finite unit vector"),
         (lambda b, h, wo, wi, m, j: b.sample(h, wo, np.ones((8, 3))), ValueError, "element 0: u[0] = 1: must be in [0, 1)"),

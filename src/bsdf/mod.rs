@@ -19,7 +19,7 @@ pub use diffuse::Diffuse;
 pub use diffuse::DiffusePoint;
 pub(crate) use hair::OwnedPoint;
 pub use hair::{ACROSS, AcrossEval, HairBsdf, HairPoint, Lobes};
-pub use huang::{HuangBsdf, HuangParams, HuangPoint};
+pub use huang::{HuangBsdf, HuangField, HuangParams, HuangPoint};
 pub use longitudinal::{LongitudinalLobe, longitudinal_variance};
 pub use params::{DEFAULT_EUMELANIN, HairParams};
 

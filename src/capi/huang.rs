@@ -10,7 +10,7 @@ use super::prepared::{
 };
 use super::{Failure, HtStatus, boundary, free_handle};
 use crate::bsdf::inputs::check_major;
-use crate::bsdf::{HuangBsdf, HuangParams, HuangPoint};
+use crate::bsdf::{HuangBsdf, HuangField, HuangParams, HuangPoint};
 use crate::error::invalid_arg;
 use crate::math::Frame;
 use glam::Vec3;
@@ -71,7 +71,8 @@ pub extern "C" fn ht_huang_params_default() -> HtHuangParams {
     HuangParams::default().into()
 }
 
-/// Which part of the fibre a Huang point sees: `HT_HUANG_NEAR` or `HT_HUANG_FAR`.
+/// Which part of the fibre a Huang point sees: `HT_HUANG_NEAR`, `HT_HUANG_FAR` or
+/// `HT_HUANG_FAR_LIT`.
 pub type HtHuangField = u32;
 /// The near field: the fibre at the hit's h, for a fibre wider than the pixel that sees it.
 pub const HT_HUANG_NEAR: HtHuangField = 0;
@@ -79,6 +80,10 @@ pub const HT_HUANG_NEAR: HtHuangField = 0;
 /// strand no wider than its pixel and at bounces (unbiased when h is uniform over the
 /// width).
 pub const HT_HUANG_FAR: HtHuangField = 1;
+/// The far field at more offsets across the fibre, for a point that also weighs sampled
+/// lights (next-event estimation): its values toward the lights are less noisy, as the
+/// renderer's own points where it samples lights (docs/conventions.md, section 4b).
+pub const HT_HUANG_FAR_LIT: HtHuangField = 2;
 
 /// The Huang model prepared for one parameter set. Create with `ht_huang_prepare`, release
 /// with `ht_huang_prepared_free`. Immutable: any number of threads may use one handle at
@@ -178,7 +183,8 @@ pub unsafe extern "C" fn ht_huang_prepared_free(prepared: *mut HtHuangPrepared) 
 ///   microfacet normals from (docs/conventions.md, section 4b). Fresh uniform numbers at each hit make a render unbiased for
 ///   the model; a fixed pair gives a deterministic BSDF, whose eval, pdf and sample agree
 ///   exactly either way.
-/// - `field`: `HT_HUANG_NEAR` or `HT_HUANG_FAR`; any other value: `HT_ERR_INVALID_ARG`.
+/// - `field`: `HT_HUANG_NEAR`, `HT_HUANG_FAR` or `HT_HUANG_FAR_LIT`; any other value:
+///   `HT_ERR_INVALID_ARG`.
 /// - Pointers: not NULL (`HT_ERR_NULL_ARG`, checked first); the floats 4-byte and `point`
 ///   16-byte aligned; no input may lie inside `*point` (`HT_ERR_INVALID_ARG`). On error
 ///   `*point` is untouched.
@@ -311,6 +317,16 @@ pub unsafe extern "C" fn ht_huang_point_init_strand(
     })
 }
 
+/// The Rust point a field names; None for an unknown field.
+fn field_point(field: HtHuangField) -> Option<HuangField> {
+    match field {
+        HT_HUANG_NEAR => Some(HuangBsdf::near),
+        HT_HUANG_FAR => Some(HuangBsdf::far),
+        HT_HUANG_FAR_LIT => Some(HuangBsdf::far_lit),
+        _ => None,
+    }
+}
+
 /// Checks the section's orientation, the jitter and the field of a point init whose
 /// pointers `check_init` passed, and writes the point of `bsdf` at (h, wo) and `frame`.
 ///
@@ -329,17 +345,12 @@ unsafe fn fill_huang(
     // SAFETY: non-NULL and aligned (checked by `check_init`), 2 floats (the caller's
     // promise).
     let jitter = check_u(unsafe { jitter.cast::<[f32; 2]>().read() }, "jitter")?;
-    let at = match field {
-        HT_HUANG_NEAR => HuangBsdf::near,
-        HT_HUANG_FAR => HuangBsdf::far,
-        other => {
-            return Err(invalid_arg!(
-                "field = {other}: must be HT_HUANG_NEAR ({HT_HUANG_NEAR}) or HT_HUANG_FAR \
-                 ({HT_HUANG_FAR})"
-            )
-            .into());
-        }
-    };
+    let at = field_point(field).ok_or_else(|| {
+        invalid_arg!(
+            "field = {field}: must be HT_HUANG_NEAR ({HT_HUANG_NEAR}), HT_HUANG_FAR \
+             ({HT_HUANG_FAR}) or HT_HUANG_FAR_LIT ({HT_HUANG_FAR_LIT})"
+        )
+    })?;
     // SAFETY: the caller's promise; the closure writes a whole point.
     unsafe { fill(point, frame, |p| p.write(at(bsdf, h, wo, major, jitter))) };
     Ok(())
@@ -504,8 +515,7 @@ mod tests {
             let wo = Vec3::new(next() - 0.5, next() - 0.5, next() + 0.05).normalize();
             let major = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5);
             let jitter = [next(), next()];
-            let far = k % 2 == 1;
-            let field = if far { HT_HUANG_FAR } else { HT_HUANG_NEAR };
+            let field = [HT_HUANG_NEAR, HT_HUANG_FAR, HT_HUANG_FAR_LIT][k % 3];
             let mut pt = point();
             let s = unsafe {
                 let (wo, major) = (wo.to_array(), major.to_array());
@@ -523,10 +533,7 @@ mod tests {
             assert_eq!(unsafe { ht_huang_prepared_free(handle) }, HtStatus::HT_OK);
             let copy = HtHuangPoint { opaque: pt.opaque };
             let yz = Vec2::new(major.y, major.z);
-            let rust = match far {
-                true => bsdf.far(h, wo, yz, jitter),
-                false => bsdf.near(h, wo, yz, jitter),
-            };
+            let rust = field_point(field).unwrap()(&bsdf, h, wo, yz, jitter);
             let wi = Vec3::new(next() - 0.5, next() - 0.5, next() - 0.5).normalize();
             let u = [next(), next(), next()];
             let axes = Frame {
@@ -561,11 +568,7 @@ mod tests {
             let org = axis + across_ray * (0.61 * k as f32).sin() * 0.95 * radius - dir * 8.0;
             let major = Vec3::new(0.2, 1.0, (0.3 * a).sin()).to_array();
             let jitter = [(0.17 * k as f32).fract(), (0.29 * k as f32).fract()];
-            let field = if k % 3 == 0 {
-                HT_HUANG_FAR
-            } else {
-                HT_HUANG_NEAR
-            };
+            let field = [HT_HUANG_FAR, HT_HUANG_NEAR, HT_HUANG_FAR_LIT, HT_HUANG_NEAR][k % 4];
             let hit = [tangent, org, dir, axis].map(|v| v.to_array());
             let [t, o, d, x] = hit.each_ref().map(|v| v.as_ptr());
             let (mut at_hit, mut framed) = (point(), point());
@@ -594,10 +597,7 @@ mod tests {
                 axes.to_local(Vec3::from_array(major)),
             );
             let m = Vec2::new(m.y, m.z);
-            let rust = match field {
-                HT_HUANG_FAR => bsdf.far(frame.h, wo, m, jitter),
-                _ => bsdf.near(frame.h, wo, m, jitter),
-            };
+            let rust = field_point(field).unwrap()(&bsdf, frame.h, wo, m, jitter);
             let wi = Vec3::new(0.3, (1.3 * a).cos(), (1.3 * a).sin()).normalize();
             let u = [(0.13 * k as f32).fract(), 0.42, (0.71 * k as f32).fract()];
             let (we, ws) = want(&rust, &axes, wi, u);
@@ -696,9 +696,9 @@ mod tests {
             "jitter[0] = NaN",
         );
         fails(
-            init(y, [0.5; 2], 2, &mut pt),
+            init(y, [0.5; 2], 3, &mut pt),
             INVALID,
-            "field = 2: must be HT_HUANG_NEAR (0) or HT_HUANG_FAR (1)",
+            "field = 3: must be HT_HUANG_NEAR (0), HT_HUANG_FAR (1) or HT_HUANG_FAR_LIT (2)",
         );
         assert_eq!(pt.opaque, [0; HT_HUANG_POINT_SIZE], "a refused init wrote");
         // NULL before any value.
@@ -886,8 +886,7 @@ mod tests {
             let color_ptr = groom.as_ref().map_or(null(), |c| c.as_ptr());
             let h = 0.9 * (0.3 * k as f32).sin();
             let jitter = [(0.17 * k as f32).fract(), (0.29 * k as f32).fract()];
-            let far = k % 3 == 0;
-            let field = if far { HT_HUANG_FAR } else { HT_HUANG_NEAR };
+            let field = [HT_HUANG_FAR, HT_HUANG_NEAR, HT_HUANG_FAR_LIT][k as usize % 3];
             let mut pt = point();
             let st = init_strand(
                 handle,
@@ -906,10 +905,7 @@ mod tests {
             absorptions.insert(bsdf.params().sigma_a.map(f32::to_bits));
             roughnesses.insert(bsdf.params().roughness.to_bits());
             let major = Vec2::new(1.0, 0.3);
-            let rust = match far {
-                true => bsdf.far(h, wo, major, jitter),
-                false => bsdf.near(h, wo, major, jitter),
-            };
+            let rust = field_point(field).unwrap()(&bsdf, h, wo, major, jitter);
             let wi = Vec3::new(-0.2, 0.7, 0.5).normalize();
             let u = [0.61, 0.27, 0.83];
             let (we, ws) = want(&rust, &axes, wi, u);
@@ -1127,8 +1123,8 @@ mod tests {
             &mut pt,
         );
         fails(st, INVALID, "jitter[1] = 1: must be in [0, 1)");
-        let st = init_strand(handle, &v, (3, 0.5, null()), 0.2, wo, [0.5; 2], 2, &mut pt);
-        fails(st, INVALID, "field = 2");
+        let st = init_strand(handle, &v, (3, 0.5, null()), 0.2, wo, [0.5; 2], 3, &mut pt);
+        fails(st, INVALID, "field = 3");
         let along = [1.0f32, 0.0, 0.0];
         let st = unsafe {
             let w = wo.to_array();

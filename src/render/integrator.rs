@@ -13,7 +13,7 @@ use super::settings::{LightOffsets, PathSettings, Roulette, Strategy};
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
 use crate::bsdf::{
-    ACROSS, DiffusePoint, HairBsdf, HairPoint, HuangBsdf, HuangPoint, Lobes, LocalBsdf,
+    ACROSS, DiffusePoint, HairBsdf, HairPoint, HuangBsdf, HuangField, HuangPoint, Lobes, LocalBsdf,
 };
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
@@ -225,11 +225,17 @@ impl World {
                     // averaged across the fibre serves.
                     let thin = events > 0 || 2.0 * h.radius <= pixel_spread * h.t;
                     if let Some(b) = m.huang_at(h.strand.id, h.s, h.absorption) {
-                        // Huang's far field at camera hits alone: a bounce's h is already
-                        // uniform across the fibre, and averaging offsets there costs more
-                        // than the noise it saves (docs/measurements.md, "The Huang model").
-                        let far = events == 0 && thin;
-                        Shading::huang(h, &b, wo_world, far, jitter(u_rr, u_lobe, events))
+                        // Huang's far field where lights are sampled (more offsets: each
+                        // light sample's value is the point's estimate of the BSDF), and
+                        // at camera hits; a bounce that samples no light keeps its own h,
+                        // already uniform across the fibre, where offsets cost more than
+                        // the noise they save (docs/measurements.md, "The Huang model").
+                        let field: HuangField = match (thin, sample_light) {
+                            (true, true) => HuangBsdf::far_lit,
+                            (true, false) if events == 0 => HuangBsdf::far,
+                            _ => HuangBsdf::near,
+                        };
+                        Shading::huang(h, &b, wo_world, field, jitter(u_rr, u_lobe, events))
                     } else {
                         varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
                         let across = settings.light_offsets == LightOffsets::Across && thin;
@@ -448,7 +454,7 @@ struct Shading<'a> {
 /// and BSDF sampling.
 enum Point<'a> {
     Hair(HairPoint<'a>),
-    /// Boxed: a far-field point holds the paths of two offsets.
+    /// Boxed: a far-field point holds the paths of several offsets.
     Huang(Box<HuangPoint>),
     Diffuse(DiffusePoint),
 }
@@ -468,16 +474,17 @@ impl<'a> Shading<'a> {
         }
     }
 
-    /// The Huang model at a hair hit: its far field where `far` (the strand narrower than
-    /// its pixel, or a bounce), else the near field at the hit's offset.
-    fn huang(h: &HairHit, bsdf: &HuangBsdf, wo_world: Vec3, far: bool, jitter: [f32; 2]) -> Self {
+    /// The Huang model at a hair hit, in `field`.
+    fn huang(
+        h: &HairHit,
+        bsdf: &HuangBsdf,
+        wo_world: Vec3,
+        field: HuangField,
+        jitter: [f32; 2],
+    ) -> Self {
         let wo = h.frame.to_local(wo_world);
         let major = h.major_axis();
-        let point = if far {
-            bsdf.far(h.h, wo, major, jitter)
-        } else {
-            bsdf.near(h.h, wo, major, jitter)
-        };
+        let point = field(bsdf, h.h, wo, major, jitter);
         Shading {
             frame: h.frame,
             point: Point::Huang(Box::new(point)),

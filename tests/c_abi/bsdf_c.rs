@@ -125,7 +125,7 @@ fn every_c_entry_point_gives_the_rust_bits() {
 
 /// The Huang model through `hairtrace.hpp` (value and status forms) and the C calls under
 /// it, and a strand's point without variation: the four agree bit for bit, and give the
-/// bits of the Rust `HuangPoint` near and far (`c/huang_bits.cpp`); a bad aspect and a
+/// bits of the Rust `HuangPoint` in each field (`c/huang_bits.cpp`); a bad aspect and a
 /// strand's point at s = 1.5 throw, a major axis along the fibre and an unfilled point get
 /// their status and message.
 #[test]
@@ -146,7 +146,8 @@ fn the_huang_model_through_cpp_gives_the_rust_bits() {
         let u = [0; 3].map(|_| rng.random::<f32>());
         let major = [0.0, rng.random_range(-1.0..1.0), rng.random_range(0.1..1.0)];
         let jitter = [0; 2].map(|_| rng.random::<f32>());
-        let far: bool = rng.random();
+        // 0 near, 1 far, 2 far for lit points (huang_bits.cpp's thresholds).
+        let field: usize = rng.random_range(0..3);
         let p = &params;
         let words = (p.sigma_a.into_iter())
             .chain([p.eta, p.roughness, p.aspect, p.alpha, h])
@@ -155,12 +156,12 @@ fn the_huang_model_through_cpp_gives_the_rust_bits() {
             .chain(u)
             .chain(major)
             .chain(jitter)
-            .chain([f32::from(u8::from(far))]);
+            .chain([[0.0, 0.5, 1.0][field]]);
         for w in words {
             write!(input, "{:08x} ", w.to_bits()).unwrap();
         }
         input.push('\n');
-        cases.push((params, h, wo, wi, u, major, jitter, far));
+        cases.push((params, h, wo, wi, u, major, jitter, field));
     }
     let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("huang_bits_input.txt");
     std::fs::write(&path, input).unwrap();
@@ -171,17 +172,15 @@ fn the_huang_model_through_cpp_gives_the_rust_bits() {
         &[path.as_os_str()],
     );
     let lines: Vec<&str> = out.lines().collect();
-    for (i, (p, h, wo, wi, u, major, jitter, far)) in cases.iter().enumerate() {
+    for (i, (p, h, wo, wi, u, major, jitter, field)) in cases.iter().enumerate() {
         let got: Vec<u32> = (lines[i].split_whitespace())
             .map(|w| u32::from_str_radix(w, 16).expect("hex"))
             .collect();
         let bsdf = HuangBsdf::new(p).unwrap();
         let (wo, wi) = (Vec3::from_array(*wo), Vec3::from_array(*wi));
         let yz = Vec2::new(major[1], major[2]);
-        let point = match far {
-            true => bsdf.far(*h, wo, yz, *jitter),
-            false => bsdf.near(*h, wo, yz, *jitter),
-        };
+        let at = [HuangBsdf::near, HuangBsdf::far, HuangBsdf::far_lit][*field];
+        let point = at(&bsdf, *h, wo, yz, *jitter);
         let e = point.eval(wi);
         let cos = e.f * wi.z.abs();
         let sample = sampled(point.sample(*u));

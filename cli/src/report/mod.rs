@@ -173,10 +173,12 @@ pub fn run(options: &ReportOptions) -> Result<()> {
     Ok(())
 }
 
-/// A copy of the running binary in a folder of its own, removed when dropped. A full report
-/// takes most of an hour, and a build in that time replaces target/release/hairtrace: a
-/// section that started the new binary would measure another renderer, or fail where
-/// the file was being written (as one run did).
+/// The running binary kept under a name of the report's own, in a folder removed when
+/// dropped. A full report takes most of an hour, and a build in that time replaces
+/// target/release/hairtrace: a section that started the new binary would measure another
+/// renderer, or fail where the file was being written (as one run did). A hard link keeps
+/// the file a build unlinks (the linker writes a new one) and writes nothing; a copy where
+/// the temporary folder is on another file system.
 struct OwnBinary(PathBuf);
 
 impl OwnBinary {
@@ -186,7 +188,9 @@ impl OwnBinary {
         let dir = std::env::temp_dir().join(format!("hairtrace-report-{}", std::process::id()));
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
         let own = dir.join("hairtrace");
-        std::fs::copy(&exe, &own).map_err(|e| Error::io(&own, e))?;
+        if std::fs::hard_link(&exe, &own).is_err() {
+            std::fs::copy(&exe, &own).map_err(|e| Error::io(&own, e))?;
+        }
         Ok(OwnBinary(own))
     }
 }

@@ -31,7 +31,8 @@
 //! The far field averages the point over the fibre's width: the same point at
 //! `FAR_SHIFTS` offsets h + 2k / `FAR_SHIFTS` (wrapped), an unbiased stratified estimate of
 //! the average across the fibre when h is uniform over it, evaluated and sampled as one
-//! mixture.
+//! mixture. A point that also weighs sampled lights takes `LIT_SHIFTS` offsets
+//! ([`HuangBsdf::far_lit`]).
 
 mod ggx;
 mod params;
@@ -39,8 +40,8 @@ mod point;
 mod section;
 
 pub use params::HuangParams;
-use point::FAR_SHIFTS;
 pub use point::HuangPoint;
+use point::{FAR_SHIFTS, LIT_SHIFTS};
 
 use super::longitudinal::LongitudinalLobe;
 use crate::error::Result;
@@ -104,7 +105,18 @@ impl HuangBsdf {
     pub fn far(&self, h: f32, wo: Vec3, major: Vec2, jitter: [f32; 2]) -> HuangPoint {
         HuangPoint::new(self, h, wo, major, jitter, FAR_SHIFTS)
     }
+
+    /// The far field at `LIT_SHIFTS` offsets, for a point that also weighs sampled lights:
+    /// their values are this point's estimate of the BSDF, whose noise more offsets cut
+    /// by more than they cost. Arguments as [`Self::near`].
+    pub fn far_lit(&self, h: f32, wo: Vec3, major: Vec2, jitter: [f32; 2]) -> HuangPoint {
+        HuangPoint::new(self, h, wo, major, jitter, LIT_SHIFTS)
+    }
 }
+
+/// One of [`HuangBsdf`]'s point constructors (`near`, `far`, `far_lit`): what a caller
+/// that chooses the field once keeps.
+pub type HuangField = fn(&HuangBsdf, f32, Vec3, Vec2, [f32; 2]) -> HuangPoint;
 
 /// Below this squared sine of its angle to the fibre a direction is too near the fibre to
 /// orient the section: a renderer's own choice of major axis falls back to another

@@ -13,6 +13,11 @@ use std::f32::consts::{FRAC_1_PI, TAU};
 
 /// Offsets a far-field point averages.
 pub(super) const FAR_SHIFTS: usize = 2;
+/// Offsets a far-field point averages where it weighs sampled lights: each light sample's
+/// value is the point's estimate of the BSDF toward it, and one draw per interface makes
+/// that estimate noisy under small lights (docs/measurements.md, "Offsets where lights
+/// are sampled").
+pub(super) const LIT_SHIFTS: usize = 4;
 /// Below this (y, z) length an internal direction runs along the fibre and never meets
 /// the far side: its path is dropped.
 const MIN_CROSSING: f32 = 1e-6;
@@ -94,7 +99,7 @@ pub struct HuangPoint {
     /// wo's azimuth as a unit (y, z) direction; y along the tangent.
     azimuth: Vec2,
     /// The offsets' paths; the first `shifts` are used.
-    paths: [Paths; FAR_SHIFTS],
+    paths: [Paths; LIT_SHIFTS],
     shifts: usize,
 }
 
@@ -114,7 +119,7 @@ impl HuangPoint {
         let section = Section::new(bsdf.params.aspect, major);
         let azimuth = Vec2::new(wo.y, wo.z).try_normalize().unwrap_or(Vec2::X);
         let sin_to = wo.x.clamp(-1.0, 1.0);
-        let mut paths = [Paths::NONE; FAR_SHIFTS];
+        let mut paths = [Paths::NONE; LIT_SHIFTS];
         for (k, p) in paths.iter_mut().enumerate().take(shifts) {
             let x = h + 2.0 * k as f32 / shifts as f32;
             let x = if x > 1.0 { x - 2.0 } else { x };

@@ -298,12 +298,13 @@ impl RefHuang {
         })
     }
 
-    /// f |wi.z| and pdf of the near point at h seen from wo, or of the far one (the mean
-    /// over the offsets h and h + 1, wrapped, formed in f32 as the crate forms them), the
-    /// section's major axis along the unit (y, z) direction `major`.
+    /// f |wi.z| and pdf of the point of `shifts` offsets at h seen from wo: the near one
+    /// (1) or a far one (the mean over the offsets h + 2k / shifts, wrapped, formed in f32
+    /// as the crate forms them), the section's major axis along the unit (y, z) direction
+    /// `major`.
     pub fn eval(
         &self,
-        far: bool,
+        shifts: usize,
         h: f32,
         wo: V3,
         wi: V3,
@@ -312,7 +313,6 @@ impl RefHuang {
     ) -> (V3, f64) {
         let model = Model { major, ..self.0 };
         let residual = mp(4.0 * model.a, wi[0], wo[0]) / (2.0 * PI);
-        let shifts = if far { 2 } else { 1 };
         let (mut f, mut pdf) = ([0.0; 3], 0.0);
         for k in 0..shifts {
             let x = f64::from(h + 2.0 * k as f32 / shifts as f32);

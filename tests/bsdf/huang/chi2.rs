@@ -24,7 +24,8 @@ struct Config {
     aspect: f32,
     eta: f32,
     alpha: f32,
-    far: bool,
+    /// Offsets of the point (`point`).
+    shifts: usize,
     theta_o: f64,
     phi_o: f64,
     h: f32,
@@ -50,7 +51,7 @@ fn configs() -> Vec<Config> {
                         aspect,
                         eta,
                         alpha,
-                        far: i % 3 == 1,
+                        shifts: [1, 2, 4][i % 3],
                         theta_o,
                         phi_o,
                         h,
@@ -76,7 +77,7 @@ fn huang_sampling_matches_pdf_chi_square() {
         let wo = v3(dir_deg(c.theta_o, c.phi_o));
         let p = point(
             &b,
-            c.far,
+            c.shifts,
             c.h,
             wo,
             Vec2::new(co, s),

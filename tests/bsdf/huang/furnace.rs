@@ -36,7 +36,7 @@ fn huang_white_furnace() {
             let jitter = [g.random(), g.random()];
             let p = point(
                 &b,
-                false,
+                1,
                 g.random_range(-1.0..1.0),
                 wo,
                 Vec2::from_angle(turn),
@@ -71,51 +71,55 @@ fn huang_sample_weights_integrate_eval() {
     };
     let gl = gauss_legendre(4);
     let cases = [
-        (0.2f32, 1.0f32, 2.0f32, false, 0.3f32, 10.0f32),
-        (0.4, 0.6, -4.0, true, -0.5, 70.0),
-        (0.15, 0.75, 6.0, false, 0.85, -30.0),
+        (0.2f32, 1.0f32, 2.0f32, 1, 0.3f32, 10.0f32),
+        (0.4, 0.6, -4.0, 2, -0.5, 70.0),
+        (0.15, 0.75, 6.0, 1, 0.85, -30.0),
+        (0.3, 0.65, 2.0, 4, 0.1, -60.0),
     ];
-    let results = par_map(&cases, |&(roughness, aspect, alpha, far, h, theta_deg)| {
-        let b = huang([0.2, 0.4, 0.8], 1.55, roughness, aspect, alpha);
-        let (s, c) = theta_deg.to_radians().sin_cos();
-        let p = point(
-            &b,
-            far,
-            h,
-            Vec3::new(s, 0.0, c),
-            Vec2::from_angle(0.7),
-            [0.2, 0.9],
-        );
-        let quad: f64 = grid
-            .integrate(
-                |w| {
-                    let e = p.eval(v3(w));
-                    f64::from(e.f.element_sum() / 3.0) * w[2].abs()
-                },
-                &[],
-                &[],
-                0.03,
-                &gl,
-            )
-            .iter()
-            .sum();
-        let mut g = rng(3);
-        let n = 400_000;
-        let (mut mc, mut mc2) = (0.0f64, 0.0f64);
-        for _ in 0..n {
-            if let Some(s) = p.sample(random_u(&mut g)) {
-                let w = f64::from((s.f * s.wi.z.abs() / s.pdf).element_sum() / 3.0);
-                mc += w;
-                mc2 += w * w;
+    let results = par_map(
+        &cases,
+        |&(roughness, aspect, alpha, shifts, h, theta_deg)| {
+            let b = huang([0.2, 0.4, 0.8], 1.55, roughness, aspect, alpha);
+            let (s, c) = theta_deg.to_radians().sin_cos();
+            let p = point(
+                &b,
+                shifts,
+                h,
+                Vec3::new(s, 0.0, c),
+                Vec2::from_angle(0.7),
+                [0.2, 0.9],
+            );
+            let quad: f64 = grid
+                .integrate(
+                    |w| {
+                        let e = p.eval(v3(w));
+                        f64::from(e.f.element_sum() / 3.0) * w[2].abs()
+                    },
+                    &[],
+                    &[],
+                    0.03,
+                    &gl,
+                )
+                .iter()
+                .sum();
+            let mut g = rng(3);
+            let n = 400_000;
+            let (mut mc, mut mc2) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                if let Some(s) = p.sample(random_u(&mut g)) {
+                    let w = f64::from((s.f * s.wi.z.abs() / s.pdf).element_sum() / 3.0);
+                    mc += w;
+                    mc2 += w * w;
+                }
             }
-        }
-        let mean = mc / n as f64;
-        (
-            quad,
-            mean,
-            ((mc2 / n as f64 - mean * mean) / n as f64).sqrt(),
-        )
-    });
+            let mean = mc / n as f64;
+            (
+                quad,
+                mean,
+                ((mc2 / n as f64 - mean * mean) / n as f64).sqrt(),
+            )
+        },
+    );
     for ((quad, mc, se), case) in results.iter().zip(&cases) {
         println!("{case:?}: quadrature {quad:.5}, sampled {mc:.5} +- {se:.5}");
         assert!(

@@ -21,18 +21,20 @@ pub fn huang(sigma_a: [f32; 3], eta: f32, roughness: f32, aspect: f32, alpha: f3
     HuangBsdf::new(&p).unwrap_or_else(|e| panic!("HuangBsdf::new({p:?}): {e}"))
 }
 
-/// The near or far point.
+/// The point of `shifts` offsets: 1 the near field, 2 the far field, 4 the far field
+/// that weighs sampled lights.
 pub fn point(
     b: &HuangBsdf,
-    far: bool,
+    shifts: usize,
     h: f32,
     wo: Vec3,
     major: Vec2,
     jitter: [f32; 2],
 ) -> HuangPoint {
-    if far {
-        b.far(h, wo, major, jitter)
-    } else {
-        b.near(h, wo, major, jitter)
+    match shifts {
+        1 => b.near(h, wo, major, jitter),
+        2 => b.far(h, wo, major, jitter),
+        4 => b.far_lit(h, wo, major, jitter),
+        _ => panic!("no Huang point of {shifts} offsets"),
     }
 }

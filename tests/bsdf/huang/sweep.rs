@@ -63,7 +63,7 @@ fn huang_sweep_is_finite() {
             1 => [0.0, 0.99999994],
             _ => [g.random(), g.random()],
         };
-        let p = point(&b, g.random(), h, wo, major, jitter);
+        let p = point(&b, [1, 2, 4][g.random_range(0..3)], h, wo, major, jitter);
         let mut wis = vec![wo, -wo, random_dir(&mut g), random_dir(&mut g)];
         if let Some(s) = p.sample(random_u(&mut g)) {
             assert!(

@@ -276,8 +276,8 @@ int main(void) {
     ROW(BAD, "major = [0, 0, 0]: lies along", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, zero3, jit, 0, &hpt));
     ROW(BAD, "major = [NaN, 0, 1]: must be finite", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, nan3, jit, 0, &hpt));
     ROW(BAD, "jitter[1] = 1: must be in [0, 1)", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit_one, 0, &hpt));
-    ROW(BAD, "field = 2: must be HT_HUANG_NEAR (0) or HT_HUANG_FAR (1)",
-        ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit, 2, &hpt));
+    ROW(BAD, "field = 3: must be HT_HUANG_NEAR (0), HT_HUANG_FAR (1) or HT_HUANG_FAR_LIT (2)",
+        ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, up, jit, 3, &hpt));
     ROW(BAD, "not aligned to 4", ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, odd, jit, 0, &hpt));
     ROW(BAD, "point and major overlap",
         ht_huang_point_at_hit(huang, x, org, d, axis, 1.0f, (const float *)hpt.opaque, jit, 0, &hpt));

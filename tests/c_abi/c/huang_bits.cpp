@@ -74,7 +74,7 @@ int main(int argc, char **argv) {
         const float *wo = c + 8, *wi = c + 11, *major = c + 17;
         const hairtrace::Vec3 u{c[14], c[15], c[16]};
         const hairtrace::Jitter jitter{c[20], c[21]};
-        const HtHuangField field = c[22] > 0.5f ? HT_HUANG_FAR : HT_HUANG_NEAR;
+        const HtHuangField field = c[22] > 0.67f ? HT_HUANG_FAR_LIT : c[22] > 0.33f ? HT_HUANG_FAR : HT_HUANG_NEAR;
         const hairtrace::HuangMaterial material(params);
         const hairtrace::HuangPoint point =
             hairtrace::HuangPoint::world(material, frame, wo, major, jitter, field);

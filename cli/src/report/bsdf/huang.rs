@@ -112,18 +112,29 @@ const CHIANG: Model = Model {
 const NEAR: Model = Model {
     name: "Huang near",
     calls: ["HuangBsdf::near", "HuangPoint::eval", "HuangPoint::sample"],
-    reference: |s, x, wi| huang_reference(s, x, wi, false),
+    reference: |s, x, wi| huang_reference(s, x, wi, 1),
 };
 
 const FAR: Model = Model {
     name: "Huang far",
     calls: ["HuangBsdf::far", "HuangPoint::eval", "HuangPoint::sample"],
-    reference: |s, x, wi| huang_reference(s, x, wi, true),
+    reference: |s, x, wi| huang_reference(s, x, wi, 2),
 };
 
-fn huang_reference(s: &Set, x: &Input, wi: Vec3, far: bool) -> ([f64; 3], f64) {
+const FAR_LIT: Model = Model {
+    name: "Huang far, lit",
+    calls: [
+        "HuangBsdf::far_lit",
+        "HuangPoint::eval",
+        "HuangPoint::sample",
+    ],
+    reference: |s, x, wi| huang_reference(s, x, wi, 4),
+};
+
+/// The reference of the Huang point of `shifts` offsets.
+fn huang_reference(s: &Set, x: &Input, wi: Vec3, shifts: usize) -> ([f64; 3], f64) {
     let major = x.major.to_array().map(f64::from);
-    (s.reference).eval(far, x.at.h, d3(x.at.wo), d3(wi), major, x.jitter)
+    (s.reference).eval(shifts, x.at.h, d3(x.at.wo), d3(wi), major, x.jitter)
 }
 
 /// One model's figures: ns per point built, per eval and per sample, and the relative
@@ -233,7 +244,7 @@ fn pooled([f, pdf]: &[Errors; 2]) -> (f64, f64) {
 }
 
 /// Progress steps of [`part`]: the inputs, then each model.
-pub const STEPS: u64 = 4;
+pub const STEPS: u64 = 5;
 
 /// The Huang part's text, table and plot; `reps` rounds of timing as the Chiang table's.
 pub fn part(ctx: &Context, reps: usize) -> Result<String> {
@@ -254,6 +265,9 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
         }),
         measure(ctx, &sets, reps, FAR, |s, x| {
             s.huang.far(x.at.h, x.at.wo, x.major, x.jitter)
+        }),
+        measure(ctx, &sets, reps, FAR_LIT, |s, x| {
+            s.huang.far_lit(x.at.h, x.at.wo, x.major, x.jitter)
         }),
     ];
     let mut rows = Vec::new();
@@ -311,7 +325,8 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
         "### The Huang model beside Chiang\n\n\
          The Huang model's points (elliptical fibres, docs/conventions.md, section 4b), \
          near field (`HuangBsdf::near`, the fibre at one offset h) and far field \
-         (`HuangBsdf::far`, averaged over two offsets across it), and a Chiang point \
+         (`HuangBsdf::far`, averaged over two offsets across it; `HuangBsdf::far_lit`, \
+         over four, where a renderer also weighs sampled lights), and a Chiang point \
          (`HairBsdf::at`) on the same inputs: {} random parameter sets over the valid \
          ranges (roughness 0.01 to 1 log-uniform, both Chiang roughnesses the Huang one; \
          aspect 0.05 to 1; eta 1.05 to 3; tilt up to 20 degrees; no or log-uniform \
@@ -325,11 +340,12 @@ pub fn part(ctx: &Context, reps: usize) -> Result<String> {
          evaluates the point at the direction it drew, but a draw lost to total internal \
          reflection returns before that, so a sample can cost less than an eval.\n\n\
          Here a Huang point's eval costs {}x a Chiang point's (near field) and {}x (far \
-         field); its sample {}x and {}x Chiang's sample; building a near point costs as \
-         much as {} Chiang point evals, a far one {}.\n\n{}\n{}\n\n{}",
+         field; {}x with four offsets); its sample {}x and {}x Chiang's sample; building \
+         a near point costs as much as {} Chiang point evals, a far one {}.\n\n{}\n{}\n\n{}",
         sets.len(),
         ratio(1, 1),
         ratio(2, 1),
+        ratio(3, 1),
         num(measured[1].1.ns[2] / measured[0].1.ns[2], 3),
         num(measured[2].1.ns[2] / measured[0].1.ns[2], 3),
         ratio(1, 0),

@@ -1588,9 +1588,9 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
  * variation; `roughness_variation` spreads `roughness`), and writes its id, counted with
  * the other materials, to `material_id`. It goes on curves as a Chiang hair material
  * does. The renderer orients each section by world up made perpendicular to the tangent
- * (world +x where the tangent is vertical), takes the far field at bounces and on strands
- * no wider than their pixel, and the near field elsewhere (docs/conventions.md, section
- * 4b). A groom's colours (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s
+ * (world +x where the tangent is vertical), takes the far field on strands no wider than
+ * their pixel and, where lights are sampled, at bounces too (at four offsets there), and
+ * the near field elsewhere (docs/conventions.md, section 4b). A groom's colours (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s
  * beta_n, as a scene file's `model = "huang"` material inverts them.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);

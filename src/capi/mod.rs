@@ -24,6 +24,9 @@ mod huang_tests;
 pub mod lights;
 #[cfg(feature = "render")]
 pub mod materials;
+// After `huang` and `materials`, which it joins.
+#[cfg(feature = "render")]
+pub mod huang_strand;
 #[cfg(all(test, feature = "render"))]
 mod scene_tests;
 #[cfg(feature = "render")]

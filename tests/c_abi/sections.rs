@@ -18,7 +18,7 @@ const SECTIONS: [(&str, &[&str]); 7] = [
     ("The prepared BSDF and path vertices", &["prepared"]),
     (
         "The Huang model of elliptical fibres: parameters, prepared BSDF, path vertices",
-        &["huang"],
+        &["huang", "huang_strand"],
     ),
     (
         "Devices and scenes: geometry, materials, lights",

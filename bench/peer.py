@@ -377,6 +377,9 @@ def main():
     global HAIRTRACE
     os.makedirs(args.work, exist_ok=True)
     own = os.path.join(args.work, "hairtrace")
+    if not os.path.isfile(HAIRTRACE):
+        sys.exit(f"bench: no hairtrace binary at {HAIRTRACE} (set HT_HAIRTRACE, or run "
+                 "cargo build --release)")
     if os.path.abspath(HAIRTRACE) != own:
         # A hard link keeps the file a build unlinks (the linker writes a new one).
         try:

@@ -677,16 +677,16 @@ typedef struct HT_ALIGNED(16) HtHuangPoint {
 #define HT_HUANG_NEAR 0
 
 /**
- * The far field: the fibre averaged across its width, stratified from the hit's h, for a
- * strand no wider than its pixel and at bounces (unbiased when h is uniform over the
- * width).
+ * The far field: the fibre averaged across its width at two offsets stratified from the
+ * hit's h, for a strand no wider than its pixel where no light is sampled (unbiased when
+ * h is uniform over the width, as at bounces).
  */
 #define HT_HUANG_FAR 1
 
 /**
- * The far field at more offsets across the fibre, for a point that also weighs sampled
- * lights (next-event estimation): its values toward the lights are less noisy, as the
- * renderer's own points where it samples lights (docs/conventions.md, section 4b).
+ * The far field at four offsets, for a thin strand's or a bounce's point that also weighs
+ * sampled lights (next-event estimation): its values toward the lights are less noisy.
+ * The renderer's own rule (docs/conventions.md, section 4b).
  */
 #define HT_HUANG_FAR_LIT 2
 
@@ -1590,8 +1590,9 @@ enum HtStatus ht_scene_add_hair_material_varied(struct HtScene *scene,
  * does. The renderer orients each section by world up made perpendicular to the tangent
  * (world +x where the tangent is vertical), takes the far field on strands no wider than
  * their pixel and, where lights are sampled, at bounces too (at four offsets there), and
- * the near field elsewhere (docs/conventions.md, section 4b). A groom's colours (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s
- * beta_n, as a scene file's `model = "huang"` material inverts them.
+ * the near field elsewhere (docs/conventions.md, section 4b). A groom's colours
+ * (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s beta_n, as a scene
+ * file's `model = "huang"` material inverts them.
  *
  * Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
  * `HT_ERR_INVALID_ARG` (a parameter or variation out of range, naming it; `material_id`

@@ -76,13 +76,13 @@ pub extern "C" fn ht_huang_params_default() -> HtHuangParams {
 pub type HtHuangField = u32;
 /// The near field: the fibre at the hit's h, for a fibre wider than the pixel that sees it.
 pub const HT_HUANG_NEAR: HtHuangField = 0;
-/// The far field: the fibre averaged across its width, stratified from the hit's h, for a
-/// strand no wider than its pixel and at bounces (unbiased when h is uniform over the
-/// width).
+/// The far field: the fibre averaged across its width at two offsets stratified from the
+/// hit's h, for a strand no wider than its pixel where no light is sampled (unbiased when
+/// h is uniform over the width, as at bounces).
 pub const HT_HUANG_FAR: HtHuangField = 1;
-/// The far field at more offsets across the fibre, for a point that also weighs sampled
-/// lights (next-event estimation): its values toward the lights are less noisy, as the
-/// renderer's own points where it samples lights (docs/conventions.md, section 4b).
+/// The far field at four offsets, for a thin strand's or a bounce's point that also weighs
+/// sampled lights (next-event estimation): its values toward the lights are less noisy.
+/// The renderer's own rule (docs/conventions.md, section 4b).
 pub const HT_HUANG_FAR_LIT: HtHuangField = 2;
 
 /// The Huang model prepared for one parameter set. Create with `ht_huang_prepare`, release

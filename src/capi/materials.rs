@@ -97,8 +97,9 @@ pub unsafe extern "C" fn ht_scene_add_hair_material_varied(
 /// does. The renderer orients each section by world up made perpendicular to the tangent
 /// (world +x where the tangent is vertical), takes the far field on strands no wider than
 /// their pixel and, where lights are sampled, at bounces too (at four offsets there), and
-/// the near field elsewhere (docs/conventions.md, section 4b). A groom's colours (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s
-/// beta_n, as a scene file's `model = "huang"` material inverts them.
+/// the near field elsewhere (docs/conventions.md, section 4b). A groom's colours
+/// (`use_vertex_colors`) are inverted at `ht_hair_params_default`'s beta_n, as a scene
+/// file's `model = "huang"` material inverts them.
 ///
 /// Statuses: `HT_ERR_NULL_ARG` (`scene`, `params` or `material_id` NULL);
 /// `HT_ERR_INVALID_ARG` (a parameter or variation out of range, naming it; `material_id`

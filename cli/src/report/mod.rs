@@ -42,8 +42,8 @@ pub struct Context {
     pub scenes: PathBuf,
     pub peers: Option<PathBuf>,
     pub machine: Machine,
-    /// The report's own copy of this binary, which sections that render in a process of
-    /// their own run (`OwnBinary`).
+    /// The report's own link to (or copy of) this binary, which sections that render in a
+    /// process of their own run (`OwnBinary`).
     pub hairtrace: PathBuf,
     bar: ProgressBar,
 }
@@ -115,7 +115,7 @@ pub fn run(options: &ReportOptions) -> Result<()> {
     std::fs::create_dir_all(&options.output).map_err(|e| Error::io(&options.output, e))?;
     plots::load_font()?;
     let start = Instant::now();
-    let binary = OwnBinary::copy()?;
+    let binary = OwnBinary::keep()?;
     let mut ctx = Context {
         quick: options.quick,
         output: options.output.clone(),
@@ -182,7 +182,7 @@ pub fn run(options: &ReportOptions) -> Result<()> {
 struct OwnBinary(PathBuf);
 
 impl OwnBinary {
-    fn copy() -> Result<Self> {
+    fn keep() -> Result<Self> {
         let exe =
             std::env::current_exe().map_err(|e| Error::io(Path::new("current executable"), e))?;
         let dir = std::env::temp_dir().join(format!("hairtrace-report-{}", std::process::id()));

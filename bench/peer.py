@@ -25,7 +25,8 @@ bench/scenes/:
    sampling off and on at Blender's default threshold (`CYCLES_ADAPTIVE`, the spp then
    its most samples); hairtrace is compared with the better of the two on each scene, and
    the table says which. hairtrace renders with the scene's own settings (its
-   `allocation` among them); `--allocation` renders it once more with that allocation.
+   `allocation` among them); `--allocation` renders it once more with that allocation, and
+   `--set NAME=VALUE` (repeatable) once more with those settings.
 4. `--time-to-rmse`: each renderer's time to one RMSE, hairtrace stopping by its noise
    target, Cycles by its adaptive threshold (`time_to_rmse`), with hairtrace's estimated
    noise beside the measured one.
@@ -95,9 +96,11 @@ class Scene:
         os.makedirs(self.work, exist_ok=True)
         run([HAIRTRACE, "export", self.path, "-o", os.path.join(self.work, "peer")])
 
-    def hairtrace(self, spp, seed, out, allocation=None, noise_target=None):
+    def hairtrace(self, spp, seed, out, allocation=None, noise_target=None, settings=()):
         stats = out + ".json"
         extra = ["--allocation", allocation] if allocation else []
+        for setting in settings:
+            extra += ["--set", setting]
         if noise_target:
             extra += ["--noise-target", repr(noise_target)]
         start = time.perf_counter()
@@ -150,11 +153,14 @@ class Reference:
         return math.sqrt(max(0.0, (ea + eb) / 2 - self.mse_ab / 4)), mean
 
 
-def measure(scene, ref, repeats, allocation, log):
+def measure(scene, ref, repeats, allocation, settings, log):
     renderers = {"hairtrace": scene.hairtrace, "Cycles": scene.cycles}
     if allocation:
         renderers[f"hairtrace allocation {allocation}"] = (
             lambda spp, seed, out: scene.hairtrace(spp, seed, out, allocation))
+    if settings:
+        renderers["hairtrace " + " ".join(settings)] = (
+            lambda spp, seed, out: scene.hairtrace(spp, seed, out, settings=settings))
     renderers["Cycles adaptive"] = (
         lambda spp, seed, out: scene.cycles(spp, seed, out, CYCLES_ADAPTIVE))
     runs = {name: [] for name in renderers}
@@ -372,6 +378,8 @@ def main():
                              "target, Cycles by its adaptive threshold")
     parser.add_argument("--allocation", choices=["uniform", "noise"],
                         help="also render hairtrace with this allocation")
+    parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                        help="also render hairtrace with this setting (repeatable: all at once)")
     args = parser.parse_args()
     names = select_scenes(args.scenes, args.exclude)
     global HAIRTRACE
@@ -399,7 +407,7 @@ def main():
         log(f"{name}:")
         scene = Scene(name, args.work, args)
         ref = Reference(scene, log)
-        result = measure(scene, ref, args.repeats, args.allocation, log)
+        result = measure(scene, ref, args.repeats, args.allocation, args.set, log)
         if args.time_to_rmse:
             result["time_to_rmse"] = time_to_rmse(scene, ref, result, args.repeats, log)
         results.append(result)

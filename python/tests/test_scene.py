@@ -152,6 +152,7 @@ def strands(**changes):
         (lambda s: s.set(spp=0), ValueError, "spp = 0: must be >= 1"),
         (lambda s: s.set(spp="many"), ValueError, "spp = many: must be an integer"),
         (lambda s: s.set(filter_radius=float("nan")), ValueError, "filter_radius = NaN"),
+        (lambda s: s.set(camera_rays=17), ValueError, "camera_rays = 17: must be [1, 16]"),
         (lambda s: s.set(sp=4), ValueError, "sp: not a render setting (the settings: width"),
         (lambda s: s.set(spp={}), TypeError, "spp: must be a number"),
         (lambda s: s.render(filter="gauss"), ValueError, "filter = gauss: must be tent | box"),

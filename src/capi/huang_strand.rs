@@ -8,6 +8,7 @@ use super::materials::{HtHairVariation, huang_varied_material};
 use super::prepared::strand_init;
 use super::{HtStatus, boundary};
 use crate::bsdf::HuangBsdf;
+use crate::error::invalid_arg;
 
 /// `ht_huang_point_init_world` for one strand of a groom whose parameters vary as a scene's
 /// Huang material varies them (`ht_scene_add_huang_material`): the parameters of
@@ -58,9 +59,10 @@ pub unsafe extern "C" fn ht_huang_point_init_strand(
         let material = huang_varied_material(given, &v)?;
         material.check_variation()?;
         let base = material.base_params()?;
-        let Some(params) = material.huang_varied(base, strand, s, groom)? else {
-            unreachable!("a material of the Huang model")
-        };
+        // `huang_varied_material` made a Huang material, which always varies into one.
+        let params = material
+            .huang_varied(base, strand, s, groom)?
+            .ok_or_else(|| invalid_arg!("the prepared BSDF is not of the Huang model"))?;
         let bsdf = HuangBsdf::new(&params)?;
         // SAFETY: non-NULL, aligned and clear of the inputs (checked).
         unsafe { fill_huang(point, &bsdf, framed, (major, jitter, field)) }

@@ -7,6 +7,7 @@
 
 use glam::Vec3;
 
+use super::camera_rays::MAX_CAMERA_RAYS;
 use super::film::FirstHit;
 use super::sampler::PixelSampler;
 use super::settings::{LightOffsets, PathSettings, Roulette, Strategy};
@@ -145,6 +146,61 @@ impl World {
         Ok(())
     }
 
+    /// One camera sample traced as `rays`, spread over its pixel (`super::camera_rays`):
+    /// the rays that escape add what they see, and the path goes on from the ray that
+    /// `choice` (in [0, 1)) picks among those that hit, weighted by their number. Its first
+    /// hit, for the AOVs, is the first ray's.
+    pub fn camera_sample(
+        &self,
+        rays: &[Ray],
+        choice: f32,
+        settings: &PathSettings,
+        aovs: bool,
+        pixel_spread: f32,
+        sampler: &mut PixelSampler,
+    ) -> CameraSample {
+        if let [ray] = rays {
+            return self.radiance(*ray, settings, aovs, pixel_spread, sampler);
+        }
+        let mut seen = Vec3::ZERO;
+        let mut hit = [0; MAX_CAMERA_RAYS];
+        let mut hits = 0;
+        for (i, ray) in rays.iter().enumerate() {
+            // Which rays hit is all a split needs of most of them: occlusion queries.
+            if self.tracer.occluded_spawned(&SpawnedRay::from(*ray)) {
+                hit[hits] = i;
+                hits += 1;
+            } else {
+                seen += self.emission(
+                    ray.org,
+                    ray.dir,
+                    f32::INFINITY,
+                    Came::Camera,
+                    settings.strategy,
+                );
+            }
+        }
+        let count = rays.len() as f32;
+        let mut sample = CameraSample {
+            radiance: seen / count,
+            first: None,
+            rays: rays.len() as u32,
+        };
+        if hits == 0 {
+            return sample;
+        }
+        let picked = hit[((choice * hits as f32) as usize).min(hits - 1)];
+        let path = self.radiance(rays[picked], settings, aovs, pixel_spread, sampler);
+        sample.radiance += path.radiance * (hits as f32 / count);
+        sample.rays += path.rays;
+        sample.first = match picked {
+            0 => path.first,
+            _ if aovs && hit[0] == 0 => self.first_hit_of(rays[0]),
+            _ => None,
+        };
+        sample
+    }
+
     /// Radiance arriving along the camera ray `camera_ray` (at its time, a fraction of the
     /// shutter, which every ray of the path keeps), what its first hit reports for
     /// the AOVs (None when it escapes or when `aovs` is false), and the number of rays
@@ -161,15 +217,12 @@ impl World {
         aovs: bool,
         pixel_spread: f32,
         sampler: &mut PixelSampler,
-    ) -> (Vec3, Option<FirstHit>, u32) {
+    ) -> CameraSample {
         let mut first = None;
         let mut rays = 0;
         let mut l = Vec3::ZERO;
         let mut beta = Vec3::ONE;
-        let mut ray = SpawnedRay {
-            ray: camera_ray,
-            exclude: None,
-        };
+        let mut ray = SpawnedRay::from(camera_ray);
         // How `ray` was made, for MIS on the emission it finds.
         let mut came = Came::Camera;
         // `events` scattering events precede the ray traced in this iteration.
@@ -225,16 +278,7 @@ impl World {
                     // averaged across the fibre serves.
                     let thin = events > 0 || 2.0 * h.radius <= pixel_spread * h.t;
                     if let Some(b) = m.huang_at(h.strand.id, h.s, h.absorption) {
-                        // Huang's far field where lights are sampled (more offsets: each
-                        // light sample's value is the point's estimate of the BSDF), and
-                        // at camera hits; a bounce that samples no light keeps its own h,
-                        // already uniform across the fibre, where offsets cost more than
-                        // the noise they save (docs/measurements.md, "The Huang model").
-                        let field: HuangField = match (thin, sample_light) {
-                            (true, true) => HuangBsdf::far_lit,
-                            (true, false) if events == 0 => HuangBsdf::far,
-                            _ => HuangBsdf::near,
-                        };
+                        let field = huang_field(thin, sample_light, events);
                         Shading::huang(h, &b, wo_world, field, jitter(u_rr, u_lobe, events))
                     } else {
                         varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
@@ -270,7 +314,19 @@ impl World {
                 pdf: if mis { shading.pdf(s.local) } else { 0.0 },
             };
         }
-        (l, first, rays)
+        CameraSample {
+            radiance: l,
+            first,
+            rays,
+        }
+    }
+
+    /// What the camera ray `ray` reports for the AOVs: its first hit's, None if it
+    /// escapes.
+    fn first_hit_of(&self, ray: Ray) -> Option<FirstHit> {
+        let ray = SpawnedRay::from(ray);
+        let found = self.tracer.find_spawned(&ray)?;
+        Some(self.first_hit(&self.tracer.record_spawned(&ray, &found)?))
     }
 
     fn first_hit(&self, hit: &Hit) -> FirstHit {
@@ -400,6 +456,17 @@ impl World {
     }
 }
 
+/// What one camera sample brings its pixel.
+#[derive(Debug, Clone, Copy)]
+pub struct CameraSample {
+    pub radiance: Vec3,
+    /// What its first hit reports for the AOVs (None where it escaped, or where no AOV is
+    /// asked for).
+    pub first: Option<FirstHit>,
+    /// Rays traced.
+    pub rays: u32,
+}
+
 /// The numbers of one light sample: which light, where on it, and the shadow-ray
 /// roulette.
 struct LightU {
@@ -457,6 +524,20 @@ enum Point<'a> {
     /// Boxed: a far-field point holds the paths of several offsets.
     Huang(Box<HuangPoint>),
     Diffuse(DiffusePoint),
+}
+
+/// The Huang model's field at a hair vertex: far where lights are sampled (more offsets:
+/// each light sample's value is the point's estimate of the BSDF) and at camera hits; a
+/// bounce that samples no light keeps its own h, already uniform across the fibre, where
+/// offsets cost more than the noise they save; near on a strand wider than its pixel
+/// (`thin` false), whose highlights the image resolves (docs/measurements.md, "The Huang
+/// model").
+pub(crate) fn huang_field(thin: bool, sample_light: bool, events: u32) -> HuangField {
+    match (thin, sample_light) {
+        (true, true) => HuangBsdf::far_lit,
+        (true, false) if events == 0 => HuangBsdf::far,
+        _ => HuangBsdf::near,
+    }
 }
 
 /// The Huang model's jitter at a hit (`HuangBsdf::near`): two numbers hashed from the

@@ -3,6 +3,7 @@
 //! camera, the lights and the traceable scene.
 
 pub(crate) mod allocation;
+pub(crate) mod camera_rays;
 pub(crate) mod film;
 pub(crate) mod integrator;
 pub(crate) mod progress;

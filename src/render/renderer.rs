@@ -3,7 +3,10 @@
 use std::sync::OnceLock;
 use std::time::Instant;
 
+use glam::Vec3;
+
 use super::allocation;
+use super::camera_rays::{self, MAX_CAMERA_RAYS};
 use super::film::{Aovs, Film, Keep, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
@@ -197,6 +200,9 @@ pub fn render(
     let mut shares: Option<allocation::Shares> = None;
     let filter = settings.pixel_filter()?;
     let pixel_spread = camera.pixel_spread(height);
+    let shifts = camera_rays::shifts(settings.camera_rays);
+    // In [1, MAX_CAMERA_RAYS]: `validate` refuses other counts.
+    let shifts = &shifts[..settings.camera_rays as usize];
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),
@@ -253,8 +259,7 @@ pub fn render(
                             return;
                         }
                         let mut sampler = PixelSampler::new(settings.seed, pixel, index);
-                        let offset = filter.sample(sampler.next_2d());
-                        let image_point = ndc(width, height, pixel, offset);
+                        let [ux, uy, choice, _] = sampler.next_4d();
                         let lens = if camera.has_lens() {
                             sampler.next_2d()
                         } else {
@@ -262,20 +267,26 @@ pub fn render(
                             [0.5; 2]
                         };
                         let time = if motion_blur { sampler.time() } else { 0.0 };
-                        let (org, dir) = camera.ray_at(image_point, lens, time);
-                        let ray = Ray {
-                            time,
-                            ..Ray::new(org, dir)
-                        };
-                        let (radiance, first, traced) = world.radiance(
-                            ray,
+                        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); MAX_CAMERA_RAYS];
+                        for (ray, shift) in rays.iter_mut().zip(shifts) {
+                            let u = [(ux + shift[0]).fract(), (uy + shift[1]).fract()];
+                            let image_point = ndc(width, height, pixel, filter.sample(u));
+                            let (org, dir) = camera.ray_at(image_point, lens, time);
+                            *ray = Ray {
+                                time,
+                                ..Ray::new(org, dir)
+                            };
+                        }
+                        let sample = world.camera_sample(
+                            &rays[..shifts.len()],
+                            choice,
                             &settings.path,
                             aovs.any(),
                             pixel_spread,
                             &mut sampler,
                         );
-                        acc.add(radiance, first.as_ref());
-                        acc.add_rays(traced);
+                        acc.add(sample.radiance, sample.first.as_ref());
+                        acc.add_rays(sample.rays);
                     }
                     acc.end_pass();
                 }

@@ -9,6 +9,7 @@
 
 use std::fmt;
 
+use super::camera_rays::MAX_CAMERA_RAYS;
 use super::film::PixelFilter;
 use crate::embree::{Device, Isa, MAX_TIME_STEPS};
 use crate::error::{Error, Result, invalid_arg};
@@ -338,6 +339,12 @@ settings! {
         /// Render only the pixels [x0, x1) x [y0, y1) of the full frame, exactly as the full
         /// render has them; none: the full frame.
         crop: Option<[u32; 4]> = None, Range::Any, Render;
+        /// Rays per camera sample, spread over its pixel: those that escape add what they
+        /// see (the sky) exactly, and the path goes on from one of the others, picked at
+        /// random and weighted by their number. The same image in expectation; less noise
+        /// where thin strands show a bright sky between them, more cost elsewhere
+        /// (docs/measurements.md, "Camera rays"). 1: one ray, the whole path.
+        camera_rays: u32 = 1, Range::Closed(1.0, MAX_CAMERA_RAYS as f64), Render;
         /// Pixel filter: tent (thin strands alias under a box) or box (one pixel, as
         /// renderers that use it).
         filter: Filter = Filter::Tent, Range::Any, Render;
@@ -637,6 +644,8 @@ mod tests {
             ("clamp_indirect", "0", "must be > 0"),
             ("roulette", "cube", "must be sqrt | throughput"),
             ("filter_radius", "0", "must be (0, 8]"),
+            ("camera_rays", "0", "must be [1, 16]"),
+            ("camera_rays", "17", "must be [1, 16]"),
             ("sp", "4", "sp: not a render setting"),
         ] {
             let before = r;

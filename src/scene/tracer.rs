@@ -89,6 +89,13 @@ pub struct SpawnedRay {
     pub exclude: Option<Exclude>,
 }
 
+/// A ray that leaves no hit (a camera ray): nothing to exclude.
+impl From<Ray> for SpawnedRay {
+    fn from(ray: Ray) -> Self {
+        SpawnedRay { ray, exclude: None }
+    }
+}
+
 impl SpawnedRay {
     /// Where the ray really starts (Embree's origin lies `tnear` behind it,
     /// [`FLAT_BLIND_RADII`]), and `t` of Embree's (a hit's distance) from there: what a

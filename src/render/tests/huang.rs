@@ -69,3 +69,42 @@ fn huang_white_fur_in_a_white_furnace() {
     println!("huang white fur ball in a white furnace: mean {m:.4}");
     assert!(m > 0.3 && m < 1.01, "{m}");
 }
+
+/// The field each vertex takes (`integrator::huang_field`): far with the lit offsets at
+/// every thin vertex where lights are sampled, far at a thin camera hit where none is,
+/// near at bounces that sample no light and on strands wider than their pixel. Fails if
+/// the rule the measurements chose changes.
+#[test]
+fn each_vertex_takes_the_field_the_measurements_chose() {
+    use crate::bsdf::{HuangBsdf, HuangParams};
+    use crate::render::integrator::huang_field;
+    let bsdf = HuangBsdf::new(&HuangParams::default()).unwrap();
+    let (h, wo, major, jitter) = (
+        0.3,
+        Vec3::new(0.2, 0.5, 0.8).normalize(),
+        glam::Vec2::X,
+        [0.4, 0.7],
+    );
+    let point =
+        |field: crate::bsdf::HuangField| format!("{:?}", field(&bsdf, h, wo, major, jitter));
+    let (near, far, lit) = (
+        point(HuangBsdf::near),
+        point(HuangBsdf::far),
+        point(HuangBsdf::far_lit),
+    );
+    assert!(near != far && far != lit && near != lit);
+    for (thin, lights, events, expected) in [
+        (true, true, 0, &lit),
+        (true, true, 3, &lit),
+        (true, false, 0, &far),
+        (true, false, 1, &near),
+        (false, true, 0, &near),
+        (false, false, 0, &near),
+    ] {
+        let got = point(huang_field(thin, lights, events));
+        assert_eq!(
+            &got, expected,
+            "thin {thin}, lights sampled {lights}, after {events} events"
+        );
+    }
+}

@@ -210,7 +210,7 @@ impl World {
     /// A path of at most `max_depth` scattering events traces up to `max_depth + 1`
     /// closest-hit rays: the last one only looks for emission, so that BSDF sampling
     /// reaches exactly as deep as next-event estimation and MIS stays unbiased at the cap.
-    pub fn radiance(
+    fn radiance(
         &self,
         camera_ray: Ray,
         settings: &PathSettings,

@@ -324,9 +324,7 @@ impl World {
     /// What the camera ray `ray` reports for the AOVs: its first hit's, None if it
     /// escapes.
     fn first_hit_of(&self, ray: Ray) -> Option<FirstHit> {
-        let ray = SpawnedRay::from(ray);
-        let found = self.tracer.find_spawned(&ray)?;
-        Some(self.first_hit(&self.tracer.record_spawned(&ray, &found)?))
+        Some(self.first_hit(&self.tracer.intersect(&ray)?))
     }
 
     fn first_hit(&self, hit: &Hit) -> FirstHit {

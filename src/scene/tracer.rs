@@ -256,8 +256,8 @@ impl Tracer {
         self.scene.heap_bytes() + tables
     }
 
-    /// The closest hit along `ray`, as a full hit record.
-    #[cfg(any(test, feature = "bench-internals"))]
+    /// The closest hit along `ray` (one that leaves no hit: a camera ray), as a full hit
+    /// record.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let hit = self.scene.intersect(ray, None)?;
         self.record(ray, &hit)
@@ -849,10 +849,7 @@ mod tests {
             ..Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z)
         };
         assert!(t.intersect(&hair_only).is_none());
-        assert!(t.occluded_spawned(&SpawnedRay {
-            ray: Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z),
-            exclude: None,
-        }));
+        assert!(t.occluded_spawned(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z).into()));
         let spawned = t.spawn(&hit, Vec3::Z, f32::INFINITY);
         assert!(t.intersect_spawned(&spawned).is_none());
     }

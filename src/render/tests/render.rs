@@ -660,7 +660,8 @@ fn thin_fur_under_the_sky() -> World {
 /// means within 4 standard errors over 64 seeds, and every pixel's mean over 16 seeds
 /// within its noise (the z-scores' RMS near 1: rays that left their pixel, or a weight
 /// off by the hit count, move the fringe's pixels by many times it). With less noise: a
-/// pixel's variance falls by more than 1.5x.
+/// pixel's variance falls by more than 1.5x (what it falls by: docs/measurements.md,
+/// "Camera rays").
 #[test]
 fn camera_samples_of_several_rays_keep_the_image_and_cut_its_noise() {
     let world = thin_fur_under_the_sky();

@@ -221,12 +221,19 @@ fn link_embree(embree: &Embree) {
 }
 
 #[cfg(feature = "render")]
+/// The shim over OpenImageIO as a shared library of its own, which `src/image/shim.rs` opens
+/// at the first image read or write: OpenImageIO's ~260 shared objects cost every process
+/// that links them a quarter second or more at start-up (docs/measurements.md, "Start-up"),
+/// and a host that never touches an image should not map them at all. The library goes into
+/// OUT_DIR, whose path the crate records (`HT_IMAGE_SHIM_BUILT`) for the build tree's own
+/// binaries, and beside the build's binaries (target/<profile>/), where scripts/install and
+/// scripts/python take it from.
 fn build_oiio_shim() {
     let shim = "src/image/oiio_shim.cpp";
     println!("cargo:rerun-if-changed={shim}");
-    // Also emits the link lines for OpenImageIO and OpenImageIO_Util.
     let oiio = pkg_config::Config::new()
         .atleast_version("2.2")
+        .cargo_metadata(false)
         .probe("OpenImageIO")
         .unwrap_or_else(|e| {
             panic!(
@@ -235,11 +242,58 @@ fn build_oiio_shim() {
                  libopenimageio-dev pkg-config`)"
             )
         });
-    // cc links the platform's C++ standard library itself for a C++ build.
-    cc::Build::new()
+    let mut build = cc::Build::new();
+    build
         .cpp(true)
         .std("c++17")
+        .pic(true)
+        // Not the sanitizer cc adds for a build whose Rust code has one (the fuzz build's
+        // ASan): the shim would then need ASan's shared runtime, which a program with
+        // ASan built in refuses to load.
+        .flag("-fno-sanitize=all")
+        .cargo_metadata(false)
         .file(shim)
-        .includes(&oiio.include_paths)
-        .compile("ht_oiio_shim");
+        .includes(&oiio.include_paths);
+    let objects = build.compile_intermediates();
+    let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let name = image_shim_name();
+    let library = out.join(&name);
+    let mut link = build.get_compiler().to_command();
+    link.arg("-shared")
+        .arg(format!("-Wl,-soname,{name}"))
+        // Every symbol resolved now, against OpenImageIO: not at a host's first image.
+        .arg("-Wl,-z,defs")
+        .arg("-o")
+        .arg(&library)
+        .args(&objects);
+    for dir in &oiio.link_paths {
+        link.arg(format!("-L{}", dir.display()));
+    }
+    for lib in &oiio.libs {
+        link.arg(format!("-l{lib}"));
+    }
+    let status = link
+        .status()
+        .unwrap_or_else(|e| panic!("hairtrace: cannot run the linker for {name}: {e}"));
+    assert!(
+        status.success(),
+        "hairtrace: linking {name} failed: {link:?}"
+    );
+    println!("cargo:rustc-env=HT_IMAGE_SHIM_NAME={name}");
+    println!("cargo:rustc-env=HT_IMAGE_SHIM_BUILT={}", library.display());
+    // target/<profile>/ is three levels above OUT_DIR (target/<profile>/build/<pkg>/out).
+    if let Some(profile_dir) = out.ancestors().nth(3) {
+        fs::copy(&library, profile_dir.join(&name))
+            .unwrap_or_else(|e| panic!("hairtrace: cannot copy {name} beside the build: {e}"));
+    }
+}
+
+#[cfg(feature = "render")]
+/// The shim's file name, with the crate's version in it: a library opens only the shim of
+/// its own version (the interface between them is internal and changes freely).
+fn image_shim_name() -> String {
+    format!(
+        "libhairtrace-oiio.so.{}",
+        env::var("CARGO_PKG_VERSION").expect("cargo sets CARGO_PKG_VERSION")
+    )
 }

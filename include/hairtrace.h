@@ -1916,7 +1916,8 @@ enum HtStatus ht_render_with(struct HtScene *scene,
  * top; channels 1 grey, 2 grey + alpha, 3 RGB or 4 RGBA with premultiplied alpha) through
  * OpenImageIO. The extension picks the format: `.exr` stores 32-bit floats as they are;
  * `.png`, `.jpg`, `.tif` store 8-bit sRGB (clamped to [0, 1]). NaN or infinite pixels are
- * refused rather than written.
+ * refused rather than written. The first image call of a process loads OpenImageIO,
+ * through the image shim installed beside the library (docs/c-abi.md, section 10).
  *
  * `pixels_len` is the length of `pixels` in floats and must equal
  * `width * height * channels` (computed without overflow).
@@ -1924,8 +1925,8 @@ enum HtStatus ht_render_with(struct HtScene *scene,
  * Statuses: `HT_ERR_NULL_ARG` (`path` or `pixels` NULL); `HT_ERR_INVALID_ARG` (empty or
  * non-UTF-8 path, a size of 0, channels not in 1..=4, `pixels_len` not the size,
  * `pixels` misaligned, NaN or infinite pixels); `HT_ERR_IMAGE` (an unknown extension, a
- * format that cannot hold the channels, or OpenImageIO could not write the file, e.g.
- * into a folder that does not exist).
+ * format that cannot hold the channels, OpenImageIO could not write the file, e.g.
+ * into a folder that does not exist, or the image shim was not found).
  * Any thread; touches no handle.
  *
  * # Safety

@@ -661,6 +661,9 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     }
     let build_start = std::time::Instant::now();
     let device = Arc::new(description.render.device()?);
+    // After the device: Embree's start loads libraries of its own, which would wait for
+    // the loader while OpenImageIO's load holds it.
+    hairtrace::image::preload_shim();
     let bars = StageBars::default();
     let mut built = description.build_with(device, &bars)?;
     bars.finish();

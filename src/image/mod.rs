@@ -2,15 +2,13 @@
 //! TIFF (sRGB-encoded), and environment maps or reference images come back in.
 //!
 //! OIIO is C++, so `oiio_shim.cpp` wraps the few calls needed in `extern "C"` functions
-//! that catch every exception. Colour handling stays here, in Rust, where it is tested:
+//! that catch every exception; that shim is a library of its own, opened at the first image
+//! read or write (`shim.rs`). Colour handling stays here, in Rust, where it is tested:
 //! OIIO only converts between float and the stored pixel type.
 
 use std::ffi::{CStr, CString, c_char, c_int, c_void};
 
-use ffi::{
-    hairtrace_oiio_attributes, hairtrace_oiio_close, hairtrace_oiio_open, hairtrace_oiio_read,
-    hairtrace_oiio_write,
-};
+use shim::{Shim, shim};
 use std::path::Path;
 
 use crate::error::invalid_arg;
@@ -18,8 +16,10 @@ use crate::{Error, Result};
 
 mod blocks;
 mod compare;
+mod shim;
 pub use blocks::{BlockBias, block_bias};
 pub use compare::{Comparison, compare};
+pub use shim::{preload_shim, shim_path};
 
 /// How samples are stored in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -278,6 +278,7 @@ pub fn write_image(
 
     let c_final = c_path(path)?;
     let cannot = |why: String| Error::Image(format!("cannot write {}: {why}", path.display()));
+    let shim = shim()?;
     let temporary = temporary_beside(path).map_err(|e| cannot(e.to_string()))?;
     let c_temporary = c_path(temporary.path())?;
     let mut err = [0 as c_char; ERR_LEN];
@@ -286,7 +287,7 @@ pub fn write_image(
     // attribute arrays hold `names.len()` live C strings each, and `err` is a writable
     // buffer of ERR_LEN.
     let status = unsafe {
-        hairtrace_oiio_write(
+        (shim.write)(
             c_final.as_ptr(),
             c_temporary.as_ptr(),
             width as c_int,
@@ -366,6 +367,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
     let c_path = c_path(path)?;
     let fail =
         |err: &[c_char]| Error::Image(format!("cannot read {}: {}", path.display(), message(err)));
+    let shim = shim()?;
 
     let mut err = [0 as c_char; ERR_LEN];
     let mut handle: *mut c_void = std::ptr::null_mut();
@@ -375,7 +377,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
     // SAFETY: every out-pointer refers to a live local (`origin_and_full` to 4 ints);
     // `err` holds ERR_LEN chars.
     let status = unsafe {
-        hairtrace_oiio_open(
+        (shim.open)(
             c_path.as_ptr(),
             &mut handle,
             &mut width,
@@ -392,7 +394,7 @@ pub fn read_image(path: &Path) -> Result<Image> {
     if status != 0 {
         return Err(fail(&err));
     }
-    let input = Input(handle);
+    let input = Input { shim, handle };
 
     let dims = [width, height, channels].map(|d| usize::try_from(d).unwrap_or(0));
     let [width, height, channels] = dims;
@@ -414,9 +416,15 @@ pub fn read_image(path: &Path) -> Result<Image> {
         ))
     })?;
     pixels.resize(len, 0.0);
-    // SAFETY: `input.0` is an open handle and `pixels` holds exactly `len` floats.
+    // SAFETY: `input.handle` is open and `pixels` holds exactly `len` floats.
     let status = unsafe {
-        hairtrace_oiio_read(input.0, pixels.as_mut_ptr(), len, err.as_mut_ptr(), ERR_LEN)
+        (shim.read)(
+            input.handle,
+            pixels.as_mut_ptr(),
+            len,
+            err.as_mut_ptr(),
+            ERR_LEN,
+        )
     };
     if status != 0 {
         return Err(fail(&err));
@@ -457,11 +465,11 @@ fn read_attributes(input: &Input) -> std::result::Result<Vec<(String, String)>, 
     loop {
         let mut err = vec![0 as c_char; ERR_LEN];
         let mut needed = 0;
-        // SAFETY: `input.0` is an open handle, `buf` holds `buf.len()` writable bytes and
-        // `err` ERR_LEN chars.
+        // SAFETY: `input.handle` is open, `buf` holds `buf.len()` writable bytes and `err`
+        // ERR_LEN chars.
         let status = unsafe {
-            hairtrace_oiio_attributes(
-                input.0,
+            (input.shim.attributes)(
+                input.handle,
                 buf.as_mut_ptr().cast(),
                 buf.len(),
                 &mut needed,
@@ -492,70 +500,15 @@ fn read_attributes(input: &Input) -> std::result::Result<Vec<(String, String)>, 
 const ERR_LEN: usize = 1024;
 
 /// An open OIIO reader, closed on every exit path.
-struct Input(*mut c_void);
+struct Input {
+    shim: &'static Shim,
+    handle: *mut c_void,
+}
 
 impl Drop for Input {
     fn drop(&mut self) {
-        // SAFETY: the handle came from a successful hairtrace_oiio_open and is closed only here.
-        unsafe { hairtrace_oiio_close(self.0) }
-    }
-}
-
-/// The C interface of `oiio_shim.cpp`, internal to this module (hence kept out of the
-/// C header):
-/// cbindgen:ignore
-mod ffi {
-    use std::ffi::{c_char, c_int, c_void};
-
-    unsafe extern "C" {
-        pub(super) fn hairtrace_oiio_write(
-            path: *const c_char,
-            write_path: *const c_char,
-            width: c_int,
-            height: c_int,
-            channels: c_int,
-            pixels: *const f32,
-            pixel_type: c_int,
-            display: c_int,
-            x: c_int,
-            y: c_int,
-            full_width: c_int,
-            full_height: c_int,
-            attribute_names: *const *const c_char,
-            attribute_values: *const *const c_char,
-            attributes: usize,
-            err: *mut c_char,
-            err_len: usize,
-        ) -> c_int;
-        pub(super) fn hairtrace_oiio_open(
-            path: *const c_char,
-            handle: *mut *mut c_void,
-            width: *mut c_int,
-            height: *mut c_int,
-            channels: *mut c_int,
-            origin_and_full: *mut c_int,
-            integer_format: *mut c_int,
-            alpha_channel: *mut c_int,
-            unassociated_alpha: *mut c_int,
-            err: *mut c_char,
-            err_len: usize,
-        ) -> c_int;
-        pub(super) fn hairtrace_oiio_read(
-            handle: *mut c_void,
-            pixels: *mut f32,
-            len: usize,
-            err: *mut c_char,
-            err_len: usize,
-        ) -> c_int;
-        pub(super) fn hairtrace_oiio_attributes(
-            handle: *mut c_void,
-            buf: *mut c_char,
-            len: usize,
-            needed: *mut usize,
-            err: *mut c_char,
-            err_len: usize,
-        ) -> c_int;
-        pub(super) fn hairtrace_oiio_close(handle: *mut c_void);
+        // SAFETY: the handle came from a successful open and is closed only here.
+        unsafe { (self.shim.close)(self.handle) }
     }
 }
 

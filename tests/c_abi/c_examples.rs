@@ -20,17 +20,7 @@ fn profile_dir() -> PathBuf {
 
 /// Libraries the static library needs besides Embree, as `--print native-static-libs`
 /// lists them; Embree's come from the build script ([`embree_link`]).
-const NATIVE_LIBS: &[&str] = &[
-    "-lOpenImageIO",
-    "-lOpenImageIO_Util",
-    "-lstdc++",
-    "-lgcc_s",
-    "-lutil",
-    "-lrt",
-    "-lpthread",
-    "-lm",
-    "-ldl",
-];
+const NATIVE_LIBS: &[&str] = &["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl"];
 
 /// The Embree link arguments of the Embree this build found (`-L<dir>` when it is not in
 /// a system path, then `-lembree3` or `-lembree4`).

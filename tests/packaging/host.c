@@ -2,7 +2,8 @@
  * through pkg-config or CMake, shared or static, full or BSDF-only. It prints the versions
  * it was compiled and linked against, one BSDF evaluation (f |cos| and pdf), what the process costs after
  * start-up (threads, resident memory, mapped shared objects) and, with the full library,
- * that a render device can be made. */
+ * that a render device can be made, and, given a path, which image shim writing an image
+ * there maps, and the shared objects after it. */
 #include <hairtrace.h>
 #include <stdio.h>
 #include <string.h>
@@ -19,8 +20,9 @@ static void print_status(const char *key) {
 }
 
 /* Counts the distinct shared objects mapped into the process, and those whose path holds
- * `a` or `b`. */
-static void print_maps(const char *a, const char *b) {
+ * `a` or `b`, on a line headed `heading`; with `shim` also prints the path of each one
+ * whose path holds it, as "image shim <path>". */
+static void print_maps(const char *heading, const char *a, const char *b, const char *shim) {
     char line[4096], last[4096] = "";
     int objects = 0, found_a = 0, found_b = 0;
     FILE *f = fopen("/proc/self/maps", "r");
@@ -32,12 +34,13 @@ static void print_maps(const char *a, const char *b) {
         objects++;
         found_a += strstr(path, a) != NULL;
         found_b += strstr(path, b) != NULL;
+        if (shim && strstr(path, shim)) printf("image shim %s", path);
     }
     fclose(f);
-    printf("maps %d objects, %d %s, %d %s\n", objects, found_a, a, found_b, b);
+    printf("%s %d objects, %d %s, %d %s\n", heading, objects, found_a, a, found_b, b);
 }
 
-int main(void) {
+int main(int argc, char **argv) {
     HtHairParams p = ht_hair_params_default();
     /* The worked example of docs/conventions.md at the local frame: f |cos| and pdf. */
     const HtHairFrame local = {{1.0f, 0.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, {0.0f, 0.0f, 1.0f}, 0.5f};
@@ -58,7 +61,7 @@ int main(void) {
     printf("eval %.9g %.9g %.9g %.9g\n", f[0], f[1], f[2], pdf);
     print_status("Threads:");
     print_status("VmRSS:");
-    print_maps("libembree", "libOpenImageIO");
+    print_maps("maps", "libembree", "libOpenImageIO", NULL);
 #ifdef HT_RENDER
     {
         HtDevice *device = NULL;
@@ -69,6 +72,17 @@ int main(void) {
         ht_device_free(device);
         printf("device ok\n");
     }
+    if (argc > 1) {
+        const float pixel[3] = {0.25f, 0.5f, 1.0f};
+        if (ht_image_write(argv[1], 1, 1, 3, pixel, 3) != HT_OK) {
+            fprintf(stderr, "ht_image_write: %s\n", ht_last_error());
+            return 1;
+        }
+        print_maps("image maps", "libembree", "libOpenImageIO", "libhairtrace-oiio");
+    }
+#else
+    (void)argc;
+    (void)argv;
 #endif
     return 0;
 }

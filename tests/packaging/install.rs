@@ -13,6 +13,48 @@ fn soname() -> String {
     format!("libhairtrace.so.{}", hairtrace::capi::HT_ABI_VERSION)
 }
 
+/// Runs `exe` with a path to write an image to: it must start without OpenImageIO and, once
+/// it writes the image, map it through the shim installed in `prefix`.
+fn check_image_shim(exe: &Path, prefix: &Path) -> Report {
+    let image = fresh_dir("host-images").join("pixel.exr");
+    let report = Report::parse(&run(Command::new(exe).arg(&image)));
+    assert_eq!(report.oiio, 0, "OpenImageIO mapped at start-up: {report:?}");
+    let shim = prefix.join("lib").join(format!(
+        "libhairtrace-oiio.so.{}",
+        env!("CARGO_PKG_VERSION")
+    ));
+    let (mapped, oiio) = report.image.clone().expect("the host wrote an image");
+    assert_eq!(
+        Path::new(&mapped),
+        shim.canonicalize().unwrap(),
+        "{report:?}"
+    );
+    assert!(oiio >= 1, "{report:?}");
+    assert!(image.is_file());
+    report
+}
+
+/// The installed command line reads an image (the one `check_image_shim` had a host
+/// write) through the shim in the prefix's `lib/`, as the loader's log shows.
+fn check_installed_command_line(prefix: &Path) {
+    let image = Path::new(env!("CARGO_TARGET_TMPDIR")).join("host-images/pixel.exr");
+    let out = Command::new(prefix.join("bin/hairtrace"))
+        .arg("compare")
+        .args([&image, &image])
+        .env_remove("LD_LIBRARY_PATH")
+        .env("LD_DEBUG", "files")
+        .output()
+        .unwrap();
+    let log = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{log}");
+    let shim = format!(
+        "file={}/bin/../lib/libhairtrace-oiio.so.{}",
+        prefix.display(),
+        env!("CARGO_PKG_VERSION")
+    );
+    assert!(log.contains(&shim), "no {shim} in the loader's log:\n{log}");
+}
+
 /// Runs a host linked against the shared library: it must record the soname (not the
 /// unversioned name, not a path into the build folder), find the library through the
 /// RUNPATH alone, and reach the render API.
@@ -30,21 +72,21 @@ fn check_shared_host(exe: &Path, prefix: &Path) {
         dynamic.contains(&format!("[{}]", prefix.join("lib").display())),
         "no RUNPATH to the prefix:\n{dynamic}"
     );
-    let report = Report::parse(&run(&mut Command::new(exe)));
+    let report = check_image_shim(exe, prefix);
     report.check_versions_and_eval();
     assert!(report.device, "{report:?}");
 }
 
 /// Runs a host linked against the static archive: nothing of hairtrace is needed at run
-/// time, and the full library's dependencies are loaded (the control for bsdf_only.rs,
-/// whose host must show none of them).
-fn check_static_host(exe: &Path) {
+/// time, Embree is loaded (the control for bsdf_only.rs, whose host must show none of
+/// it), OpenImageIO only once an image is written, through the prefix's shim.
+fn check_static_host(exe: &Path, prefix: &Path) {
     let needs = needed(exe);
     assert!(!needs.iter().any(|n| n.contains("hairtrace")), "{needs:?}");
-    let report = Report::parse(&run(&mut Command::new(exe)));
+    let report = check_image_shim(exe, prefix);
     report.check_versions_and_eval();
     assert!(report.device, "{report:?}");
-    assert!(report.embree >= 1 && report.oiio >= 1, "{report:?}");
+    assert!(report.embree >= 1, "{report:?}");
     println!(
         "full static host at start-up: {} shared objects, {} threads, {} KiB resident",
         report.objects, report.threads, report.rss_kib
@@ -96,6 +138,7 @@ fn cpp_hosts_build_against_the_installed_prefix() {
     flags.push(format!("-Wl,-rpath,{}", lib.display()));
     compile(&shared, flags);
     check_shared_host(&shared, prefix);
+    check_installed_command_line(prefix);
     let static_exe = out.join("static");
     compile(
         &static_exe,
@@ -104,7 +147,7 @@ fn cpp_hosts_build_against_the_installed_prefix() {
             &["--static", "--cflags", "--libs", "hairtrace-static"],
         ),
     );
-    check_static_host(&static_exe);
+    check_static_host(&static_exe, prefix);
 
     // CMake: find_package with this version, refusing the next minor (0.x) or major.
     let project = fresh_dir("hosts-cmake");
@@ -152,7 +195,7 @@ fn cpp_hosts_build_against_the_installed_prefix() {
         .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix.display())));
     run(Command::new("cmake").arg("--build").arg(&build));
     check_shared_host(&build.join("host_shared"), prefix);
-    check_static_host(&build.join("host_static"));
+    check_static_host(&build.join("host_static"), prefix);
     check_furnace(&run(&mut Command::new(build.join("furnace"))));
 }
 

@@ -141,6 +141,9 @@ struct Report {
     oiio: u32,
     /// The full library made and freed a render device.
     device: bool,
+    /// After the host wrote an image (given a path): the image shim's path as mapped, and
+    /// how many OpenImageIO objects are mapped then.
+    image: Option<(String, u32)>,
 }
 
 impl Report {
@@ -169,6 +172,10 @@ impl Report {
             embree: maps[1] as u32,
             oiio: maps[2] as u32,
             device: out.lines().any(|l| l == "device ok"),
+            image: out
+                .lines()
+                .find_map(|l| l.strip_prefix("image shim "))
+                .map(|shim| (shim.trim().to_string(), numbers("image maps")[2] as u32)),
         }
     }
 

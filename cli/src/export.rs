@@ -18,6 +18,7 @@ use serde::Serialize;
 
 use hairtrace::description::{
     EnvironmentSource, GroomSource, LightDesc, MaterialDesc, SceneDescription, Shutter, Transform,
+    is_sequence,
 };
 use hairtrace::embree::CurveBasis;
 use hairtrace::formats::hair::{HairTag, Thickness, write_tagged_hair_file};
@@ -161,6 +162,13 @@ pub fn export_for_peer(description: &SceneDescription, dir: &Path) -> Result<()>
         };
         let usd = match moving {
             Some((path, frame)) => {
+                if is_sequence(path) {
+                    return Err(invalid_arg!(
+                        "groom[{i}]: {} is a sequence of per-frame files: a moving groom is \
+                         exported as one file, whose time samples the peer imports",
+                        path.display()
+                    ));
+                }
                 if g.transform != Transform::default() || g.radius_scale != 1.0 {
                     return Err(invalid_arg!(
                         "groom[{i}]: a moving USD groom is exported as its file, which the peer \

@@ -833,6 +833,23 @@ fn a_huang_material_and_a_moving_usd_groom_go_out_as_the_peer_reads_them() {
     );
     let (o, ..) = export(&text, "cli_peer_moving_placed");
     assert_one_line_error(&o, "groom[0]: a moving USD groom is exported as its file");
+    // A sequence of per-frame stages has no one file whose time samples the peer imports.
+    let frames = tmp("cli_peer_usd_sequence");
+    std::fs::create_dir_all(&frames).unwrap();
+    for f in [2, 3] {
+        std::fs::copy(&usd, format!("{frames}/sway.{f:04}.usda")).unwrap();
+    }
+    let sequence = format!("{frames}/sway.####.usda");
+    let (o, ..) = export(
+        &text
+            .replace(&*usd.to_string_lossy(), &sequence)
+            .replace("scale = 2.0\n", ""),
+        "cli_peer_moving_sequence",
+    );
+    assert_one_line_error(
+        &o,
+        &format!("groom[0]: {sequence} is a sequence of per-frame files"),
+    );
     // A camera that moves over the shutter has no still pose to export.
     let text = text.replace("scale = 2.0\n", "") + "[camera.shutter_close]\neye = [0, 0, 3]\n";
     let (o, ..) = export(&text, "cli_peer_moving_camera");

@@ -610,7 +610,7 @@ fn blend(a: &Strands, b: &Strands, t: f32) -> Strands {
 }
 
 /// Whether `path` names a sequence of per-frame files: a run of # in its file name.
-fn is_sequence(path: &Path) -> bool {
+pub fn is_sequence(path: &Path) -> bool {
     path.file_name()
         .is_some_and(|n| n.to_string_lossy().contains('#'))
 }

@@ -129,7 +129,7 @@ use crate::scene::material::HairMaterial;
 use crate::scene::mesh::Mesh;
 use crate::scene::strands::Strands;
 
-pub use build::Shutter;
+pub use build::{Shutter, is_sequence};
 pub use demos::{DEMOS, demo, quick_look};
 
 /// A whole scene as plain data. Adjust fields before [`SceneDescription::build`], not the

@@ -282,8 +282,12 @@ fn build_oiio_shim() {
     println!("cargo:rustc-env=HT_IMAGE_SHIM_NAME={name}");
     println!("cargo:rustc-env=HT_IMAGE_SHIM_BUILT={}", library.display());
     // target/<profile>/ is three levels above OUT_DIR (target/<profile>/build/<pkg>/out).
+    // Copied under another name, then renamed over the old copy: a process running with the
+    // old copy mapped keeps it, where writing into it in place would crash that process.
     if let Some(profile_dir) = out.ancestors().nth(3) {
-        fs::copy(&library, profile_dir.join(&name))
+        let part = profile_dir.join(format!(".{name}.{}.part", std::process::id()));
+        fs::copy(&library, &part)
+            .and_then(|_| fs::rename(&part, profile_dir.join(&name)))
             .unwrap_or_else(|e| panic!("hairtrace: cannot copy {name} beside the build: {e}"));
     }
 }

@@ -93,7 +93,10 @@ pub(super) fn shim() -> Result<&'static Shim> {
 /// later: OpenImageIO then loads while the process does other work (a render's scene read
 /// and build), instead of before it or at the end. A failure is reported at the first use.
 pub fn preload_shim() {
-    std::thread::spawn(|| shim().is_ok());
+    // A thread that cannot start leaves the opening to the first use.
+    let _ = std::thread::Builder::new()
+        .name("image shim".into())
+        .spawn(|| shim().is_ok());
 }
 
 /// The file the image shim was opened from, opening it if no image was read or written yet.
@@ -115,10 +118,11 @@ fn open(places: Vec<Place>) -> std::result::Result<Shim, String> {
             Place::File(path) => path.as_path(),
             Place::Search => Path::new(NAME),
         };
-        // SAFETY: the file is this build's shim (its name carries the crate's version),
-        // whose initialisers only set up OpenImageIO.
+        // SAFETY: opening runs the file's initialisers: a file of the shim's name (which
+        // carries the crate's version) or the one HT_IMAGE_SHIM names, whose initialisers
+        // only set up OpenImageIO.
         match unsafe { Library::new(name) } {
-            Ok(library) => return entry_points(library),
+            Ok(library) => return entry_points(library, name),
             Err(e) => tried.push(format!("{} ({e})", name.display())),
         }
     }
@@ -129,8 +133,10 @@ fn open(places: Vec<Place>) -> std::result::Result<Shim, String> {
     ))
 }
 
-fn entry_points(library: Library) -> std::result::Result<Shim, String> {
-    let cannot = |e: libloading::Error| format!("{NAME} is not hairtrace's image shim: {e}");
+/// The shim's entry points in `library`, opened from `name`.
+fn entry_points(library: Library, name: &Path) -> std::result::Result<Shim, String> {
+    let cannot =
+        |e: libloading::Error| format!("{} is not hairtrace's image shim: {e}", name.display());
     // SAFETY: each symbol is read as the type `oiio_shim.cpp` defines it with.
     unsafe {
         let write = *library.get(b"hairtrace_oiio_write\0").map_err(cannot)?;

@@ -519,6 +519,12 @@ struct Bar(ProgressBar);
 
 impl Progress for Bar {
     fn update(&self, done: u64, total: u64) -> bool {
+        // OpenImageIO loads beside the render once its threads run, unless it started
+        // with a groom's read (`render`): loading holds the loader's lock, which starting
+        // a thread also takes, so opened during the build it stalled the build's thread
+        // pools (docs/measurements.md, "Start-up").
+        static PRELOAD: std::sync::Once = std::sync::Once::new();
+        PRELOAD.call_once(hairtrace::image::preload_shim);
         self.0.set_length(total);
         self.0.set_position(done);
         true
@@ -661,9 +667,14 @@ fn render(args: &RenderArgs) -> hairtrace::Result<()> {
     }
     let build_start = std::time::Instant::now();
     let device = Arc::new(description.render.device()?);
-    // After the device: Embree's start loads libraries of its own, which would wait for
-    // the loader while OpenImageIO's load holds it.
-    hairtrace::image::preload_shim();
+    // A groom read from a file keeps the main thread busy alone for a while: OpenImageIO
+    // loads beside that read (otherwise once the render's threads run, `Bar::update`).
+    // After the device: Embree's start loads libraries of its own, which would wait.
+    let reads_files =
+        (description.grooms.iter()).any(|g| matches!(g.source, GroomSource::File { .. }));
+    if reads_files {
+        hairtrace::image::preload_shim();
+    }
     let bars = StageBars::default();
     let mut built = description.build_with(device, &bars)?;
     bars.finish();

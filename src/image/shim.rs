@@ -90,8 +90,9 @@ pub(super) fn shim() -> Result<&'static Shim> {
 }
 
 /// Opens the shim on a thread of its own, for a process that will read or write an image
-/// later: OpenImageIO then loads while the process does other work (a render's scene read
-/// and build), instead of before it or at the end. A failure is reported at the first use.
+/// later: OpenImageIO then loads while the process does other work, instead of before it or
+/// at the end. Loading holds the dynamic loader's lock, which a thread being started also
+/// takes: call it once the work's threads run. A failure is reported at the first use.
 pub fn preload_shim() {
     // A thread that cannot start leaves the opening to the first use.
     let _ = std::thread::Builder::new()

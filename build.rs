@@ -222,9 +222,9 @@ fn link_embree(embree: &Embree) {
 
 #[cfg(feature = "render")]
 /// The shim over OpenImageIO as a shared library of its own, which `src/image/shim.rs` opens
-/// at the first image read or write: OpenImageIO's ~260 shared objects cost every process
-/// that links them a quarter second or more at start-up (docs/measurements.md, "Start-up"),
-/// and a host that never touches an image should not map them at all. The library goes into
+/// at the first image read or write: OpenImageIO's many shared objects cost every process
+/// that links them start-up time (docs/measurements.md, "Start-up"), and a host that never
+/// touches an image should not map them at all. The library goes into
 /// OUT_DIR, whose path the crate records (`HT_IMAGE_SHIM_BUILT`) for the build tree's own
 /// binaries, and beside the build's binaries (target/<profile>/), where scripts/install and
 /// scripts/python take it from.

@@ -523,8 +523,7 @@ impl Progress for Bar {
         // with a groom's read (`render`): loading holds the loader's lock, which starting
         // a thread also takes, so opened during the build it stalled the build's thread
         // pools (docs/measurements.md, "Start-up").
-        static PRELOAD: std::sync::Once = std::sync::Once::new();
-        PRELOAD.call_once(hairtrace::image::preload_shim);
+        hairtrace::image::preload_shim();
         self.0.set_length(total);
         self.0.set_position(done);
         true

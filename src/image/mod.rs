@@ -19,7 +19,7 @@ mod compare;
 mod shim;
 pub use blocks::{BlockBias, block_bias};
 pub use compare::{Comparison, compare};
-pub use shim::{preload_shim, shim_path};
+pub use shim::preload_shim;
 
 /// How samples are stored in the file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

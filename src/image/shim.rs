@@ -1,7 +1,7 @@
 //! `oiio_shim.cpp`'s C interface, opened at the first image read or write rather than
-//! linked: OpenImageIO brings some 260 shared objects, which cost every process that links
-//! them a quarter second at start-up (docs/measurements.md, "Start-up") and put their
-//! symbols beside a host's own. build.rs builds the shim as a shared library of its own.
+//! linked: OpenImageIO's many shared objects cost every process that links them start-up
+//! time (docs/measurements.md, "Start-up") and put their symbols beside a host's own.
+//! build.rs builds the shim as a shared library of its own.
 //!
 //! Where it is looked for, first found wins:
 //! 1. `HT_IMAGE_SHIM`, a path to the file (a static host whose install moved);
@@ -16,7 +16,7 @@
 use std::ffi::{CStr, c_char, c_int, c_void};
 use std::os::unix::ffi::OsStrExt;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Once, OnceLock};
 
 use libloading::Library;
 
@@ -75,8 +75,6 @@ pub(super) struct Shim {
         err_len: usize,
     ) -> c_int,
     pub close: unsafe extern "C" fn(handle: *mut c_void),
-    /// The file it was opened from.
-    pub path: PathBuf,
     /// Kept open for the process's life: the entry points point into it.
     _library: Library,
 }
@@ -92,17 +90,16 @@ pub(super) fn shim() -> Result<&'static Shim> {
 /// Opens the shim on a thread of its own, for a process that will read or write an image
 /// later: OpenImageIO then loads while the process does other work, instead of before it or
 /// at the end. Loading holds the dynamic loader's lock, which a thread being started also
-/// takes: call it once the work's threads run. A failure is reported at the first use.
+/// takes: call it once the work's threads run. Only the first call starts the thread; a
+/// failure is reported at the first use.
 pub fn preload_shim() {
-    // A thread that cannot start leaves the opening to the first use.
-    let _ = std::thread::Builder::new()
-        .name("image shim".into())
-        .spawn(|| shim().is_ok());
-}
-
-/// The file the image shim was opened from, opening it if no image was read or written yet.
-pub fn shim_path() -> Result<&'static Path> {
-    Ok(&shim()?.path)
+    static STARTED: Once = Once::new();
+    STARTED.call_once(|| {
+        // A thread that cannot start leaves the opening to the first use.
+        let _ = std::thread::Builder::new()
+            .name("image shim".into())
+            .spawn(|| shim().is_ok());
+    });
 }
 
 /// Opens the first shim found at `places`.
@@ -140,16 +137,14 @@ fn entry_points(library: Library, name: &Path) -> std::result::Result<Shim, Stri
         |e: libloading::Error| format!("{} is not hairtrace's image shim: {e}", name.display());
     // SAFETY: each symbol is read as the type `oiio_shim.cpp` defines it with.
     unsafe {
-        let write = *library.get(b"hairtrace_oiio_write\0").map_err(cannot)?;
         Ok(Shim {
-            write,
+            write: *library.get(b"hairtrace_oiio_write\0").map_err(cannot)?,
             open: *library.get(b"hairtrace_oiio_open\0").map_err(cannot)?,
             read: *library.get(b"hairtrace_oiio_read\0").map_err(cannot)?,
             attributes: *library
                 .get(b"hairtrace_oiio_attributes\0")
                 .map_err(cannot)?,
             close: *library.get(b"hairtrace_oiio_close\0").map_err(cannot)?,
-            path: object_of(write as *const c_void).unwrap_or_else(|| PathBuf::from(NAME)),
             _library: library,
         })
     }
@@ -209,7 +204,8 @@ mod tests {
     /// own copy last.
     #[test]
     fn the_shim_is_found_and_the_places_are_in_order() {
-        let path = shim_path().expect("the build's shim");
+        let write = shim().expect("the build's shim").write;
+        let path = object_of(write as *const c_void).expect("dladdr names the shim");
         assert!(path.ends_with(NAME), "{path:?}");
         let files: Vec<PathBuf> = places()
             .into_iter()

@@ -278,7 +278,7 @@ impl World {
                     // averaged across the fibre serves.
                     let thin = events > 0 || 2.0 * h.radius <= pixel_spread * h.t;
                     if let Some(b) = m.huang_at(h.strand.id, h.s, h.absorption) {
-                        let field = huang_field(thin, sample_light, events);
+                        let field = huang_field(thin, sample_light);
                         Shading::huang(h, &b, wo_world, field, jitter(u_rr, u_lobe, events))
                     } else {
                         varied_bsdf = m.bsdf_at(h.strand.id, h.s, h.absorption);
@@ -524,16 +524,18 @@ enum Point<'a> {
     Diffuse(DiffusePoint),
 }
 
-/// The Huang model's field at a hair vertex: far where lights are sampled (more offsets:
-/// each light sample's value is the point's estimate of the BSDF) and at camera hits; a
-/// bounce that samples no light keeps its own h, already uniform across the fibre, where
-/// offsets cost more than the noise they save; near on a strand wider than its pixel
-/// (`thin` false), whose highlights the image resolves (docs/measurements.md, "The Huang
-/// model").
-pub(crate) fn huang_field(thin: bool, sample_light: bool, events: u32) -> HuangField {
+/// The Huang model's field at a hair vertex: far where lights are sampled, at
+/// `LIT_SHIFTS` offsets (each light sample's value is the point's estimate of the BSDF);
+/// near on a strand wider than its pixel (`thin` false), whose highlights the image
+/// resolves. A thin vertex that samples no light scatters by the far field too, but its
+/// only use is one drawn direction weighted by the offset and lobe that drew it
+/// (`HuangPoint::sample_weight`): that is the far field sampled at one offset drawn
+/// uniformly, and the hit's own h, uniform across the fibre, is such an offset, so the near
+/// point at h is that draw without the other offsets' cost (docs/measurements.md, "The
+/// Huang model").
+pub(crate) fn huang_field(thin: bool, sample_light: bool) -> HuangField {
     match (thin, sample_light) {
         (true, true) => HuangBsdf::far_lit,
-        (true, false) if events == 0 => HuangBsdf::far,
         _ => HuangBsdf::near,
     }
 }

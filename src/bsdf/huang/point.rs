@@ -5,7 +5,7 @@ use super::section::Section;
 use super::{Ggx, HuangBsdf};
 use crate::bsdf::fresnel::{fresnel_dielectric, fresnel_inside};
 use crate::bsdf::pick::{U_MIN, pick};
-use crate::bsdf::{BsdfEval, BsdfSample, LocalBsdf, inv_cos};
+use crate::bsdf::{BsdfEval, BsdfSample, LocalBsdf, WeightedSample, inv_cos};
 use crate::math::sampling::ONE_MINUS_EPSILON;
 use crate::math::{cos_from_sin, hashed_pair};
 use glam::{Vec2, Vec3};
@@ -163,16 +163,29 @@ impl HuangPoint {
     /// `u[1]`, `u[2]` the microfacet normal or the residual's theta. None where the density
     /// there is zero or the draw met total internal reflection.
     pub fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
-        let n = self.shifts as f32;
-        let k = ((u[0] * n) as usize).min(self.shifts - 1);
-        let u0 = (u[0] * n - k as f32).clamp(0.0, 1.0);
-        let wi = self.paths[k].draw(self, [u0, u[1].max(U_MIN), u[2]])?;
+        let (wi, _) = self.draw(u)?;
         let e = self.eval(wi);
         (e.pdf > 0.0 && e.f.is_finite()).then_some(BsdfSample {
             wi,
             f: e.f,
             pdf: e.pdf,
         })
+    }
+
+    /// The direction of [`Self::sample`], weighted by the offset and lobe that drew it
+    /// alone (`Paths::draw`): no offset or lobe is evaluated at wi. None also where that
+    /// weight is zero (a direction the last interface masks).
+    pub fn sample_weight(&self, u: [f32; 3]) -> Option<WeightedSample> {
+        let (wi, weight) = self.draw(u)?;
+        (weight.is_finite() && weight.max_element() > 0.0).then_some(WeightedSample { wi, weight })
+    }
+
+    /// The offset `u[0]` picks, and its draw from the rest of `u`.
+    fn draw(&self, u: [f32; 3]) -> Option<(Vec3, Vec3)> {
+        let n = self.shifts as f32;
+        let k = ((u[0] * n) as usize).min(self.shifts - 1);
+        let u0 = (u[0] * n - k as f32).clamp(0.0, 1.0);
+        self.paths[k].draw(self, [u0, u[1].max(U_MIN), u[2]])
     }
 
     /// The RGB energy of R, TT, TRT and the residual leaving wo, averaged over the
@@ -197,6 +210,10 @@ impl LocalBsdf for HuangPoint {
 
     fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
         HuangPoint::sample(self, u)
+    }
+
+    fn sample_weight(&self, u: [f32; 3]) -> Option<WeightedSample> {
+        HuangPoint::sample_weight(self, u)
     }
 }
 
@@ -404,32 +421,46 @@ impl Paths {
         (f, pdf)
     }
 
-    /// A direction from this offset's lobes; None where a refraction out meets total
-    /// internal reflection, or nothing leaves.
-    fn draw(&self, point: &HuangPoint, u: [f32; 3]) -> Option<Vec3> {
+    /// A direction from this offset's lobes and its weight from the lobe that drew it
+    /// alone: f_l |cos| / (P(l) pdf_l), with f_l and pdf_l the lobe's terms of [`Self::eval`],
+    /// which each lobe's draw follows exactly (the visible normals' density, the residual's
+    /// longitudinal lobe), so the weight is the lobe's energy toward wi over P(l): R's
+    /// Fresnel and unmasked share, an exit's weight and unmasked share out, the residual's
+    /// energy. Its mean is the mixture's. None where a refraction out meets total internal
+    /// reflection, or nothing leaves.
+    fn draw(&self, point: &HuangPoint, u: [f32; 3]) -> Option<(Vec3, Vec3)> {
         if self.cos_om <= 0.0 {
             return None;
         }
-        let ggx = &point.bsdf.ggx;
+        let bsdf = &point.bsdf;
+        let (ggx, eta) = (&bsdf.ggx, bsdf.params.eta);
         let (lobe, u0) = pick(&self.lobe_pdf, u[0]);
-        match lobe {
+        let (wi, energy) = match lobe {
             R => {
                 let wh = ggx.sample_visible(self.m, point.wo, [u[1], u[2]]);
-                Some(wh * (2.0 * point.wo.dot(wh)) - point.wo)
+                let c = point.wo.dot(wh);
+                let wi = wh * (2.0 * c) - point.wo;
+                let cos_im = wi.dot(self.m);
+                let unmasked = if cos_im > 0.0 {
+                    ggx.g2_over_g1(self.cos_om, cos_im)
+                } else {
+                    0.0
+                };
+                let fr = fresnel_dielectric(c.clamp(0.0, 1.0), eta).0;
+                (wi, Vec3::splat(fr * unmasked))
             }
             RESIDUAL => {
                 let (sin_ti, cos_ti) =
-                    point
-                        .bsdf
-                        .residual
+                    bsdf.residual
                         .sample(point.sin_to, point.cos_to, [u[1], u[2]]);
                 let (s, c) = (TAU * u0).sin_cos();
                 let a = point.azimuth;
-                Some(Vec3::new(
+                let wi = Vec3::new(
                     sin_ti,
                     cos_ti * (a.x * c - a.y * s),
                     cos_ti * (a.y * c + a.x * s),
-                ))
+                );
+                (wi, self.residual)
             }
             _ => {
                 let e = &self.exits[lobe - TT];
@@ -437,9 +468,23 @@ impl Paths {
                     return None;
                 }
                 let wh = ggx.sample_visible(e.n, e.v, [u[1], u[2]]);
-                refract_out(point.bsdf.params.eta, e.v, wh)
+                let wi = refract_out(eta, e.v, wh)?;
+                (wi, e.weight * leaving(ggx, eta, e, e.v.dot(wh), wi))
             }
-        }
+        };
+        Some((wi, energy / self.lobe_pdf[lobe]))
+    }
+}
+
+/// The share of the light refracted out at the exit `e` through a microfacet at cosine
+/// `cv` to its inside direction, toward wi, that leaves unmasked: 1 - F times G2 / G1; 0
+/// where wi points back across the mesonormal's plane (drawn, but masked).
+fn leaving(ggx: &Ggx, eta: f32, e: &Exit, cv: f32, wi: Vec3) -> f32 {
+    let cos_wn = wi.dot(e.n);
+    if cos_wn < 0.0 {
+        (1.0 - fresnel_inside(cv, eta)) * ggx.g2_over_g1(e.cos_vn, cos_wn)
+    } else {
+        0.0
     }
 }
 
@@ -473,13 +518,7 @@ fn refraction_out(ggx: &Ggx, eta: f32, e: &Exit, wi: Vec3) -> (f32, f32) {
     }
     let denom = eta * cv + cw;
     let pdf = ggx.visible_pdf(e.n, e.v, wh) * (-cw) / (denom * denom);
-    // A rough refraction may point back across the mesonormal's plane: drawn, but masked.
-    let cos_wn = wi.dot(e.n);
-    let leaves = if cos_wn < 0.0 {
-        (1.0 - fresnel_inside(cv, eta)) * ggx.g2_over_g1(e.cos_vn, cos_wn)
-    } else {
-        0.0
-    };
+    let leaves = leaving(ggx, eta, e, cv, wi);
     // Not finite only where the half vector degenerates (denom = 0).
     if pdf.is_finite() {
         (pdf, leaves)

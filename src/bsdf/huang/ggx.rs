@@ -64,18 +64,20 @@ impl Ggx {
     /// G1(v) max(0, v.m) D(m) / (v.n) per solid angle of m (Heitz 2018); drawn as Dupuy and
     /// Benyoub 2023 do, from a spherical cap of the stretched view.
     pub(super) fn sample_visible(&self, n: Vec3, v: Vec3, u: [f32; 2]) -> Vec3 {
+        self.visible_from(n, v).sample(u)
+    }
+
+    /// What every draw of [`Self::sample_visible`] from the same `n` and `v` shares.
+    pub(super) fn visible_from(&self, n: Vec3, v: Vec3) -> VisibleNormals {
         let frame = Frame::from_z(n);
         let vl = frame.to_local(v);
         // The view in the frame where the distribution is a hemisphere of unit radius.
         let vh = Vec3::new(self.a * vl.x, self.a * vl.y, vl.z).normalize();
-        // A normal visible from vh: uniform on the spherical cap the view sees.
-        let phi = TAU * u[0];
-        let z = (1.0 - u[1]) * (1.0 + vh.z) - vh.z;
-        let sin_theta = (1.0 - z * z).max(0.0).sqrt();
-        let c = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), z);
-        let nh = c + vh;
-        let m = Vec3::new(self.a * nh.x, self.a * nh.y, nh.z.max(0.0)).normalize_or(Vec3::Z);
-        frame.to_world(m)
+        VisibleNormals {
+            frame,
+            vh,
+            a: self.a,
+        }
     }
 
     /// Density of [`Self::sample_visible`] at m: G1(v) max(0, v.m) D(m) / (v.n).
@@ -86,6 +88,30 @@ impl Ggx {
             return 0.0;
         }
         self.g1(vn) * vm * self.d(m.dot(n)) / vn
+    }
+}
+
+/// The microfacet normals of a [`Ggx`] visible from one direction, ready to draw from.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct VisibleNormals {
+    frame: Frame,
+    /// The view, stretched to where the distribution is a unit hemisphere.
+    vh: Vec3,
+    a: f32,
+}
+
+impl VisibleNormals {
+    /// A normal from `u` in [0, 1)^2: uniform on the spherical cap the stretched view
+    /// sees, stretched back.
+    pub(super) fn sample(&self, u: [f32; 2]) -> Vec3 {
+        let vh = self.vh;
+        let phi = TAU * u[0];
+        let z = (1.0 - u[1]) * (1.0 + vh.z) - vh.z;
+        let sin_theta = (1.0 - z * z).max(0.0).sqrt();
+        let c = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), z);
+        let nh = c + vh;
+        let m = Vec3::new(self.a * nh.x, self.a * nh.y, nh.z.max(0.0)).normalize_or(Vec3::Z);
+        self.frame.to_world(m)
     }
 }
 

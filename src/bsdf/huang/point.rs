@@ -359,8 +359,8 @@ impl Paths {
         // letting out 1 - F with F averaged over visible normals (a few, stratified from
         // the first): a geometric series. One normal's F would trap all of it wherever
         // that normal reflects totally, and later interfaces meet other normals.
-        let fresnel_at =
-            |u: [f32; 2]| fresnel_inside(v3.dot(ggx.sample_visible(n3, v3, u)).max(0.0), eta);
+        let seen = ggx.visible_from(n3, v3);
+        let fresnel_at = |u: [f32; 2]| fresnel_inside(v3.dot(seen.sample(u)).max(0.0), eta);
         let f3 = fresnel_at(u[2]);
         let f_mean = (1..ESCAPE_NODES)
             .map(|k| fresnel_at(stratum(k, u[2])))

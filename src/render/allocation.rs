@@ -48,6 +48,23 @@ pub(super) fn pilot_window(crop: Window, width: u32, height: u32) -> Window {
     }
 }
 
+/// The blocks of `window` (whole blocks aligned on the full frame, but at its right and
+/// bottom edges), row by row.
+pub(super) fn blocks(window: Window) -> impl Iterator<Item = Window> {
+    (window.y0..window.y1)
+        .step_by(BLOCK as usize)
+        .flat_map(move |y0| {
+            (window.x0..window.x1)
+                .step_by(BLOCK as usize)
+                .map(move |x0| Window {
+                    x0,
+                    y0,
+                    x1: (x0 + BLOCK).min(window.x1),
+                    y1: (y0 + BLOCK).min(window.y1),
+                })
+        })
+}
+
 /// Samples per pass of each pixel of a crop, as the pilot decided them.
 #[derive(Debug)]
 pub(super) struct Shares {
@@ -65,20 +82,11 @@ impl Shares {
     /// pixel's neighbours ([`block_shares`]), plus [`FLOOR`].
     pub(super) fn new(pilot: &Film, crop: Window, per_pixel: u32) -> Shares {
         let mut counts = vec![per_pixel; crop.pixel_count() as usize];
-        let blocks = pilot.crop();
-        for by in (blocks.y0..blocks.y1).step_by(BLOCK as usize) {
-            for bx in (blocks.x0..blocks.x1).step_by(BLOCK as usize) {
-                let block = Window {
-                    x0: bx,
-                    y0: by,
-                    x1: (bx + BLOCK).min(blocks.x1),
-                    y1: (by + BLOCK).min(blocks.y1),
-                };
-                for ((x, y), n) in block_shares(pilot, block, per_pixel) {
-                    if (crop.x0..crop.x1).contains(&x) && (crop.y0..crop.y1).contains(&y) {
-                        let i = (y - crop.y0) * crop.width() + (x - crop.x0);
-                        counts[i as usize] = n;
-                    }
+        for block in blocks(pilot.crop()) {
+            for ((x, y), n) in block_shares(pilot, block, per_pixel) {
+                if (crop.x0..crop.x1).contains(&x) && (crop.y0..crop.y1).contains(&y) {
+                    let i = (y - crop.y0) * crop.width() + (x - crop.x0);
+                    counts[i as usize] = n;
                 }
             }
         }

@@ -76,6 +76,30 @@ pub struct FirstHit {
     pub strand: Option<u32>,
 }
 
+/// What a camera sample's single ray met first: what `camera_rays = auto` reads of the
+/// pilot (`super::camera_rays::Choice`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Seen {
+    /// It escaped.
+    Nothing,
+    /// A surface.
+    Surface,
+    /// A strand this many pixels wide there.
+    Strand(f32),
+    /// The sample was several rays.
+    Split,
+}
+
+/// A pixel's samples as [`Seen`] sums them: those whose ray escaped and their summed
+/// radiance, and those that met a strand first and the strands' summed width in pixels.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Coverage {
+    pub escaped: u32,
+    pub escaped_rgb: [f32; 3],
+    pub strands: u32,
+    pub strand_width: f32,
+}
+
 /// How a pixel's samples map to positions: each sample's offset from the pixel centre
 /// is drawn from the filter (filter importance sampling), so every sample has weight 1
 /// and belongs to exactly one pixel, which keeps pixels independent of each other (and of
@@ -183,6 +207,7 @@ pub struct PixelAccumulator {
     /// before (half as many passes); f32, as they only estimate the noise.
     last_power: ([f32; 3], u32),
     half_power: ([f32; 3], u32),
+    coverage: Coverage,
 }
 
 impl Default for PixelAccumulator {
@@ -199,6 +224,7 @@ impl Default for PixelAccumulator {
             passes: 0,
             last_power: ([0.0; 3], 0),
             half_power: ([0.0; 3], 0),
+            coverage: Coverage::default(),
         }
     }
 }
@@ -239,6 +265,33 @@ impl PixelAccumulator {
     fn mean(&self, sum: [f64; 3]) -> [f32; 3] {
         let n = f64::from(self.samples.max(1));
         sum.map(|s| (s / n) as f32)
+    }
+
+    /// Adds what a sample's single camera ray met first ([`Self::coverage`]); a radiance
+    /// [`Self::add`] rejects is left out here too.
+    pub fn add_seen(&mut self, seen: Seen, radiance: Vec3) {
+        if !radiance.is_finite() {
+            return;
+        }
+        let c = &mut self.coverage;
+        match seen {
+            Seen::Nothing => {
+                c.escaped += 1;
+                for (sum, v) in c.escaped_rgb.iter_mut().zip(radiance.to_array()) {
+                    *sum += v;
+                }
+            }
+            Seen::Strand(width) if width.is_finite() => {
+                c.strands += 1;
+                c.strand_width += width;
+            }
+            _ => {}
+        }
+    }
+
+    /// What [`Self::add_seen`] summed.
+    pub fn coverage(&self) -> Coverage {
+        self.coverage
     }
 
     /// Counts the rays a sample traced.
@@ -324,7 +377,7 @@ pub enum Keep {
     /// passes that estimates its noise.
     Halves,
     /// The sums, the squares and the rays of each pixel: its variance and cost per sample
-    /// (the noise allocation's pilot).
+    /// (the noise allocation's pilot); and what its single camera rays met (`Coverage`).
     Spread,
 }
 
@@ -353,7 +406,9 @@ impl Keep {
         bytes
             + match self {
                 Keep::Halves => size_of::<Halves>() as u64,
-                Keep::Spread => (size_of::<[f64; 3]>() + size_of::<u64>()) as u64,
+                Keep::Spread => {
+                    (size_of::<[f64; 3]>() + size_of::<u64>() + size_of::<Coverage>()) as u64
+                }
                 Keep::Image | Keep::Sums => 0,
             }
     }
@@ -388,6 +443,7 @@ pub struct Film {
     halves: Vec<Halves>,
     squares: Vec<[f64; 3]>,
     rays: Vec<u64>,
+    coverage: Vec<Coverage>,
     /// Over the whole film: samples taken, rejected (`PixelAccumulator::add`) and rays
     /// traced by the samples of the pixels as stored.
     totals: Totals,
@@ -459,6 +515,7 @@ impl Film {
             halves: filled(kept(keep == Keep::Halves), Halves::default())?,
             squares: filled(kept(keep == Keep::Spread), [0.0; 3])?,
             rays: filled(kept(keep == Keep::Spread), 0)?,
+            coverage: filled(kept(keep == Keep::Spread), Coverage::default())?,
             totals: Totals::default(),
         })
     }
@@ -586,6 +643,9 @@ impl Film {
         if let (Some(&squares), Some(&rays)) = (self.squares.get(i), self.rays.get(i)) {
             (acc.rgb_sq, acc.rays) = (squares, rays);
         }
+        if let Some(&coverage) = self.coverage.get(i) {
+            acc.coverage = coverage;
+        }
         acc
     }
 
@@ -617,6 +677,9 @@ impl Film {
         }
         if let (Some(squares), Some(rays)) = (self.squares.get_mut(i), self.rays.get_mut(i)) {
             (*squares, *rays) = (acc.rgb_sq, acc.rays);
+        }
+        if let Some(coverage) = self.coverage.get_mut(i) {
+            *coverage = acc.coverage;
         }
         self.write(i, acc.mean(acc.rgb), acc.mean(acc.albedo), acc);
     }

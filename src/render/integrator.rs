@@ -8,7 +8,7 @@
 use glam::Vec3;
 
 use super::camera_rays::MAX_CAMERA_RAYS;
-use super::film::FirstHit;
+use super::film::{FirstHit, Seen};
 use super::sampler::PixelSampler;
 use super::settings::{LightOffsets, PathSettings, Roulette, Strategy};
 use crate::bsdf::absorption::color_from_sigma_a;
@@ -185,6 +185,7 @@ impl World {
             radiance: seen / count,
             first: None,
             rays: rays.len() as u32,
+            seen: Seen::Split,
         };
         if hits == 0 {
             return sample;
@@ -219,6 +220,7 @@ impl World {
         sampler: &mut PixelSampler,
     ) -> CameraSample {
         let mut first = None;
+        let mut seen = Seen::Nothing;
         let mut rays = 0;
         let mut l = Vec3::ZERO;
         let mut beta = Vec3::ONE;
@@ -255,11 +257,21 @@ impl World {
                 }
                 beta /= survive;
             }
+            if events == 0 {
+                seen = Seen::Surface;
+            }
             let Some(hit) = self.tracer.record_spawned(&ray, &found) else {
                 break;
             };
-            if events == 0 && aovs {
-                first = Some(self.first_hit(&hit));
+            if events == 0 {
+                if let Hit::Hair(h) = &hit {
+                    // Not finite where the spread is 0: `PixelAccumulator::add_seen`
+                    // leaves that out.
+                    seen = Seen::Strand(2.0 * h.radius / (pixel_spread * h.t));
+                }
+                if aovs {
+                    first = Some(self.first_hit(&hit));
+                }
             }
             if events == settings.max_depth {
                 break;
@@ -318,6 +330,7 @@ impl World {
             radiance: l,
             first,
             rays,
+            seen,
         }
     }
 
@@ -463,6 +476,8 @@ pub struct CameraSample {
     pub first: Option<FirstHit>,
     /// Rays traced.
     pub rays: u32,
+    /// What its ray met first ([`Seen::Split`] for a sample of several).
+    pub seen: Seen,
 }
 
 /// The numbers of one light sample: which light, where on it, and the shadow-ray

@@ -6,13 +6,13 @@ use std::time::Instant;
 use glam::Vec3;
 
 use super::allocation;
-use super::camera_rays::{self, MAX_CAMERA_RAYS};
+use super::camera_rays::{self, CHOOSING_SAMPLES, FrameRates, MAX_CAMERA_RAYS};
 use super::film::{Aovs, Film, Keep, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::rounds::{Rounds, Stops, Taken};
 use super::sampler::PixelSampler;
-use super::settings::{Allocation, RenderSettings};
+use super::settings::{Allocation, CameraRays, RenderSettings};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
@@ -200,9 +200,15 @@ pub fn render(
     let mut shares: Option<allocation::Shares> = None;
     let filter = settings.pixel_filter()?;
     let pixel_spread = camera.pixel_spread(height);
-    let shifts = camera_rays::shifts(settings.camera_rays);
-    // In [1, MAX_CAMERA_RAYS]: `validate` refuses other counts.
-    let shifts = &shifts[..settings.camera_rays as usize];
+    // Each count's shifts (`validate` refuses counts outside [1, MAX_CAMERA_RAYS]).
+    let shift_sets: Vec<_> = (0..=MAX_CAMERA_RAYS as u32)
+        .map(camera_rays::shifts)
+        .collect();
+    // `auto` chooses where the pilot lets it; it takes one ray elsewhere.
+    let choosing = settings.camera_rays == CameraRays::Auto && pilot.is_some();
+    let mut choice: Option<camera_rays::Choice> = None;
+    // Rays `auto` traced outside the pilot's window to measure the frame's rates.
+    let mut lattice_rays = 0;
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),
@@ -221,6 +227,37 @@ pub fn render(
     let parts_before = world.tracer.scene().parts_built();
     let motion_blur = settings.motion_blur();
     let first_tile = OnceLock::new();
+    // Sample `index` of `pixel`, traced as `count` rays.
+    let sample_at = |pixel: (u32, u32), index: u32, count: u32| {
+        let shifts = &shift_sets[count as usize][..count as usize];
+        let mut sampler = PixelSampler::new(settings.seed, pixel, index);
+        let [ux, uy, choice, _] = sampler.next_4d();
+        let lens = if camera.has_lens() {
+            sampler.next_2d()
+        } else {
+            sampler.skip();
+            [0.5; 2]
+        };
+        let time = if motion_blur { sampler.time() } else { 0.0 };
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); MAX_CAMERA_RAYS];
+        for (ray, shift) in rays.iter_mut().zip(shifts) {
+            let u = [(ux + shift[0]).fract(), (uy + shift[1]).fract()];
+            let image_point = ndc(width, height, pixel, filter.sample(u));
+            let (org, dir) = camera.ray_at(image_point, lens, time);
+            *ray = Ray {
+                time,
+                ..Ray::new(org, dir)
+            };
+        }
+        world.camera_sample(
+            &rays[..shifts.len()],
+            choice,
+            &settings.path,
+            aovs.any(),
+            pixel_spread,
+            &mut sampler,
+        )
+    };
     let start = Instant::now();
     // One pool of workers for every round: `render_tiles` runs on it.
     let (spp, noise, status) = threads::scoped(options.threads, || -> Result<_> {
@@ -245,52 +282,73 @@ pub fn render(
             let (offset, total) = (u64::from(round.start) * pixels, u64::from(passes) * pixels);
             let round_pixels = u128::from(round.len() as u64 * pixels);
             let in_pass = u128::from(target.crop().pixel_count());
-            let pass_progress = |done: u64, _| {
-                if done > 0 {
-                    first_tile.get_or_init(|| start.elapsed().as_secs_f64());
-                }
-                let done = u128::from(done) * round_pixels / in_pass;
-                progress.update(offset + done as u64, total)
+            // The sample indices a round takes in parts, between these bounds: the pilot
+            // of `auto` camera rays in two, its first samples, of one ray, choosing the
+            // count of the rest's.
+            let bounds: &[u32] = if choosing && round.start == 0 {
+                &[0, CHOOSING_SAMPLES, u32::MAX]
+            } else {
+                &[0, u32::MAX]
             };
-            status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
-                for pass in round.clone() {
-                    for index in indices(pixel, pass) {
-                        if !pulse.keep_going() {
-                            return;
-                        }
-                        let mut sampler = PixelSampler::new(settings.seed, pixel, index);
-                        let [ux, uy, choice, _] = sampler.next_4d();
-                        let lens = if camera.has_lens() {
-                            sampler.next_2d()
-                        } else {
-                            sampler.skip();
-                            [0.5; 2]
-                        };
-                        let time = if motion_blur { sampler.time() } else { 0.0 };
-                        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); MAX_CAMERA_RAYS];
-                        for (ray, shift) in rays.iter_mut().zip(shifts) {
-                            let u = [(ux + shift[0]).fract(), (uy + shift[1]).fract()];
-                            let image_point = ndc(width, height, pixel, filter.sample(u));
-                            let (org, dir) = camera.ray_at(image_point, lens, time);
-                            *ray = Ray {
-                                time,
-                                ..Ray::new(org, dir)
-                            };
-                        }
-                        let sample = world.camera_sample(
-                            &rays[..shifts.len()],
-                            choice,
-                            &settings.path,
-                            aovs.any(),
-                            pixel_spread,
-                            &mut sampler,
-                        );
-                        acc.add(sample.radiance, sample.first.as_ref());
-                        acc.add_rays(sample.rays);
+            for part in bounds.windows(2).map(|b| b[0]..b[1]) {
+                // This part's share of the round's samples, and the shares before it.
+                let (before, share) = (
+                    u128::from(part.start),
+                    u128::from(part.end.min(PASS_SAMPLES) - part.start),
+                );
+                let pass_progress = |done: u64, _| {
+                    if done > 0 {
+                        first_tile.get_or_init(|| start.elapsed().as_secs_f64());
                     }
-                    acc.end_pass();
+                    let done = match part.end {
+                        u32::MAX if part.start == 0 => u128::from(done) * round_pixels / in_pass,
+                        _ => {
+                            (before * in_pass + u128::from(done) * share) * round_pixels
+                                / (in_pass * u128::from(PASS_SAMPLES))
+                        }
+                    };
+                    progress.update(offset + done as u64, total)
+                };
+                let collecting = choosing && part.end == CHOOSING_SAMPLES;
+                let chosen = choice.as_ref();
+                status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
+                    for pass in round.clone() {
+                        for index in indices(pixel, pass).filter(|i| part.contains(i)) {
+                            if !pulse.keep_going() {
+                                return;
+                            }
+                            let count = match (settings.camera_rays, chosen) {
+                                (CameraRays::Fixed(n), _) => n,
+                                (CameraRays::Auto, Some(c)) if index >= CHOOSING_SAMPLES => {
+                                    c.rays(pixel)
+                                }
+                                (CameraRays::Auto, _) => 1,
+                            };
+                            let sample = sample_at(pixel, index, count);
+                            if collecting {
+                                acc.add_seen(sample.seen, sample.radiance);
+                            }
+                            acc.add(sample.radiance, sample.first.as_ref());
+                            acc.add_rays(sample.rays);
+                        }
+                        if part.end == u32::MAX {
+                            acc.end_pass();
+                        }
+                    }
+                })?;
+                if status == RenderStatus::Cancelled {
+                    break;
                 }
-            })?;
+                if collecting {
+                    let one_ray = |p, i| {
+                        let s = sample_at(p, i, 1);
+                        (s.radiance, s.rays)
+                    };
+                    let rates = [0, 1].map(|c| FrameRates::measure(target, c, one_ray));
+                    lattice_rays += rates[0].1 + rates[1].1;
+                    choice = Some(camera_rays::Choice::new(target, rates.map(|r| r.0)));
+                }
+            }
             if status == RenderStatus::Cancelled {
                 break;
             }
@@ -324,7 +382,7 @@ pub fn render(
         samples: film.samples() + pilot.as_ref().map_or(0, Film::samples),
         spp,
         noise,
-        rays: film.rays() + pilot.as_ref().map_or(0, Film::rays),
+        rays: film.rays() + pilot.as_ref().map_or(0, Film::rays) + lattice_rays,
         first_tile_seconds: first_tile.get().copied(),
         parts_built: parts.built - parts_before.built,
         part_build_seconds: parts.seconds - parts_before.seconds,

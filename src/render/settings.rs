@@ -127,6 +127,31 @@ named_value!(Allocation { Uniform = "uniform", Noise = "noise" });
 named_value!(LightOffsets { Across = "across", Hit = "hit" });
 named_value!(CurveParts { Auto = "auto", On = "on", Off = "off" });
 
+/// `auto` or a count.
+impl Value for CameraRays {
+    fn kind() -> String {
+        "auto or an integer".into()
+    }
+    fn parse(text: &str) -> Option<Self> {
+        match text.trim() {
+            "auto" => Some(CameraRays::Auto),
+            t => t.parse().ok().map(CameraRays::Fixed),
+        }
+    }
+    fn show(&self) -> String {
+        match self {
+            CameraRays::Auto => "auto".into(),
+            CameraRays::Fixed(n) => n.to_string(),
+        }
+    }
+    fn number(&self) -> Option<f64> {
+        match self {
+            CameraRays::Auto => None,
+            CameraRays::Fixed(n) => Some(f64::from(*n)),
+        }
+    }
+}
+
 /// By the names `Isa` itself gives Embree.
 impl Value for Isa {
     fn kind() -> String {
@@ -342,9 +367,12 @@ settings! {
         /// Rays per camera sample, spread over its pixel: those that escape add what they
         /// see (the sky) exactly, and the path goes on from one of the others, picked at
         /// random and weighted by their number. The same image in expectation; less noise
-        /// where thin strands show a bright sky between them, more cost elsewhere
-        /// (docs/measurements.md, "Camera rays"). 1: one ray, the whole path.
-        camera_rays: u32 = 1, Range::Closed(1.0, MAX_CAMERA_RAYS as f64), Render;
+        /// where thin strands show a bright sky between them, more cost elsewhere. auto:
+        /// chosen for each 32 x 32 block from the noise allocation's pilot, 1 to 8 where
+        /// strands far under a pixel wide against a bright background make most of the
+        /// noise, else 1 (and 1 without a pilot); a count: that many everywhere
+        /// (docs/measurements.md, "Camera rays").
+        camera_rays: CameraRays = CameraRays::Auto, Range::Closed(1.0, MAX_CAMERA_RAYS as f64), Render;
         /// Pixel filter: tent (thin strands alias under a box) or box (one pixel, as
         /// renderers that use it).
         filter: Filter = Filter::Tent, Range::Any, Render;
@@ -456,6 +484,16 @@ pub enum Allocation {
     Uniform,
     /// A pilot pass, then samples in proportion to each pixel's estimated noise.
     Noise,
+}
+
+/// How many rays a camera sample is traced as (`super::camera_rays`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CameraRays {
+    /// Chosen per block of pixels from the noise allocation's pilot
+    /// (`camera_rays::Choice`).
+    Auto,
+    /// This many everywhere.
+    Fixed(u32),
 }
 
 /// When a large groom is built in parts (`crate::embree::PartsRule`).

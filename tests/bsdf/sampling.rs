@@ -2,7 +2,9 @@
 //! and `pdf`, and the sampled directions are unit vectors.
 
 use crate::common::sphere::uniform_sphere;
-use crate::common::{Timer, bsdf, d3, params, random_h, random_params, random_u, rng, v3};
+use crate::common::{
+    Timer, WEIGHT_TESTS, bsdf, d3, params, random_h, random_params, random_u, rng, v3,
+};
 use glam::Vec3;
 use hairtrace::LocalBsdf;
 use rand::Rng;
@@ -66,13 +68,7 @@ fn one_lobe_weights_estimate_the_mixture() {
     let _t = Timer::start("one_lobe_weights_estimate_the_mixture");
     const N: usize = 100_000;
     let mut g = rng(12);
-    let tests: [fn(Vec3) -> f64; 5] = [
-        |_| 1.0,
-        |w| f64::from(w.x > 0.0),
-        |w| f64::from(w.y > 0.0),
-        |w| f64::from(w.z > 0.0),
-        |w| f64::from(w.x * w.x),
-    ];
+    let tests = WEIGHT_TESTS;
     for beta in [0.1, 0.3, 0.8] {
         let p = params([0.5447, 0.9061, 1.781], 1.55, beta, beta, 2.0);
         let b = bsdf(&p);

@@ -129,8 +129,8 @@ fn a_noise_target_stops_at_the_first_round_that_reaches_it_with_the_plain_render
 
 /// A film keeps only what its render reads: a plain render its image alone (the sums too
 /// for a progress sink that keeps passes), one that may stop early the sums and the noise
-/// estimate's halves, the noise allocation the sums of its film and its pilot's squares and
-/// rays. The bytes per pixel are the layout's.
+/// estimate's halves, the noise allocation the sums of its film and its pilot's squares,
+/// rays and coverage. The bytes per pixel are the layout's.
 #[test]
 fn a_film_keeps_only_what_its_render_reads() {
     let world = lit_world();
@@ -140,12 +140,13 @@ fn a_film_keeps_only_what_its_render_reads() {
         strand_id: true,
     };
     // Image: rgb f32; sums: rgb f64 and a u32 count; halves: two f32 rgb and counts and a
-    // pass count; spread: rgb squares f64 and a u64 ray count.
+    // pass count; spread: rgb squares f64, a u64 ray count and the coverage (two u32 counts
+    // and four f32 sums).
     let layout = [
         (Keep::Image, 12, 12 + 12 + 4 + 4),
         (Keep::Sums, 12 + 28, 32 + 28 + 24 + 4),
         (Keep::Halves, 12 + 28 + 36, 32 + 28 + 24 + 4 + 36),
-        (Keep::Spread, 12 + 28 + 32, 32 + 28 + 24 + 4 + 32),
+        (Keep::Spread, 12 + 28 + 56, 32 + 28 + 24 + 4 + 56),
     ];
     for (keep, plain, with_aovs) in layout {
         assert_eq!(keep.bytes_per_pixel(Aovs::default()), plain, "{keep:?}");

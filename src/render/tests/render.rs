@@ -4,7 +4,7 @@
 use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
 use crate::render::integrator::World;
 use crate::render::renderer::render;
-use crate::render::settings::{LightOffsets, PathSettings, RenderSettings, Strategy};
+use crate::render::settings::{CameraRays, LightOffsets, PathSettings, RenderSettings, Strategy};
 use crate::render::{Aovs, NoProgress, RenderStatus};
 use crate::scene::FurBall;
 use crate::scene::camera::Camera;
@@ -393,10 +393,20 @@ fn renders_are_deterministic_across_threads_and_crops() {
     assert_deterministic(&lit_world(), base, "lit fur");
     let split = RenderSettings {
         spp: 12,
-        camera_rays: 4,
+        camera_rays: CameraRays::Fixed(4),
         ..base
     };
     assert_deterministic(&thin_fur_under_the_sky(), split, "split samples");
+    let auto = RenderSettings {
+        spp: 12,
+        camera_rays: CameraRays::Auto,
+        ..base
+    };
+    assert_deterministic(
+        &thin_fur_under_the_sky(),
+        auto,
+        "camera rays chosen per block",
+    );
 }
 
 /// `world` rendered with `base` (a 40 x 30 frame) gives the same bits on one thread and on
@@ -669,8 +679,8 @@ fn camera_samples_of_several_rays_keep_the_image_and_cut_its_noise() {
         camera_rays,
         ..quadrant_settings(PathSettings::default())
     };
-    let one = quadrant_means(&world, settings(1));
-    let four = quadrant_means(&world, settings(4));
+    let one = quadrant_means(&world, settings(CameraRays::Fixed(1)));
+    let four = quadrant_means(&world, settings(CameraRays::Fixed(4)));
     assert_quadrants_agree("4 rays vs 1", &four, &one);
     let images = |camera_rays| -> Vec<Vec<f32>> {
         (0..16)
@@ -687,7 +697,7 @@ fn camera_samples_of_several_rays_keep_the_image_and_cut_its_noise() {
             })
             .collect()
     };
-    let (one, four) = (images(1), images(4));
+    let (one, four) = (images(CameraRays::Fixed(1)), images(CameraRays::Fixed(4)));
     let stats = |images: &[Vec<f32>], i: usize| {
         let n = images.len() as f64;
         let m = images.iter().map(|im| f64::from(im[i])).sum::<f64>() / n;
@@ -725,6 +735,33 @@ fn camera_samples_of_several_rays_keep_the_image_and_cut_its_noise() {
         "pixel means differ beyond their noise: z rms {z_rms}"
     );
     assert!(v1 > 1.5 * v4, "{v1} against {v4}");
+}
+
+/// `camera_rays = auto` splits the samples of a frame of strands far under a pixel wide
+/// against a bright sky (it traces more rays per sample than one ray does) and keeps its
+/// image: quadrant means within 4 standard errors of one ray's over 64 seeds, at an spp
+/// that takes the noise allocation's pilot, from which it chooses.
+#[test]
+fn auto_camera_rays_split_where_strands_show_the_sky_and_keep_the_image() {
+    let world = thin_fur_under_the_sky();
+    let settings = |camera_rays| RenderSettings {
+        camera_rays,
+        spp: 16,
+        ..quadrant_settings(PathSettings::default())
+    };
+    let one = quadrant_means(&world, settings(CameraRays::Fixed(1)));
+    let auto = quadrant_means(&world, settings(CameraRays::Auto));
+    println!(
+        "rays per sample: {:.3} with one ray, {:.3} with auto",
+        one.1, auto.1
+    );
+    assert!(
+        auto.1 > one.1 + 0.2,
+        "auto did not split: {} against {}",
+        auto.1,
+        one.1
+    );
+    assert_quadrants_agree("auto vs 1", &auto, &one);
 }
 
 /// A split sample's first hit, for the AOVs, is its first ray's: none where that ray

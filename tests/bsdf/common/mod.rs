@@ -132,6 +132,16 @@ pub fn random_h(g: &mut impl rand::Rng) -> f32 {
     }
 }
 
+/// Test functions of a sampled direction, for paired comparisons of two sample weights:
+/// 1, each hemisphere in x, y and z, and wi.x^2.
+pub const WEIGHT_TESTS: [fn(Vec3) -> f64; 5] = [
+    |_| 1.0,
+    |w| f64::from(w.x > 0.0),
+    |w| f64::from(w.y > 0.0),
+    |w| f64::from(w.z > 0.0),
+    |w| f64::from(w.x * w.x),
+];
+
 /// Maps `f` over `items` on all cores, keeping the order (deterministic as long as each
 /// item is computed independently, e.g. with its own seed). Items are handed out one at
 /// a time, so uneven costs still balance.

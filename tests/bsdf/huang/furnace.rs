@@ -8,7 +8,7 @@
 use super::{huang, point};
 use crate::common::chi2::Grid;
 use crate::common::quad::gauss_legendre;
-use crate::common::{Timer, par_map, random_u, rng, v3};
+use crate::common::{Timer, WEIGHT_TESTS, par_map, random_u, rng, v3};
 use glam::{Vec2, Vec3};
 use rand::Rng;
 
@@ -139,13 +139,7 @@ fn huang_sample_weights_integrate_eval() {
 fn huang_one_lobe_weights_estimate_the_mixture() {
     let _t = Timer::start("huang_one_lobe_weights_estimate_the_mixture");
     const N: usize = 100_000;
-    let tests: [fn(Vec3) -> f64; 5] = [
-        |_| 1.0,
-        |w| f64::from(w.x > 0.0),
-        |w| f64::from(w.y > 0.0),
-        |w| f64::from(w.z > 0.0),
-        |w| f64::from(w.x * w.x),
-    ];
+    let tests = WEIGHT_TESTS;
     let cases = [
         (0.15f32, 1.0f32, 2.0f32, 1usize, 0.3f32, 10.0f32),
         (0.3, 0.65, 2.0, 2, -0.6, 50.0),

@@ -956,8 +956,8 @@ mod tests {
         let message = big.check_memory(Some(4 * GIB)).unwrap_err().to_string();
         for part in [
             "scalp.toml",
-            // 32768^2 pixels of 112 bytes: the noise allocation's sums (40) and pilot (72).
-            "film needs about 114688 MiB",
+            // 32768^2 pixels of 136 bytes: the noise allocation's sums (40) and pilot (96).
+            "film needs about 139264 MiB",
             "4096 MiB are available",
         ] {
             assert!(message.contains(part), "{message:?} lacks {part:?}");

@@ -15,7 +15,7 @@
 //! strands it meets are; the rest of the render takes the count that a model of that
 //! variance and of the rays' cost says makes the frame's noise cheapest, weighed against
 //! the frame's mean variance and cost ([`FrameRates`]) (docs/measurements.md, "Camera
-//! rays").
+//! rays chosen per block").
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -36,11 +36,11 @@ const COUNTS: [u32; 4] = [1, 2, 4, 8];
 /// Strands at most this wide, in pixels, where their camera rays meet them: far under the
 /// strata of the sampler's positions, which thus cannot tell strand from background
 /// (wider strands' coverage the stratified positions already take: docs/measurements.md,
-/// "Camera rays").
+/// "Camera rays chosen per block").
 const MAX_STRAND_WIDTH: f64 = 0.05;
 
 /// The time of an extra camera ray (an occlusion query from the eye) over that of one of a
-/// path's rays (docs/measurements.md, "Camera rays").
+/// path's rays (docs/measurements.md, "Camera rays chosen per block").
 const EXTRA_RAY_COST: f64 = 0.5;
 
 /// Side of the cells of the lattices of pixels whose first samples measure a frame's

@@ -956,7 +956,9 @@ mod tests {
         let message = big.check_memory(Some(4 * GIB)).unwrap_err().to_string();
         for part in [
             "scalp.toml",
-            // 32768^2 pixels of 136 bytes: the noise allocation's sums (40) and pilot (96).
+            // 32768^2 pixels of the noise allocation's sums and pilot (the layout
+            // `Keep::bytes_per_pixel` gives, which `a_film_keeps_only_what_its_render_reads`
+            // pins).
             "film needs about 139264 MiB",
             "4096 MiB are available",
         ] {

@@ -300,13 +300,8 @@ pub fn render(
                     if done > 0 {
                         first_tile.get_or_init(|| start.elapsed().as_secs_f64());
                     }
-                    let done = match part.end {
-                        u32::MAX if part.start == 0 => u128::from(done) * round_pixels / in_pass,
-                        _ => {
-                            (before * in_pass + u128::from(done) * share) * round_pixels
-                                / (in_pass * u128::from(PASS_SAMPLES))
-                        }
-                    };
+                    let done = (before * in_pass + u128::from(done) * share) * round_pixels
+                        / (in_pass * u128::from(PASS_SAMPLES));
                     progress.update(offset + done as u64, total)
                 };
                 let collecting = choosing && part.end == CHOOSING_SAMPLES;

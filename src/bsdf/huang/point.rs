@@ -163,7 +163,7 @@ impl HuangPoint {
     /// `u[1]`, `u[2]` the microfacet normal or the residual's theta. None where the density
     /// there is zero or the draw met total internal reflection.
     pub fn sample(&self, u: [f32; 3]) -> Option<BsdfSample> {
-        let (wi, _) = self.draw(u)?;
+        let wi = self.draw(u)?.1.wi;
         let e = self.eval(wi);
         (e.pdf > 0.0 && e.f.is_finite()).then_some(BsdfSample {
             wi,
@@ -176,16 +176,19 @@ impl HuangPoint {
     /// alone (`Paths::draw`): no offset or lobe is evaluated at wi. None also where that
     /// weight is zero (a direction the last interface masks).
     pub fn sample_weight(&self, u: [f32; 3]) -> Option<WeightedSample> {
-        let (wi, weight) = self.draw(u)?;
-        (weight.is_finite() && weight.max_element() > 0.0).then_some(WeightedSample { wi, weight })
+        let (paths, d) = self.draw(u)?;
+        let weight = paths.weight(&self.bsdf, &d);
+        (weight.is_finite() && weight.max_element() > 0.0)
+            .then_some(WeightedSample { wi: d.wi, weight })
     }
 
     /// The offset `u[0]` picks, and its draw from the rest of `u`.
-    fn draw(&self, u: [f32; 3]) -> Option<(Vec3, Vec3)> {
+    fn draw(&self, u: [f32; 3]) -> Option<(&Paths, Drawn)> {
         let n = self.shifts as f32;
         let k = ((u[0] * n) as usize).min(self.shifts - 1);
         let u0 = (u[0] * n - k as f32).clamp(0.0, 1.0);
-        self.paths[k].draw(self, [u0, u[1].max(U_MIN), u[2]])
+        let paths = &self.paths[k];
+        Some((paths, paths.draw(self, [u0, u[1].max(U_MIN), u[2]])?))
     }
 
     /// The RGB energy of R, TT, TRT and the residual leaving wo, averaged over the
@@ -421,33 +424,20 @@ impl Paths {
         (f, pdf)
     }
 
-    /// A direction from this offset's lobes and its weight from the lobe that drew it
-    /// alone: f_l |cos| / (P(l) pdf_l), with f_l and pdf_l the lobe's terms of [`Self::eval`],
-    /// which each lobe's draw follows exactly (the visible normals' density, the residual's
-    /// longitudinal lobe), so the weight is the lobe's energy toward wi over P(l): R's
-    /// Fresnel and unmasked share, an exit's weight and unmasked share out, the residual's
-    /// energy. Its mean is the mixture's. None where a refraction out meets total internal
-    /// reflection, or nothing leaves.
-    fn draw(&self, point: &HuangPoint, u: [f32; 3]) -> Option<(Vec3, Vec3)> {
+    /// A direction from this offset's lobes: what [`Self::weight`] needs of it. None where
+    /// a refraction out meets total internal reflection, or nothing leaves.
+    fn draw(&self, point: &HuangPoint, u: [f32; 3]) -> Option<Drawn> {
         if self.cos_om <= 0.0 {
             return None;
         }
         let bsdf = &point.bsdf;
         let (ggx, eta) = (&bsdf.ggx, bsdf.params.eta);
         let (lobe, u0) = pick(&self.lobe_pdf, u[0]);
-        let (wi, energy) = match lobe {
+        let (wi, cos) = match lobe {
             R => {
                 let wh = ggx.sample_visible(self.m, point.wo, [u[1], u[2]]);
                 let c = point.wo.dot(wh);
-                let wi = wh * (2.0 * c) - point.wo;
-                let cos_im = wi.dot(self.m);
-                let unmasked = if cos_im > 0.0 {
-                    ggx.g2_over_g1(self.cos_om, cos_im)
-                } else {
-                    0.0
-                };
-                let fr = fresnel_dielectric(c.clamp(0.0, 1.0), eta).0;
-                (wi, Vec3::splat(fr * unmasked))
+                (wh * (2.0 * c) - point.wo, c)
             }
             RESIDUAL => {
                 let (sin_ti, cos_ti) =
@@ -460,7 +450,7 @@ impl Paths {
                     cos_ti * (a.x * c - a.y * s),
                     cos_ti * (a.y * c + a.x * s),
                 );
-                (wi, self.residual)
+                (wi, 0.0)
             }
             _ => {
                 let e = &self.exits[lobe - TT];
@@ -468,12 +458,48 @@ impl Paths {
                     return None;
                 }
                 let wh = ggx.sample_visible(e.n, e.v, [u[1], u[2]]);
-                let wi = refract_out(eta, e.v, wh)?;
-                (wi, e.weight * leaving(ggx, eta, e, e.v.dot(wh), wi))
+                (refract_out(eta, e.v, wh)?, e.v.dot(wh))
             }
         };
-        Some((wi, energy / self.lobe_pdf[lobe]))
+        Some(Drawn { wi, lobe, cos })
     }
+
+    /// The weight of `d` from the lobe that drew it alone: f_l |cos| / (P(l) pdf_l), with
+    /// f_l and pdf_l the lobe's terms of [`Self::eval`], which each lobe's draw follows
+    /// exactly (the visible normals' density, the residual's longitudinal lobe), so the
+    /// weight is the lobe's energy toward wi over P(l): R's Fresnel and unmasked share, an
+    /// exit's weight and unmasked share out, the residual's energy. Its mean is the
+    /// mixture's.
+    fn weight(&self, bsdf: &HuangBsdf, d: &Drawn) -> Vec3 {
+        let (ggx, eta) = (&bsdf.ggx, bsdf.params.eta);
+        let energy = match d.lobe {
+            R => {
+                let cos_im = d.wi.dot(self.m);
+                let unmasked = if cos_im > 0.0 {
+                    ggx.g2_over_g1(self.cos_om, cos_im)
+                } else {
+                    0.0
+                };
+                Vec3::splat(fresnel_dielectric(d.cos.clamp(0.0, 1.0), eta).0 * unmasked)
+            }
+            RESIDUAL => self.residual,
+            lobe => {
+                let e = &self.exits[lobe - TT];
+                e.weight * leaving(ggx, eta, e, d.cos, d.wi)
+            }
+        };
+        energy / self.lobe_pdf[d.lobe]
+    }
+}
+
+/// A direction [`Paths::draw`] drew, the lobe that drew it, and the cosine of the
+/// microfacet it went through: with wo for R, with the inside direction for an exit (0 for
+/// the residual, which has none).
+#[derive(Debug, Clone, Copy)]
+struct Drawn {
+    wi: Vec3,
+    lobe: usize,
+    cos: f32,
 }
 
 /// The share of the light refracted out at the exit `e` through a microfacet at cosine

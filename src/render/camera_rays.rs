@@ -131,14 +131,15 @@ impl Choice {
     /// from the other colour's pixels of the block and lattice alone ([`count_for`]), so
     /// that no pixel's count depends on its own samples, which the image keeps (the noise
     /// allocation's reason, `allocation.rs`); and from its block's and the frame's, so that
-    /// a crop chooses as the full frame does.
-    pub(super) fn new(pilot: &Film, frame: [FrameRates; 2]) -> Choice {
+    /// a crop chooses as the full frame does. `blurred`: the shutter is open.
+    pub(super) fn new(pilot: &Film, frame: [FrameRates; 2], blurred: bool) -> Choice {
         let window = pilot.crop();
         let counts = blocks(window)
             .map(|block| {
                 let colour = |c: u32| {
                     let others = block.pixels().filter(move |(x, y)| (x + y) % 2 != c);
-                    count_for(others.map(|p| pilot.accumulator(p)), frame[1 - c as usize])
+                    let frame = frame[1 - c as usize];
+                    count_for(others.map(|p| pilot.accumulator(p)), frame, blurred)
                 };
                 [colour(0), colour(1)]
             })
@@ -163,9 +164,15 @@ impl Choice {
 /// over the pixel take that part down k-fold and cost (k - 1) extra rays; the frame's
 /// noise times its cost then changes, to first order, by these pixels' change of v over
 /// the frame's mean variance plus their change of c over the frame's mean rays: the count
-/// of [`COUNTS`] that makes that least. One ray where the strands are wider than
-/// [`MAX_STRAND_WIDTH`] or none is met.
-fn count_for(pixels: impl Iterator<Item = PixelAccumulator>, frame: FrameRates) -> u32 {
+/// of [`COUNTS`] that makes that least. One ray where none is met, or where the strands are
+/// wider than [`MAX_STRAND_WIDTH`] and `blurred` is false: under motion blur each sample
+/// sees the strands where they are at its own time, so the strata of positions across
+/// samples do not resolve their edges, and the rays of one sample, at its time, do.
+fn count_for(
+    pixels: impl Iterator<Item = PixelAccumulator>,
+    frame: FrameRates,
+    blurred: bool,
+) -> u32 {
     let (mut variance, mut part, mut rays, mut samples, mut count) = (0.0, 0.0, 0.0, 0.0, 0.0);
     let (mut width, mut strands) = (0.0, 0.0);
     for acc in pixels {
@@ -198,7 +205,7 @@ fn count_for(pixels: impl Iterator<Item = PixelAccumulator>, frame: FrameRates) 
             part += on_strands * f * (1.0 - f) * gap * n / (n - 1.0);
         }
     }
-    let coarse = strands == 0.0 || width / strands > MAX_STRAND_WIDTH;
+    let coarse = strands == 0.0 || (!blurred && width / strands > MAX_STRAND_WIDTH);
     if coarse || variance <= 0.0 || frame.variance <= 0.0 || frame.rays <= 0.0 {
         return 1;
     }
@@ -231,7 +238,9 @@ fn count_for(pixels: impl Iterator<Item = PixelAccumulator>, frame: FrameRates) 
 /// own position (wrapped into the pixel): a Hammersley set, (j / count, the base-2
 /// radical inverse of j), whose points spread over the pixel as evenly as `count` points
 /// can. Each shifted position is as uniform over the pixel as the sample's own, so every
-/// ray sees the pixel as a single camera ray would.
+/// ray sees the pixel as a single camera ray would. The rays share the sample's time:
+/// spreading them over the shutter too measured worse (docs/measurements.md, "Camera rays
+/// under motion blur").
 pub fn shifts(count: u32) -> [[f32; 2]; MAX_CAMERA_RAYS] {
     let n = count.max(1) as f32;
     std::array::from_fn(|j| {
@@ -272,19 +281,24 @@ mod tests {
 
     /// Strands far under a pixel against a bright sky split: more ways where the block is
     /// noisier than the frame; not where the strands are wide (the sampler's strata
-    /// resolve them), where no ray escapes (no background to tell from), nor where the
-    /// block's noise is small beside the frame's (its extra rays buy the frame little).
+    /// resolve them) unless the shutter is open, where no ray escapes (no background to
+    /// tell from), nor where the block's noise is small beside the frame's (its extra rays
+    /// buy the frame little).
     #[test]
     fn samples_split_where_thin_strands_against_the_sky_make_the_frames_noise() {
         let thin = mixed(0.02);
-        let like = |acc: &PixelAccumulator, scale| {
-            count_for(std::iter::repeat_n(acc.clone(), 64), frame_of(&thin, scale))
+        let count = |acc: &PixelAccumulator, scale, blurred| {
+            let pixels = std::iter::repeat_n(acc.clone(), 64);
+            count_for(pixels, frame_of(&thin, scale), blurred)
         };
+        let like = |acc: &PixelAccumulator, scale| count(acc, scale, false);
         assert_eq!(like(&thin, 2.0), 1);
         assert_eq!(like(&thin, 0.5), 2);
         assert_eq!(like(&thin, 0.125), 4);
         assert_eq!(like(&thin, 0.03125), 8);
         assert_eq!(like(&mixed(0.2), 0.0625), 1);
+        assert_eq!(count(&mixed(0.2), 0.0625, true), 4);
+        assert_eq!(count(&thin, 2.0, true), 1);
         let covered = pixel([(0.1, Seen::Strand(0.02)), (0.9, Seen::Strand(0.02))], 1);
         assert_eq!(like(&covered, 0.0625), 1);
         // A surface's silhouette against the sky is an edge: the strata resolve it.
@@ -310,7 +324,7 @@ mod tests {
             pilot.store(p, &acc);
         }
         let frame = frame_of(&mixed(0.02), 0.0625);
-        let choice = Choice::new(&pilot, [frame; 2]);
+        let choice = Choice::new(&pilot, [frame; 2], false);
         assert_eq!(choice.rays((0, 0)), 1, "an even pixel read its own colour");
         assert!(choice.rays((1, 0)) > 1, "an odd pixel missed the even ones");
         assert_eq!(

@@ -341,7 +341,8 @@ pub fn render(
                     };
                     let rates = [0, 1].map(|c| FrameRates::measure(target, c, one_ray));
                     lattice_rays += rates[0].1 + rates[1].1;
-                    choice = Some(camera_rays::Choice::new(target, rates.map(|r| r.0)));
+                    let frame = rates.map(|r| r.0);
+                    choice = Some(camera_rays::Choice::new(target, frame, motion_blur));
                 }
             }
             if status == RenderStatus::Cancelled {

@@ -369,9 +369,9 @@ settings! {
         /// random and weighted by their number. The same image in expectation; less noise
         /// where thin strands show a bright sky between them, more cost elsewhere. auto:
         /// chosen for each 32 x 32 block from the noise allocation's pilot, 1 to 8 where
-        /// strands far under a pixel wide against a bright background make most of the
-        /// noise, else 1 (and 1 without a pilot); a count: that many everywhere
-        /// (docs/measurements.md, "Camera rays").
+        /// strands far under a pixel wide, or moving under an open shutter, against a
+        /// bright background make most of the noise, else 1 (and 1 without a pilot); a
+        /// count: that many everywhere (docs/measurements.md, "Camera rays").
         camera_rays: CameraRays = CameraRays::Auto, Range::Closed(1.0, MAX_CAMERA_RAYS as f64), Render;
         /// Pixel filter: tent (thin strands alias under a box) or box (one pixel, as
         /// renderers that use it).

@@ -27,7 +27,8 @@ use super::film::{Film, PixelAccumulator, Window};
 pub const MAX_CAMERA_RAYS: usize = 16;
 
 /// The pilot's samples of a pixel traced with one ray, from which `auto` chooses for the
-/// rest: the same samples as a render of one ray takes.
+/// rest (and roulette learns its survival: `super::survival`): the same samples as a
+/// render of one ray takes.
 pub const CHOOSING_SAMPLES: u32 = 2;
 
 /// The counts `auto` chooses among.

@@ -11,6 +11,7 @@ use super::camera_rays::MAX_CAMERA_RAYS;
 use super::film::{FirstHit, Seen};
 use super::sampler::PixelSampler;
 use super::settings::{LightOffsets, PathSettings, Roulette, Strategy};
+use super::survival::{Recorder, Survival};
 use crate::bsdf::absorption::color_from_sigma_a;
 use crate::bsdf::diffuse::Diffuse;
 use crate::bsdf::{
@@ -29,11 +30,12 @@ impl Roulette {
     /// The probability that a path goes on when it is decided at a hit, before the
     /// vertex is shaded (where no light is sampled: `World::radiance`): the square of
     /// [`Self::survival`], which also stands in for the attenuation of the vertex it has
-    /// not seen. Measured on the uniform-sky fur ball: as many rays and the same error as
-    /// the rule after the vertex, in 9% less time (docs/measurements.md, "Render efficiency").
-    pub fn survival_at_hit(self, beta: Vec3) -> f32 {
+    /// not seen (measured on the uniform-sky fur ball: as many rays and the same error as
+    /// the rule after the vertex, in 9% less time: docs/measurements.md, "Render
+    /// efficiency"), times the depth's learned `factor` (`render::survival`), at most 1.
+    pub fn survival_at_hit(self, beta: Vec3, factor: f32) -> f32 {
         let s = self.survival(beta);
-        s * s
+        (s * s * factor).min(1.0)
     }
 
     /// The probability that a path with throughput `beta` goes on.
@@ -146,10 +148,18 @@ impl World {
         Ok(())
     }
 
+    /// Whether next-event estimation samples a light at each vertex: not where no light
+    /// needs it (a uniform sky alone) or when only the BSDF is sampled.
+    pub fn samples_lights(&self, settings: &PathSettings) -> bool {
+        settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some()
+    }
+
     /// One camera sample traced as `rays`, spread over its pixel (`super::camera_rays`):
     /// the rays that escape add what they see, and the path goes on from the ray that
     /// `choice` (in [0, 1)) picks among those that hit, weighted by their number. Its first
-    /// hit, for the AOVs, is the first ray's.
+    /// hit, for the AOVs, is the first ray's. Where no light is sampled, `survival` scales
+    /// the roulette, and `record`, when given, records the path's decisions.
+    #[allow(clippy::too_many_arguments)]
     pub fn camera_sample(
         &self,
         rays: &[Ray],
@@ -158,9 +168,11 @@ impl World {
         aovs: bool,
         pixel_spread: f32,
         sampler: &mut PixelSampler,
+        (survival, record): (&Survival, Option<&mut Recorder>),
     ) -> CameraSample {
+        let ending = (survival, record);
         if let [ray] = rays {
-            return self.radiance(*ray, settings, aovs, pixel_spread, sampler);
+            return self.radiance(*ray, settings, aovs, pixel_spread, sampler, ending);
         }
         let mut seen = Vec3::ZERO;
         let mut hit = [0; MAX_CAMERA_RAYS];
@@ -191,7 +203,7 @@ impl World {
             return sample;
         }
         let picked = hit[((choice * hits as f32) as usize).min(hits - 1)];
-        let path = self.radiance(rays[picked], settings, aovs, pixel_spread, sampler);
+        let path = self.radiance(rays[picked], settings, aovs, pixel_spread, sampler, ending);
         sample.radiance += path.radiance * (hits as f32 / count);
         sample.rays += path.rays;
         sample.first = match picked {
@@ -218,6 +230,7 @@ impl World {
         aovs: bool,
         pixel_spread: f32,
         sampler: &mut PixelSampler,
+        (survival, mut record): (&Survival, Option<&mut Recorder>),
     ) -> CameraSample {
         let mut first = None;
         let mut seen = Seen::Nothing;
@@ -228,7 +241,7 @@ impl World {
         // How `ray` was made, for MIS on the emission it finds.
         let mut came = Came::Camera;
         // `events` scattering events precede the ray traced in this iteration.
-        let sample_light = settings.strategy != Strategy::BsdfOnly && self.light_choice.is_some();
+        let sample_light = self.samples_lights(settings);
         // Without next-event estimation a vertex's only product is the path's continuation,
         // so roulette decides at the hit, before the hit record and the BSDF are built.
         let roulette_at_hit = !sample_light;
@@ -251,9 +264,14 @@ impl World {
             // The direction takes the best stratified pair, the lobe and roulette the rest.
             let [dx, dy, u_lobe, u_rr] = sampler.next_4d();
             if roulette_at_hit && events > 0 && events + 1 >= settings.rr_depth {
-                let survive = settings.roulette.survival_at_hit(beta);
+                let survive = settings
+                    .roulette
+                    .survival_at_hit(beta, survival.factor(events));
                 if u_rr >= survive {
                     break;
+                }
+                if let Some(r) = record.as_deref_mut() {
+                    r.survived(events, survive, beta, l, rays);
                 }
                 beta /= survive;
             }
@@ -325,6 +343,9 @@ impl World {
             came = Came::Bsdf {
                 pdf: if mis { shading.pdf(s.local) } else { 0.0 },
             };
+        }
+        if let Some(r) = record {
+            r.finish(l, rays);
         }
         CameraSample {
             radiance: l,

@@ -11,6 +11,7 @@ pub(crate) mod renderer;
 mod rounds;
 pub(crate) mod sampler;
 pub mod settings;
+pub(crate) mod survival;
 pub(crate) mod tiles;
 
 pub use film::{Aovs, Film, Keep, NO_HIT_DEPTH, NO_STRAND, PixelFilter, Window};

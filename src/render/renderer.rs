@@ -4,6 +4,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::allocation;
 use super::camera_rays::{self, CHOOSING_SAMPLES, FrameRates, MAX_CAMERA_RAYS};
@@ -12,7 +13,8 @@ use super::integrator::World;
 use super::progress::Progress;
 use super::rounds::{Rounds, Stops, Taken};
 use super::sampler::PixelSampler;
-use super::settings::{Allocation, CameraRays, RenderSettings};
+use super::settings::{Allocation, CameraRays, RenderSettings, RouletteScale};
+use super::survival::{LatticePixel, Recorder, Survival};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
@@ -206,6 +208,13 @@ pub fn render(
         .collect();
     // `auto` chooses where the pilot lets it; it takes one ray elsewhere.
     let choosing = settings.camera_rays == CameraRays::Auto && pilot.is_some();
+    // The roulette where no light is sampled learns its survival from the pilot's first
+    // samples, as `auto` camera rays choose their counts.
+    let learning = pilot.is_some()
+        && settings.path.roulette_scale == RouletteScale::Auto
+        && !world.samples_lights(&settings.path);
+    let learned: OnceLock<Survival> = OnceLock::new();
+    let throughput_rule = Survival::default();
     let mut choice: Option<camera_rays::Choice> = None;
     // Rays `auto` traced outside the pilot's window to measure the frame's rates.
     let mut lattice_rays = 0;
@@ -228,7 +237,7 @@ pub fn render(
     let motion_blur = settings.motion_blur();
     let first_tile = OnceLock::new();
     // Sample `index` of `pixel`, traced as `count` rays.
-    let sample_at = |pixel: (u32, u32), index: u32, count: u32| {
+    let sample_at = |pixel: (u32, u32), index: u32, count: u32, record: Option<&mut Recorder>| {
         let shifts = &shift_sets[count as usize][..count as usize];
         let mut sampler = PixelSampler::new(settings.seed, pixel, index);
         let [ux, uy, choice, _] = sampler.next_4d();
@@ -256,6 +265,7 @@ pub fn render(
             aovs.any(),
             pixel_spread,
             &mut sampler,
+            (learned.get().unwrap_or(&throughput_rule), record),
         )
     };
     let start = Instant::now();
@@ -283,9 +293,10 @@ pub fn render(
             let round_pixels = u128::from(round.len() as u64 * pixels);
             let in_pass = u128::from(target.crop().pixel_count());
             // The sample indices a round takes in parts, between these bounds: the pilot
-            // of `auto` camera rays in two, its first samples, of one ray, choosing the
-            // count of the rest's.
-            let bounds: &[u32] = if choosing && round.start == 0 {
+            // of `auto` camera rays or a learned roulette in two, its first samples, of one
+            // ray and the rule's survival, choosing the count and the survival of the
+            // rest's.
+            let bounds: &[u32] = if (choosing || learning) && round.start == 0 {
                 &[0, CHOOSING_SAMPLES, u32::MAX]
             } else {
                 &[0, u32::MAX]
@@ -319,7 +330,7 @@ pub fn render(
                                 }
                                 (CameraRays::Auto, _) => 1,
                             };
-                            let sample = sample_at(pixel, index, count);
+                            let sample = sample_at(pixel, index, count, None);
                             if collecting {
                                 acc.add_seen(sample.seen, sample.radiance);
                             }
@@ -334,9 +345,14 @@ pub fn render(
                 if status == RenderStatus::Cancelled {
                     break;
                 }
+                if learning && part.end == CHOOSING_SAMPLES {
+                    let (survival, rays) = learn_survival(width, height, &sample_at);
+                    lattice_rays += rays;
+                    learned.set(survival).expect("learned once");
+                }
                 if collecting {
                     let one_ray = |p, i| {
-                        let s = sample_at(p, i, 1);
+                        let s = sample_at(p, i, 1, None);
                         (s.radiance, s.rays)
                     };
                     let rates = [0, 1].map(|c| FrameRates::measure(target, c, one_ray));
@@ -388,4 +404,45 @@ pub fn render(
         status,
         stats,
     })
+}
+
+/// Side of the cells of the lattice of pixels whose first two samples the roulette learns
+/// from ([`Survival::learn`]): fixed on the full frame, so a crop learns what the full frame
+/// does.
+const SURVIVAL_LATTICE: u32 = 4;
+
+/// The survival learned from the first two samples, one ray each, of every
+/// [`SURVIVAL_LATTICE`]-th pixel of the `width` x `height` frame, traced again by `sample`
+/// with a recorder, and the rays that took.
+fn learn_survival(
+    width: u32,
+    height: u32,
+    sample: &(
+         impl Fn((u32, u32), u32, u32, Option<&mut Recorder>) -> super::integrator::CameraSample + Sync
+     ),
+) -> (Survival, u64) {
+    let step = SURVIVAL_LATTICE as usize;
+    let pixels: Vec<(u32, u32)> = (0..height)
+        .step_by(step)
+        .flat_map(|y| (0..width).step_by(step).map(move |x| (x, y)))
+        .collect();
+    let lattice: Vec<LatticePixel> = pixels
+        .par_iter()
+        .map(|&p| {
+            let mut recorder = Recorder::default();
+            let mut out = LatticePixel::default();
+            for i in 0..CHOOSING_SAMPLES {
+                let s = sample(p, i, 1, Some(&mut recorder));
+                out.luminance[i as usize] = crate::math::luminance(s.radiance);
+                out.rays[i as usize] = s.rays;
+            }
+            out.depths = recorder.sums();
+            out
+        })
+        .collect();
+    let rays = lattice
+        .iter()
+        .map(|p| u64::from(p.rays[0] + p.rays[1]))
+        .sum();
+    (Survival::learn(&lattice), rays)
 }

@@ -121,6 +121,7 @@ macro_rules! named_value {
     };
 }
 named_value!(Roulette { SqrtThroughput = "sqrt", Throughput = "throughput" });
+named_value!(RouletteScale { Auto = "auto", Off = "off" });
 named_value!(Strategy { Mis = "mis", LightOnly = "light", BsdfOnly = "bsdf" });
 named_value!(Filter { Tent = "tent", Box = "box" });
 named_value!(Allocation { Uniform = "uniform", Noise = "noise" });
@@ -415,6 +416,12 @@ settings! {
         /// Russian roulette's survival: sqrt (of the path throughput's largest channel:
         /// keeps long chains through light hair) or throughput (pbrt's rule).
         roulette: Roulette = Roulette::SqrtThroughput, Range::Any, Render;
+        /// Where no light is sampled (a uniform sky alone), roulette's survival at each
+        /// depth times a factor learned from the noise allocation's pilot: auto (at least 1,
+        /// raised where light the path may still gather outweighs the rays it costs, to
+        /// first order: light hair; the rule alone without a pilot) or off
+        /// (docs/measurements.md, "Roulette from the pilot").
+        roulette_scale: RouletteScale = RouletteScale::Auto, Range::Any, Render;
         /// Upper bound on the luminance of one contribution of indirect light (biased, cuts
         /// fireflies); none: no clamping.
         clamp_indirect: Option<f32> = None, Range::Above(0.0), Render;
@@ -449,6 +456,17 @@ pub enum LightOffsets {
     Across,
     /// The hit's offset alone.
     Hit,
+}
+
+/// Whether Russian roulette where no light is sampled scales its survival per depth by
+/// what the noise allocation's pilot measured (`super::survival`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RouletteScale {
+    /// Learned from the pilot, never below the rule's survival; the rule's alone without a
+    /// pilot.
+    Auto,
+    /// The rule's survival alone.
+    Off,
 }
 
 /// How Russian roulette turns a path's throughput into its chance to go on. Both are

@@ -43,6 +43,7 @@ const KNOBS: &[Knob] = &[
     knob("rr_depth 1", |v| set(v, "rr_depth", "1")),
     knob("rr_depth 8", |v| set(v, "rr_depth", "8")),
     knob("roulette throughput", |v| set(v, "roulette", "throughput")),
+    knob("roulette_scale off", |v| set(v, "roulette_scale", "off")),
     knob("max_depth 16", |v| set(v, "max_depth", "16")),
     knob("max_depth 4", |v| set(v, "max_depth", "4")),
     knob("filter tent", |v| set(v, "filter", "tent")),

@@ -4,7 +4,9 @@
 use crate::embree::{CurveBasis, CurveShape, Device, SceneOptions};
 use crate::render::integrator::World;
 use crate::render::renderer::render;
-use crate::render::settings::{CameraRays, LightOffsets, PathSettings, RenderSettings, Strategy};
+use crate::render::settings::{
+    CameraRays, LightOffsets, PathSettings, RenderSettings, RouletteScale, Strategy,
+};
 use crate::render::{Aovs, NoProgress, RenderStatus};
 use crate::scene::FurBall;
 use crate::scene::camera::Camera;
@@ -157,8 +159,8 @@ pub(crate) fn quadrant_settings(path: PathSettings) -> RenderSettings {
     }
 }
 
-/// Mean and standard error of each image quadrant's mean over 64 seeds of a 24 x 24
-/// render with these settings, and the rays per camera sample.
+/// Mean and standard error of each image quadrant's mean over 64 seeds of a render with
+/// these settings (an even width and height), and the rays per camera sample.
 fn quadrant_means(world: &World, base: RenderSettings) -> (Vec<(f64, f64)>, f64) {
     quadrant_means_over(world, base, 64)
 }
@@ -176,12 +178,14 @@ pub(crate) fn quadrant_means_over(
             let out = render(world, &camera(), &settings, Aovs::default(), &NoProgress).unwrap();
             rays += out.stats.rays as f64 / out.stats.samples as f64 / seeds as f64;
             let rgb = out.film.rgb();
+            let (w, h) = (settings.width as usize, settings.height as usize);
+            let quarter = 3.0 * (w / 2 * h / 2) as f64;
             let mut q = [0.0f64; 4];
-            for y in 0..24 {
-                for x in 0..24 {
-                    let i = 3 * (y * 24 + x);
-                    q[(y / 12) * 2 + x / 12] +=
-                        f64::from(rgb[i] + rgb[i + 1] + rgb[i + 2]) / (3.0 * 144.0);
+            for y in 0..h {
+                for x in 0..w {
+                    let i = 3 * (y * w + x);
+                    q[(y / (h / 2)) * 2 + x / (w / 2)] +=
+                        f64::from(rgb[i] + rgb[i + 1] + rgb[i + 2]) / quarter;
                 }
             }
             q
@@ -212,6 +216,27 @@ pub(crate) fn assert_quadrants_agree(
             "{label}, quadrant {k}: {ma} vs {mb} (bound {bound})"
         );
     }
+}
+
+/// `more` renders `base`'s image (quadrant means within 4 standard errors) with more than
+/// `margin` more rays per sample: what a choice that spends rays where they pay shows.
+pub(crate) fn assert_same_image_more_rays(
+    label: &str,
+    more: &(Vec<(f64, f64)>, f64),
+    base: &(Vec<(f64, f64)>, f64),
+    margin: f64,
+) {
+    println!(
+        "{label}: rays per sample {:.3} against {:.3}",
+        more.1, base.1
+    );
+    assert!(
+        more.1 > base.1 + margin,
+        "{label}: rays per sample {} against {}",
+        more.1,
+        base.1
+    );
+    assert_quadrants_agree(label, more, base);
 }
 
 /// Shadow-ray roulette is unbiased: with every shadow ray traced (threshold 0), at the
@@ -406,6 +431,11 @@ fn renders_are_deterministic_across_threads_and_crops() {
         &thin_fur_under_the_sky(),
         auto,
         "camera rays chosen per block",
+    );
+    assert_deterministic(
+        &blonde_fur_under_the_sky(),
+        auto,
+        "roulette learned from the pilot",
     );
 }
 
@@ -666,6 +696,42 @@ fn thin_fur_under_the_sky() -> World {
     world_of(&groom, HairMaterial::default(), vec![sky])
 }
 
+/// A fur ball of blonde hair, whose light is mostly many bounces deep, alone under a
+/// uniform sky: no light is sampled, so roulette learns its survival from the pilot.
+fn blonde_fur_under_the_sky() -> World {
+    let blonde = HairMaterial {
+        color: HairColor::Melanin {
+            eumelanin: 0.3,
+            pheomelanin: 0.1,
+        },
+        ..HairMaterial::default()
+    };
+    let sky = Light::Environment(Environment::uniform(Vec3::ONE).unwrap());
+    fur_world(blonde, vec![sky], 3000)
+}
+
+/// Roulette's survival learned from the pilot (`roulette_scale = auto`) keeps the image
+/// that the rule alone (`off`) renders: quadrant means within 4 standard errors over 32
+/// seeds. On blonde fur under the sky it learns to let paths live longer: more rays per
+/// sample.
+#[test]
+fn roulette_learned_from_the_pilot_keeps_the_image() {
+    let world = blonde_fur_under_the_sky();
+    // Enough pixels for the lattice's paths to make a decision at each depth often.
+    let settings = |roulette_scale| RenderSettings {
+        spp: 16,
+        width: 64,
+        height: 64,
+        ..quadrant_settings(PathSettings {
+            roulette_scale,
+            ..PathSettings::default()
+        })
+    };
+    let off = quadrant_means_over(&world, settings(RouletteScale::Off), 32);
+    let auto = quadrant_means_over(&world, settings(RouletteScale::Auto), 32);
+    assert_same_image_more_rays("learned vs off", &auto, &off, 0.03);
+}
+
 /// Camera samples of four rays render the image that samples of one render: quadrant
 /// means within 4 standard errors over 64 seeds, and every pixel's mean over 16 seeds
 /// within its noise (the z-scores' RMS near 1: rays that left their pixel, or a weight
@@ -751,17 +817,7 @@ fn auto_camera_rays_split_where_strands_show_the_sky_and_keep_the_image() {
     };
     let one = quadrant_means(&world, settings(CameraRays::Fixed(1)));
     let auto = quadrant_means(&world, settings(CameraRays::Auto));
-    println!(
-        "rays per sample: {:.3} with one ray, {:.3} with auto",
-        one.1, auto.1
-    );
-    assert!(
-        auto.1 > one.1 + 0.2,
-        "auto did not split: {} against {}",
-        auto.1,
-        one.1
-    );
-    assert_quadrants_agree("auto vs 1", &auto, &one);
+    assert_same_image_more_rays("auto vs 1", &auto, &one, 0.2);
 }
 
 /// A split sample's first hit, for the AOVs, is its first ray's: none where that ray
@@ -787,6 +843,7 @@ fn a_split_samples_first_hit_is_its_first_rays() {
             true,
             1e-3,
             &mut sampler,
+            (&crate::render::survival::Survival::default(), None),
         )
     };
     assert!(sample(&[sky, hair], 0.5).first.is_none());

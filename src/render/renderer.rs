@@ -216,7 +216,8 @@ pub fn render(
     let learned: OnceLock<Survival> = OnceLock::new();
     let throughput_rule = Survival::default();
     let mut choice: Option<camera_rays::Choice> = None;
-    // Rays `auto` traced outside the pilot's window to measure the frame's rates.
+    // Rays traced again for what the pilot measures: `auto` camera rays' frame rates outside
+    // the pilot's window, and the lattice roulette learns from.
     let mut lattice_rays = 0;
     let options = TileOptions {
         tile_size: 16,
@@ -346,9 +347,12 @@ pub fn render(
                     break;
                 }
                 if learning && part.end == CHOOSING_SAMPLES {
-                    let (survival, rays) = learn_survival(width, height, &sample_at);
-                    lattice_rays += rays;
-                    learned.set(survival).expect("learned once");
+                    // The pilot's first part runs once: this learns once.
+                    learned.get_or_init(|| {
+                        let (survival, rays) = learn_survival(width, height, &sample_at);
+                        lattice_rays += rays;
+                        survival
+                    });
                 }
                 if collecting {
                     let one_ray = |p, i| {

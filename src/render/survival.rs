@@ -19,7 +19,7 @@ use crate::math::luminance;
 const DEPTHS: usize = 16;
 
 /// The fewest surviving decisions at a depth whose factor is its own: a second moment of
-/// fewer is mostly its noise. A depth with fewer takes the depth before it's factor.
+/// fewer is mostly its noise. A depth with fewer takes the factor of the depth before it.
 const MIN_DECISIONS: f64 = 32.0;
 
 /// The largest factor. The least is 1: below the rule's survival the first-order factor

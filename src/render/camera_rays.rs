@@ -70,14 +70,7 @@ impl FrameRates {
         sample: impl Fn((u32, u32), u32) -> (Vec3, u32) + Sync,
     ) -> (FrameRates, u64) {
         let (width, height, window) = (pilot.width(), pilot.height(), pilot.crop());
-        let pixels: Vec<(u32, u32)> = (0..height)
-            .step_by(LATTICE as usize)
-            .flat_map(|y| {
-                (colour..width)
-                    .step_by(LATTICE as usize)
-                    .map(move |x| (x, y))
-            })
-            .collect();
+        let pixels = lattice(width, height, LATTICE, colour);
         let inside = |(x, y): (u32, u32)| {
             (window.x0..window.x1).contains(&x) && (window.y0..window.y1).contains(&y)
         };
@@ -114,6 +107,15 @@ impl FrameRates {
         };
         (rates, traced)
     }
+}
+
+/// The pixels (`x0` + `step` i, `step` j) of a `width` x `height` frame, row by row: the
+/// full frame's, whatever the crop, so that a crop measures what the full frame does.
+pub(super) fn lattice(width: u32, height: u32, step: u32, x0: u32) -> Vec<(u32, u32)> {
+    (0..height)
+        .step_by(step as usize)
+        .flat_map(|y| (x0..width).step_by(step as usize).map(move |x| (x, y)))
+        .collect()
 }
 
 /// The rays per camera sample of each pixel after the pilot's first

@@ -30,9 +30,9 @@ impl Roulette {
     /// The probability that a path goes on when it is decided at a hit, before the
     /// vertex is shaded (where no light is sampled: `World::radiance`): the square of
     /// [`Self::survival`], which also stands in for the attenuation of the vertex it has
-    /// not seen (measured on the uniform-sky fur ball: as many rays and the same error as
-    /// the rule after the vertex, in 9% less time: docs/measurements.md, "Render
-    /// efficiency"), times the depth's learned `factor` (`render::survival`), at most 1.
+    /// not seen (measured cheaper than the rule after the vertex at the same error:
+    /// docs/measurements.md, "Render efficiency"), times the depth's learned `factor`
+    /// (`render::survival`), at most 1.
     pub fn survival_at_hit(self, beta: Vec3, factor: f32) -> f32 {
         let s = self.survival(beta);
         (s * s * factor).min(1.0)
@@ -168,9 +168,8 @@ impl World {
         aovs: bool,
         pixel_spread: f32,
         sampler: &mut PixelSampler,
-        (survival, record): (&Survival, Option<&mut Recorder>),
+        ending: (&Survival, Option<&mut Recorder>),
     ) -> CameraSample {
-        let ending = (survival, record);
         if let [ray] = rays {
             return self.radiance(*ray, settings, aovs, pixel_spread, sampler, ending);
         }

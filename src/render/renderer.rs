@@ -425,12 +425,7 @@ fn learn_survival(
          impl Fn((u32, u32), u32, u32, Option<&mut Recorder>) -> super::integrator::CameraSample + Sync
      ),
 ) -> (Survival, u64) {
-    let step = SURVIVAL_LATTICE as usize;
-    let pixels: Vec<(u32, u32)> = (0..height)
-        .step_by(step)
-        .flat_map(|y| (0..width).step_by(step).map(move |x| (x, y)))
-        .collect();
-    let lattice: Vec<LatticePixel> = pixels
+    let lattice: Vec<LatticePixel> = camera_rays::lattice(width, height, SURVIVAL_LATTICE, 0)
         .par_iter()
         .map(|&p| {
             let mut recorder = Recorder::default();

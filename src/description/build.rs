@@ -959,7 +959,7 @@ mod tests {
             // 32768^2 pixels of the noise allocation's sums and pilot (the layout
             // `Keep::bytes_per_pixel` gives, which `a_film_keeps_only_what_its_render_reads`
             // pins).
-            "film needs about 139264 MiB",
+            "film needs about 114688 MiB",
             "4096 MiB are available",
         ] {
             assert!(message.contains(part), "{message:?} lacks {part:?}");

@@ -305,6 +305,17 @@ impl Scene {
         self.parts.len()
     }
 
+    /// The curve segments of every curve geometry: what its build cost scales with.
+    pub(crate) fn curve_segments(&self) -> usize {
+        self.geometries
+            .iter()
+            .map(|g| match g {
+                Geometry::Curves(c) => c.segment_count(),
+                Geometry::Triangles(_) => 0,
+            })
+            .sum()
+    }
+
     /// How many parts have been built so far, and the seconds their builds took
     /// (summed over the threads that built them).
     pub(crate) fn parts_built(&self) -> PartsBuilt {

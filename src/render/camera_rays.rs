@@ -9,27 +9,20 @@
 //! The extra rays are occlusion queries from the eye, cheaper than the paths they stand
 //! in for; where the strands cover the pixel, or the background is dim, they only cost.
 //!
-//! So `auto` (the default) chooses ([`Choice`]): the noise allocation's pilot takes its
-//! first [`CHOOSING_SAMPLES`] with one ray, which tell, block by block, how much of a
-//! sample's variance is which of background and hair its ray meets, and how wide the
-//! strands it meets are; the rest of the render takes the count that a model of that
-//! variance and of the rays' cost says makes the frame's noise cheapest, weighed against
-//! the frame's mean variance and cost ([`FrameRates`]) (docs/measurements.md, "Camera
-//! rays chosen per block").
-
-use glam::Vec3;
-use rayon::prelude::*;
+//! So `auto` (the default) chooses ([`Choice`]), per block of pixels, from the survey
+//! traced before the image (`super::survey`), one ray a sample: how much of a sample's
+//! variance is which of background and hair its ray meets, and how wide the strands it
+//! meets are; every sample of the image takes the count that a model of that variance and
+//! of the rays' cost says makes the frame's noise cheapest, weighed against the frame's
+//! mean variance and cost ([`FrameRates`]) (docs/measurements.md, "Camera rays chosen per
+//! block", "A survey before the image").
 
 use super::allocation::{BLOCK, blocks};
-use super::film::{Film, PixelAccumulator, Window};
+use super::film::{PixelAccumulator, Window};
+use super::survey::{Survey, SurveyPixel};
 
 /// The most rays a camera sample may be traced as.
 pub const MAX_CAMERA_RAYS: usize = 16;
-
-/// The pilot's samples of a pixel traced with one ray, from which `auto` chooses for the
-/// rest (and roulette learns its survival: `super::survival`): the same samples as a
-/// render of one ray takes.
-pub const CHOOSING_SAMPLES: u32 = 2;
 
 /// The counts `auto` chooses among.
 const COUNTS: [u32; 4] = [1, 2, 4, 8];
@@ -44,107 +37,67 @@ const MAX_STRAND_WIDTH: f64 = 0.05;
 /// path's rays (docs/measurements.md, "Camera rays chosen per block").
 const EXTRA_RAY_COST: f64 = 0.5;
 
-/// Side of the cells of the lattices of pixels whose first samples measure a frame's
-/// [`FrameRates`]: fixed on the full frame, so that a crop measures what the full frame
-/// does.
-const LATTICE: u32 = 8;
+/// What reading and building a curve segment costs, in the path rays that take as long:
+/// a frame's cost counts its share of its scene's segments, so that where they outweigh
+/// its rays, as on a close-up of a large groom, more rays a sample cost the frame little
+/// (measured on the real-groom close-ups, and chosen among nearby values by their
+/// efficiency: docs/measurements.md, "A survey before the image").
+pub const BUILD_RAYS_PER_SEGMENT: f64 = 1.0;
 
-/// A frame's mean, over pixels, of a sample's variance (summed over channels) and of its
-/// rays, from the first [`CHOOSING_SAMPLES`] (one ray each) of the pixels
-/// (`LATTICE` i + colour, `LATTICE` j), all of that checkerboard colour: what a block's
+/// A frame's mean, over the survey's pixels, of a sample's variance (summed over channels)
+/// and of its cost in rays: its own, and its share of the build (`build`): what a block's
 /// gain in noise and extra rays are weighed against.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) struct FrameRates {
     variance: f64,
     rays: f64,
+    build: f64,
 }
 
 impl FrameRates {
-    /// The rates of the lattice of `colour` of `pilot`'s frame, and the rays traced for
-    /// them: the pilot's own first samples where the lattice is inside its window (as its
-    /// first [`CHOOSING_SAMPLES`] left them), else `sample`'s radiance and rays of sample
-    /// `index` of a pixel traced as one ray: the same samples.
-    pub(super) fn measure(
-        pilot: &Film,
-        colour: u32,
-        sample: impl Fn((u32, u32), u32) -> (Vec3, u32) + Sync,
-    ) -> (FrameRates, u64) {
-        let (width, height, window) = (pilot.width(), pilot.height(), pilot.crop());
-        let pixels = lattice(width, height, LATTICE, colour);
-        let inside = |(x, y): (u32, u32)| {
-            (window.x0..window.x1).contains(&x) && (window.y0..window.y1).contains(&y)
-        };
-        let per_pixel: Vec<(f64, f64, u64)> = pixels
-            .par_iter()
-            .map(|&p| {
-                let (acc, traced) = if inside(p) {
-                    (pilot.accumulator(p), 0)
-                } else {
-                    let mut acc = PixelAccumulator::default();
-                    for index in 0..CHOOSING_SAMPLES {
-                        let (radiance, rays) = sample(p, index);
-                        acc.add(radiance, None);
-                        acc.add_rays(rays);
-                    }
-                    let traced = acc.rays();
-                    (acc, traced)
-                };
-                let n = f64::from(acc.samples().max(1));
-                (
-                    acc.sample_variance().iter().sum(),
-                    acc.rays() as f64 / n,
-                    traced,
-                )
-            })
-            .collect();
-        let n = per_pixel.len().max(1) as f64;
-        let (variance, rays, traced) = per_pixel
-            .iter()
-            .fold((0.0, 0.0, 0), |(v, r, t), p| (v + p.0, r + p.1, t + p.2));
-        let rates = FrameRates {
+    /// The rates of `survey`'s frame, whose build costs `build` rays a sample.
+    pub(super) fn of(survey: &Survey, build: f64) -> FrameRates {
+        let pixels = survey.pixels();
+        let n = pixels.len().max(1) as f64;
+        let (variance, rays) = pixels.iter().fold((0.0, 0.0), |(v, r), p| {
+            let samples = f64::from(p.acc.samples().max(1));
+            (
+                v + p.acc.sample_variance().iter().sum::<f64>(),
+                r + p.acc.rays() as f64 / samples,
+            )
+        });
+        FrameRates {
             variance: variance / n,
-            rays: rays / n,
-        };
-        (rates, traced)
+            rays: rays / n + build,
+            build,
+        }
+    }
+
+    /// What a frame built in `segments` curve segments, rendered at `samples` camera
+    /// samples (its full frame's), pays a sample for its build, in rays.
+    pub(super) fn build_rays(segments: usize, samples: u64) -> f64 {
+        BUILD_RAYS_PER_SEGMENT * segments as f64 / samples.max(1) as f64
     }
 }
 
-/// The pixels (`x0` + `step` i, `step` j) of a `width` x `height` frame, row by row: the
-/// full frame's, whatever the crop, so that a crop measures what the full frame does.
-pub(super) fn lattice(width: u32, height: u32, step: u32, x0: u32) -> Vec<(u32, u32)> {
-    (0..height)
-        .step_by(step as usize)
-        .flat_map(|y| (x0..width).step_by(step as usize).map(move |x| (x, y)))
-        .collect()
-}
-
-/// The rays per camera sample of each pixel after the pilot's first
-/// [`CHOOSING_SAMPLES`], block by block.
+/// The rays per camera sample of each pixel, block by block.
 #[derive(Debug)]
 pub(super) struct Choice {
-    /// The pilot's window, whole blocks aligned on the full frame.
+    /// The window chosen for, whole blocks aligned on the full frame.
     window: Window,
-    /// Per block, row by row, the count of each checkerboard colour (`(x + y) % 2`).
-    counts: Vec<[u32; 2]>,
+    /// Per block, row by row.
+    counts: Vec<u32>,
 }
 
 impl Choice {
-    /// The counts for the blocks of `pilot`'s window, from its first samples and the
-    /// frame's rates of each colour (`frame[c]`, [`FrameRates::measure`]): each colour's
-    /// from the other colour's pixels of the block and lattice alone ([`count_for`]), so
-    /// that no pixel's count depends on its own samples, which the image keeps (the noise
-    /// allocation's reason, `allocation.rs`); and from its block's and the frame's, so that
-    /// a crop chooses as the full frame does. `blurred`: the shutter is open.
-    pub(super) fn new(pilot: &Film, frame: [FrameRates; 2], blurred: bool) -> Choice {
-        let window = pilot.crop();
+    /// The counts for the blocks of `window` (aligned on the full frame), each from the
+    /// survey's pixels inside it and the frame's rates ([`count_for`]): the same for a
+    /// crop as for the full frame. `blurred`: the shutter is open.
+    pub(super) fn new(survey: &Survey, window: Window, frame: FrameRates, blurred: bool) -> Choice {
         let counts = blocks(window)
             .map(|block| {
-                let colour = |c: u32| {
-                    let others = block.pixels().filter(move |(x, y)| (x + y) % 2 != c);
-                    let frame = frame[1 - c as usize];
-                    count_for(others.map(|p| pilot.accumulator(p)), frame, blurred)
-                };
-                [colour(0), colour(1)]
+                let inside = survey.within((block.x0, block.x1), (block.y0, block.y1));
+                count_for(inside.map(|p: &SurveyPixel| &p.acc), frame, blurred)
             })
             .collect();
         Choice { window, counts }
@@ -154,7 +107,7 @@ impl Choice {
     pub(super) fn rays(&self, (x, y): (u32, u32)) -> u32 {
         let across = self.window.width().div_ceil(BLOCK);
         let block = (y - self.window.y0) / BLOCK * across + (x - self.window.x0) / BLOCK;
-        self.counts[block as usize][((x + y) % 2) as usize]
+        self.counts[block as usize]
     }
 }
 
@@ -162,28 +115,28 @@ impl Choice {
 /// `frame`'s rates. Over the pixels: a sample's variance v (summed over channels), its
 /// part from which of background and strands the ray meets (per pixel f (1 - f) |S - H|^2,
 /// f the fraction of rays that met a strand, S and H the mean radiance of those that
-/// escaped and of the others, unbiased for the pixel's samples, in pixels whose hits were
-/// strands), the mean width of the strands met and the rays per sample c. k rays spread
+/// escaped and of the others, |S - H|^2 less what the hair's own noise adds to it
+/// ([`hit_variance`]), unbiased for the pixel's samples, in pixels whose hits were
+/// strands), the mean width of the strands met and the cost of a sample c in rays (its
+/// own and its share of the build, [`FrameRates`]). k rays spread
 /// over the pixel take that part down k-fold and cost (k - 1) extra rays; the frame's
 /// noise times its cost then changes, to first order, by these pixels' change of v over
-/// the frame's mean variance plus their change of c over the frame's mean rays: the count
+/// the frame's mean variance plus their change of c over the frame's mean cost: the count
 /// of [`COUNTS`] that makes that least. One ray where none is met, or where the strands are
 /// wider than [`MAX_STRAND_WIDTH`] and `blurred` is false: under motion blur each sample
 /// sees the strands where they are at its own time, so the strata of positions across
 /// samples do not resolve their edges, and the rays of one sample, at its time, do.
-fn count_for(
-    pixels: impl Iterator<Item = PixelAccumulator>,
+fn count_for<'a>(
+    pixels: impl Iterator<Item = &'a PixelAccumulator>,
     frame: FrameRates,
     blurred: bool,
 ) -> u32 {
-    let (mut variance, mut part, mut rays, mut samples, mut count) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let pixels: Vec<&PixelAccumulator> = pixels.filter(|acc| acc.samples() >= 2).collect();
+    let hit_variance = hit_variance(&pixels);
+    let (mut variance, mut part, mut rays, mut samples) = (0.0, 0.0, 0.0, 0.0);
     let (mut width, mut strands) = (0.0, 0.0);
-    for acc in pixels {
+    for acc in &pixels {
         let n = f64::from(acc.samples());
-        if n < 2.0 {
-            continue;
-        }
-        count += 1.0;
         variance += acc.sample_variance().iter().sum::<f64>();
         rays += acc.rays() as f64;
         samples += n;
@@ -201,6 +154,9 @@ fn count_for(
                     (s - h) * (s - h)
                 })
                 .sum();
+            // The mean of `hit` hits strays from the hair's by their own variance over
+            // `hit`: taken out, the gap is the background's from the hair's mean.
+            let gap = (gap - hit_variance / hit).max(0.0);
             let f = hit / n;
             // Only strands' share: a surface's silhouette is an edge, which the sampler's
             // stratified positions resolve.
@@ -208,11 +164,12 @@ fn count_for(
             part += on_strands * f * (1.0 - f) * gap * n / (n - 1.0);
         }
     }
+    let count = pixels.len() as f64;
     let coarse = strands == 0.0 || (!blurred && width / strands > MAX_STRAND_WIDTH);
     if coarse || variance <= 0.0 || frame.variance <= 0.0 || frame.rays <= 0.0 {
         return 1;
     }
-    let (v, c) = (variance / count, rays / samples);
+    let (v, c) = (variance / count, rays / samples + frame.build);
     let at = |k: u32| {
         let k = f64::from(k);
         (
@@ -237,6 +194,22 @@ fn count_for(
         .unwrap_or(1)
 }
 
+/// The variance of a sample's radiance (summed over channels) among samples whose rays met
+/// strands, from the pixels all of whose rays did: the hair's own noise, which the gap
+/// between background and hair in a pixel of few hits also holds. 0 where no pixel is
+/// covered.
+fn hit_variance(pixels: &[&PixelAccumulator]) -> f64 {
+    let covered: Vec<f64> = pixels
+        .iter()
+        .filter(|acc| acc.coverage().strands == acc.samples())
+        .map(|acc| acc.sample_variance().iter().sum())
+        .collect();
+    match covered.len() {
+        0 => 0.0,
+        n => covered.iter().sum::<f64>() / n as f64,
+    }
+}
+
 /// Where the `count` rays of a camera sample go in its pixel, as shifts of the sample's
 /// own position (wrapped into the pixel): a Hammersley set, (j / count, the base-2
 /// radical inverse of j), whose points spread over the pixel as evenly as `count` points
@@ -255,7 +228,9 @@ pub fn shifts(count: u32) -> [[f32; 2]; MAX_CAMERA_RAYS] {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::render::film::{Aovs, Keep, Seen};
+    use crate::render::film::Seen;
+    use crate::render::integrator::CameraSample;
+    use glam::Vec3;
 
     /// A pixel of two one-ray samples: `(radiance, what the ray met)`, each of `rays` rays.
     fn pixel(samples: [(f32, Seen); 2], rays: u32) -> PixelAccumulator {
@@ -274,66 +249,121 @@ mod tests {
         pixel([(0.1, Seen::Strand(width)), (1.0, Seen::Nothing)], 1)
     }
 
-    /// The rates of a frame of pixels like `acc`, its variance scaled by `scale`.
-    fn frame_of(acc: &PixelAccumulator, scale: f64) -> FrameRates {
+    /// The rates of a frame of pixels like `acc`, its variance scaled by `scale`, its build
+    /// costing `build` rays a sample.
+    fn frame_of(acc: &PixelAccumulator, scale: f64, build: f64) -> FrameRates {
         FrameRates {
             variance: scale * acc.sample_variance().iter().sum::<f64>(),
-            rays: acc.rays() as f64 / f64::from(acc.samples()),
+            rays: acc.rays() as f64 / f64::from(acc.samples()) + build,
+            build,
         }
     }
 
     /// Strands far under a pixel against a bright sky split: more ways where the block is
-    /// noisier than the frame; not where the strands are wide (the sampler's strata
-    /// resolve them) unless the shutter is open, where no ray escapes (no background to
-    /// tell from), nor where the block's noise is small beside the frame's (its extra rays
-    /// buy the frame little).
+    /// noisier than the frame, or where the build makes a frame's rays a small part of
+    /// its cost; not where the strands are wide (the sampler's strata resolve them) unless
+    /// the shutter is open, where no ray escapes (no background to tell from), nor where
+    /// the block's noise is small beside the frame's (its extra rays buy the frame little).
     #[test]
     fn samples_split_where_thin_strands_against_the_sky_make_the_frames_noise() {
         let thin = mixed(0.02);
-        let count = |acc: &PixelAccumulator, scale, blurred| {
-            let pixels = std::iter::repeat_n(acc.clone(), 64);
-            count_for(pixels, frame_of(&thin, scale), blurred)
+        let count = |acc: &PixelAccumulator, scale, build, blurred| {
+            let pixels = std::iter::repeat_n(acc, 64);
+            count_for(pixels, frame_of(&thin, scale, build), blurred)
         };
-        let like = |acc: &PixelAccumulator, scale| count(acc, scale, false);
+        let like = |acc: &PixelAccumulator, scale| count(acc, scale, 0.0, false);
         assert_eq!(like(&thin, 2.0), 1);
         assert_eq!(like(&thin, 0.5), 2);
         assert_eq!(like(&thin, 0.125), 4);
         assert_eq!(like(&thin, 0.03125), 8);
+        assert_eq!(count(&thin, 0.5, 4.0, false), 4);
+        assert_eq!(count(&thin, 2.0, 4.0, false), 2);
         assert_eq!(like(&mixed(0.2), 0.0625), 1);
-        assert_eq!(count(&mixed(0.2), 0.0625, true), 4);
-        assert_eq!(count(&thin, 2.0, true), 1);
+        assert_eq!(count(&mixed(0.2), 0.0625, 4.0, false), 1);
+        assert_eq!(count(&mixed(0.2), 0.0625, 0.0, true), 4);
+        assert_eq!(count(&thin, 2.0, 0.0, true), 1);
         let covered = pixel([(0.1, Seen::Strand(0.02)), (0.9, Seen::Strand(0.02))], 1);
         assert_eq!(like(&covered, 0.0625), 1);
+        assert_eq!(count(&covered, 0.0625, 4.0, false), 1);
+        // Strands whose own radiance varies about the sky's (a highlight or none, under a
+        // key light) against a sky as bright as their mean: the gaps are their noise.
+        let lit = pixel([(0.0, Seen::Strand(0.02)), (2.0, Seen::Strand(0.02))], 1);
+        let glints = [(0.0, Seen::Strand(0.02)), (2.0, Seen::Strand(0.02))]
+            .map(|hit| pixel([hit, (1.0, Seen::Nothing)], 1));
+        let block = [&lit, &lit, &glints[0], &glints[1]];
+        let frame = frame_of(&glints[0], 0.03125, 4.0);
+        assert_eq!(
+            count_for(block.into_iter().cycle().take(64), frame, false),
+            1
+        );
+        assert_eq!(
+            count_for(
+                [&glints[0], &glints[1]].into_iter().cycle().take(64),
+                frame,
+                false
+            ),
+            8
+        );
         // A surface's silhouette against the sky is an edge: the strata resolve it.
         let edge = pixel([(0.1, Seen::Surface), (1.0, Seen::Nothing)], 1);
         assert_eq!(like(&edge, 0.0625), 1);
     }
 
-    /// A colour's count is read from the other colour's pixels alone: with the even
-    /// pixels of a block showing thin strands against the sky and the odd ones plain
-    /// hair, the odd pixels split and the even ones do not; other blocks keep their own.
+    /// A block's count is read from the survey's pixels inside it: in a frame whose left
+    /// block shows thin strands against the sky and whose other blocks show plain hair,
+    /// the left block splits and the others do not, in the full frame and in a crop.
     #[test]
-    fn each_colour_chooses_from_the_other_colours_pixels() {
-        let (width, height) = (64, 32);
-        let mut pilot = Film::keeping(width, height, None, Aovs::default(), Keep::Spread).unwrap();
-        let plain = pixel([(0.1, Seen::Strand(0.02)), (0.3, Seen::Strand(0.02))], 1);
-        for p in Window::full(width, height).pixels() {
-            let even = (p.0 + p.1) % 2 == 0;
-            let acc = if p.0 < BLOCK && even {
-                mixed(0.02)
-            } else {
-                plain.clone()
+    fn each_block_chooses_from_the_survey_inside_it() {
+        let (width, height) = (3 * BLOCK, BLOCK + 8);
+        let survey = Survey::trace(width, height, &|(x, _), i, _| {
+            let (radiance, seen) = match (x < BLOCK, i) {
+                (true, 0) => (0.1, Seen::Strand(0.02)),
+                (true, _) => (1.0, Seen::Nothing),
+                (false, 0) => (0.1, Seen::Strand(0.02)),
+                (false, _) => (0.3, Seen::Strand(0.02)),
             };
-            pilot.store(p, &acc);
-        }
-        let frame = frame_of(&mixed(0.02), 0.0625);
-        let choice = Choice::new(&pilot, [frame; 2], false);
-        assert_eq!(choice.rays((0, 0)), 1, "an even pixel read its own colour");
-        assert!(choice.rays((1, 0)) > 1, "an odd pixel missed the even ones");
+            CameraSample {
+                radiance: Vec3::splat(radiance),
+                first: None,
+                rays: 1,
+                seen,
+            }
+        });
+        let frame = FrameRates::of(&survey, 0.0);
+        let full = Choice::new(&survey, Window::full(width, height), frame, false);
+        assert!(full.rays((0, 0)) > 1, "the left block split");
+        assert!(full.rays((BLOCK - 1, BLOCK + 7)) > 1);
         assert_eq!(
-            choice.rays((BLOCK + 1, 0)),
+            full.rays((BLOCK, 0)),
             1,
-            "the next block took this one's"
+            "the next block took the left one's"
         );
+        assert_eq!(full.rays((2 * BLOCK + 5, BLOCK + 3)), 1);
+        let window = Window {
+            x0: BLOCK,
+            y0: 0,
+            x1: 3 * BLOCK,
+            y1: BLOCK + 8,
+        };
+        let crop = Choice::new(&survey, window, frame, false);
+        assert_eq!(crop.rays((BLOCK, 0)), 1);
+        assert_eq!(crop.rays((2 * BLOCK + 5, BLOCK + 3)), 1);
+        let left = Window {
+            x0: 0,
+            y0: BLOCK,
+            x1: BLOCK,
+            y1: BLOCK + 8,
+        };
+        let crop = Choice::new(&survey, left, frame, false);
+        assert_eq!(crop.rays((3, BLOCK + 2)), full.rays((3, BLOCK + 2)));
+    }
+
+    /// A frame's build is its segments' share of its samples.
+    #[test]
+    fn a_frames_build_in_rays_a_sample() {
+        let build = FrameRates::build_rays(1 << 20, 1 << 18);
+        assert!((build - 4.0 * BUILD_RAYS_PER_SEGMENT).abs() < 1e-12);
+        assert_eq!(FrameRates::build_rays(0, 100), 0.0);
+        assert!(FrameRates::build_rays(10, 0).is_finite());
     }
 }

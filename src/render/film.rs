@@ -377,7 +377,7 @@ pub enum Keep {
     /// passes that estimates its noise.
     Halves,
     /// The sums, the squares and the rays of each pixel: its variance and cost per sample
-    /// (the noise allocation's pilot); and what its single camera rays met (`Coverage`).
+    /// (the noise allocation's pilot).
     Spread,
 }
 
@@ -406,9 +406,7 @@ impl Keep {
         bytes
             + match self {
                 Keep::Halves => size_of::<Halves>() as u64,
-                Keep::Spread => {
-                    (size_of::<[f64; 3]>() + size_of::<u64>() + size_of::<Coverage>()) as u64
-                }
+                Keep::Spread => (size_of::<[f64; 3]>() + size_of::<u64>()) as u64,
                 Keep::Image | Keep::Sums => 0,
             }
     }
@@ -443,7 +441,6 @@ pub struct Film {
     halves: Vec<Halves>,
     squares: Vec<[f64; 3]>,
     rays: Vec<u64>,
-    coverage: Vec<Coverage>,
     /// Over the whole film: samples taken, rejected (`PixelAccumulator::add`) and rays
     /// traced by the samples of the pixels as stored.
     totals: Totals,
@@ -515,7 +512,6 @@ impl Film {
             halves: filled(kept(keep == Keep::Halves), Halves::default())?,
             squares: filled(kept(keep == Keep::Spread), [0.0; 3])?,
             rays: filled(kept(keep == Keep::Spread), 0)?,
-            coverage: filled(kept(keep == Keep::Spread), Coverage::default())?,
             totals: Totals::default(),
         })
     }
@@ -643,9 +639,6 @@ impl Film {
         if let (Some(&squares), Some(&rays)) = (self.squares.get(i), self.rays.get(i)) {
             (acc.rgb_sq, acc.rays) = (squares, rays);
         }
-        if let Some(&coverage) = self.coverage.get(i) {
-            acc.coverage = coverage;
-        }
         acc
     }
 
@@ -677,9 +670,6 @@ impl Film {
         }
         if let (Some(squares), Some(rays)) = (self.squares.get_mut(i), self.rays.get_mut(i)) {
             (*squares, *rays) = (acc.rgb_sq, acc.rays);
-        }
-        if let Some(coverage) = self.coverage.get_mut(i) {
-            *coverage = acc.coverage;
         }
         self.write(i, acc.mean(acc.rgb), acc.mean(acc.albedo), acc);
     }

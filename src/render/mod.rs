@@ -11,6 +11,7 @@ pub(crate) mod renderer;
 mod rounds;
 pub(crate) mod sampler;
 pub mod settings;
+mod survey;
 pub(crate) mod survival;
 pub(crate) mod tiles;
 

@@ -4,17 +4,17 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use glam::Vec3;
-use rayon::prelude::*;
 
 use super::allocation;
-use super::camera_rays::{self, CHOOSING_SAMPLES, FrameRates, MAX_CAMERA_RAYS};
+use super::camera_rays::{self, FrameRates, MAX_CAMERA_RAYS};
 use super::film::{Aovs, Film, Keep, Window, ndc};
 use super::integrator::World;
 use super::progress::Progress;
 use super::rounds::{Rounds, Stops, Taken};
 use super::sampler::PixelSampler;
 use super::settings::{Allocation, CameraRays, RenderSettings, RouletteScale};
-use super::survival::{LatticePixel, Recorder, Survival};
+use super::survey::{self, Survey};
+use super::survival::{Recorder, Survival};
 use super::tiles::{RenderStatus, TileOptions, render_tiles};
 use crate::embree::Ray;
 use crate::error::{Result, invalid_arg};
@@ -206,19 +206,17 @@ pub fn render(
     let shift_sets: Vec<_> = (0..=MAX_CAMERA_RAYS as u32)
         .map(camera_rays::shifts)
         .collect();
-    // `auto` chooses where the pilot lets it; it takes one ray elsewhere.
+    // `auto` chooses from the survey where the render has a pilot (and so samples enough
+    // to pay for the survey); it takes one ray elsewhere.
     let choosing = settings.camera_rays == CameraRays::Auto && pilot.is_some();
-    // The roulette where no light is sampled learns its survival from the pilot's first
-    // samples, as `auto` camera rays choose their counts.
+    // The roulette where no light is sampled learns its survival from the survey too.
     let learning = pilot.is_some()
         && settings.path.roulette_scale == RouletteScale::Auto
         && !world.samples_lights(&settings.path);
-    let learned: OnceLock<Survival> = OnceLock::new();
-    let throughput_rule = Survival::default();
+    let mut survival = Survival::default();
     let mut choice: Option<camera_rays::Choice> = None;
-    // Rays traced again for what the pilot measures: `auto` camera rays' frame rates outside
-    // the pilot's window, and the lattice roulette learns from.
-    let mut lattice_rays = 0;
+    // Rays the survey traced.
+    let mut survey_rays = 0;
     let options = TileOptions {
         tile_size: 16,
         threads: settings.threads.unwrap_or(0),
@@ -237,10 +235,15 @@ pub fn render(
     let parts_before = world.tracer.scene().parts_built();
     let motion_blur = settings.motion_blur();
     let first_tile = OnceLock::new();
-    // Sample `index` of `pixel`, traced as `count` rays.
-    let sample_at = |pixel: (u32, u32), index: u32, count: u32, record: Option<&mut Recorder>| {
+    // Sample `index` of `pixel` of the render seeded `seed`, traced as `count` rays, its
+    // roulette's survival `survival`.
+    let sample_at = |seed: u64,
+                     (pixel, index): ((u32, u32), u32),
+                     count: u32,
+                     survival: &Survival,
+                     record: Option<&mut Recorder>| {
         let shifts = &shift_sets[count as usize][..count as usize];
-        let mut sampler = PixelSampler::new(settings.seed, pixel, index);
+        let mut sampler = PixelSampler::new(seed, pixel, index);
         let [ux, uy, choice, _] = sampler.next_4d();
         let lens = if camera.has_lens() {
             sampler.next_2d()
@@ -266,12 +269,31 @@ pub fn render(
             aovs.any(),
             pixel_spread,
             &mut sampler,
-            (learned.get().unwrap_or(&throughput_rule), record),
+            (survival, record),
         )
     };
     let start = Instant::now();
     // One pool of workers for every round: `render_tiles` runs on it.
     let (spp, noise, status) = threads::scoped(options.threads, || -> Result<_> {
+        if choosing || learning {
+            let seed = survey::seed(settings.seed);
+            let rule = Survival::default();
+            let survey = Survey::trace(width, height, &|p, i, recorder| {
+                sample_at(seed, (p, i), 1, &rule, Some(recorder))
+            });
+            survey_rays = survey.rays();
+            let frame_samples = u64::from(width) * u64::from(height) * u64::from(settings.spp);
+            let segments = world.tracer.scene().curve_segments();
+            let build = FrameRates::build_rays(segments, frame_samples);
+            if learning {
+                survival = Survival::learn(survey.pixels().iter().map(|p| &p.roulette), build);
+            }
+            if let (true, Some(pilot)) = (choosing, &pilot) {
+                let frame = FrameRates::of(&survey, build);
+                let chosen = camera_rays::Choice::new(&survey, pilot.crop(), frame, motion_blur);
+                choice = Some(chosen);
+            }
+        }
         let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);
         let mut taken = None;
         while let Some(round) = rounds.next(taken) {
@@ -293,78 +315,33 @@ pub fn render(
             let (offset, total) = (u64::from(round.start) * pixels, u64::from(passes) * pixels);
             let round_pixels = u128::from(round.len() as u64 * pixels);
             let in_pass = u128::from(target.crop().pixel_count());
-            // The sample indices a round takes in parts, between these bounds: the pilot
-            // of `auto` camera rays or a learned roulette in two, its first samples, of one
-            // ray and the rule's survival, choosing the count and the survival of the
-            // rest's.
-            let bounds: &[u32] = if (choosing || learning) && round.start == 0 {
-                &[0, CHOOSING_SAMPLES, u32::MAX]
-            } else {
-                &[0, u32::MAX]
+            let pass_progress = |done: u64, _| {
+                if done > 0 {
+                    first_tile.get_or_init(|| start.elapsed().as_secs_f64());
+                }
+                let done = u128::from(done) * round_pixels / in_pass;
+                progress.update(offset + done as u64, total)
             };
-            for part in bounds.windows(2).map(|b| b[0]..b[1]) {
-                // This part's share of the round's samples, and the shares before it.
-                let (before, share) = (
-                    u128::from(part.start),
-                    u128::from(part.end.min(PASS_SAMPLES) - part.start),
-                );
-                let pass_progress = |done: u64, _| {
-                    if done > 0 {
-                        first_tile.get_or_init(|| start.elapsed().as_secs_f64());
-                    }
-                    let done = (before * in_pass + u128::from(done) * share) * round_pixels
-                        / (in_pass * u128::from(PASS_SAMPLES));
-                    progress.update(offset + done as u64, total)
+            let chosen = choice.as_ref();
+            status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
+                let count = match (settings.camera_rays, chosen) {
+                    (CameraRays::Fixed(n), _) => n,
+                    (CameraRays::Auto, Some(c)) => c.rays(pixel),
+                    (CameraRays::Auto, None) => 1,
                 };
-                let collecting = choosing && part.end == CHOOSING_SAMPLES;
-                let chosen = choice.as_ref();
-                status = render_tiles(target, &options, &pass_progress, |pixel, acc, pulse| {
-                    for pass in round.clone() {
-                        for index in indices(pixel, pass).filter(|i| part.contains(i)) {
-                            if !pulse.keep_going() {
-                                return;
-                            }
-                            let count = match (settings.camera_rays, chosen) {
-                                (CameraRays::Fixed(n), _) => n,
-                                (CameraRays::Auto, Some(c)) if index >= CHOOSING_SAMPLES => {
-                                    c.rays(pixel)
-                                }
-                                (CameraRays::Auto, _) => 1,
-                            };
-                            let sample = sample_at(pixel, index, count, None);
-                            if collecting {
-                                acc.add_seen(sample.seen, sample.radiance);
-                            }
-                            acc.add(sample.radiance, sample.first.as_ref());
-                            acc.add_rays(sample.rays);
+                for pass in round.clone() {
+                    for index in indices(pixel, pass) {
+                        if !pulse.keep_going() {
+                            return;
                         }
-                        if part.end == u32::MAX {
-                            acc.end_pass();
-                        }
+                        let sample =
+                            sample_at(settings.seed, (pixel, index), count, &survival, None);
+                        acc.add(sample.radiance, sample.first.as_ref());
+                        acc.add_rays(sample.rays);
                     }
-                })?;
-                if status == RenderStatus::Cancelled {
-                    break;
+                    acc.end_pass();
                 }
-                if learning && part.end == CHOOSING_SAMPLES {
-                    // The pilot's first part runs once: this learns once.
-                    learned.get_or_init(|| {
-                        let (survival, rays) = learn_survival(width, height, &sample_at);
-                        lattice_rays += rays;
-                        survival
-                    });
-                }
-                if collecting {
-                    let one_ray = |p, i| {
-                        let s = sample_at(p, i, 1, None);
-                        (s.radiance, s.rays)
-                    };
-                    let rates = [0, 1].map(|c| FrameRates::measure(target, c, one_ray));
-                    lattice_rays += rates[0].1 + rates[1].1;
-                    let frame = rates.map(|r| r.0);
-                    choice = Some(camera_rays::Choice::new(target, frame, motion_blur));
-                }
-            }
+            })?;
             if status == RenderStatus::Cancelled {
                 break;
             }
@@ -398,7 +375,7 @@ pub fn render(
         samples: film.samples() + pilot.as_ref().map_or(0, Film::samples),
         spp,
         noise,
-        rays: film.rays() + pilot.as_ref().map_or(0, Film::rays) + lattice_rays,
+        rays: film.rays() + pilot.as_ref().map_or(0, Film::rays) + survey_rays,
         first_tile_seconds: first_tile.get().copied(),
         parts_built: parts.built - parts_before.built,
         part_build_seconds: parts.seconds - parts_before.seconds,
@@ -408,40 +385,4 @@ pub fn render(
         status,
         stats,
     })
-}
-
-/// Side of the cells of the lattice of pixels whose first two samples the roulette learns
-/// from ([`Survival::learn`]): fixed on the full frame, so a crop learns what the full frame
-/// does.
-const SURVIVAL_LATTICE: u32 = 4;
-
-/// The survival learned from the first two samples, one ray each, of every
-/// [`SURVIVAL_LATTICE`]-th pixel of the `width` x `height` frame, traced again by `sample`
-/// with a recorder, and the rays that took.
-fn learn_survival(
-    width: u32,
-    height: u32,
-    sample: &(
-         impl Fn((u32, u32), u32, u32, Option<&mut Recorder>) -> super::integrator::CameraSample + Sync
-     ),
-) -> (Survival, u64) {
-    let lattice: Vec<LatticePixel> = camera_rays::lattice(width, height, SURVIVAL_LATTICE, 0)
-        .par_iter()
-        .map(|&p| {
-            let mut recorder = Recorder::default();
-            let mut out = LatticePixel::default();
-            for i in 0..CHOOSING_SAMPLES {
-                let s = sample(p, i, 1, Some(&mut recorder));
-                out.luminance[i as usize] = crate::math::luminance(s.radiance);
-                out.rays[i as usize] = s.rays;
-            }
-            out.depths = recorder.sums();
-            out
-        })
-        .collect();
-    let rays = lattice
-        .iter()
-        .map(|p| u64::from(p.rays[0] + p.rays[1]))
-        .sum();
-    (Survival::learn(&lattice), rays)
 }

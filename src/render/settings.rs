@@ -369,10 +369,11 @@ settings! {
         /// see (the sky) exactly, and the path goes on from one of the others, picked at
         /// random and weighted by their number. The same image in expectation; less noise
         /// where thin strands show a bright sky between them, more cost elsewhere. auto:
-        /// chosen for each 32 x 32 block from the noise allocation's pilot, 1 to 8 where
-        /// strands far under a pixel wide, or moving under an open shutter, against a
-        /// bright background make most of the noise, else 1 (and 1 without a pilot); a
-        /// count: that many everywhere (docs/measurements.md, "Camera rays").
+        /// chosen for each 32 x 32 block from a survey of the frame before the image, 1 to 8
+        /// where strands far under a pixel wide, or moving under an open shutter, against a
+        /// bright background make most of the noise, else 1 (and 1 in renders without the
+        /// noise allocation's pilot); a count: that many everywhere (docs/measurements.md,
+        /// "Camera rays").
         camera_rays: CameraRays = CameraRays::Auto, Range::Closed(1.0, MAX_CAMERA_RAYS as f64), Render;
         /// Pixel filter: tent (thin strands alias under a box) or box (one pixel, as
         /// renderers that use it).
@@ -417,9 +418,10 @@ settings! {
         /// keeps long chains through light hair) or throughput (pbrt's rule).
         roulette: Roulette = Roulette::SqrtThroughput, Range::Any, Render;
         /// Where no light is sampled (a uniform sky alone), roulette's survival at each
-        /// depth times a factor learned from the noise allocation's pilot: auto (at least 1,
-        /// raised where light the path may still gather outweighs the rays it costs, to
-        /// first order: light hair; the rule alone without a pilot) or off
+        /// depth times a factor learned from a survey of the frame before the image: auto
+        /// (at least 1, raised where light the path may still gather outweighs the rays it
+        /// costs, to first order: light hair; the rule alone in renders without the noise
+        /// allocation's pilot) or off
         /// (docs/measurements.md, "Roulette from the pilot").
         roulette_scale: RouletteScale = RouletteScale::Auto, Range::Any, Render;
         /// Upper bound on the luminance of one contribution of indirect light (biased, cuts

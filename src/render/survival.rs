@@ -1,5 +1,5 @@
 //! Russian roulette where no light is sampled, its survival scaled per depth by what the
-//! pilot measured: an efficiency-aware roulette (Rath et al. 2022, "EARS"), reduced to one
+//! survey measured: an efficiency-aware roulette (Rath et al. 2022, "EARS"), reduced to one
 //! factor a depth for the whole frame, and never below the rule's survival.
 //!
 //! Ending a path with throughput w at a vertex with probability 1 - q adds w^2 M (1/q - 1)
@@ -8,7 +8,7 @@
 //! would still trace. The q that makes V T least is, to first order, w sqrt(M T / (V T')).
 //! How much of a pixel's light is deep in a groom is what the hair's colour sets (blonde
 //! fur gathers most of its light many bounces deep, brown hair little), so M and T' are
-//! measured per depth, on the first samples of a fixed lattice of pixels, where the
+//! measured per depth, on the survey's samples (`super::survey`), where the
 //! throughput rule ran (docs/measurements.md, "Roulette from the pilot").
 
 use glam::Vec3;
@@ -49,19 +49,20 @@ impl Survival {
 
     /// The factors the first-order rule gives from `pixels`, each a pixel's two samples
     /// (in a fixed order, so the sums, and the image, are the same on any thread count):
-    /// V from the pairs' differences, T their mean rays, and per depth M and T' from the
+    /// V from the pairs' differences, T their mean rays plus `build`, the frame's build in
+    /// rays a sample (`super::camera_rays::FrameRates`), and per depth M and T' from the
     /// decisions the paths survived. Depths without enough decisions keep the one before
     /// theirs (1 for the first).
-    pub fn learn(pixels: &[LatticePixel]) -> Survival {
+    pub fn learn<'a>(pixels: impl Iterator<Item = &'a LatticePixel>, build: f64) -> Survival {
         let mut sums = DepthSums::default();
-        let (mut variance, mut rays) = (0.0, 0.0);
+        let (mut variance, mut rays, mut n) = (0.0, 0.0, 0.0);
         for p in pixels {
             variance += 0.5 * f64::from(p.luminance[0] - p.luminance[1]).powi(2);
             rays += 0.5 * f64::from(p.rays[0] + p.rays[1]);
             sums.add(&p.depths);
+            n += 1.0;
         }
-        let n = pixels.len() as f64;
-        let (variance, rays) = (variance / n, rays / n);
+        let (variance, rays) = (variance / n, rays / n + build);
         let mut factors = [1.0; DEPTHS];
         let mut last = 1.0;
         for (d, factor) in factors.iter_mut().enumerate() {
@@ -80,7 +81,7 @@ impl Survival {
     }
 }
 
-/// What the survival is learned from: one lattice pixel's first two samples, their
+/// What the survival is learned from: one survey pixel's two samples, their
 /// luminance and rays, and the decisions their paths survived.
 #[derive(Debug, Clone, Default)]
 pub struct LatticePixel {
@@ -171,7 +172,7 @@ mod tests {
     #[test]
     fn the_factor_weighs_the_light_still_to_come_against_the_pixels_noise() {
         // V = 0.5 (1 - 0)^2 = 0.5, T = 2; M = 2, T' = 4 at depth 1: sqrt(2 * 2 / (0.5 * 4)).
-        let learned = Survival::learn(&vec![pixel([1.0, 0.0], 8.0, 16.0, 32.0); 4]);
+        let learned = Survival::learn(vec![pixel([1.0, 0.0], 8.0, 16.0, 32.0); 4].iter(), 0.0);
         assert!(
             (learned.factor(1) - 2f32.sqrt()).abs() < 1e-6,
             "{learned:?}"
@@ -179,14 +180,17 @@ mod tests {
         assert_eq!(learned.factor(0), 1.0);
         assert_eq!(learned.factor(5), learned.factor(1));
         assert_eq!(learned.factor(1000), learned.factor(1));
+        // A build of 6 rays a sample makes T 8: twice the factor.
+        let built = Survival::learn(vec![pixel([1.0, 0.0], 8.0, 16.0, 32.0); 4].iter(), 6.0);
+        assert!((built.factor(1) - 2.0 * learned.factor(1)).abs() < 1e-5);
         // sqrt(0.02) before the bound.
-        let dim = Survival::learn(&vec![pixel([1.0, 0.0], 8.0, 0.16, 32.0); 4]);
+        let dim = Survival::learn(vec![pixel([1.0, 0.0], 8.0, 0.16, 32.0); 4].iter(), 0.0);
         assert_eq!(dim, Survival::default());
-        let bright = Survival::learn(&vec![pixel([1.0, 0.0], 8.0, 1e6, 32.0); 4]);
+        let bright = Survival::learn(vec![pixel([1.0, 0.0], 8.0, 1e6, 32.0); 4].iter(), 0.0);
         assert_eq!(bright.factor(1), MAX_FACTOR);
-        let few = Survival::learn(&[pixel([1.0, 0.0], 8.0, 16.0, 32.0)]);
+        let few = Survival::learn([pixel([1.0, 0.0], 8.0, 16.0, 32.0)].iter(), 0.0);
         assert_eq!(few, Survival::default());
-        let flat = Survival::learn(&vec![pixel([1.0, 1.0], 8.0, 16.0, 32.0); 4]);
+        let flat = Survival::learn(vec![pixel([1.0, 1.0], 8.0, 16.0, 32.0); 4].iter(), 0.0);
         assert_eq!(flat, Survival::default());
     }
 

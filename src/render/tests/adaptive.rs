@@ -140,13 +140,12 @@ fn a_film_keeps_only_what_its_render_reads() {
         strand_id: true,
     };
     // Image: rgb f32; sums: rgb f64 and a u32 count; halves: two f32 rgb and counts and a
-    // pass count; spread: rgb squares f64, a u64 ray count and the coverage (two u32 counts
-    // and four f32 sums).
+    // pass count; spread: rgb squares f64 and a u64 ray count.
     let layout = [
         (Keep::Image, 12, 12 + 12 + 4 + 4),
         (Keep::Sums, 12 + 28, 32 + 28 + 24 + 4),
         (Keep::Halves, 12 + 28 + 36, 32 + 28 + 24 + 4 + 36),
-        (Keep::Spread, 12 + 28 + 56, 32 + 28 + 24 + 4 + 56),
+        (Keep::Spread, 12 + 28 + 32, 32 + 28 + 24 + 4 + 32),
     ];
     for (keep, plain, with_aovs) in layout {
         assert_eq!(keep.bytes_per_pixel(Aovs::default()), plain, "{keep:?}");

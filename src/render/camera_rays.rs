@@ -27,11 +27,21 @@ pub const MAX_CAMERA_RAYS: usize = 16;
 /// The counts `auto` chooses among.
 const COUNTS: [u32; 4] = [1, 2, 4, 8];
 
-/// Strands at most this wide, in pixels, where their camera rays meet them: far under the
-/// strata of the sampler's positions, which thus cannot tell strand from background
-/// (wider strands' coverage the stratified positions already take: docs/measurements.md,
-/// "Camera rays chosen per block").
-const MAX_STRAND_WIDTH: f64 = 0.05;
+/// The widest strands whose samples split, where their camera rays meet them, as a
+/// fraction of the side of a stratum of the sampler's positions (1 / sqrt(spp) of a
+/// pixel): strands far under a stratum the strata cannot tell from the background between
+/// them, while wider strands' coverage the stratified positions already take
+/// (docs/measurements.md, "Camera rays chosen per block", "The width rule relative to the
+/// strata").
+const WIDEST_IN_STRATA: f64 = 0.8;
+
+/// The widest strands, in pixels, whose samples `auto` splits in a render of `spp` samples
+/// per pixel ([`WIDEST_IN_STRATA`]); any where `blurred` (the shutter is open): each sample
+/// then sees the strands where they are at its own time, so the strata of positions
+/// across samples do not resolve their edges, and the rays of one sample, at its time, do.
+pub(super) fn widest_split(spp: u32, blurred: bool) -> Option<f64> {
+    (!blurred).then(|| WIDEST_IN_STRATA / f64::from(spp.max(1)).sqrt())
+}
 
 /// The time of an extra camera ray (an occlusion query from the eye) over that of one of a
 /// path's rays (docs/measurements.md, "Camera rays chosen per block").
@@ -92,12 +102,17 @@ pub(super) struct Choice {
 impl Choice {
     /// The counts for the blocks of `window` (aligned on the full frame), each from the
     /// survey's pixels inside it and the frame's rates ([`count_for`]): the same for a
-    /// crop as for the full frame. `blurred`: the shutter is open.
-    pub(super) fn new(survey: &Survey, window: Window, frame: FrameRates, blurred: bool) -> Choice {
+    /// crop as for the full frame. `widest`: [`widest_split`].
+    pub(super) fn new(
+        survey: &Survey,
+        window: Window,
+        frame: FrameRates,
+        widest: Option<f64>,
+    ) -> Choice {
         let counts = blocks(window)
             .map(|block| {
                 let inside = survey.within((block.x0, block.x1), (block.y0, block.y1));
-                count_for(inside.map(|p: &SurveyPixel| &p.acc), frame, blurred)
+                count_for(inside.map(|p: &SurveyPixel| &p.acc), frame, widest)
             })
             .collect();
         Choice { window, counts }
@@ -123,13 +138,11 @@ impl Choice {
 /// noise times its cost then changes, to first order, by these pixels' change of v over
 /// the frame's mean variance plus their change of c over the frame's mean cost: the count
 /// of [`COUNTS`] that makes that least. One ray where none is met, or where the strands are
-/// wider than [`MAX_STRAND_WIDTH`] and `blurred` is false: under motion blur each sample
-/// sees the strands where they are at its own time, so the strata of positions across
-/// samples do not resolve their edges, and the rays of one sample, at its time, do.
+/// on average wider than `widest` ([`widest_split`]).
 fn count_for<'a>(
     pixels: impl Iterator<Item = &'a PixelAccumulator>,
     frame: FrameRates,
-    blurred: bool,
+    widest: Option<f64>,
 ) -> u32 {
     let pixels: Vec<&PixelAccumulator> = pixels.filter(|acc| acc.samples() >= 2).collect();
     let hit_variance = hit_variance(&pixels);
@@ -165,7 +178,7 @@ fn count_for<'a>(
         }
     }
     let count = pixels.len() as f64;
-    let coarse = strands == 0.0 || (!blurred && width / strands > MAX_STRAND_WIDTH);
+    let coarse = strands == 0.0 || widest.is_some_and(|w| width / strands > w);
     if coarse || variance <= 0.0 || frame.variance <= 0.0 || frame.rays <= 0.0 {
         return 1;
     }
@@ -261,30 +274,38 @@ mod tests {
 
     /// Strands far under a pixel against a bright sky split: more ways where the block is
     /// noisier than the frame, or where the build makes a frame's rays a small part of
-    /// its cost; not where the strands are wide (the sampler's strata resolve them) unless
-    /// the shutter is open, where no ray escapes (no background to tell from), nor where
+    /// its cost; not where the strands are wide beside the sampler's strata (which resolve
+    /// them), fewer samples making the strata wider, unless the shutter is open, where no ray escapes (no background to tell from), nor where
     /// the block's noise is small beside the frame's (its extra rays buy the frame little).
     #[test]
     fn samples_split_where_thin_strands_against_the_sky_make_the_frames_noise() {
         let thin = mixed(0.02);
-        let count = |acc: &PixelAccumulator, scale, build, blurred| {
+        let (at_64, at_16, blurred) = (
+            widest_split(64, false),
+            widest_split(16, false),
+            widest_split(64, true),
+        );
+        let count = |acc: &PixelAccumulator, scale, build, widest| {
             let pixels = std::iter::repeat_n(acc, 64);
-            count_for(pixels, frame_of(&thin, scale, build), blurred)
+            count_for(pixels, frame_of(&thin, scale, build), widest)
         };
-        let like = |acc: &PixelAccumulator, scale| count(acc, scale, 0.0, false);
+        let like = |acc: &PixelAccumulator, scale| count(acc, scale, 0.0, at_64);
         assert_eq!(like(&thin, 2.0), 1);
         assert_eq!(like(&thin, 0.5), 2);
         assert_eq!(like(&thin, 0.125), 4);
         assert_eq!(like(&thin, 0.03125), 8);
-        assert_eq!(count(&thin, 0.5, 4.0, false), 4);
-        assert_eq!(count(&thin, 2.0, 4.0, false), 2);
-        assert_eq!(like(&mixed(0.2), 0.0625), 1);
-        assert_eq!(count(&mixed(0.2), 0.0625, 4.0, false), 1);
-        assert_eq!(count(&mixed(0.2), 0.0625, 0.0, true), 4);
-        assert_eq!(count(&thin, 2.0, 0.0, true), 1);
+        assert_eq!(count(&thin, 0.5, 4.0, at_64), 4);
+        assert_eq!(count(&thin, 2.0, 4.0, at_64), 2);
+        // 0.15 pixel: over a tenth of a pixel (64 spp's strata, 0.125 on a side, times
+        // 0.8), under a fifth (16 spp's).
+        assert_eq!(like(&mixed(0.15), 0.0625), 1);
+        assert_eq!(count(&mixed(0.15), 0.0625, 0.0, at_16), 4);
+        assert_eq!(count(&mixed(0.15), 0.0625, 4.0, at_64), 1);
+        assert_eq!(count(&mixed(0.2), 0.0625, 0.0, blurred), 4);
+        assert_eq!(count(&thin, 2.0, 0.0, blurred), 1);
         let covered = pixel([(0.1, Seen::Strand(0.02)), (0.9, Seen::Strand(0.02))], 1);
         assert_eq!(like(&covered, 0.0625), 1);
-        assert_eq!(count(&covered, 0.0625, 4.0, false), 1);
+        assert_eq!(count(&covered, 0.0625, 4.0, at_64), 1);
         // Strands whose own radiance varies about the sky's (a highlight or none, under a
         // key light) against a sky as bright as their mean: the gaps are their noise.
         let lit = pixel([(0.0, Seen::Strand(0.02)), (2.0, Seen::Strand(0.02))], 1);
@@ -292,18 +313,10 @@ mod tests {
             .map(|hit| pixel([hit, (1.0, Seen::Nothing)], 1));
         let block = [&lit, &lit, &glints[0], &glints[1]];
         let frame = frame_of(&glints[0], 0.03125, 4.0);
-        assert_eq!(
-            count_for(block.into_iter().cycle().take(64), frame, false),
-            1
-        );
-        assert_eq!(
-            count_for(
-                [&glints[0], &glints[1]].into_iter().cycle().take(64),
-                frame,
-                false
-            ),
-            8
-        );
+        let glinting = block.into_iter().cycle().take(64);
+        assert_eq!(count_for(glinting, frame, at_64), 1);
+        let bare = [&glints[0], &glints[1]].into_iter().cycle().take(64);
+        assert_eq!(count_for(bare, frame, at_64), 8);
         // A surface's silhouette against the sky is an edge: the strata resolve it.
         let edge = pixel([(0.1, Seen::Surface), (1.0, Seen::Nothing)], 1);
         assert_eq!(like(&edge, 0.0625), 1);
@@ -330,7 +343,8 @@ mod tests {
             }
         });
         let frame = FrameRates::of(&survey, 0.0);
-        let full = Choice::new(&survey, Window::full(width, height), frame, false);
+        let widest = widest_split(16, false);
+        let full = Choice::new(&survey, Window::full(width, height), frame, widest);
         assert!(full.rays((0, 0)) > 1, "the left block split");
         assert!(full.rays((BLOCK - 1, BLOCK + 7)) > 1);
         assert_eq!(
@@ -345,7 +359,7 @@ mod tests {
             x1: 3 * BLOCK,
             y1: BLOCK + 8,
         };
-        let crop = Choice::new(&survey, window, frame, false);
+        let crop = Choice::new(&survey, window, frame, widest);
         assert_eq!(crop.rays((BLOCK, 0)), 1);
         assert_eq!(crop.rays((2 * BLOCK + 5, BLOCK + 3)), 1);
         let left = Window {
@@ -354,7 +368,7 @@ mod tests {
             x1: BLOCK,
             y1: BLOCK + 8,
         };
-        let crop = Choice::new(&survey, left, frame, false);
+        let crop = Choice::new(&survey, left, frame, widest);
         assert_eq!(crop.rays((3, BLOCK + 2)), full.rays((3, BLOCK + 2)));
     }
 

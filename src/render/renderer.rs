@@ -290,7 +290,8 @@ pub fn render(
             }
             if let (true, Some(pilot)) = (choosing, &pilot) {
                 let frame = FrameRates::of(&survey, build);
-                let chosen = camera_rays::Choice::new(&survey, pilot.crop(), frame, motion_blur);
+                let widest = camera_rays::widest_split(settings.spp, motion_blur);
+                let chosen = camera_rays::Choice::new(&survey, pilot.crop(), frame, widest);
                 choice = Some(chosen);
             }
         }

@@ -52,7 +52,7 @@ const EXTRA_RAY_COST: f64 = 0.5;
 /// its rays, as on a close-up of a large groom, more rays a sample cost the frame little
 /// (measured on the real-groom close-ups, and chosen among nearby values by their
 /// efficiency: docs/measurements.md, "A survey before the image").
-pub const BUILD_RAYS_PER_SEGMENT: f64 = 1.0;
+const BUILD_RAYS_PER_SEGMENT: f64 = 1.0;
 
 /// A frame's mean, over the survey's pixels, of a sample's variance (summed over channels)
 /// and of its cost in rays: its own, and its share of the build (`build`): what a block's
@@ -126,7 +126,7 @@ impl Choice {
     }
 }
 
-/// The count for pixels like these (their samples so far all of one ray), in a frame of
+/// The count for pixels like these (the survey's: samples of one ray each), in a frame of
 /// `frame`'s rates. Over the pixels: a sample's variance v (summed over channels), its
 /// part from which of background and strands the ray meets (per pixel f (1 - f) |S - H|^2,
 /// f the fraction of rays that met a strand, S and H the mean radiance of those that

@@ -435,7 +435,7 @@ fn renders_are_deterministic_across_threads_and_crops() {
     assert_deterministic(
         &blonde_fur_under_the_sky(),
         auto,
-        "roulette learned from the pilot",
+        "roulette learned from the survey",
     );
 }
 
@@ -697,7 +697,7 @@ fn thin_fur_under_the_sky() -> World {
 }
 
 /// A fur ball of blonde hair, whose light is mostly many bounces deep, alone under a
-/// uniform sky: no light is sampled, so roulette learns its survival from the pilot.
+/// uniform sky: no light is sampled, so roulette learns its survival from the survey.
 fn blonde_fur_under_the_sky() -> World {
     let blonde = HairMaterial {
         color: HairColor::Melanin {
@@ -710,14 +710,14 @@ fn blonde_fur_under_the_sky() -> World {
     fur_world(blonde, vec![sky], 3000)
 }
 
-/// Roulette's survival learned from the pilot (`roulette_scale = auto`) keeps the image
+/// Roulette's survival learned from the survey (`roulette_scale = auto`) keeps the image
 /// that the rule alone (`off`) renders: quadrant means within 4 standard errors over 32
 /// seeds. On blonde fur under the sky it learns to let paths live longer: more rays per
 /// sample.
 #[test]
-fn roulette_learned_from_the_pilot_keeps_the_image() {
+fn roulette_learned_from_the_survey_keeps_the_image() {
     let world = blonde_fur_under_the_sky();
-    // Enough pixels for the lattice's paths to make a decision at each depth often.
+    // Enough pixels for the survey's paths to make a decision at each depth often.
     let settings = |roulette_scale| RenderSettings {
         spp: 16,
         width: 64,

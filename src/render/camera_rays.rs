@@ -296,8 +296,8 @@ mod tests {
         assert_eq!(like(&thin, 0.03125), 8);
         assert_eq!(count(&thin, 0.5, 4.0, at_64), 4);
         assert_eq!(count(&thin, 2.0, 4.0, at_64), 2);
-        // 0.15 pixel: over a tenth of a pixel (64 spp's strata, 0.125 on a side, times
-        // 0.8), under a fifth (16 spp's).
+        // Strands between the widest that split at 64 spp and at 16 spp (the strata are
+        // wider at fewer samples).
         assert_eq!(like(&mixed(0.15), 0.0625), 1);
         assert_eq!(count(&mixed(0.15), 0.0625, 0.0, at_16), 4);
         assert_eq!(count(&mixed(0.15), 0.0625, 4.0, at_64), 1);

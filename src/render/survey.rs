@@ -16,11 +16,11 @@ use super::integrator::CameraSample;
 use super::survival::{LatticePixel, Recorder};
 
 /// Side of the lattice's cells: every `LATTICE`-th pixel of every `LATTICE`-th row.
-pub(super) const LATTICE: u32 = 4;
+const LATTICE: u32 = 4;
 
 /// Samples of each lattice pixel, one camera ray each: two, the fewest a pixel's variance
 /// is measured from.
-pub(super) const SAMPLES: u32 = 2;
+const SAMPLES: u32 = 2;
 
 /// What the survey's seed is the render's seed mixed with.
 const SEED_SALT: u64 = 0x5f3c_a7e1_9b2d_4c81;
@@ -30,11 +30,12 @@ pub(super) fn seed(seed: u64) -> u64 {
     seed ^ SEED_SALT
 }
 
-/// The pixels (`x0` + `step` i, `step` j) of a `width` x `height` frame, row by row.
-pub(super) fn lattice(width: u32, height: u32, step: u32, x0: u32) -> Vec<(u32, u32)> {
+/// The lattice's pixels of a `width` x `height` frame, row by row.
+fn lattice(width: u32, height: u32) -> Vec<(u32, u32)> {
+    let step = LATTICE as usize;
     (0..height)
-        .step_by(step as usize)
-        .flat_map(|y| (x0..width).step_by(step as usize).map(move |x| (x, y)))
+        .step_by(step)
+        .flat_map(|y| (0..width).step_by(step).map(move |x| (x, y)))
         .collect()
 }
 
@@ -62,7 +63,7 @@ impl Survey {
         height: u32,
         sample: &(impl Fn((u32, u32), u32, &mut Recorder) -> CameraSample + Sync),
     ) -> Survey {
-        let pixels = lattice(width, height, LATTICE, 0)
+        let pixels = lattice(width, height)
             .par_iter()
             .map(|&p| {
                 let mut recorder = Recorder::default();

@@ -318,7 +318,8 @@ fn a_deforming_mesh_blurs_to_the_mean_of_static_renders_across_the_shutter() {
 /// the one-ray image.
 #[test]
 fn auto_camera_rays_split_moving_strands_and_keep_the_image() {
-    // About a third of a pixel wide at this framing: over the width rule's 0.2 at 16 spp.
+    // Wider at this framing than the width rule lets split at 16 spp
+    // (`camera_rays::widest_split`): the still ball's one ray below shows it.
     let strands = FurBall {
         strands: 1500,
         segments: 8,

@@ -65,17 +65,18 @@ pub(super) struct FrameRates {
 }
 
 impl FrameRates {
-    /// The rates of `survey`'s frame, whose build costs `build` rays a sample.
+    /// The rates of `survey`'s frame (its frame lattice), whose build costs `build` rays
+    /// a sample.
     pub(super) fn of(survey: &Survey, build: f64) -> FrameRates {
-        let pixels = survey.pixels();
-        let n = pixels.len().max(1) as f64;
-        let (variance, rays) = pixels.iter().fold((0.0, 0.0), |(v, r), p| {
+        let (n, variance, rays) = survey.frame().fold((0.0, 0.0, 0.0), |(n, v, r), p| {
             let samples = f64::from(p.acc.samples().max(1));
             (
+                n + 1.0,
                 v + p.acc.sample_variance().iter().sum::<f64>(),
                 r + p.acc.rays() as f64 / samples,
             )
         });
+        let n = f64::max(n, 1.0);
         FrameRates {
             variance: variance / n,
             rays: rays / n + build,
@@ -324,27 +325,30 @@ mod tests {
 
     /// A block's count is read from the survey's pixels inside it: in a frame whose left
     /// block shows thin strands against the sky and whose other blocks show plain hair,
-    /// the left block splits and the others do not, in the full frame and in a crop.
+    /// the left block splits and the others do not, in the full frame and in a crop
+    /// (whose survey traces its own blocks).
     #[test]
     fn each_block_chooses_from_the_survey_inside_it() {
         let (width, height) = (3 * BLOCK, BLOCK + 8);
-        let survey = Survey::trace(width, height, &|(x, _), i, _| {
-            let (radiance, seen) = match (x < BLOCK, i) {
-                (true, 0) => (0.1, Seen::Strand(0.02)),
-                (true, _) => (1.0, Seen::Nothing),
-                (false, 0) => (0.1, Seen::Strand(0.02)),
-                (false, _) => (0.3, Seen::Strand(0.02)),
-            };
-            CameraSample {
-                radiance: Vec3::splat(radiance),
-                first: None,
-                rays: 1,
-                seen,
-            }
-        });
-        let frame = FrameRates::of(&survey, 0.0);
-        let widest = widest_split(16, false);
-        let full = Choice::new(&survey, Window::full(width, height), frame, widest);
+        let choose = |window: Window| {
+            let survey = Survey::trace(width, height, Some(window), &|(x, _), i, _| {
+                let (radiance, seen) = match (x < BLOCK, i) {
+                    (true, 0) => (0.1, Seen::Strand(0.02)),
+                    (true, _) => (1.0, Seen::Nothing),
+                    (false, 0) => (0.1, Seen::Strand(0.02)),
+                    (false, _) => (0.3, Seen::Strand(0.02)),
+                };
+                CameraSample {
+                    radiance: Vec3::splat(radiance),
+                    first: None,
+                    rays: 1,
+                    seen,
+                }
+            });
+            let frame = FrameRates::of(&survey, 0.0);
+            Choice::new(&survey, window, frame, widest_split(16, false))
+        };
+        let full = choose(Window::full(width, height));
         assert!(full.rays((0, 0)) > 1, "the left block split");
         assert!(full.rays((BLOCK - 1, BLOCK + 7)) > 1);
         assert_eq!(
@@ -359,7 +363,7 @@ mod tests {
             x1: 3 * BLOCK,
             y1: BLOCK + 8,
         };
-        let crop = Choice::new(&survey, window, frame, widest);
+        let crop = choose(window);
         assert_eq!(crop.rays((BLOCK, 0)), 1);
         assert_eq!(crop.rays((2 * BLOCK + 5, BLOCK + 3)), 1);
         let left = Window {
@@ -368,7 +372,7 @@ mod tests {
             x1: BLOCK,
             y1: BLOCK + 8,
         };
-        let crop = Choice::new(&survey, left, frame, widest);
+        let crop = choose(left);
         assert_eq!(crop.rays((3, BLOCK + 2)), full.rays((3, BLOCK + 2)));
     }
 

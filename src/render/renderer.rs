@@ -278,7 +278,9 @@ pub fn render(
         if choosing || learning {
             let seed = survey::seed(settings.seed);
             let rule = Survival::default();
-            let survey = Survey::trace(width, height, &|p, i, recorder| {
+            // The block lattice only where blocks choose: the pilot's window.
+            let window = pilot.as_ref().filter(|_| choosing).map(Film::crop);
+            let survey = Survey::trace(width, height, window, &|p, i, recorder| {
                 sample_at(seed, (p, i), 1, &rule, Some(recorder))
             });
             survey_rays = survey.rays();
@@ -286,7 +288,7 @@ pub fn render(
             let segments = world.tracer.scene().curve_segments();
             let build = FrameRates::build_rays(segments, frame_samples);
             if learning {
-                survival = Survival::learn(survey.pixels().iter().map(|p| &p.roulette), build);
+                survival = Survival::learn(survey.frame().map(|p| &p.roulette), build);
             }
             if let (true, Some(pilot)) = (choosing, &pilot) {
                 let frame = FrameRates::of(&survey, build);

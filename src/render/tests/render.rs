@@ -439,6 +439,59 @@ fn renders_are_deterministic_across_threads_and_crops() {
     );
 }
 
+/// In a frame large enough for the survey's frame lattice to be sparser than its block
+/// lattice, a tile renders exactly the pixels a larger crop around it renders, with camera
+/// rays chosen per block and the roulette learned: each traces the same frame lattice and
+/// its own blocks' lattice (`survey.rs`'s tests: the same as the full frame's).
+#[test]
+fn a_tile_of_a_large_frame_renders_what_a_larger_crop_does() {
+    let settings = |crop: [u32; 4]| RenderSettings {
+        width: 1024,
+        height: 1024,
+        spp: 12,
+        seed: 5,
+        camera_rays: CameraRays::Auto,
+        crop: Some(crop),
+        threads: Some(2),
+        ..RenderSettings::default()
+    };
+    // Three blocks square over the ball's right edge, and a tile across four of them.
+    let large = [832, 480, 928, 576];
+    let small = [850, 500, 900, 540];
+    let fixed: fn(&mut RenderSettings) = |s| s.camera_rays = CameraRays::Fixed(1);
+    let unlearned: fn(&mut RenderSettings) = |s| s.path.roulette_scale = RouletteScale::Off;
+    for (world, what, without) in [
+        (thin_fur_under_the_sky(), "camera rays", fixed),
+        (blonde_fur_under_the_sky(), "roulette", unlearned),
+    ] {
+        let run = |s: RenderSettings| {
+            render(&world, &camera(), &s, Aovs::default(), &NoProgress).unwrap()
+        };
+        let (l, s) = (run(settings(large)), run(settings(small)));
+        let at = |rgb: &[f32], crop: [u32; 4], (x, y): (u32, u32)| {
+            let i = 3 * ((y - crop[1]) * (crop[2] - crop[0]) + (x - crop[0])) as usize;
+            rgb[i..i + 3]
+                .iter()
+                .map(|v| v.to_bits())
+                .collect::<Vec<_>>()
+        };
+        for y in small[1]..small[3] {
+            for x in small[0]..small[2] {
+                assert_eq!(
+                    at(l.film.rgb(), large, (x, y)),
+                    at(s.film.rgb(), small, (x, y)),
+                    "{what}: pixel ({x}, {y})"
+                );
+            }
+        }
+        // What the survey chose changed the tile's rays.
+        let mut plain = settings(small);
+        without(&mut plain);
+        let plain = run(plain);
+        assert_ne!(s.stats.rays, plain.stats.rays, "{what}");
+    }
+}
+
 /// `world` rendered with `base` (a 40 x 30 frame) gives the same bits on one thread and on
 /// two, and its [`CROP`] those pixels of the full frame.
 pub(crate) fn assert_deterministic(world: &World, base: RenderSettings, what: &str) {

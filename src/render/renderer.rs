@@ -280,8 +280,9 @@ pub fn render(
             let rule = Survival::default();
             // The block lattice only where blocks choose: the pilot's window.
             let window = pilot.as_ref().filter(|_| choosing).map(Film::crop);
+            // The roulette's decisions are recorded only for a survival to learn.
             let survey = Survey::trace(width, height, window, &|p, i, recorder| {
-                sample_at(seed, (p, i), 1, &rule, Some(recorder))
+                sample_at(seed, (p, i), 1, &rule, learning.then_some(recorder))
             });
             survey_rays = survey.rays();
             let frame_samples = u64::from(width) * u64::from(height) * u64::from(settings.spp);

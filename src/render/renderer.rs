@@ -291,11 +291,10 @@ pub fn render(
             if learning {
                 survival = Survival::learn(survey.frame().map(|p| &p.roulette), build);
             }
-            if let (true, Some(pilot)) = (choosing, &pilot) {
+            if let Some(window) = window {
                 let frame = FrameRates::of(&survey, build);
                 let widest = camera_rays::widest_split(settings.spp, motion_blur);
-                let chosen = camera_rays::Choice::new(&survey, pilot.crop(), frame, widest);
-                choice = Some(chosen);
+                choice = Some(camera_rays::Choice::new(&survey, window, frame, widest));
             }
         }
         let (mut spp, mut noise, mut status) = (0, None, RenderStatus::Complete);

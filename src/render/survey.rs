@@ -27,8 +27,9 @@ const LATTICE: u32 = 4;
 
 /// The fewest pixels the frame lattice keeps, where the frame has them: its pixels measure
 /// a frame's mean variance, whose samples are heavy-tailed under highlights, and the
-/// survival's light per depth, so they stay many; a frame of up to about 512 x 512 pixels
-/// reads them from the whole block lattice.
+/// survival's light per depth, so they stay many; a frame whose block lattice holds fewer
+/// than four times this reads them from the whole block lattice (docs/conventions.md,
+/// "The survey").
 const FRAME_PIXELS: u64 = 1 << 14;
 
 /// Samples of each lattice pixel, one camera ray each: two, the fewest a pixel's variance

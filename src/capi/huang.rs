@@ -113,7 +113,7 @@ pub struct HtHuangPoint {
 impl HostPoint for HtHuangPoint {
     type Point = HuangPoint;
     /// "htgg" (GGX) and a layout version.
-    const TAG: u64 = 0x6874_6767_0000_0001;
+    const TAG: u64 = 0x6874_6767_0000_0002;
     const FILLED_BY: &'static str = "ht_huang_point_at_hit or ht_huang_point_init_world";
 }
 

@@ -17,7 +17,7 @@
 //!   third. Each is drawn from the distribution of visible normals at its own pair of
 //!   numbers (the point's jitter, and pairs hashed from it). Every path ends at an *exit*:
 //!   an internal direction, the inner normal there and the path's RGB weight (Fresnel,
-//!   masking, absorption).
+//!   masking, absorption, and each interface's energy compensation: `albedo`).
 //! - wi: R's microfacet reflection, and at each exit the exact density of a GGX
 //!   refraction out toward wi. The last interface of TT and TRT is thus integrated
 //!   exactly, and the earlier ones by the draws, which a renderer's fresh jitter at each
@@ -34,6 +34,7 @@
 //! mixture. A point that also weighs sampled lights takes `LIT_SHIFTS` offsets
 //! ([`HuangBsdf::far_lit`]).
 
+mod albedo;
 mod ggx;
 mod params;
 mod point;
@@ -45,6 +46,7 @@ use point::{FAR_SHIFTS, LIT_SHIFTS};
 
 use super::longitudinal::LongitudinalLobe;
 use crate::error::Result;
+use albedo::Albedos;
 use ggx::Ggx;
 use glam::{Vec2, Vec3};
 
@@ -66,6 +68,8 @@ use glam::{Vec2, Vec3};
 pub struct HuangBsdf {
     params: HuangParams,
     ggx: Ggx,
+    /// What its interfaces keep, by the cosine of the light meeting them (`albedo`).
+    albedos: Albedos,
     /// (sin, cos) of the cuticle tilt.
     tilt: (f32, f32),
     /// The residual lobe's longitudinal spread.
@@ -80,6 +84,7 @@ impl HuangBsdf {
         Ok(Self {
             params: *params,
             ggx: Ggx::new(params.roughness),
+            albedos: Albedos::new(params.roughness, params.eta),
             tilt: (alpha.sin() as f32, alpha.cos() as f32),
             residual: LongitudinalLobe::new(RESIDUAL_VARIANCE_PER_ROUGHNESS * params.roughness),
         })

@@ -1,6 +1,7 @@
 //! The Huang model at one point (h, wo): the light paths through the section, what each
 //! gives toward wi, and the sampler whose density is their sum (module doc of `huang`).
 
+use super::albedo::Side;
 use super::section::Section;
 use super::{Ggx, HuangBsdf};
 use crate::bsdf::fresnel::{fresnel_dielectric, fresnel_inside};
@@ -81,6 +82,9 @@ struct Paths {
     /// dot(wo, m); the point sends nothing where it is <= 0.
     cos_om: f32,
     g1_o: f32,
+    /// The entry's energy compensation (`albedo`): R's factor, and the first of TT's and
+    /// TRT's.
+    entry_scale: f32,
     /// TT's exit and TRT's; a path that ends early leaves `cos_vn` 0.
     exits: [Exit; 2],
     /// The residual lobe's RGB energy.
@@ -260,6 +264,7 @@ impl Paths {
         m: Vec3::Z,
         cos_om: 0.0,
         g1_o: 0.0,
+        entry_scale: 1.0,
         exits: [Exit {
             v: Vec3::Z,
             n: Vec3::Z,
@@ -288,10 +293,11 @@ impl Paths {
         p.m = m;
         p.cos_om = cos_om;
         p.g1_o = bsdf.ggx.g1(cos_om);
+        p.entry_scale = bsdf.albedos.scale(Side::Outside, cos_om);
         // A path that ends early leaves the later exits and the residual dark.
         let _ = p.follow(bsdf, section, q1, wo, u);
         let lobe_sums = [
-            fresnel_dielectric(cos_om, bsdf.params.eta).0,
+            fresnel_dielectric(cos_om, bsdf.params.eta).0 * p.entry_scale,
             mean(p.exits[0].weight),
             mean(p.exits[1].weight),
             mean(p.residual),
@@ -331,11 +337,14 @@ impl Paths {
         let v = -wt;
         let cos_vn = v.dot(n2);
         let weight = a1 * (t * ggx.g2_over_g1(self.cos_om, cos_tm));
+        // Energy compensation at the entry and at the second interface, which TT leaves by
+        // and TRT reflects at; the residual goes without, as in Cycles.
+        let scale = self.entry_scale * bsdf.albedos.scale(Side::Inside, cos_vn);
         self.exits[0] = Exit {
             v,
             n: n2,
             cos_vn,
-            weight,
+            weight: weight * scale,
         };
         let wh2 = ggx.sample_visible(n2, v, u[1]);
         let c2 = v.dot(wh2);
@@ -350,11 +359,12 @@ impl Paths {
         let (_, n3, a2) = cross(bsdf, section, q2, wr)?;
         let v3 = -wr;
         let arriving = weight * (fresnel_inside(c2, eta) * ggx.g2_over_g1(cos_vn, cos_rn)) * a2;
+        let cos_v3n = v3.dot(n3);
         self.exits[1] = Exit {
             v: v3,
             n: n3,
-            cos_vn: v3.dot(n3),
-            weight: arriving,
+            cos_vn: cos_v3n,
+            weight: arriving * (scale * bsdf.albedos.scale(Side::Inside, cos_v3n)),
         };
         // Past TRT: the third interface reflects the light at one visible normal (its
         // Fresnel, total internal reflection included). That light crosses again and
@@ -386,7 +396,7 @@ impl Paths {
         }
         let leaving = |e: &Exit| e.weight * (1.0 - fresnel_inside(e.cos_vn, bsdf.params.eta));
         [
-            Vec3::splat(fresnel_dielectric(self.cos_om, bsdf.params.eta).0),
+            Vec3::splat(fresnel_dielectric(self.cos_om, bsdf.params.eta).0 * self.entry_scale),
             leaving(&self.exits[0]),
             leaving(&self.exits[1]),
             self.residual,
@@ -407,7 +417,8 @@ impl Paths {
             let cos_im = wi.dot(self.m);
             if cos_im > 0.0 {
                 let fr = fresnel_dielectric(wo.dot(wh).clamp(0.0, 1.0), bsdf.params.eta).0;
-                f += Vec3::splat(fr * ggx.g2_over_g1(self.cos_om, cos_im) * pdf_r);
+                let unmasked = ggx.g2_over_g1(self.cos_om, cos_im) * self.entry_scale;
+                f += Vec3::splat(fr * unmasked * pdf_r);
             }
             pdf += self.lobe_pdf[R] * pdf_r;
         }
@@ -476,7 +487,7 @@ impl Paths {
             R => {
                 let cos_im = d.wi.dot(self.m);
                 let unmasked = if cos_im > 0.0 {
-                    ggx.g2_over_g1(self.cos_om, cos_im)
+                    ggx.g2_over_g1(self.cos_om, cos_im) * self.entry_scale
                 } else {
                     0.0
                 };

@@ -1,9 +1,11 @@
 //! The white furnace of the Huang model: a non-absorbing fibre, h uniform across it and wo
-//! over the sphere. Its albedo is 1 less what the model loses: single-scattering
-//! microfacets (masked light is dropped, not scattered again), paths that leave the
-//! section's mesonormal side, and the residual's smooth-Fresnel series. The figure is
-//! measured (docs/measurements.md, "The Huang model"); this checks that the sampler's
-//! weights and the quadrature of `eval` agree on it, and that it stays in a stated band.
+//! over the sphere. Its albedo is 1 less what the model loses: what the energy
+//! compensation of its first three interfaces does not give back (the residual's
+//! interfaces go without it, and the compensation assumes the masked light leaves as the
+//! kept light does), paths that leave the section's mesonormal side, and the residual's
+//! smooth-Fresnel series. The figure is measured (docs/measurements.md, "The Huang
+//! model"); this checks that the sampler's weights and the quadrature of `eval` agree on
+//! it, and that it stays in a stated band.
 
 use super::{huang, point};
 use crate::common::chi2::Grid;
@@ -12,8 +14,9 @@ use crate::common::{Timer, WEIGHT_TESTS, par_map, random_u, rng, v3};
 use glam::{Vec2, Vec3};
 use rand::Rng;
 
-/// The lowest albedo a non-absorbing fibre may have, over the configurations below.
-const MIN_ALBEDO: f64 = 0.40;
+/// The lowest albedo a non-absorbing fibre may have, over the configurations below: the
+/// energy compensation holds even the roughest fibre near 1 (without it, 0.43 there).
+const MIN_ALBEDO: f64 = 0.85;
 
 #[test]
 fn huang_white_furnace() {

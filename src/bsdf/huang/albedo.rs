@@ -41,9 +41,10 @@ fn table(side: Side) -> &'static [f32; NODES * NODES * NODES] {
 }
 
 /// The position of `x` in [0, 1] between an axis's nodes: the node below and the weight
-/// of the one above.
+/// of the one above; NaN is taken as 0.
 fn between(x: f32) -> (usize, f32) {
-    let s = x.clamp(0.0, 1.0) * (NODES - 1) as f32;
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    let s = x * (NODES - 1) as f32;
     let i = (s as usize).min(NODES - 2);
     (i, s - i as f32)
 }
@@ -201,9 +202,17 @@ mod tests {
     }
 
     /// A smooth interface keeps everything; a rough one loses more at grazing light and
-    /// higher roughness, never gains, and keeps most of the light seen square on.
+    /// higher roughness, keeps most of the light seen square on, and never gains or keeps
+    /// nothing (so that every scale is finite and at least 1).
     #[test]
     fn rough_interfaces_lose_light_where_masking_is_strong() {
+        let mut every = OUTSIDE.iter().chain(INSIDE.iter());
+        assert!(every.all(|&e| e > 0.2 && e <= 1.0));
+        let scales = Albedos::new(0.3, 1.55);
+        for cos in [f32::NAN, -1.0, 0.0, 0.5, 1.0, 2.0] {
+            let s = scales.scale(Side::Inside, cos);
+            assert!(s.is_finite() && s >= 1.0, "{cos}: {s}");
+        }
         for side in [Side::Outside, Side::Inside] {
             assert_eq!(albedo(side, 0.0, 0.5, 1.55), 1.0);
             for eta in [1.2, 1.55, 3.0] {

@@ -348,6 +348,7 @@ fn node_albedo(inside: bool, sqrt_a: f64, cos: f64, eta: f64) -> f64 {
                 (i as f64 + 0.5) / strata as f64,
                 (j as f64 + 0.5) / strata as f64,
             ];
+            // The crate's cell centres are f32: the same numbers, the same normals.
             let m = model.visible(n, v, [f64::from(u[0] as f32), f64::from(u[1] as f32)]);
             let c = dot(v, m);
             if c <= 0.0 {

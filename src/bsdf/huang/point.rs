@@ -196,8 +196,8 @@ impl HuangPoint {
     }
 
     /// The RGB energy of R, TT, TRT and the residual leaving wo, averaged over the
-    /// point's offsets, without the masking of the last interface (an upper bound of the
-    /// albedo, for the lobes' balance).
+    /// point's offsets, with the interfaces' energy compensation and without the masking of
+    /// the last interface (for the lobes' balance).
     pub fn lobe_energies(&self) -> [Vec3; 4] {
         let mut out = [Vec3::ZERO; 4];
         for p in &self.paths[..self.shifts] {
@@ -478,9 +478,9 @@ impl Paths {
     /// The weight of `d` from the lobe that drew it alone: f_l |cos| / (P(l) pdf_l), with
     /// f_l and pdf_l the lobe's terms of [`Self::eval`], which each lobe's draw follows
     /// exactly (the visible normals' density, the residual's longitudinal lobe), so the
-    /// weight is the lobe's energy toward wi over P(l): R's Fresnel and unmasked share, an
-    /// exit's weight and unmasked share out, the residual's energy. Its mean is the
-    /// mixture's.
+    /// weight is the lobe's energy toward wi over P(l): R's Fresnel and unmasked share
+    /// times the entry's compensation, an exit's weight (its compensations in it) and
+    /// unmasked share out, the residual's energy. Its mean is the mixture's.
     fn weight(&self, bsdf: &HuangBsdf, d: &Drawn) -> Vec3 {
         let (ggx, eta) = (&bsdf.ggx, bsdf.params.eta);
         let energy = match d.lobe {

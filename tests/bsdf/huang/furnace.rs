@@ -15,7 +15,8 @@ use glam::{Vec2, Vec3};
 use rand::Rng;
 
 /// The lowest albedo a non-absorbing fibre may have, over the configurations below: the
-/// energy compensation holds even the roughest fibre near 1 (without it, 0.43 there).
+/// energy compensation holds even the roughest fibre near 1, and without it the roughest
+/// falls far below this (docs/measurements.md, "Energy compensation").
 const MIN_ALBEDO: f64 = 0.85;
 
 #[test]
